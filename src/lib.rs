@@ -1,0 +1,17 @@
+//! # usm-study
+//!
+//! A batch workbench for designing and tuning underwater swimming manipulators (USMs) and
+//! underwater vehicle-manipulator systems (UVMS): floating-base multibody hydrodynamics,
+//! task-priority kinematic control, thrust allocation in Clarabel, thruster-matrix
+//! singularity scoring, closed-loop scenarios and parallel parameter sweeps.
+//!
+//! The physics and control formulation is `SPEC.md` (equations cited as USM-nn / AC-nn);
+//! modules follow the layout of `DESIGN.md`: data flows from [`model`] through
+//! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports.
+
+pub mod cli;
+pub mod kinematics;
+pub mod model;
+pub mod sampling;
+pub mod spatial;
+pub mod state;

@@ -1,0 +1,347 @@
+//! The parametric USM generator (foundation issue, item 4): `N` links with 2-DOF joint
+//! modules between them and a named thruster-placement rule, so that a sweep can vary the
+//! link count and move thrusters without hand-writing every body.
+//!
+//! Body layout for `N` links: `L0 J1 L1 J2 … J(N-1) L(N-1)`, i.e. link `k` is body `2k` and
+//! module `k` (between link `k-1` and link `k`) is body `2k-1`. Each module carries a yaw
+//! joint (z) at its rear face and a pitch joint (y) at its front face, like `usm-paper`.
+
+use super::presets::{face_joint, neutral_body, thruster};
+use super::{Fluid, Hydro, ModelError, Thruster, Vehicle};
+use crate::spatial::{Se3, Vec3};
+use std::f64::consts::PI;
+use std::fmt;
+use std::str::FromStr;
+
+/// Named thruster-placement rules.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ThrusterRule {
+    /// The paper's 7-thruster pattern generalised: vertical + lateral on link 1, a
+    /// longitudinal pair and a vertical on the middle link `⌊N/2⌋`, lateral + vertical on
+    /// link `N-2` (for `N = 5` with the paper's lengths this is the SPEC §2 layout).
+    Paper,
+    /// A lateral and a vertical thruster on every inner link, plus the longitudinal pair on
+    /// the middle link.
+    Distributed,
+    /// Lateral + vertical on the tail and head links, the longitudinal pair on the middle link.
+    Ends,
+    /// No thrusters from the rule (thrusters may be listed explicitly instead).
+    None,
+}
+
+impl ThrusterRule {
+    /// All rules, for error messages and sweeps.
+    pub const ALL: [ThrusterRule; 4] = [
+        ThrusterRule::Paper,
+        ThrusterRule::Distributed,
+        ThrusterRule::Ends,
+        ThrusterRule::None,
+    ];
+
+    /// The rule's name as written in design and study files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ThrusterRule::Paper => "paper",
+            ThrusterRule::Distributed => "distributed",
+            ThrusterRule::Ends => "ends",
+            ThrusterRule::None => "none",
+        }
+    }
+}
+
+impl fmt::Display for ThrusterRule {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ThrusterRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|r| r.name()).collect();
+                format!("unknown thruster rule '{s}'; valid: {}", names.join(", "))
+            })
+    }
+}
+
+/// Parameters of the generator. Defaults follow `usm-paper` (radius 0.085 m, 0.104 m / 6 kg
+/// joint modules, ±90° joints, ±40 N thrusters, drag coefficients of USM Table II).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeneratorSpec {
+    /// Number of links `N` (2 ≤ N ≤ 20; studies use 3–9).
+    pub links: usize,
+    /// Link lengths [m]: one value for every link, or exactly `N` values.
+    pub link_length: Vec<f64>,
+    /// Link masses [kg]: empty = neutrally buoyant solid cylinders `ρπr²l`; one value for
+    /// every link; or exactly `N` values.
+    pub link_mass: Vec<f64>,
+    /// Radius of every body [m].
+    pub radius: f64,
+    /// Joint module length [m].
+    pub module_length: f64,
+    /// Joint module mass [kg].
+    pub module_mass: f64,
+    /// Symmetric joint limit [rad].
+    pub joint_limit: f64,
+    /// Thruster placement rule.
+    pub thruster_rule: ThrusterRule,
+    /// Symmetric thrust limit [N].
+    pub thrust_limit: f64,
+    /// Lateral offset of the longitudinal thruster pair from the body axis [m].
+    pub longitudinal_offset: f64,
+    /// Axial drag coefficient of the tail and head links.
+    pub cd_axial_ends: f64,
+    /// Axial drag coefficient of inner links and modules.
+    pub cd_axial: f64,
+    /// Cross-flow drag coefficient of every body.
+    pub cd_cross: f64,
+}
+
+impl Default for GeneratorSpec {
+    fn default() -> Self {
+        Self {
+            links: 5,
+            link_length: vec![0.6],
+            link_mass: Vec::new(),
+            radius: 0.085,
+            module_length: 0.104,
+            module_mass: 6.0,
+            joint_limit: PI / 2.0,
+            thruster_rule: ThrusterRule::Paper,
+            thrust_limit: 40.0,
+            longitudinal_offset: 0.10,
+            cd_axial_ends: 0.8,
+            cd_axial: 0.1,
+            cd_cross: 1.0,
+        }
+    }
+}
+
+fn per_link(key: &str, v: &[f64], n: usize) -> Result<Vec<f64>, ModelError> {
+    match v.len() {
+        1 => Ok(vec![v[0]; n]),
+        len if len == n => Ok(v.to_vec()),
+        len => Err(ModelError::new(
+            format!("generator.{key}"),
+            format!("needs 1 or {n} values (one per link), got {len}"),
+        )),
+    }
+}
+
+/// Body index of link `k`.
+pub fn link_body(k: usize) -> usize {
+    2 * k
+}
+
+impl GeneratorSpec {
+    /// Build the vehicle (validated).
+    pub fn build(&self, name: &str) -> Result<Vehicle, ModelError> {
+        let n = self.links;
+        if !(2..=20).contains(&n) {
+            return Err(ModelError::new(
+                "generator.links",
+                format!("must be between 2 and 20, got {n}"),
+            ));
+        }
+        let lengths = per_link("link_length", &self.link_length, n)?;
+        let fluid = Fluid::default();
+        let rho = fluid.rho;
+        let r = self.radius;
+        for (key, v) in [
+            ("radius", r),
+            ("module_length", self.module_length),
+            ("module_mass", self.module_mass),
+            ("joint_limit", self.joint_limit),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(ModelError::new(
+                    format!("generator.{key}"),
+                    format!("must be a finite number > 0, got {v}"),
+                ));
+            }
+        }
+        if !self.thrust_limit.is_finite() || self.thrust_limit < 0.0 {
+            return Err(ModelError::new(
+                "generator.thrust_limit",
+                format!("must be finite and >= 0, got {}", self.thrust_limit),
+            ));
+        }
+        let masses = if self.link_mass.is_empty() {
+            lengths.iter().map(|l| rho * PI * r * r * l).collect()
+        } else {
+            per_link("link_mass", &self.link_mass, n)?
+        };
+        let mut bodies = Vec::with_capacity(2 * n - 1);
+        for k in 0..n {
+            if k > 0 {
+                bodies.push(neutral_body(
+                    &format!("J{k}"),
+                    self.module_mass,
+                    self.module_length,
+                    r,
+                    Hydro::cylinder(self.cd_axial, self.cd_cross),
+                    rho,
+                ));
+            }
+            let cd_x = if k == 0 || k == n - 1 {
+                self.cd_axial_ends
+            } else {
+                self.cd_axial
+            };
+            bodies.push(neutral_body(
+                &format!("L{k}"),
+                masses[k],
+                lengths[k],
+                r,
+                Hydro::cylinder(cd_x, self.cd_cross),
+                rho,
+            ));
+        }
+        let mut joints = Vec::with_capacity(2 * (n - 1));
+        for (b, parent) in bodies.iter().enumerate().take(bodies.len() - 1) {
+            let (axis, kind) = if b % 2 == 0 {
+                (Vec3::z(), "yaw")
+            } else {
+                (Vec3::y(), "pitch")
+            };
+            joints.push(face_joint(
+                &format!("{kind}{}", b / 2 + 1),
+                parent.length,
+                axis,
+                self.joint_limit,
+            ));
+        }
+        let thrusters = self.rule_thrusters(&lengths);
+        let last = lengths[n - 1];
+        let v = Vehicle {
+            name: name.to_string(),
+            bodies,
+            joints,
+            thrusters,
+            base: Se3::identity(),
+            end_effector: Se3::from_translation(Vec3::new(last, 0.0, 0.0)),
+            fluid,
+        };
+        v.validate()?;
+        Ok(v)
+    }
+
+    fn rule_thrusters(&self, lengths: &[f64]) -> Vec<Thruster> {
+        let n = lengths.len();
+        let lim = self.thrust_limit;
+        let (ex, ey, ez) = (Vec3::x(), Vec3::y(), Vec3::z());
+        let mid = n / 2;
+        let inner_first = 1.min(n - 1);
+        let inner_last = n.saturating_sub(2).max(inner_first);
+        let mut out: Vec<Thruster> = Vec::new();
+        let mut add = |link: usize, frac: f64, y: f64, dir: Vec3| {
+            let name = format!("T{}", out.len() + 1);
+            out.push(thruster(
+                &name,
+                link_body(link),
+                frac * lengths[link],
+                y,
+                dir,
+                lim,
+            ));
+        };
+        let pair = |add: &mut dyn FnMut(usize, f64, f64, Vec3), link: usize, frac: f64| {
+            add(link, frac, -self.longitudinal_offset, ex);
+            add(link, frac, self.longitudinal_offset, ex);
+        };
+        match self.thruster_rule {
+            ThrusterRule::Paper => {
+                // Fractions of the link length from the SPEC §2 layout on usm-paper:
+                // 0.237/0.584, 0.347/0.584, 0.278/0.726, 0.488/0.726.
+                let (f1, f2) = (0.237 / 0.584, 0.347 / 0.584);
+                add(inner_first, f1, 0.0, ez);
+                add(inner_first, f2, 0.0, ey);
+                pair(&mut add, mid, 0.278 / 0.726);
+                add(mid, 0.488 / 0.726, 0.0, ez);
+                add(inner_last, f1, 0.0, ey);
+                add(inner_last, f2, 0.0, ez);
+            }
+            ThrusterRule::Distributed => {
+                for link in inner_first..=inner_last {
+                    add(link, 0.35, 0.0, ey);
+                    add(link, 0.65, 0.0, ez);
+                }
+                pair(&mut add, mid, 0.5);
+            }
+            ThrusterRule::Ends => {
+                for link in [0, n - 1] {
+                    add(link, 0.4, 0.0, ey);
+                    add(link, 0.6, 0.0, ez);
+                }
+                pair(&mut add, mid, 0.5);
+            }
+            ThrusterRule::None => {}
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generator_counts() {
+        for n in 3..=9 {
+            for rule in ThrusterRule::ALL {
+                let spec = GeneratorSpec {
+                    links: n,
+                    thruster_rule: rule,
+                    ..Default::default()
+                };
+                let v = spec.build("g").unwrap();
+                assert_eq!(v.bodies.len(), 2 * n - 1);
+                assert_eq!(v.n_joints(), 2 * (n - 1));
+                match rule {
+                    ThrusterRule::Paper => assert_eq!(v.n_thrusters(), 7),
+                    ThrusterRule::Ends => assert_eq!(v.n_thrusters(), 6),
+                    ThrusterRule::Distributed => assert_eq!(v.n_thrusters(), 2 * (n - 2) + 2),
+                    ThrusterRule::None => assert_eq!(v.n_thrusters(), 0),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn paper_rule_reproduces_paper_layout() {
+        // With the paper's lengths the rule puts thrusters where SPEC §2 lists them.
+        let spec = GeneratorSpec {
+            links: 5,
+            link_length: vec![0.62, 0.584, 0.726, 0.584, 0.37],
+            ..Default::default()
+        };
+        let g = spec.build("g").unwrap();
+        let p = super::super::presets::usm_paper();
+        for (a, b) in g.thrusters.iter().zip(&p.thrusters) {
+            assert_eq!(a.body, b.body);
+            assert!((a.position - b.position).norm() < 1e-12);
+            assert_eq!(a.direction, b.direction);
+        }
+    }
+
+    #[test]
+    fn bad_generator_input() {
+        let spec = GeneratorSpec {
+            links: 4,
+            link_length: vec![0.5, 0.5],
+            ..Default::default()
+        };
+        assert_eq!(spec.build("g").unwrap_err().key, "generator.link_length");
+        let spec = GeneratorSpec {
+            links: 1,
+            ..Default::default()
+        };
+        assert_eq!(spec.build("g").unwrap_err().key, "generator.links");
+        assert!("diagonal".parse::<ThrusterRule>().is_err());
+    }
+}

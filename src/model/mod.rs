@@ -1,0 +1,467 @@
+//! The vehicle model (SPEC §2): a floating-base serial chain of rigid bodies joined by 1-DOF
+//! revolute joints, with thrusters fixed to bodies and per-body hydrodynamic parameters.
+//!
+//! Frames: every body frame has its origin at the body's rear (tail) face and its x axis
+//! along the body towards the head. Joint `i` (1-based in the SPEC, index `i-1` here) joins
+//! body `i-1` (parent) to body `i` (child). Nothing here assumes a USM: a UVMS is one large
+//! vehicle body with thrusters followed by thruster-less links (SPEC §8).
+
+pub mod design;
+pub mod generator;
+pub mod presets;
+
+use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};
+use nalgebra::Vector6;
+use std::f64::consts::PI;
+use thiserror::Error;
+
+/// Default water density [kg/m³] (SPEC §2, ρ = 1026).
+pub const RHO_SEAWATER: f64 = 1026.0;
+/// Gravitational acceleration [m/s²] (SPEC §1).
+pub const GRAVITY: f64 = 9.81;
+
+/// The fluid the vehicle moves in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fluid {
+    /// Density ρ [kg/m³].
+    pub rho: f64,
+    /// Gravitational acceleration g [m/s²], acting along −z of the inertial frame.
+    pub g: f64,
+    /// Constant irrotational current ν_c, linear velocity in the inertial frame [m/s].
+    pub current: Vec3,
+}
+
+impl Default for Fluid {
+    fn default() -> Self {
+        Self {
+            rho: RHO_SEAWATER,
+            g: GRAVITY,
+            current: Vec3::zeros(),
+        }
+    }
+}
+
+/// Per-body hydrodynamics (SPEC §2): a sum type over the two ways a body is described.
+///
+/// The `Coefficients` variant is large (three 6×6 matrices); bodies are few and built once,
+/// so it is kept inline rather than boxed.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+pub enum Hydro {
+    /// A slender cylinder along the body's x axis: the USM paper's added-mass formulas
+    /// (`M_A11 = 0.1 m`, `M_A22 = M_A33 = πρr²l`, `M_A44 = 0`, `M_A55 = M_A66 = πρr²l³/12`,
+    /// about the geometric centre) and strip-theory drag coefficients.
+    Cylinder {
+        /// Axial drag coefficient `C_d,x` (on the cross-section area πr²).
+        cd_x: f64,
+        /// Cross-flow drag coefficient along body y (on the projected area 2r per unit length).
+        cd_y: f64,
+        /// Cross-flow drag coefficient along body z.
+        cd_z: f64,
+        /// Small linear damping on every axis, `[N·s/m ×3, N·m·s/rad ×3]`, applied to the
+        /// relative twist at the body's geometric centre (inferred, SPEC §2).
+        linear_damping: [f64; 6],
+        /// Number of integration points along the body for the cross-flow strip integral.
+        strips: usize,
+        /// Ratio of axial added mass to body mass (paper: 0.1).
+        axial_added_mass_ratio: f64,
+    },
+    /// Hydrodynamic derivatives in matrix form about the body frame's origin:
+    /// added mass `M_A` (6×6, symmetric PSD), linear damping `D_l` and quadratic damping
+    /// `D_q` so that the damping wrench is `−(D_l ν_r + D_q (|ν_r| ∘ ν_r))`.
+    Coefficients {
+        /// Added-mass matrix [kg, kg·m, kg·m²] about the body frame origin.
+        added_mass: Mat6,
+        /// Linear damping matrix.
+        linear: Mat6,
+        /// Quadratic damping matrix, multiplying the element-wise `|ν_r| ∘ ν_r`.
+        quadratic: Mat6,
+    },
+}
+
+impl Hydro {
+    /// The USM paper's cylinder model with the given drag coefficients and default small
+    /// linear damping (inferred defaults: 1 N·s/m on translations, 0.05 N·m·s/rad on rotations).
+    pub fn cylinder(cd_x: f64, cd_yz: f64) -> Self {
+        Hydro::Cylinder {
+            cd_x,
+            cd_y: cd_yz,
+            cd_z: cd_yz,
+            linear_damping: [1.0, 1.0, 1.0, 0.05, 0.05, 0.05],
+            strips: 5,
+            axial_added_mass_ratio: 0.1,
+        }
+    }
+}
+
+/// A rigid body of the chain (SPEC §2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name used in reports and design files.
+    pub name: String,
+    /// Mass [kg].
+    pub mass: f64,
+    /// Length along the body x axis [m]; the next joint sits at the front face by default.
+    pub length: f64,
+    /// Radius [m] (cylinder model).
+    pub radius: f64,
+    /// Centre of gravity in the body frame [m].
+    pub cg: Vec3,
+    /// Centre of buoyancy in the body frame [m].
+    pub cb: Vec3,
+    /// Displaced volume [m³].
+    pub volume: f64,
+    /// Rotational inertia about the centre of gravity, body axes [kg·m²].
+    pub inertia: Mat3,
+    /// Hydrodynamic description.
+    pub hydro: Hydro,
+}
+
+impl Body {
+    /// A solid cylinder body with CG = CB at the geometric centre, inertia
+    /// `Ixx = m r²/2, Iyy = Izz = m(3r²+l²)/12` and volume `πr²l` (SPEC §2 defaults).
+    pub fn cylinder(name: &str, mass: f64, length: f64, radius: f64, hydro: Hydro) -> Self {
+        let c = Vec3::new(length / 2.0, 0.0, 0.0);
+        let ixx = mass * radius * radius / 2.0;
+        let iyy = mass * (3.0 * radius * radius + length * length) / 12.0;
+        Body {
+            name: name.to_string(),
+            mass,
+            length,
+            radius,
+            cg: c,
+            cb: c,
+            volume: PI * radius * radius * length,
+            inertia: Mat3::from_diagonal(&Vec3::new(ixx, iyy, iyy)),
+            hydro,
+        }
+    }
+
+    /// Geometric centre `(l/2, 0, 0)` in the body frame [m].
+    pub fn centre(&self) -> Vec3 {
+        Vec3::new(self.length / 2.0, 0.0, 0.0)
+    }
+
+    /// Rigid-body spatial inertia `I_RB` about the body frame origin (USM-22 summand).
+    pub fn rigid_spatial_inertia(&self) -> Mat6 {
+        rigid_inertia(self.mass, &self.cg, &self.inertia)
+    }
+
+    /// Added-mass spatial inertia `M_A` about the body frame origin (SPEC §2), in fluid
+    /// of density `rho` [kg/m³].
+    pub fn added_mass(&self, rho: f64) -> Mat6 {
+        match &self.hydro {
+            Hydro::Cylinder {
+                axial_added_mass_ratio,
+                ..
+            } => {
+                let (r, l) = (self.radius, self.length);
+                let lat = PI * rho * r * r * l;
+                let rot = PI * rho * r * r * l * l * l / 12.0;
+                let d = Vector6::new(axial_added_mass_ratio * self.mass, lat, lat, 0.0, rot, rot);
+                // Paper formulas hold about the geometric centre; move to the frame origin.
+                Se3::from_translation(self.centre()).inertia_to_parent(&Mat6::from_diagonal(&d))
+            }
+            Hydro::Coefficients { added_mass, .. } => *added_mass,
+        }
+    }
+}
+
+/// A revolute joint (SPEC §2). The child body's frame at zero angle is `placement` in the
+/// parent body's frame; the joint rotates the child about `axis` (a unit vector in the
+/// child frame, through its origin).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// Name used in reports and design files.
+    pub name: String,
+    /// Child frame in the parent frame at zero joint angle.
+    pub placement: Se3,
+    /// Unit rotation axis in the child frame.
+    pub axis: Vec3,
+    /// Lower limit [rad].
+    pub min: f64,
+    /// Upper limit [rad].
+    pub max: f64,
+}
+
+/// A thruster fixed to a body (SPEC §2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Thruster {
+    /// Name used in reports and design files.
+    pub name: String,
+    /// Index of the body it is fixed to.
+    pub body: usize,
+    /// Point of application in the body frame [m].
+    pub position: Vec3,
+    /// Unit thrust direction in the body frame.
+    pub direction: Vec3,
+    /// Lower thrust limit [N].
+    pub u_min: f64,
+    /// Upper thrust limit [N].
+    pub u_max: f64,
+    /// Optional first-order lag time constant [s].
+    pub time_constant: Option<f64>,
+    /// Optional rate limit [N/s].
+    pub rate_limit: Option<f64>,
+}
+
+/// A complete design: the floating-base chain (SPEC §2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vehicle {
+    /// Design name.
+    pub name: String,
+    /// Bodies, tail to head; body 0 carries the base frame.
+    pub bodies: Vec<Body>,
+    /// Joints; joint `k` joins body `k` to body `k+1`.
+    pub joints: Vec<Joint>,
+    /// Thrusters.
+    pub thrusters: Vec<Thruster>,
+    /// Pose of the base frame `F_b` in body 0's frame (default identity: the tail face).
+    pub base: Se3,
+    /// Pose of the end-effector frame `F_e` in the last body's frame (default: front face).
+    pub end_effector: Se3,
+    /// The surrounding fluid.
+    pub fluid: Fluid,
+}
+
+/// An invalid model: what is wrong and where (a key path such as `body[2].mass`).
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("{key}: {message}")]
+pub struct ModelError {
+    /// Key path of the offending value, e.g. `thruster[3].direction`.
+    pub key: String,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+impl ModelError {
+    /// A new error at `key`.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
+fn finite_pos(key: String, v: f64) -> Result<(), ModelError> {
+    if !v.is_finite() {
+        return Err(ModelError::new(
+            key,
+            format!("must be a finite number, got {v}"),
+        ));
+    }
+    if v <= 0.0 {
+        return Err(ModelError::new(key, format!("must be > 0, got {v}")));
+    }
+    Ok(())
+}
+
+fn finite_vec(key: String, v: &[f64]) -> Result<(), ModelError> {
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(ModelError::new(key, format!("must be finite, got {x}")));
+    }
+    Ok(())
+}
+
+impl Vehicle {
+    /// Number of joints `n`.
+    pub fn n_joints(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Number of generalised velocities `6 + n`.
+    pub fn n_dof(&self) -> usize {
+        6 + self.joints.len()
+    }
+
+    /// Number of thrusters `m`.
+    pub fn n_thrusters(&self) -> usize {
+        self.thrusters.len()
+    }
+
+    /// Total mass [kg].
+    pub fn total_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.mass).sum()
+    }
+
+    /// Total length [m]: the sum of the body lengths (the straight chain's extent).
+    pub fn total_length(&self) -> f64 {
+        self.bodies.iter().map(|b| b.length).sum()
+    }
+
+    /// Characteristic length for scaling moments (SPEC §6 default: half the vehicle length) [m].
+    pub fn characteristic_length(&self) -> f64 {
+        0.5 * self.total_length()
+    }
+
+    /// Joint limits as `(min, max)` pairs [rad].
+    pub fn joint_limits(&self) -> Vec<(f64, f64)> {
+        self.joints.iter().map(|j| (j.min, j.max)).collect()
+    }
+
+    /// Check every physical requirement; the error names the key path of the first problem.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        if self.bodies.is_empty() {
+            return Err(ModelError::new("body", "a design needs at least one body"));
+        }
+        if self.joints.len() + 1 != self.bodies.len() {
+            return Err(ModelError::new(
+                "joint",
+                format!(
+                    "a chain of {} bodies needs {} joints, got {}",
+                    self.bodies.len(),
+                    self.bodies.len() - 1,
+                    self.joints.len()
+                ),
+            ));
+        }
+        finite_pos("fluid.rho".into(), self.fluid.rho)?;
+        if !self.fluid.g.is_finite() || self.fluid.g < 0.0 {
+            return Err(ModelError::new("fluid.g", "must be finite and >= 0"));
+        }
+        finite_vec("fluid.current".into(), self.fluid.current.as_slice())?;
+        for (i, b) in self.bodies.iter().enumerate() {
+            let k = |f: &str| format!("body[{i}].{f}");
+            finite_pos(k("mass"), b.mass)?;
+            finite_pos(k("length"), b.length)?;
+            finite_pos(k("radius"), b.radius)?;
+            finite_pos(k("volume"), b.volume)?;
+            finite_vec(k("cg"), b.cg.as_slice())?;
+            finite_vec(k("cb"), b.cb.as_slice())?;
+            finite_vec(k("inertia"), b.inertia.as_slice())?;
+            if (b.inertia - b.inertia.transpose()).abs().max() > 1e-9 * b.inertia.abs().max() {
+                return Err(ModelError::new(k("inertia"), "must be symmetric"));
+            }
+            if b.inertia.cholesky().is_none() {
+                return Err(ModelError::new(k("inertia"), "must be positive definite"));
+            }
+            match &b.hydro {
+                Hydro::Cylinder {
+                    cd_x,
+                    cd_y,
+                    cd_z,
+                    linear_damping,
+                    strips,
+                    axial_added_mass_ratio,
+                } => {
+                    for (name, v) in [("cd_x", cd_x), ("cd_y", cd_y), ("cd_z", cd_z)] {
+                        if !v.is_finite() || *v < 0.0 {
+                            return Err(ModelError::new(
+                                k(&format!("hydro.{name}")),
+                                format!("must be finite and >= 0, got {v}"),
+                            ));
+                        }
+                    }
+                    if linear_damping.iter().any(|d| !d.is_finite() || *d < 0.0) {
+                        return Err(ModelError::new(
+                            k("hydro.linear_damping"),
+                            "entries must be finite and >= 0",
+                        ));
+                    }
+                    if *strips == 0 {
+                        return Err(ModelError::new(k("hydro.strips"), "must be >= 1"));
+                    }
+                    if !axial_added_mass_ratio.is_finite() || *axial_added_mass_ratio < 0.0 {
+                        return Err(ModelError::new(
+                            k("hydro.axial_added_mass_ratio"),
+                            "must be finite and >= 0",
+                        ));
+                    }
+                }
+                Hydro::Coefficients {
+                    added_mass,
+                    linear,
+                    quadratic,
+                } => {
+                    for (name, m) in [
+                        ("added_mass", added_mass),
+                        ("linear", linear),
+                        ("quadratic", quadratic),
+                    ] {
+                        finite_vec(k(&format!("hydro.{name}")), m.as_slice())?;
+                    }
+                    if (added_mass - added_mass.transpose()).abs().max()
+                        > 1e-9 * added_mass.abs().max().max(1.0)
+                    {
+                        return Err(ModelError::new(k("hydro.added_mass"), "must be symmetric"));
+                    }
+                    let ev = added_mass.symmetric_eigenvalues();
+                    if ev
+                        .iter()
+                        .any(|e| !e.is_finite() || *e < -1e-9 * ev.amax().max(1.0))
+                    {
+                        return Err(ModelError::new(
+                            k("hydro.added_mass"),
+                            "must be positive semi-definite",
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, j) in self.joints.iter().enumerate() {
+            let k = |f: &str| format!("joint[{i}].{f}");
+            finite_vec(k("position"), j.placement.p.as_slice())?;
+            finite_vec(k("rotation"), j.placement.r.as_slice())?;
+            if crate::spatial::orthonormality_error(&j.placement.r) > 1e-9 {
+                return Err(ModelError::new(k("rotation"), "is not a rotation matrix"));
+            }
+            finite_vec(k("axis"), j.axis.as_slice())?;
+            if (j.axis.norm() - 1.0).abs() > 1e-9 {
+                return Err(ModelError::new(
+                    k("axis"),
+                    format!("must be a unit vector, has norm {}", j.axis.norm()),
+                ));
+            }
+            if !j.min.is_finite() || !j.max.is_finite() || j.min > j.max {
+                return Err(ModelError::new(
+                    k("limits"),
+                    format!("need finite min <= max, got [{}, {}]", j.min, j.max),
+                ));
+            }
+        }
+        for (i, t) in self.thrusters.iter().enumerate() {
+            let k = |f: &str| format!("thruster[{i}].{f}");
+            if t.body >= self.bodies.len() {
+                return Err(ModelError::new(
+                    k("body"),
+                    format!(
+                        "body {} does not exist (the design has {} bodies)",
+                        t.body,
+                        self.bodies.len()
+                    ),
+                ));
+            }
+            finite_vec(k("position"), t.position.as_slice())?;
+            finite_vec(k("direction"), t.direction.as_slice())?;
+            if (t.direction.norm() - 1.0).abs() > 1e-9 {
+                return Err(ModelError::new(
+                    k("direction"),
+                    format!("must be a unit vector, has norm {}", t.direction.norm()),
+                ));
+            }
+            if !t.u_min.is_finite() || !t.u_max.is_finite() || t.u_min > t.u_max {
+                return Err(ModelError::new(
+                    k("u_min"),
+                    format!("need finite u_min <= u_max, got [{}, {}]", t.u_min, t.u_max),
+                ));
+            }
+            if let Some(tc) = t.time_constant {
+                finite_pos(k("time_constant"), tc)?;
+            }
+            if let Some(r) = t.rate_limit {
+                finite_pos(k("rate_limit"), r)?;
+            }
+        }
+        for (key, g) in [("base", &self.base), ("end_effector", &self.end_effector)] {
+            finite_vec(format!("{key}.position"), g.p.as_slice())?;
+            if crate::spatial::orthonormality_error(&g.r) > 1e-9 {
+                return Err(ModelError::new(
+                    format!("{key}.rotation"),
+                    "is not a rotation matrix",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
