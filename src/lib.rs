@@ -10,6 +10,7 @@
 //! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports.
 
 pub mod cli;
+pub mod dynamics;
 pub mod kinematics;
 pub mod model;
 pub mod sampling;

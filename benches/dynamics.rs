@@ -1,0 +1,122 @@
+//! Benchmarks of the dynamics core on `usm-paper` (SPEC §4): mass matrix (CRBA), bias
+//! forces (RNEA), forward and hybrid dynamics, and one RK4 step with full hydrodynamics.
+//!
+//! Run with `cargo bench --bench dynamics -- --warm-up-time 1 --measurement-time 3`.
+//! Before measuring, a counting allocator checks that a simulator step allocates nothing.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use usm_study::dynamics::{
+    bias, dynamics_terms, forward_dynamics, hybrid_dynamics, mass_matrix, solve_forward,
+    ActuatorCommand, DynOptions, DynWorkspace, SimConfig, SimState, Simulator,
+};
+use usm_study::kinematics::BasePose;
+use usm_study::model::presets::usm_paper;
+use usm_study::spatial::Vec3;
+
+/// Counts heap allocations (all threads) to check the hot path allocates nothing.
+struct Counting;
+
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// A bent, moving state of the paper's USM in a current.
+fn state() -> (BasePose, Vec<f64>, Vec<f64>) {
+    let pose = BasePose {
+        orientation: nalgebra::UnitQuaternion::from_euler_angles(0.1, -0.2, 0.7),
+        position: Vec3::new(1.0, 2.0, -3.0),
+    };
+    let q: Vec<f64> = (0..8).map(|k| 0.3 * ((k as f64) * 1.3).sin()).collect();
+    let zeta: Vec<f64> = (0..14).map(|k| 0.2 * ((k as f64) * 0.7).cos()).collect();
+    (pose, q, zeta)
+}
+
+fn bench_dynamics(c: &mut Criterion) {
+    let mut v = usm_paper();
+    v.fluid.current = Vec3::new(0.2, 0.1, 0.0);
+    let opts = DynOptions::full();
+    let (pose, q, zeta) = state();
+    let mut ws = DynWorkspace::new(&v);
+    let tau: Vec<f64> = (0..14).map(|k| k as f64 - 6.0).collect();
+    let qdd: Vec<f64> = (0..8).map(|k| 0.1 * k as f64).collect();
+
+    // One-off allocation check of a full RK4 step (after a warm-up step).
+    let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
+    let mut st = SimState::rest(&v);
+    st.pose = pose;
+    st.joint_angles = q.clone();
+    st.set_zeta(&zeta);
+    sim.set_state(st).unwrap();
+    let thrust = [5.0, -3.0, 10.0, 10.0, 2.0, -1.0, 4.0];
+    let qr: Vec<f64> = q.iter().map(|x| 0.9 * x).collect();
+    let qdr = vec![0.0; 8];
+    let cmd = ActuatorCommand {
+        thrust: &thrust,
+        joint_ref: &qr,
+        joint_rate_ref: &qdr,
+    };
+    sim.step(1e-3, &cmd).unwrap();
+    let before = ALLOCS.load(Ordering::Relaxed);
+    for _ in 0..100 {
+        sim.step(1e-3, &cmd).unwrap();
+    }
+    let allocs = ALLOCS.load(Ordering::Relaxed) - before;
+    println!("heap allocations in 100 RK4 steps: {allocs}");
+    assert_eq!(allocs, 0, "Simulator::step must not allocate");
+
+    c.bench_function("mass_matrix", |b| {
+        b.iter(|| mass_matrix(&v, &mut ws, black_box(&q), &opts))
+    });
+    c.bench_function("bias_full_hydro", |b| {
+        b.iter(|| bias(&v, &mut ws, &pose, black_box(&q), black_box(&zeta), &opts))
+    });
+    c.bench_function("dynamics_terms", |b| {
+        b.iter(|| dynamics_terms(&v, &mut ws, &pose, black_box(&q), black_box(&zeta), &opts))
+    });
+    c.bench_function("forward_dynamics", |b| {
+        b.iter(|| {
+            forward_dynamics(
+                &v,
+                &mut ws,
+                &pose,
+                black_box(&q),
+                black_box(&zeta),
+                &tau,
+                &opts,
+            )
+            .unwrap()
+        })
+    });
+    dynamics_terms(&v, &mut ws, &pose, &q, &zeta, &opts);
+    c.bench_function("solve_forward_cholesky", |b| {
+        b.iter(|| solve_forward(&mut ws, black_box(&tau)).unwrap())
+    });
+    c.bench_function("hybrid_dynamics", |b| {
+        b.iter(|| {
+            hybrid_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    c.bench_function("rk4_step_full_hydro", |b| {
+        b.iter(|| sim.step(1e-3, black_box(&cmd)).unwrap())
+    });
+}
+
+criterion_group!(benches, bench_dynamics);
+criterion_main!(benches);
