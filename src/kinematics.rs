@@ -217,7 +217,7 @@ mod tests {
     /// `ζ` (base twist in F_b, joint rates): V = [Rᵀ ṗ; vee(Rᵀ Ṙ)].
     fn fd_twist(v: &Vehicle, base: &Se3, q: &[f64], zeta: &[f64], body: Option<usize>) -> Vec6 {
         let h = 1e-6;
-        let mut eval = |s: f64| {
+        let eval = |s: f64| {
             let dx = Vec6::from_iterator(zeta[..6].iter().map(|z| z * s));
             let b = perturb_base(base, &dx);
             let qq: Vec<f64> = q.iter().zip(&zeta[6..]).map(|(a, d)| a + d * s).collect();

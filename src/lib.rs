@@ -9,9 +9,11 @@
 //! modules follow the layout of `DESIGN.md`: data flows from [`model`] through
 //! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports.
 
+pub mod allocation;
 pub mod cli;
 pub mod dynamics;
 pub mod kinematics;
+pub mod metrics;
 pub mod model;
 pub mod sampling;
 pub mod spatial;

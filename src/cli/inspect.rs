@@ -1,7 +1,9 @@
-//! `usm-study inspect DESIGN [--state STATE.json] [--format text|json]`.
+//! `usm-study inspect DESIGN [--state STATE.json] [--format text|json] [--rigid]`.
 
 use super::{fmt_num, Format};
+use crate::dynamics::{inspect_dynamics, DynOptions, DynamicsReport, SimState};
 use crate::kinematics::{ee_jacobian, forward_kinematics, thruster_matrix_owned, KinWorkspace};
+use crate::metrics::singularity::{tcm_metrics, tcm_svd_metrics, LostDirection, TcmMetrics};
 use crate::model::design::load_design;
 use crate::model::Vehicle;
 use crate::state::{load_state, VehicleState};
@@ -27,6 +29,10 @@ pub struct InspectArgs {
     /// Relative tolerance for the rank of T(q) (fraction of the largest singular value).
     #[arg(long, default_value_t = 1e-6)]
     pub rank_tol: f64,
+    /// Bodies in vacuum: no added mass, drag, restoring forces or current (for comparison
+    /// with ordinary rigid-body libraries).
+    #[arg(long)]
+    pub rigid: bool,
 }
 
 /// The kinematic part of the inspect report (stable JSON keys, SI units).
@@ -46,25 +52,15 @@ pub struct KinematicsReport {
     pub ee_jacobian: Vec<Vec<f64>>,
     /// Thruster configuration matrix T(q) (USM-26) in the base frame, 6×m rows.
     pub tcm: Vec<Vec<f64>>,
-    /// Singular values of T(q), unscaled, descending.
+    /// Singular values of T(q), unscaled, six, descending (zeros when m < 6).
     pub tcm_singular_values: Vec<f64>,
     /// Numerical rank of T(q) with the relative tolerance `rank_tol`.
     pub tcm_rank: usize,
-    /// Unit base-wrench directions T(q) cannot produce (left singular vectors with
-    /// singular value below the tolerance), each labelled by its dominant axis.
+    /// Wrench directions T(q) cannot produce, each labelled by its dominant base axis.
     pub tcm_lost_directions: Vec<LostDirection>,
+    /// Metrics of the moment-scaled T(q) (SPEC §6): σ_min, κ, rank, attainable wrench.
+    pub tcm_scaled: TcmMetrics,
 }
-
-/// A wrench direction lost by T(q).
-#[derive(Debug, Serialize)]
-pub struct LostDirection {
-    /// Dominant base axis: surge, sway, heave, roll, pitch or yaw.
-    pub axis: String,
-    /// Unit 6-vector `[f; m]` in the base frame.
-    pub direction: [f64; 6],
-}
-
-const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
 
 fn rows(m: &Mat<f64>) -> Vec<Vec<f64>> {
     (0..m.nrows())
@@ -72,8 +68,12 @@ fn rows(m: &Mat<f64>) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Evaluate the kinematic report of `v` at `s`.
-pub fn kinematics_report(v: &Vehicle, s: &VehicleState, rank_tol: f64) -> KinematicsReport {
+/// Evaluate the kinematic report of `v` at `s`; `rank_tol` is relative to σ_max.
+pub fn kinematics_report(
+    v: &Vehicle,
+    s: &VehicleState,
+    rank_tol: f64,
+) -> anyhow::Result<KinematicsReport> {
     let mut ws = KinWorkspace::new(v);
     forward_kinematics(v, &s.q, &mut ws);
     let g_ie = s.base.to_se3().compose(&ws.g_be);
@@ -81,43 +81,13 @@ pub fn kinematics_report(v: &Vehicle, s: &VehicleState, rank_tol: f64) -> Kinema
     ee_jacobian(&ws, &mut j);
     let t = thruster_matrix_owned(v, &ws);
     let m = t.ncols();
-    let (sv, lost) = if m == 0 {
-        (Vec::new(), Vec::new())
-    } else {
-        // Full SVD of the 6×6 Gram matrix T Tᵀ gives all six left singular directions,
-        // including those of a T with fewer than six columns.
-        let gram = &t * t.transpose();
-        let eig = gram.symmetric_eigen();
-        let mut idx: Vec<usize> = (0..6).collect();
-        idx.sort_by(|a, b| eig.eigenvalues[*b].total_cmp(&eig.eigenvalues[*a]));
-        let sv: Vec<f64> = idx
-            .iter()
-            .map(|&i| eig.eigenvalues[i].max(0.0).sqrt())
-            .collect();
-        let tol = rank_tol * sv[0];
-        let lost = idx
-            .iter()
-            .zip(&sv)
-            .filter(|(_, s)| **s <= tol)
-            .map(|(&i, _)| {
-                let d = eig.eigenvectors.column(i);
-                let k = d.iamax();
-                let sign = if d[k] < 0.0 { -1.0 } else { 1.0 };
-                let mut dir = [0.0; 6];
-                for (r, x) in dir.iter_mut().enumerate() {
-                    *x = sign * d[r];
-                }
-                LostDirection {
-                    axis: AXES[k].to_string(),
-                    direction: dir,
-                }
-            })
-            .collect();
-        let keep = m.min(6);
-        (sv[..keep].to_vec(), lost)
-    };
-    let tol = rank_tol * sv.first().copied().unwrap_or(0.0);
-    KinematicsReport {
+    let u_min: Vec<f64> = v.thrusters.iter().map(|t| t.u_min).collect();
+    let u_max: Vec<f64> = v.thrusters.iter().map(|t| t.u_max).collect();
+    // A characteristic length of 1 m leaves T unscaled.
+    let raw = tcm_svd_metrics(&t, 1.0, rank_tol).context("analysing T(q)")?;
+    let scaled = tcm_metrics(&t, &u_min, &u_max, v.characteristic_length(), rank_tol)
+        .context("analysing the scaled T(q)")?;
+    Ok(KinematicsReport {
         design: v.name.clone(),
         total_mass: v.total_mass(),
         total_length: v.total_length(),
@@ -127,31 +97,57 @@ pub fn kinematics_report(v: &Vehicle, s: &VehicleState, rank_tol: f64) -> Kinema
         tcm: (0..6)
             .map(|r| (0..m).map(|c| t[(r, c)]).collect())
             .collect(),
-        tcm_rank: sv.iter().filter(|s| **s > tol).count(),
-        tcm_singular_values: sv,
-        tcm_lost_directions: lost,
-    }
+        tcm_singular_values: raw.singular_values.to_vec(),
+        tcm_rank: raw.rank,
+        tcm_lost_directions: raw.lost_directions,
+        tcm_scaled: scaled,
+    })
 }
 
 /// Run `inspect`.
 pub fn run(a: &InspectArgs) -> anyhow::Result<ExitCode> {
+    if !(a.rank_tol.is_finite() && a.rank_tol >= 0.0) {
+        anyhow::bail!(
+            "--rank-tol must be a finite number >= 0, got {}",
+            a.rank_tol
+        );
+    }
     let v = load_design(&a.design)?;
     let s = match &a.state {
         Some(p) => load_state(p, &v)?,
         None => VehicleState::rest(&v),
     };
-    let k = kinematics_report(&v, &s, a.rank_tol);
+    let k = kinematics_report(&v, &s, a.rank_tol)?;
+    let sim_state = SimState {
+        pose: s.base,
+        joint_angles: s.q.clone(),
+        base_twist: s.twist,
+        joint_rates: s.qd.clone(),
+        thrust: vec![0.0; v.n_thrusters()],
+    };
+    let options = if a.rigid {
+        DynOptions::rigid()
+    } else {
+        DynOptions::full()
+    };
+    let d = inspect_dynamics(&v, &sim_state, &s.generalized_forces, &options)
+        .context("evaluating the dynamics at the state")?;
     match a.format {
         Format::Json => {
-            let text = serde_json::to_string_pretty(&k).context("serialising the report")?;
-            println!("{text}");
+            let mut obj = serde_json::to_value(&k).context("serialising the report")?;
+            let dv = serde_json::to_value(&d).context("serialising the report")?;
+            if let (Some(o), serde_json::Value::Object(dm)) = (obj.as_object_mut(), dv) {
+                o.extend(dm);
+                o.insert("rigid".into(), serde_json::Value::Bool(a.rigid));
+            }
+            println!("{}", serde_json::to_string_pretty(&obj)?);
         }
-        Format::Text => print!("{}", text_report(&v, &k)),
+        Format::Text => print!("{}", text_report(&v, &k, &d, a.rigid)),
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn text_report(v: &Vehicle, k: &KinematicsReport) -> String {
+fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: bool) -> String {
     use std::fmt::Write;
     let mut o = String::new();
     let _ = writeln!(o, "design {}", v.name);
@@ -245,8 +241,56 @@ fn text_report(v: &Vehicle, k: &KinematicsReport) -> String {
     let _ = writeln!(o, "singular values: {}", sv.join(", "));
     let _ = writeln!(o, "rank: {} of 6", k.tcm_rank);
     for l in &k.tcm_lost_directions {
-        let d: Vec<String> = l.direction.iter().map(|x| format!("{x:.3}")).collect();
-        let _ = writeln!(o, "lost direction: {} [{}]", l.axis, d.join(" "));
+        let dir: Vec<String> = l.direction.iter().map(|x| format!("{x:.3}")).collect();
+        let _ = writeln!(o, "lost direction: {} [{}]", l.dominant_axis, dir.join(" "));
     }
+    let sc = &k.tcm_scaled;
+    let _ = writeln!(
+        o,
+        "scaled T (moments / {:.3} m): sigma_min {}, condition number {}",
+        sc.char_length,
+        fmt_num(sc.sigma_min),
+        fmt_num(sc.condition_number)
+    );
+    if let Some(att) = &sc.attainable {
+        let _ = writeln!(
+            o,
+            "attainable base wrench under the thrust limits [N, N·m]:"
+        );
+        for (i, axis) in ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+            .iter()
+            .enumerate()
+        {
+            let _ = writeln!(
+                o,
+                "  {axis:<6} +{} / -{}",
+                fmt_num(att.positive[i]),
+                fmt_num(att.negative[i])
+            );
+        }
+    }
+    let _ = writeln!(
+        o,
+        "\ndynamics ({})",
+        if rigid {
+            "rigid bodies in vacuum"
+        } else {
+            "added mass, drag, restoring forces, current"
+        }
+    );
+    let ev = &d.mass_matrix_eigenvalues;
+    let _ = writeln!(
+        o,
+        "  mass matrix {n}x{n}: eigenvalues {} .. {}, condition number {}",
+        fmt_num(ev.first().copied().unwrap_or(f64::NAN)),
+        fmt_num(ev.last().copied().unwrap_or(f64::NAN)),
+        fmt_num(d.mass_matrix_condition),
+        n = d.mass_matrix.len()
+    );
+    let _ = writeln!(o, "  kinetic energy: {} J", fmt_num(d.kinetic_energy));
+    let bias: Vec<String> = d.bias.iter().map(|x| fmt_num(*x)).collect();
+    let _ = writeln!(o, "  bias h: [{}]", bias.join(", "));
+    let acc: Vec<String> = d.acceleration.iter().map(|x| fmt_num(*x)).collect();
+    let _ = writeln!(o, "  acceleration: [{}]", acc.join(", "));
     o
 }

@@ -1,10 +1,9 @@
 //! The command-line interface: clap commands, output formatting and exit codes. This is the
 //! only module that prints.
 
+pub mod allocate;
 pub mod design;
 pub mod inspect;
-pub mod sweep;
-pub mod tcm;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -24,14 +23,8 @@ enum Command {
     /// Work with design files and presets.
     #[command(subcommand)]
     Design(design::DesignCommand),
-    /// Static configuration-space analysis of the thruster matrix: how often is T(q) singular.
-    Tcm(tcm::TcmArgs),
-    /// Run a batch study (parameter sweep) from a study file.
-    Sweep(sweep::SweepArgs),
-    /// Merge the outputs of sweep shards into one result.
-    Merge(sweep::MergeArgs),
-    /// Regenerate summary.md and plots of a sweep output directory.
-    Report(sweep::ReportArgs),
+    /// Solve one thrust-allocation problem with one or all methods.
+    Allocate(allocate::AllocateArgs),
 }
 
 /// Parse `std::env::args` and run the chosen command.
@@ -40,10 +33,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
     match &cli.command {
         Command::Inspect(a) => inspect::run(a),
         Command::Design(c) => design::run(c),
-        Command::Tcm(a) => tcm::run(a),
-        Command::Sweep(a) => sweep::run(a),
-        Command::Merge(a) => sweep::run_merge(a),
-        Command::Report(a) => sweep::run_report(a),
+        Command::Allocate(a) => allocate::run(a),
     }
 }
 
