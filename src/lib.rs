@@ -11,10 +11,12 @@
 
 pub mod allocation;
 pub mod cli;
+pub mod control;
 pub mod dynamics;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod report;
 pub mod sampling;
 pub mod spatial;
 pub mod state;

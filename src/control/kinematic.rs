@@ -1,0 +1,892 @@
+//! Kinematic control (SPEC §5, USM section IV-A, USM-27…32): damped weighted pseudoinverse,
+//! singularity-robust multiple task priority (SRMTP), and the task errors and Jacobians of the
+//! end-effector pose, base position and joint-limit tasks.
+//!
+//! - Damped weighted pseudoinverse (USM-31 with the usage-weight reading of SPEC §5):
+//!   `J^# = U Jᵀ (J U Jᵀ + λ² I)⁻¹`, `U = diag(u)` a **usage** weight (`u_i = 0` forbids
+//!   coordinate `i`, larger `u_i` prefers it; the paper's `W` multiplies as `U`, not as `W⁻¹`).
+//! - SRMTP (USM-32): `ζ_r = J_1^#(σ̇_1d + Λ_1σ̃_1) + N_1 J_2^#(σ̇_2d + Λ_2σ̃_2) + …`, where the
+//!   projector below level `k` is `N_{1…k−1} = I − J_A^# J_A` with `J_A` the stacked Jacobians of
+//!   all higher-priority tasks; [`Srmtp`] builds it incrementally. The stacked pseudoinverse of
+//!   the projector uses the solver's own usage weights and damping (those given to
+//!   [`Srmtp::new`]): the usage weight is a property of the vehicle's coordinates, not of a task.
+//!   Each task's own pseudoinverse can be weighted or plain ([`TaskInverse`]).
+//! - Tasks: end-effector pose ([`ee_pose_error`], Jacobian [`crate::kinematics::ee_jacobian`]),
+//!   base position ([`base_position_jacobian`]), joint limits (set-based, [`JointLimitTask`]).
+//!   The paper's other secondary objectives — manipulability and TCM conditioning — are **not
+//!   implemented yet** (TODO): they need configuration gradients (analytic derivatives of the
+//!   Jacobian / of `T(q)`); [`Srmtp::push_velocity`] is the hook that will project such a
+//!   gradient step into the remaining null space.
+//!
+//! Dimensions: `N = 6 + n` generalised velocities `ζ = [V_b; q̇]` (base twist in `F_b`, m/s and
+//! rad/s, then joint rates rad/s). Matrices are faer `Mat<f64>`; the small SPD systems are solved
+//! by an in-place Cholesky factorisation in preallocated buffers — nothing allocates per call.
+//! A non-positive pivot (λ = 0 and a singular `J U Jᵀ`) is retried once with a tiny diagonal
+//! regularisation and counted ([`PinvWorkspace::regularised`]); if that also fails (non-finite
+//! input) the contribution is zero and counted ([`PinvWorkspace::failed`]).
+
+use super::{check_nonneg, orientation_error, ControlError};
+use crate::kinematics::BasePose;
+use crate::spatial::{stack, Mat3, Se3, Vec3, Vec6};
+use faer::{Mat, MatRef};
+use nalgebra::{Rotation3, UnitQuaternion};
+use serde::{Deserialize, Serialize};
+
+/// In-place Cholesky `A = L Lᵀ` of the leading `m×m` block of the row-major buffer `a`
+/// (lower triangle overwritten with `L`). Returns `false` on a non-positive or non-finite pivot.
+fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
+    for j in 0..m {
+        let mut d = a[j * m + j];
+        for k in 0..j {
+            d -= a[j * m + k] * a[j * m + k];
+        }
+        if !d.is_finite() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * m + j] = d;
+        for i in (j + 1)..m {
+            let mut s = a[i * m + j];
+            for k in 0..j {
+                s -= a[i * m + k] * a[j * m + k];
+            }
+            a[i * m + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solve `L Lᵀ x = b` in place with the factor from [`cholesky_in_place`].
+fn cholesky_solve(l: &[f64], m: usize, b: &mut [f64]) {
+    for i in 0..m {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= l[i * m + k] * b[k];
+        }
+        b[i] = s / l[i * m + i];
+    }
+    for i in (0..m).rev() {
+        let mut s = b[i];
+        for k in (i + 1)..m {
+            s -= l[k * m + i] * b[k];
+        }
+        b[i] = s / l[i * m + i];
+    }
+}
+
+/// Usage weight `u_c` of column `c` (1 when no weights are given).
+#[inline]
+fn weight(u: Option<&[f64]>, c: usize) -> f64 {
+    u.map_or(1.0, |u| u[c])
+}
+
+/// Preallocated buffers for damped weighted pseudoinverses of Jacobians with up to `max_rows`
+/// rows and exactly `n` columns (USM-31).
+#[derive(Clone, Debug)]
+pub struct PinvWorkspace {
+    max_rows: usize,
+    n: usize,
+    a: Vec<f64>,
+    y: Vec<f64>,
+    regularised: u64,
+    failed: u64,
+}
+
+impl PinvWorkspace {
+    /// Buffers for `J` of at most `max_rows` rows and `n` columns.
+    pub fn new(max_rows: usize, n: usize) -> Self {
+        Self {
+            max_rows,
+            n,
+            a: vec![0.0; max_rows * max_rows],
+            y: vec![0.0; max_rows],
+            regularised: 0,
+            failed: 0,
+        }
+    }
+
+    /// How many factorisations needed the fallback diagonal regularisation.
+    pub fn regularised(&self) -> u64 {
+        self.regularised
+    }
+
+    /// How many factorisations failed (non-finite input); their results were zero.
+    pub fn failed(&self) -> u64 {
+        self.failed
+    }
+
+    fn check(
+        &self,
+        j: MatRef<'_, f64>,
+        u: Option<&[f64]>,
+        lambda: f64,
+    ) -> Result<(), ControlError> {
+        if j.nrows() > self.max_rows || j.ncols() != self.n {
+            return Err(ControlError::new(
+                "jacobian",
+                format!(
+                    "is {}×{}, the workspace holds up to {}×{}",
+                    j.nrows(),
+                    j.ncols(),
+                    self.max_rows,
+                    self.n
+                ),
+            ));
+        }
+        if let Some(u) = u {
+            if u.len() != self.n {
+                return Err(ControlError::new(
+                    "weights",
+                    format!("has {} entries, needs {}", u.len(), self.n),
+                ));
+            }
+        }
+        check_nonneg("damping", lambda)
+    }
+
+    /// Build and factor `A = J U Jᵀ + λ² I` (m×m). Returns false if it could not be factored.
+    fn factor(&mut self, j: MatRef<'_, f64>, u: Option<&[f64]>, lambda: f64) -> bool {
+        let m = j.nrows();
+        let build = |a: &mut [f64], extra: f64| {
+            for r in 0..m {
+                for s in 0..=r {
+                    let mut acc = 0.0;
+                    for c in 0..j.ncols() {
+                        acc += j[(r, c)] * weight(u, c) * j[(s, c)];
+                    }
+                    a[r * m + s] = acc;
+                    a[s * m + r] = acc;
+                }
+                a[r * m + r] += lambda * lambda + extra;
+            }
+        };
+        build(&mut self.a, 0.0);
+        if cholesky_in_place(&mut self.a, m) {
+            return true;
+        }
+        build(&mut self.a, 0.0);
+        let scale = (0..m).map(|r| self.a[r * m + r].abs()).fold(0.0, f64::max);
+        build(&mut self.a, 1e-12 * scale.max(1.0));
+        if cholesky_in_place(&mut self.a, m) {
+            self.regularised += 1;
+            true
+        } else {
+            self.failed += 1;
+            false
+        }
+    }
+
+    /// `out = J^# rhs = U Jᵀ (J U Jᵀ + λ² I)⁻¹ rhs` (USM-28/31). `j` is m×n (m ≤ `max_rows`),
+    /// `u` the usage weights (n, `None` = identity), `lambda` the damping λ ≥ 0, `rhs` of length
+    /// m, `out` of length n. Errors only on mismatched dimensions or invalid λ.
+    pub fn apply(
+        &mut self,
+        j: MatRef<'_, f64>,
+        u: Option<&[f64]>,
+        lambda: f64,
+        rhs: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ControlError> {
+        self.check(j, u, lambda)?;
+        let m = j.nrows();
+        if rhs.len() != m || out.len() != self.n {
+            return Err(ControlError::new(
+                "rhs",
+                format!(
+                    "lengths {} / {} do not match J ({}×{})",
+                    rhs.len(),
+                    out.len(),
+                    m,
+                    self.n
+                ),
+            ));
+        }
+        if !self.factor(j, u, lambda) {
+            out.fill(0.0);
+            return Ok(());
+        }
+        self.y[..m].copy_from_slice(rhs);
+        cholesky_solve(&self.a, m, &mut self.y[..m]);
+        for (c, o) in out.iter_mut().enumerate() {
+            let mut acc = 0.0;
+            for r in 0..m {
+                acc += j[(r, c)] * self.y[r];
+            }
+            *o = weight(u, c) * acc;
+        }
+        Ok(())
+    }
+
+    /// The explicit `J^#` (n×m) into `out` (resized only if its shape differs).
+    pub fn pinv(
+        &mut self,
+        j: MatRef<'_, f64>,
+        u: Option<&[f64]>,
+        lambda: f64,
+        out: &mut Mat<f64>,
+    ) -> Result<(), ControlError> {
+        self.check(j, u, lambda)?;
+        let m = j.nrows();
+        if out.nrows() != self.n || out.ncols() != m {
+            *out = Mat::zeros(self.n, m);
+        }
+        if !self.factor(j, u, lambda) {
+            out.fill(0.0);
+            return Ok(());
+        }
+        // Row c of J^# is u_c (A⁻¹ J[:, c])ᵀ.
+        for c in 0..self.n {
+            for r in 0..m {
+                self.y[r] = j[(r, c)];
+            }
+            cholesky_solve(&self.a, m, &mut self.y[..m]);
+            for r in 0..m {
+                out[(c, r)] = weight(u, c) * self.y[r];
+            }
+        }
+        Ok(())
+    }
+
+    /// The null-space projector `N = I − J^# J` (n×n) into `out`.
+    pub fn null_projector(
+        &mut self,
+        j: MatRef<'_, f64>,
+        u: Option<&[f64]>,
+        lambda: f64,
+        out: &mut Mat<f64>,
+    ) -> Result<(), ControlError> {
+        self.check(j, u, lambda)?;
+        let (m, n) = (j.nrows(), self.n);
+        if out.nrows() != n || out.ncols() != n {
+            *out = Mat::zeros(n, n);
+        }
+        for a in 0..n {
+            for b in 0..n {
+                out[(a, b)] = if a == b { 1.0 } else { 0.0 };
+            }
+        }
+        if m == 0 || !self.factor(j, u, lambda) {
+            return Ok(());
+        }
+        // (J^# J)[a, b] = u_a Σ_r J[r, a] (A⁻¹ J)[r, b]; solve A x = J[:, b] column by column.
+        for b in 0..n {
+            for r in 0..m {
+                self.y[r] = j[(r, b)];
+            }
+            cholesky_solve(&self.a, m, &mut self.y[..m]);
+            for a in 0..n {
+                let wa = weight(u, a);
+                if wa == 0.0 {
+                    continue;
+                }
+                let mut acc = 0.0;
+                for r in 0..m {
+                    acc += j[(r, a)] * self.y[r];
+                }
+                out[(a, b)] -= wa * acc;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Convenience: the explicit damped weighted pseudoinverse `J^# = U Jᵀ(J U Jᵀ + λ²I)⁻¹`
+/// (n×m) of an m×n `j` (allocates a workspace; for analysis and tests, not for time steps).
+pub fn damped_weighted_pinv(
+    j: MatRef<'_, f64>,
+    u: Option<&[f64]>,
+    lambda: f64,
+) -> Result<Mat<f64>, ControlError> {
+    let mut ws = PinvWorkspace::new(j.nrows(), j.ncols());
+    let mut out = Mat::zeros(j.ncols(), j.nrows());
+    ws.pinv(j, u, lambda, &mut out)?;
+    Ok(out)
+}
+
+/// How a task's own pseudoinverse is formed in [`Srmtp::push_task`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TaskInverse {
+    /// Use the solver's usage weights `U` (true) or the identity (false).
+    pub weighted: bool,
+    /// Damping λ ≥ 0 of this task's pseudoinverse (0: exact pseudoinverse, which requires a
+    /// full-row-rank Jacobian).
+    pub damping: f64,
+}
+
+impl TaskInverse {
+    /// Weighted by `U`, damped by `damping`.
+    pub fn weighted(damping: f64) -> Self {
+        Self {
+            weighted: true,
+            damping,
+        }
+    }
+
+    /// Unweighted (`U = I`), damped by `damping` (0 = the Moore–Penrose pseudoinverse `J⁺`).
+    pub fn plain(damping: f64) -> Self {
+        Self {
+            weighted: false,
+            damping,
+        }
+    }
+}
+
+/// The SRMTP solver (USM-32): tasks are pushed in priority order; each contributes
+/// `N_{1…k−1} J_k^# (σ̇_kd + Λ_k σ̃_k)` and its Jacobian rows are stacked into the projector of
+/// the tasks below it. Preallocated for `N` columns and up to `max_rows` stacked rows.
+///
+/// Per step: [`Srmtp::reset`], then [`Srmtp::push_task`] for each task from the highest
+/// priority, optionally [`Srmtp::push_velocity`], then read [`Srmtp::zeta`].
+#[derive(Clone, Debug)]
+pub struct Srmtp {
+    n: usize,
+    max_rows: usize,
+    weights: Vec<f64>,
+    lambda: f64,
+    stack: Mat<f64>,
+    rows: usize,
+    null: Mat<f64>,
+    null_dirty: bool,
+    zeta: Vec<f64>,
+    x: Vec<f64>,
+    pinv: PinvWorkspace,
+}
+
+impl Srmtp {
+    /// A solver for `n` generalised velocities, up to `max_rows` stacked task rows, usage
+    /// weights `weights` (length `n`, each ≥ 0) and damping `lambda` ≥ 0 for the stacked
+    /// null-space projectors.
+    pub fn new(
+        n: usize,
+        max_rows: usize,
+        weights: &[f64],
+        lambda: f64,
+    ) -> Result<Self, ControlError> {
+        if weights.len() != n {
+            return Err(ControlError::new(
+                "weights",
+                format!("has {} entries, needs {n}", weights.len()),
+            ));
+        }
+        for (i, w) in weights.iter().enumerate() {
+            check_nonneg(&format!("weights[{i}]"), *w)?;
+        }
+        check_nonneg("damping", lambda)?;
+        Ok(Self {
+            n,
+            max_rows,
+            weights: weights.to_vec(),
+            lambda,
+            stack: Mat::zeros(max_rows, n),
+            rows: 0,
+            null: Mat::identity(n, n),
+            null_dirty: false,
+            zeta: vec![0.0; n],
+            x: vec![0.0; n],
+            pinv: PinvWorkspace::new(max_rows, n),
+        })
+    }
+
+    /// Start a new resolution: `ζ = 0`, `N = I`, no stacked rows.
+    pub fn reset(&mut self) {
+        self.zeta.fill(0.0);
+        self.rows = 0;
+        self.null_dirty = true;
+    }
+
+    /// Number of generalised velocities `N`.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The usage weights `U`.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// Damping λ of the stacked projectors.
+    pub fn damping(&self) -> f64 {
+        self.lambda
+    }
+
+    /// The pseudoinverse workspace's counters (regularised / failed factorisations).
+    pub fn pinv_stats(&self) -> (u64, u64) {
+        (self.pinv.regularised(), self.pinv.failed())
+    }
+
+    fn refresh_null(&mut self) {
+        if !self.null_dirty {
+            return;
+        }
+        let j = self.stack.as_ref().subrows(0, self.rows);
+        // Dimensions are consistent by construction, so this cannot fail.
+        let _ = self
+            .pinv
+            .null_projector(j, Some(&self.weights), self.lambda, &mut self.null);
+        self.null_dirty = false;
+    }
+
+    /// The current projector `N_{1…k}` onto the null space of all pushed tasks (N×N).
+    pub fn null_projector(&mut self) -> MatRef<'_, f64> {
+        self.refresh_null();
+        self.null.as_ref()
+    }
+
+    /// Push the next task in priority order: `j` its m×N Jacobian, `rate` the m-vector
+    /// `σ̇_d + Λ σ̃` (task units per second). Adds `N_{1…k−1} J^# rate` to `ζ` and stacks `j`
+    /// below the higher-priority tasks. Errors on mismatched dimensions or when the stacked
+    /// rows would exceed `max_rows`; nothing changes then.
+    pub fn push_task(
+        &mut self,
+        j: MatRef<'_, f64>,
+        rate: &[f64],
+        inv: TaskInverse,
+    ) -> Result<(), ControlError> {
+        let m = j.nrows();
+        if j.ncols() != self.n || rate.len() != m {
+            return Err(ControlError::new(
+                "task",
+                format!(
+                    "Jacobian {}×{} and rate of length {} do not fit N = {}",
+                    m,
+                    j.ncols(),
+                    rate.len(),
+                    self.n
+                ),
+            ));
+        }
+        if self.rows + m > self.max_rows {
+            return Err(ControlError::new(
+                "task",
+                format!(
+                    "stacking {m} more rows exceeds the {} rows the solver was built for",
+                    self.max_rows
+                ),
+            ));
+        }
+        let u = if inv.weighted {
+            Some(self.weights.as_slice())
+        } else {
+            None
+        };
+        self.pinv.apply(j, u, inv.damping, rate, &mut self.x)?;
+        self.add_projected();
+        for r in 0..m {
+            for c in 0..self.n {
+                self.stack[(self.rows + r, c)] = j[(r, c)];
+            }
+        }
+        self.rows += m;
+        self.null_dirty = true;
+        Ok(())
+    }
+
+    /// `ζ += N_{1…k} x` with `x` in `self.x`.
+    fn add_projected(&mut self) {
+        if self.rows == 0 {
+            for (z, x) in self.zeta.iter_mut().zip(&self.x) {
+                *z += x;
+            }
+            return;
+        }
+        self.refresh_null();
+        for a in 0..self.n {
+            let mut acc = 0.0;
+            for b in 0..self.n {
+                acc += self.null[(a, b)] * self.x[b];
+            }
+            self.zeta[a] += acc;
+        }
+    }
+
+    /// Add a lowest-priority generalised velocity `v` (length N) projected into the null space
+    /// of every pushed task, `ζ += N_{1…k} v` — the hook for gradient-based secondary
+    /// objectives (e.g. `v = k U ∇w(q)` for a manipulability or TCM-conditioning measure `w`).
+    pub fn push_velocity(&mut self, v: &[f64]) -> Result<(), ControlError> {
+        if v.len() != self.n {
+            return Err(ControlError::new(
+                "velocity",
+                format!("has {} entries, needs {}", v.len(), self.n),
+            ));
+        }
+        self.x.copy_from_slice(v);
+        self.add_projected();
+        Ok(())
+    }
+
+    /// The resolved reference `ζ_r = [V_r; q̇_r]` (length N).
+    pub fn zeta(&self) -> &[f64] {
+        &self.zeta
+    }
+}
+
+/// End-effector pose error `ẽ = [p̃_e; ε̃_e]` in the end-effector frame (SPEC §5, USM-42):
+/// `p̃_e = R_Ieᵀ (p_d − p_Ie)` [m] and `ε̃_e` the quaternion vector-part error of
+/// [`super::orientation_error`] (current → desired, in `F_e`). `g_ie` is the end-effector pose
+/// in `I`; `p_d` [m, `I`] and `q_d` (maps `F_e,d` vectors to `I`) the setpoint. With
+/// `V_e = k ẽ` (k > 0) both parts decrease.
+pub fn ee_pose_error(g_ie: &Se3, p_d: &Vec3, q_d: &UnitQuaternion<f64>) -> Vec6 {
+    let q_e = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(g_ie.r));
+    let p = g_ie.r.transpose() * (p_d - g_ie.p);
+    stack(&p, &orientation_error(q_d, &q_e))
+}
+
+/// End-effector pose in `I`, `g_Ie = g_Ib g_be`, from the base pose and a workspace after
+/// [`crate::kinematics::forward_kinematics`].
+pub fn ee_pose(base: &BasePose, g_be: &Se3) -> Se3 {
+    base.to_se3().compose(g_be)
+}
+
+/// Base-position task Jacobian (SPEC §5, USM-42): `J_b = [R_Ib 0_{3×(n+3)}]`, 3×(6+n), so that
+/// `ṗ_Ib = J_b ζ` (inertial, m/s). `out` must be 3×(6+n); every entry is written.
+pub fn base_position_jacobian(r_ib: &Mat3, out: &mut Mat<f64>) {
+    for r in 0..3 {
+        for c in 0..out.ncols() {
+            out[(r, c)] = if c < 3 { r_ib[(r, c)] } else { 0.0 };
+        }
+    }
+}
+
+/// Settings of the set-based joint-limit task (USM section IV-A objective 1).
+///
+/// A joint is *active* when it lies within `margin` of a limit and the lower-priority solution
+/// would move it further towards that limit; active joints then get an equality task at the
+/// highest priority, `q̇_i = gain (q_b − q_i)` with `q_b = max − margin` (or `min + margin`): hold
+/// at the activation boundary, pushed back gently if past it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JointLimitSettings {
+    /// Whether the task is used (default false: the paper's work-mode simulation has none).
+    pub enabled: bool,
+    /// Activation band inside each limit [rad] (default 5° = 0.0873 rad).
+    pub margin: f64,
+    /// Gain pulling an active joint back to the band's edge [1/s] (default 1).
+    pub gain: f64,
+}
+
+impl Default for JointLimitSettings {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            margin: 5f64.to_radians(),
+            gain: 1.0,
+        }
+    }
+}
+
+impl JointLimitSettings {
+    /// Check the values; errors name `joint_limits.<key>`.
+    pub fn validate(&self) -> Result<(), ControlError> {
+        check_nonneg("joint_limits.margin", self.margin)?;
+        check_nonneg("joint_limits.gain", self.gain)
+    }
+}
+
+/// Buffers of the set-based joint-limit task: the active joints' selection rows
+/// `e_{6+i}ᵀ` (k×(6+n)) and their rates.
+#[derive(Clone, Debug)]
+pub struct JointLimitTask {
+    settings: JointLimitSettings,
+    jac: Mat<f64>,
+    rate: Vec<f64>,
+    active: Vec<i8>,
+    count: usize,
+}
+
+impl JointLimitTask {
+    /// Buffers for `n` joints.
+    pub fn new(n: usize, settings: JointLimitSettings) -> Self {
+        Self {
+            settings,
+            jac: Mat::zeros(n, 6 + n),
+            rate: vec![0.0; n],
+            active: vec![0; n],
+            count: 0,
+        }
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &JointLimitSettings {
+        &self.settings
+    }
+
+    /// Clear the active set.
+    pub fn clear(&mut self) {
+        self.active.fill(0);
+        self.count = 0;
+    }
+
+    /// Add to the active set every joint within the margin of a limit whose candidate rate
+    /// `qd[i]` points towards it; rebuild the rows. `q` [rad], `qd` [rad/s], `limits` (min, max)
+    /// [rad]. Returns whether the active set grew.
+    pub fn update(&mut self, q: &[f64], qd: &[f64], limits: &[(f64, f64)]) -> bool {
+        let mut grew = false;
+        let m = self.settings.margin;
+        for i in 0..self.active.len() {
+            if self.active[i] != 0 {
+                continue;
+            }
+            let (lo, hi) = limits[i];
+            if q[i] >= hi - m && qd[i] > 0.0 {
+                self.active[i] = 1;
+                grew = true;
+            } else if q[i] <= lo + m && qd[i] < 0.0 {
+                self.active[i] = -1;
+                grew = true;
+            }
+        }
+        if grew {
+            let n = self.active.len();
+            self.count = 0;
+            for i in 0..n {
+                if self.active[i] == 0 {
+                    continue;
+                }
+                let row = self.count;
+                for c in 0..(6 + n) {
+                    self.jac[(row, c)] = 0.0;
+                }
+                self.jac[(row, 6 + i)] = 1.0;
+                let (lo, hi) = limits[i];
+                let rate = if self.active[i] > 0 {
+                    (hi - m - q[i]).min(0.0)
+                } else {
+                    (lo + m - q[i]).max(0.0)
+                };
+                self.rate[row] = self.settings.gain * rate;
+                self.count += 1;
+            }
+        }
+        grew
+    }
+
+    /// Number of active joints.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Rows of the active joints (count × (6+n)).
+    pub fn jacobian(&self) -> MatRef<'_, f64> {
+        self.jac.as_ref().subrows(0, self.count)
+    }
+
+    /// Rates of the active joints [rad/s].
+    pub fn rate(&self) -> &[f64] {
+        &self.rate[..self.count]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_mat(rng: &mut ChaCha8Rng, m: usize, n: usize) -> Mat<f64> {
+        Mat::from_fn(m, n, |_, _| rng.random_range(-1.0..1.0))
+    }
+
+    fn mul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+        Mat::from_fn(a.nrows(), b.ncols(), |i, j| {
+            (0..a.ncols()).map(|k| a[(i, k)] * b[(k, j)]).sum()
+        })
+    }
+
+    fn max_abs_diff_identity(a: &Mat<f64>) -> f64 {
+        let mut e: f64 = 0.0;
+        for i in 0..a.nrows() {
+            for j in 0..a.ncols() {
+                let t = if i == j { 1.0 } else { 0.0 };
+                e = e.max((a[(i, j)] - t).abs());
+            }
+        }
+        e
+    }
+
+    #[test]
+    fn pinv_right_inverse_as_damping_vanishes() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let j = random_mat(&mut rng, 6, 14);
+        let u: Vec<f64> = (0..14).map(|i| 0.2 + 0.1 * i as f64).collect();
+        let mut prev = f64::INFINITY;
+        for lambda in [1e-1, 1e-2, 1e-3, 1e-5] {
+            let p = damped_weighted_pinv(j.as_ref(), Some(&u), lambda).unwrap();
+            let e = max_abs_diff_identity(&mul(j.as_ref(), p.as_ref()));
+            // J J^# = I − λ²(JUJᵀ + λ²I)⁻¹: the defect shrinks like λ².
+            assert!(e < prev, "λ = {lambda}: {e}");
+            prev = e;
+        }
+        assert!(prev < 1e-8, "{prev}");
+        // λ = 0 is the exact weighted right inverse.
+        let p = damped_weighted_pinv(j.as_ref(), Some(&u), 0.0).unwrap();
+        assert!(max_abs_diff_identity(&mul(j.as_ref(), p.as_ref())) < 1e-10);
+    }
+
+    #[test]
+    fn pinv_matches_formula_and_apply() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let j = random_mat(&mut rng, 4, 9);
+        let u: Vec<f64> = (0..9).map(|_| rng.random_range(0.1..2.0)).collect();
+        let lambda = 0.3;
+        let p = damped_weighted_pinv(j.as_ref(), Some(&u), lambda).unwrap();
+        // Check (J U Jᵀ + λ²I) (U⁻¹ p)ᵀ... directly: J^# (J U Jᵀ + λ²I) = U Jᵀ.
+        let ud = Mat::from_fn(9, 9, |a, b| if a == b { u[a] } else { 0.0 });
+        let mut a = mul(mul(j.as_ref(), ud.as_ref()).as_ref(), j.transpose());
+        for i in 0..4 {
+            a[(i, i)] += lambda * lambda;
+        }
+        let lhs = mul(p.as_ref(), a.as_ref());
+        let rhs = mul(ud.as_ref(), j.transpose());
+        for r in 0..9 {
+            for c in 0..4 {
+                assert!((lhs[(r, c)] - rhs[(r, c)]).abs() < 1e-12);
+            }
+        }
+        let b = [0.3, -1.0, 0.5, 2.0];
+        let mut x = vec![0.0; 9];
+        let mut ws = PinvWorkspace::new(6, 9);
+        ws.apply(j.as_ref(), Some(&u), lambda, &b, &mut x).unwrap();
+        for r in 0..9 {
+            let e: f64 = (0..4).map(|c| p[(r, c)] * b[c]).sum();
+            assert!((x[r] - e).abs() < 1e-12);
+        }
+        // Mismatched dimensions are errors, not panics.
+        assert!(ws
+            .apply(j.as_ref(), Some(&u), lambda, &b[..3], &mut x)
+            .is_err());
+        assert!(ws
+            .apply(j.as_ref(), Some(&u[..8]), lambda, &b, &mut x)
+            .is_err());
+    }
+
+    #[test]
+    fn zero_usage_weight_freezes_coordinate() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let j = random_mat(&mut rng, 6, 14);
+        let mut u = vec![1.0; 14];
+        u[3] = 0.0; // base roll, as in the paper's W
+        u[9] = 0.0;
+        let mut ws = PinvWorkspace::new(6, 14);
+        let mut x = vec![0.0; 14];
+        ws.apply(
+            j.as_ref(),
+            Some(&u),
+            0.1,
+            &[1.0, -2.0, 0.5, 0.3, 0.1, -0.7],
+            &mut x,
+        )
+        .unwrap();
+        assert_eq!(x[3], 0.0);
+        assert_eq!(x[9], 0.0);
+        assert!(x.iter().map(|v| v.abs()).sum::<f64>() > 0.1);
+    }
+
+    #[test]
+    fn singular_jacobian_without_damping_is_regularised() {
+        let mut j = Mat::<f64>::zeros(2, 3);
+        j[(0, 0)] = 1.0;
+        j[(1, 0)] = 1.0; // rank 1
+        let mut ws = PinvWorkspace::new(2, 3);
+        let mut x = vec![0.0; 3];
+        ws.apply(j.as_ref(), None, 0.0, &[1.0, 1.0], &mut x)
+            .unwrap();
+        assert!(x.iter().all(|v| v.is_finite()));
+        assert_eq!(ws.regularised(), 1);
+        let mut jn = j.clone();
+        jn[(0, 1)] = f64::NAN;
+        ws.apply(jn.as_ref(), None, 0.1, &[1.0, 1.0], &mut x)
+            .unwrap();
+        assert_eq!(ws.failed(), 1);
+        assert!(x.iter().all(|v| *v == 0.0));
+    }
+
+    #[test]
+    fn srmtp_secondary_does_not_disturb_primary() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let n = 14;
+        let j1 = random_mat(&mut rng, 6, n);
+        let j2 = random_mat(&mut rng, 3, n);
+        let j3 = random_mat(&mut rng, 2, n);
+        let u: Vec<f64> = (0..n).map(|_| rng.random_range(0.3..1.0)).collect();
+        let r1 = [0.2, -0.1, 0.3, 0.0, 0.05, -0.2];
+        let r2 = [1.0, 2.0, -1.5];
+        let r3 = [-3.0, 0.7];
+        let lambda = 1e-6;
+        let mut s = Srmtp::new(n, 11, &u, lambda).unwrap();
+        s.reset();
+        s.push_task(j1.as_ref(), &r1, TaskInverse::weighted(lambda))
+            .unwrap();
+        let z1 = s.zeta().to_vec();
+        // J_1 N_1 ≈ 0 (it is λ²(J U Jᵀ + λ²I)⁻¹ J_1).
+        let jn = mul(j1.as_ref(), s.null_projector());
+        let worst = (0..6)
+            .flat_map(|r| (0..n).map(move |c| (r, c)))
+            .map(|(r, c)| jn[(r, c)].abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{worst}");
+        s.push_task(j2.as_ref(), &r2, TaskInverse::plain(lambda))
+            .unwrap();
+        s.push_task(j3.as_ref(), &r3, TaskInverse::weighted(lambda))
+            .unwrap();
+        let z = s.zeta().to_vec();
+        let task =
+            |j: &Mat<f64>, z: &[f64], r: usize| -> f64 { (0..n).map(|c| j[(r, c)] * z[c]).sum() };
+        for (r, want) in r1.iter().enumerate() {
+            // Primary achieved exactly and unchanged by the lower tasks.
+            assert!((task(&j1, &z, r) - want).abs() < 1e-8);
+            assert!((task(&j1, &z, r) - task(&j1, &z1, r)).abs() < 1e-8);
+        }
+        // SRMTP as printed (USM-32) does not compensate J_2 ζ_1, so the lower tasks are not met
+        // exactly, only without disturbing the primary. With J_2 = J_1's first three rows the
+        // secondary is fully conflicting and contributes nothing beyond damping leakage.
+        let mut s2 = Srmtp::new(n, 9, &u, lambda).unwrap();
+        s2.reset();
+        s2.push_task(j1.as_ref(), &r1, TaskInverse::weighted(lambda))
+            .unwrap();
+        let j_conf = Mat::from_fn(3, n, |r, c| j1[(r, c)]);
+        s2.push_task(j_conf.as_ref(), &r2, TaskInverse::weighted(lambda))
+            .unwrap();
+        let diff: f64 = s2.zeta().iter().zip(&z1).map(|(a, b)| (a - b).abs()).sum();
+        assert!(diff < 1e-8, "{diff}");
+        // Exceeding the preallocated rows is an error, not a panic.
+        assert!(s
+            .push_task(j3.as_ref(), &r3, TaskInverse::weighted(lambda))
+            .is_err());
+    }
+
+    #[test]
+    fn base_position_jacobian_layout() {
+        let r = crate::spatial::rot_axis_angle(&Vec3::new(0.0, 0.6, 0.8), 0.4);
+        let mut j = Mat::from_fn(3, 10, |_, _| 9.0);
+        base_position_jacobian(&r, &mut j);
+        for a in 0..3 {
+            for c in 0..10 {
+                let e = if c < 3 { r[(a, c)] } else { 0.0 };
+                assert_eq!(j[(a, c)], e);
+            }
+        }
+    }
+
+    #[test]
+    fn joint_limit_task_activation() {
+        let mut t = JointLimitTask::new(
+            3,
+            JointLimitSettings {
+                enabled: true,
+                margin: 0.1,
+                gain: 2.0,
+            },
+        );
+        let lim = [(-1.0, 1.0); 3];
+        // Joint 0 near the top moving up: active. Joint 1 near the bottom moving away: not.
+        // Joint 2 past the band at the bottom moving down: active with a positive push-back.
+        assert!(t.update(&[0.95, -0.95, -0.98], &[0.1, 0.1, -0.1], &lim));
+        assert_eq!(t.count(), 2);
+        let j = t.jacobian();
+        assert_eq!(j[(0, 6)], 1.0);
+        assert_eq!(j[(1, 8)], 1.0);
+        assert!((t.rate()[0] - 2.0 * (0.9 - 0.95)).abs() < 1e-12);
+        assert!((t.rate()[1] - 2.0 * (-0.9 + 0.98)).abs() < 1e-12);
+        assert!(!t.update(&[0.95, -0.95, -0.98], &[0.1, 0.1, -0.1], &lim));
+    }
+}

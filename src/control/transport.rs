@@ -1,0 +1,756 @@
+//! Transport mode (SPEC §5, USM section V-A): LOS path following with joint bending and base
+//! surge/yaw accelerations.
+//!
+//! - **Joint references (USM-38)**: `q_r,i = s_q k_ψ wrap(ψ − ψ_r)` for the yaw joints, 0 for the
+//!   others (pitch), clamped to the joint limits. `ψ` is the heading of the front link (the yaw of
+//!   the end-effector frame about inertial +z), `ψ_r` from [`super::guidance`] (USM-39).
+//!
+//!   **Sign `s_q` (`joint_sign`, default −1).** Our joint convention (SPEC §1) makes a positive
+//!   yaw-joint angle rotate the child counter-clockwise about +z (seen from above, z up)
+//!   relative to its parent, so in a level configuration the head's heading relative to the tail
+//!   is `ψ − ψ_b = Σ q_yaw`. If the head points left of the reference (`ψ > ψ_r`) the body must
+//!   bend so that the head turns right relative to the tail, i.e. `Σ q_yaw < 0`: hence
+//!   `q_r,i = −k_ψ (ψ − ψ_r)`. The paper's `+k_ψ(ψ − ψ_r)` comes from the snake-robot literature it
+//!   builds on (Liljebäck et al.; ref. [6]), where the joint angle is the *rear* link angle minus
+//!   the *front* link angle, the opposite sense of ours. With a quasi-static base and first-order
+//!   servos the head heading obeys `d/dt Σq = −(Σq + 4 s_q k_ψ (ψ_b + Σq − ψ_r))/T`, stable for
+//!   `s_q = −1` (pole `−(1 + 4k_ψ)/T`) and unstable for `+1` with the paper's `k_ψ = 0.45`
+//!   (pole `+(4k_ψ − 1)/T`) — pinned by a kinematic test below.
+//! - **Surge (USM-40)**: `a_1 = −k_1p (u − u_c) − k_1I ∫(u − u_c) dt` ([`SurgeLaw::ProportionalIntegral`],
+//!   as printed), or `a_1 = −k_1p (u − u_c) − k_1d d/dt (u − u_c)`
+//!   ([`SurgeLaw::ProportionalDerivative`], the OCR'd table header "k_1p, k_1d"; the derivative is a
+//!   first-order filtered backward difference with time constant
+//!   [`TransportGains::derivative_time_constant`]). `u` is the end-effector surge `v_e,x` (its
+//!   `F_e` x component) in Method 1 and the base surge `v_b,x` in Method 2 ([`SurgeSource`]); `u_c`
+//!   = `u0`. In both methods `a_1` is applied as the **base** surge acceleration (x of `F_b`) —
+//!   as the paper does.
+//! - **Yaw (USM-41)**: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)`, applied as the base yaw
+//!   acceleration (z of `F_b`). `ψ̇` is, by default, the rate of the same heading ψ (the front
+//!   link's, [`YawRateSource::FrontHeading`]) so that the law is a PD on one signal; the base
+//!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]).
+//! - All other components of `a^b` are zero; `τ_c = M_11 a^b (+ n)` follows in
+//!   [`super::dynamic::DynamicController::acceleration_control`] (USM-33).
+
+use super::guidance::{LosGuidance, LosOutput, PathSpec};
+use super::{
+    check_finite, check_nonneg, check_pos, heading, heading_rate, wrap_angle, ControlError,
+};
+use crate::kinematics::{BasePose, KinWorkspace};
+use crate::model::Vehicle;
+use crate::spatial::{ang, lin, Vec3, Vec6};
+use serde::{Deserialize, Serialize};
+
+/// The paper's two transport methods (USM section VI-B, Table III).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TransportMethod {
+    /// Method 1: regulate the end-effector surge ("dragging the USM by its head").
+    Method1,
+    /// Method 2: regulate the base surge ("pushing at the back end"); the paper's recommendation.
+    Method2,
+}
+
+/// Whose surge velocity `u` USM-40 regulates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurgeSource {
+    /// `u = v_e,x`, the end-effector's surge in `F_e` (Method 1).
+    EndEffector,
+    /// `u = v_b,x`, the base surge in `F_b` (Method 2).
+    Base,
+}
+
+/// Form of the surge law USM-40.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurgeLaw {
+    /// `−k_1p e − k_1I ∫e dt` (as printed in USM-40).
+    ProportionalIntegral,
+    /// `−k_1p e − k_1d ė` (as the OCR'd Table III header "k_1p, k_1d" suggests).
+    ProportionalDerivative,
+}
+
+/// Which yaw rate is `ψ̇` in USM-41.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum YawRateSource {
+    /// The rate of the front-link heading ψ (exact heading rate of `F_e`).
+    FrontHeading,
+    /// The base body yaw rate `r = ω_b,z` (z component of the base angular velocity in `F_b`).
+    BaseYawRate,
+}
+
+/// Transport-mode gains (USM Table III) and the choices the paper leaves open.
+///
+/// Deserialises from a table whose every key is optional: `method = "method1" | "method2"`
+/// (default `method2`) picks the Table III row and its surge source, and any other key
+/// overrides that preset. `k_1d` is accepted as an alias of `k_1i`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "TransportGainsSpec")]
+pub struct TransportGains {
+    /// The Table III row these gains started from.
+    pub method: TransportMethod,
+    /// Commanded surge velocity `u_c = u0` [m/s].
+    pub u0: f64,
+    /// LOS look-ahead distance Δ [m] (USM-39).
+    pub look_ahead: f64,
+    /// Joint gain `k_ψ` [rad/rad] (USM-38).
+    pub k_psi: f64,
+    /// Surge proportional gain `k_1p` [1/s] (USM-40).
+    pub k_1p: f64,
+    /// Surge integral gain `k_1I` [1/s²] (or derivative gain `k_1d` [—] in the PD form).
+    pub k_1i: f64,
+    /// Yaw proportional gain `k_6p` [1/s²] (USM-41).
+    pub k_6p: f64,
+    /// Yaw derivative gain `k_6d` [1/s] (USM-41).
+    pub k_6d: f64,
+    /// Form of USM-40.
+    pub surge_law: SurgeLaw,
+    /// Whose surge is regulated.
+    pub surge_source: SurgeSource,
+    /// Which yaw rate is ψ̇.
+    pub yaw_rate_source: YawRateSource,
+    /// Sign `s_q` of USM-38 in our joint convention (default −1; see the module docs).
+    pub joint_sign: f64,
+    /// Bound on `|∫(u − u_c) dt|` [m] (anti-windup; `None` = unbounded, as in the paper).
+    pub integral_limit: Option<f64>,
+    /// Time constant [s] of the filtered difference in the PD surge law.
+    pub derivative_time_constant: f64,
+}
+
+impl TransportGains {
+    fn common(method: TransportMethod) -> Self {
+        Self {
+            method,
+            u0: 0.5,
+            look_ahead: 2.0,
+            k_psi: 0.45,
+            k_1p: 0.5,
+            k_1i: 0.0625,
+            k_6p: 0.01,
+            k_6d: 0.2,
+            surge_law: SurgeLaw::ProportionalIntegral,
+            surge_source: SurgeSource::Base,
+            yaw_rate_source: YawRateSource::FrontHeading,
+            joint_sign: -1.0,
+            integral_limit: None,
+            derivative_time_constant: 0.5,
+        }
+    }
+
+    /// USM Table III, Method 1: `u0 = 0.5, Δ = 3, k_ψ = 0.45, k_1p = 0.5, k_1I = 0.0625,
+    /// k_6p = 0.13, k_6d = 0.12`; end-effector surge.
+    pub fn method1() -> Self {
+        Self {
+            look_ahead: 3.0,
+            k_6p: 0.13,
+            k_6d: 0.12,
+            surge_source: SurgeSource::EndEffector,
+            ..Self::common(TransportMethod::Method1)
+        }
+    }
+
+    /// USM Table III, Method 2: `u0 = 0.5, Δ = 2, k_ψ = 0.45, k_1p = 0.5, k_1I = 0.0625,
+    /// k_6p = 0.01, k_6d = 0.2`; base surge.
+    pub fn method2() -> Self {
+        Self::common(TransportMethod::Method2)
+    }
+
+    /// The preset of a method.
+    pub fn preset(method: TransportMethod) -> Self {
+        match method {
+            TransportMethod::Method1 => Self::method1(),
+            TransportMethod::Method2 => Self::method2(),
+        }
+    }
+
+    /// Check the values; errors name `transport.<key>`.
+    pub fn validate(&self) -> Result<(), ControlError> {
+        check_finite("transport.u0", self.u0)?;
+        check_pos("transport.look_ahead", self.look_ahead)?;
+        for (k, v) in [
+            ("transport.k_psi", self.k_psi),
+            ("transport.k_1p", self.k_1p),
+            ("transport.k_1i", self.k_1i),
+            ("transport.k_6p", self.k_6p),
+            ("transport.k_6d", self.k_6d),
+            (
+                "transport.derivative_time_constant",
+                self.derivative_time_constant,
+            ),
+        ] {
+            check_nonneg(k, v)?;
+        }
+        if self.joint_sign != 1.0 && self.joint_sign != -1.0 {
+            return Err(ControlError::new(
+                "transport.joint_sign",
+                format!("must be 1 or -1, got {}", self.joint_sign),
+            ));
+        }
+        if let Some(l) = self.integral_limit {
+            check_pos("transport.integral_limit", l)?;
+        }
+        Ok(())
+    }
+}
+
+impl Default for TransportGains {
+    /// Method 2, the paper's recommendation.
+    fn default() -> Self {
+        Self::method2()
+    }
+}
+
+/// Wire form of [`TransportGains`]: every key optional over the chosen preset.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TransportGainsSpec {
+    method: Option<TransportMethod>,
+    u0: Option<f64>,
+    look_ahead: Option<f64>,
+    k_psi: Option<f64>,
+    k_1p: Option<f64>,
+    #[serde(alias = "k_1d")]
+    k_1i: Option<f64>,
+    k_6p: Option<f64>,
+    k_6d: Option<f64>,
+    surge_law: Option<SurgeLaw>,
+    surge_source: Option<SurgeSource>,
+    yaw_rate_source: Option<YawRateSource>,
+    joint_sign: Option<f64>,
+    integral_limit: Option<f64>,
+    derivative_time_constant: Option<f64>,
+}
+
+impl TryFrom<TransportGainsSpec> for TransportGains {
+    type Error = ControlError;
+
+    fn try_from(s: TransportGainsSpec) -> Result<Self, ControlError> {
+        let mut g = TransportGains::preset(s.method.unwrap_or(TransportMethod::Method2));
+        macro_rules! set {
+            ($($f:ident),*) => { $( if let Some(x) = s.$f { g.$f = x; } )* };
+        }
+        set!(
+            u0,
+            look_ahead,
+            k_psi,
+            k_1p,
+            k_1i,
+            k_6p,
+            k_6d,
+            surge_law,
+            surge_source,
+            yaw_rate_source,
+            joint_sign,
+            derivative_time_constant
+        );
+        if s.integral_limit.is_some() {
+            g.integral_limit = s.integral_limit;
+        }
+        g.validate()?;
+        Ok(g)
+    }
+}
+
+/// Which joints are yaw joints: those whose axis, expressed in the base frame at the zero
+/// configuration, is within ~11° of the base z axis (`|axis_b · e_z| > 0.98`). All others are
+/// treated as pitch (or other) joints and get a zero reference in USM-38.
+pub fn yaw_joint_mask(v: &Vehicle) -> Vec<bool> {
+    let ws = KinWorkspace::new(v);
+    ws.joint_twist_b
+        .iter()
+        .map(|t| ang(t).z.abs() > 0.98)
+        .collect()
+}
+
+/// USM-38 into `out` (see [`TransportController::joint_references`]).
+fn fill_joint_references(
+    gains: &TransportGains,
+    yaw: &[bool],
+    limits: &[(f64, f64)],
+    psi: f64,
+    psi_r: f64,
+    out: &mut [f64],
+) {
+    let e = wrap_angle(psi - psi_r);
+    for (i, o) in out.iter_mut().enumerate().take(yaw.len()) {
+        let (lo, hi) = limits[i];
+        let q = if yaw[i] {
+            gains.joint_sign * gains.k_psi * e
+        } else {
+            0.0
+        };
+        *o = if q.is_finite() { q } else { 0.0 }.clamp(lo, hi);
+    }
+}
+
+/// The measured signals transport mode needs, in the frames the laws use.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TransportMeasurement {
+    /// Heading ψ of the front link (`F_e` yaw about inertial +z) [rad].
+    pub psi: f64,
+    /// Its rate ψ̇ [rad/s].
+    pub psi_dot: f64,
+    /// Heading of the base frame [rad].
+    pub base_heading: f64,
+    /// Base body yaw rate `r = ω_b,z` (in `F_b`) [rad/s].
+    pub base_yaw_rate: f64,
+    /// End-effector surge `v_e,x` (in `F_e`) [m/s].
+    pub surge_ee: f64,
+    /// Base surge `v_b,x` (in `F_b`) [m/s].
+    pub surge_base: f64,
+    /// End-effector position in `I` [m] (the "front of the vehicle" for LOS).
+    pub ee_position: Vec3,
+    /// End-effector velocity in `I` [m/s].
+    pub ee_velocity: Vec3,
+}
+
+/// Compute [`TransportMeasurement`] from the state: base pose, a workspace after
+/// [`crate::kinematics::forward_kinematics`] at the measured joints, the base twist `v_b` (in
+/// `F_b`) and the joint rates `qd` [rad/s]. The end-effector twist is
+/// `V_e = Ad_{g_be}⁻¹ (V_b + Σ_k X_k^b q̇_k)` (USM-18 without forming `J_e`). Allocation-free.
+pub fn measure_transport(
+    base: &BasePose,
+    ws: &KinWorkspace,
+    v_b: &Vec6,
+    qd: &[f64],
+) -> TransportMeasurement {
+    let mut v_in_b = *v_b;
+    for (x, r) in ws.joint_twist_b.iter().zip(qd) {
+        v_in_b += x * *r;
+    }
+    let v_e = ws.g_be.twist_to_child(&v_in_b);
+    let g_ib = base.to_se3();
+    let g_ie = g_ib.compose(&ws.g_be);
+    TransportMeasurement {
+        psi: heading(&g_ie.r),
+        psi_dot: heading_rate(&g_ie.r, &ang(&v_e)),
+        base_heading: heading(&g_ib.r),
+        base_yaw_rate: v_b[5],
+        surge_ee: v_e[0],
+        surge_base: v_b[0],
+        ee_position: g_ie.p,
+        ee_velocity: g_ie.r * lin(&v_e),
+    }
+}
+
+/// Result of one transport step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TransportOutput {
+    /// Guidance output (ψ_r, ψ̇_r, cross-track error, segment …).
+    pub los: LosOutput,
+    /// Commanded base acceleration `a^b = [a_1, 0, 0, 0, 0, a_6]` in `F_b` [m/s², rad/s²].
+    pub a_b: Vec6,
+    /// Heading error `wrap(ψ − ψ_r)` [rad].
+    pub heading_error: f64,
+    /// Surge error `u − u_c` [m/s].
+    pub surge_error: f64,
+}
+
+/// The transport-mode controller: LOS guidance, USM-38 joint references, USM-40/41 base
+/// accelerations, with the integral / derivative-filter state. Allocation-free per step.
+#[derive(Clone, Debug)]
+pub struct TransportController {
+    gains: TransportGains,
+    guidance: LosGuidance,
+    yaw: Vec<bool>,
+    limits: Vec<(f64, f64)>,
+    q_ref: Vec<f64>,
+    integral: f64,
+    prev_error: Option<f64>,
+    error_rate: f64,
+}
+
+impl TransportController {
+    /// Build for a design, with gains and a path (LOS look-ahead Δ = `gains.look_ahead`).
+    pub fn new(v: &Vehicle, gains: TransportGains, path: &PathSpec) -> Result<Self, ControlError> {
+        gains.validate()?;
+        let guidance = LosGuidance::new(path, gains.look_ahead)?;
+        Ok(Self {
+            yaw: yaw_joint_mask(v),
+            limits: v.joint_limits(),
+            q_ref: vec![0.0; v.n_joints()],
+            gains,
+            guidance,
+            integral: 0.0,
+            prev_error: None,
+            error_rate: 0.0,
+        })
+    }
+
+    /// The gains.
+    pub fn gains(&self) -> &TransportGains {
+        &self.gains
+    }
+
+    /// The guidance (active segment, look-ahead).
+    pub fn guidance(&self) -> &LosGuidance {
+        &self.guidance
+    }
+
+    /// Which joints are yaw joints (see [`yaw_joint_mask`]).
+    pub fn yaw_joints(&self) -> &[bool] {
+        &self.yaw
+    }
+
+    /// Joint angle references `q_r` [rad] of the last step (USM-38).
+    pub fn q_ref(&self) -> &[f64] {
+        &self.q_ref
+    }
+
+    /// The surge integral `∫(u − u_c) dt` [m].
+    pub fn surge_integral(&self) -> f64 {
+        self.integral
+    }
+
+    /// Clear the integral and filter state and restart the path at segment 0.
+    pub fn reset(&mut self) {
+        self.integral = 0.0;
+        self.prev_error = None;
+        self.error_rate = 0.0;
+        self.guidance.reset();
+        self.q_ref.fill(0.0);
+    }
+
+    /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
+    /// joint limits. `psi`, `psi_r` [rad]; `out` of length n (extra entries untouched).
+    pub fn joint_references(&self, psi: f64, psi_r: f64, out: &mut [f64]) {
+        fill_joint_references(&self.gains, &self.yaw, &self.limits, psi, psi_r, out);
+    }
+
+    /// USM-40: the surge acceleration for measured surge `u` [m/s], advancing the integral /
+    /// filter state over `dt` [s] (no state change unless `dt` is positive and finite).
+    pub fn surge_acceleration(&mut self, u: f64, dt: f64) -> f64 {
+        let g = &self.gains;
+        let e = u - g.u0;
+        let advance = dt.is_finite() && dt > 0.0 && e.is_finite();
+        match g.surge_law {
+            SurgeLaw::ProportionalIntegral => {
+                if advance {
+                    self.integral += e * dt;
+                    if let Some(l) = g.integral_limit {
+                        self.integral = self.integral.clamp(-l, l);
+                    }
+                }
+                -g.k_1p * e - g.k_1i * self.integral
+            }
+            SurgeLaw::ProportionalDerivative => {
+                if advance {
+                    if let Some(prev) = self.prev_error {
+                        let raw = (e - prev) / dt;
+                        let alpha = dt / (g.derivative_time_constant + dt);
+                        self.error_rate += alpha * (raw - self.error_rate);
+                    }
+                    self.prev_error = Some(e);
+                }
+                -g.k_1p * e - g.k_1i * self.error_rate
+            }
+        }
+    }
+
+    /// USM-41: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)` [rad/s²].
+    pub fn yaw_acceleration(&self, psi: f64, psi_dot: f64, psi_r: f64, psi_r_dot: f64) -> f64 {
+        -self.gains.k_6p * wrap_angle(psi - psi_r) - self.gains.k_6d * (psi_dot - psi_r_dot)
+    }
+
+    /// One transport step at time `t` [s] over `dt` [s]: LOS guidance at the end-effector
+    /// (USM-39), joint references (USM-38, read with [`TransportController::q_ref`]) and the
+    /// commanded base acceleration (USM-40/41). Allocation-free.
+    pub fn step(&mut self, t: f64, m: &TransportMeasurement, dt: f64) -> TransportOutput {
+        let los = self.guidance.update(t, &m.ee_position, &m.ee_velocity);
+        fill_joint_references(
+            &self.gains,
+            &self.yaw,
+            &self.limits,
+            m.psi,
+            los.psi_r,
+            &mut self.q_ref,
+        );
+        let u = match self.gains.surge_source {
+            SurgeSource::EndEffector => m.surge_ee,
+            SurgeSource::Base => m.surge_base,
+        };
+        let a1 = self.surge_acceleration(u, dt);
+        let psi_dot = match self.gains.yaw_rate_source {
+            YawRateSource::FrontHeading => m.psi_dot,
+            YawRateSource::BaseYawRate => m.base_yaw_rate,
+        };
+        let a6 = self.yaw_acceleration(m.psi, psi_dot, los.psi_r, los.psi_r_dot);
+        TransportOutput {
+            los,
+            a_b: Vec6::new(a1, 0.0, 0.0, 0.0, 0.0, a6),
+            heading_error: wrap_angle(m.psi - los.psi_r),
+            surge_error: u - self.gains.u0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::forward_kinematics;
+    use crate::model::presets::{usm_paper, uvms_planar};
+    use nalgebra::UnitQuaternion;
+
+    fn path() -> PathSpec {
+        PathSpec {
+            waypoints: vec![[0.0, 0.0], [100.0, 0.0]],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn yaw_joints_of_presets() {
+        let m = yaw_joint_mask(&usm_paper());
+        assert_eq!(m, vec![true, false, true, false, true, false, true, false]);
+        assert!(yaw_joint_mask(&uvms_planar()).iter().all(|y| *y));
+    }
+
+    #[test]
+    fn positive_yaw_joint_turns_head_left() {
+        // The premise of the sign derivation: Σ q_yaw adds to the head heading.
+        let v = usm_paper();
+        let mut ws = KinWorkspace::new(&v);
+        let q = [0.1, 0.0, 0.2, 0.0, -0.05, 0.0, 0.15, 0.0];
+        forward_kinematics(&v, &q, &mut ws);
+        let m = measure_transport(&BasePose::default(), &ws, &Vec6::zeros(), &[0.0; 8]);
+        assert!((m.psi - 0.4).abs() < 1e-12);
+    }
+
+    /// Base fixed at heading ψ_b, joints follow q_r through first-order servos (time constant
+    /// T); ψ from forward kinematics each step. Returns the final head heading.
+    fn servo_loop(sign: f64, psi_b: f64, psi_r: f64) -> (f64, Vec<f64>) {
+        let v = usm_paper();
+        let gains = TransportGains {
+            joint_sign: sign,
+            ..TransportGains::method2()
+        };
+        let ctl = TransportController::new(&v, gains, &path()).unwrap();
+        let mut ws = KinWorkspace::new(&v);
+        let base = BasePose {
+            orientation: UnitQuaternion::from_euler_angles(0.0, 0.0, psi_b),
+            position: Vec3::zeros(),
+        };
+        let (dt, tau) = (0.01, 0.5);
+        let mut q = vec![0.0; 8];
+        let mut qr = vec![0.0; 8];
+        let mut psi = psi_b;
+        for _ in 0..2000 {
+            forward_kinematics(&v, &q, &mut ws);
+            psi = measure_transport(&base, &ws, &Vec6::zeros(), &[0.0; 8]).psi;
+            ctl.joint_references(psi, psi_r, &mut qr);
+            for (qi, ri) in q.iter_mut().zip(&qr) {
+                *qi += dt / tau * (ri - *qi);
+            }
+        }
+        (psi, q)
+    }
+
+    #[test]
+    fn usm38_sign_bends_head_towards_reference() {
+        // Head (and tail) pointing 0.3 rad left of the reference ψ_r = 0.
+        let (psi_b, psi_r) = (0.3, 0.0);
+        // Derived sign −1: one law application turns the head towards ψ_r relative to the base,
+        // and with servos it settles at ψ − ψ_r = (ψ_b − ψ_r)/(1 + 4k_ψ) (4 yaw joints).
+        let (psi, q) = servo_loop(-1.0, psi_b, psi_r);
+        assert!(
+            q[0] < 0.0 && q[1] == 0.0,
+            "yaw joints bend right, pitch stays 0: {q:?}"
+        );
+        let expect = (psi_b - psi_r) / (1.0 + 4.0 * 0.45);
+        assert!((psi - expect).abs() < 1e-6, "{psi} vs {expect}");
+        assert!((psi - psi_r).abs() < (psi_b - psi_r).abs());
+        // The paper's sign read in our convention runs away to the joint limits, head turned
+        // further from ψ_r than the tail.
+        let (psi_bad, q_bad) = servo_loop(1.0, psi_b, psi_r);
+        assert!((psi_bad - psi_r).abs() > (psi_b - psi_r).abs());
+        assert!(q_bad[0] > 0.5, "{q_bad:?}");
+        // And symmetric for a head pointing right of the reference.
+        let (psi, _) = servo_loop(-1.0, -0.2, 0.1);
+        assert!((psi - 0.1 - (-0.3) / 2.8).abs() < 1e-6);
+    }
+
+    #[test]
+    fn accelerations_follow_usm40_41() {
+        let v = usm_paper();
+        let mut ctl = TransportController::new(&v, TransportGains::method1(), &path()).unwrap();
+        // Method 1 regulates the end-effector surge.
+        let m = TransportMeasurement {
+            psi: 0.2,
+            psi_dot: 0.05,
+            surge_ee: 0.3,
+            surge_base: 0.9,
+            ee_position: Vec3::new(5.0, 1.0, 0.0),
+            ee_velocity: Vec3::new(0.3, 0.0, 0.0),
+            ..Default::default()
+        };
+        let out = ctl.step(0.0, &m, 0.1);
+        let e = 0.3 - 0.5;
+        assert!((out.surge_error - e).abs() < 1e-15);
+        assert!((ctl.surge_integral() - e * 0.1).abs() < 1e-15);
+        assert!((out.a_b[0] - (-0.5 * e - 0.0625 * e * 0.1)).abs() < 1e-15);
+        let los = out.los;
+        assert!((los.psi_r + (1.0f64 / 3.0).atan()).abs() < 1e-12);
+        let a6 = -0.13 * (0.2 - los.psi_r) - 0.12 * (0.05 - los.psi_r_dot);
+        assert!((out.a_b[5] - a6).abs() < 1e-15);
+        assert_eq!([out.a_b[1], out.a_b[2], out.a_b[3], out.a_b[4]], [0.0; 4]);
+        // ψ > ψ_r: yaw acceleration to the right, surge too slow: accelerate forward.
+        assert!(out.a_b[5] < 0.0 && out.a_b[0] > 0.0);
+        // Heading error is wrapped across ±π.
+        let a = ctl.yaw_acceleration(3.1, 0.0, -3.1, 0.0);
+        assert!((a - (-0.13 * (6.2 - 2.0 * std::f64::consts::PI))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pd_surge_form() {
+        let v = usm_paper();
+        let g = TransportGains {
+            surge_law: SurgeLaw::ProportionalDerivative,
+            derivative_time_constant: 0.0,
+            ..TransportGains::method2()
+        };
+        let mut ctl = TransportController::new(&v, g, &path()).unwrap();
+        assert!((ctl.surge_acceleration(0.4, 0.1) - (-0.5 * -0.1)).abs() < 1e-15);
+        // Error −0.1 → −0.05 over 0.1 s: rate 0.5, k_1d = 0.0625.
+        let a = ctl.surge_acceleration(0.45, 0.1);
+        assert!((a - (0.5 * 0.05 - 0.0625 * 0.5)).abs() < 1e-12, "{a}");
+    }
+
+    #[test]
+    fn measurement_matches_jacobian() {
+        let v = usm_paper();
+        let mut ws = KinWorkspace::new(&v);
+        let q = [0.3, -0.2, 0.1, 0.25, -0.4, 0.1, 0.2, -0.1];
+        forward_kinematics(&v, &q, &mut ws);
+        let vb = Vec6::new(0.4, 0.1, -0.05, 0.02, -0.03, 0.1);
+        let qd = [0.1, -0.2, 0.05, 0.0, 0.3, -0.1, 0.2, 0.1];
+        let base = BasePose {
+            orientation: UnitQuaternion::from_euler_angles(0.0, 0.0, 0.7),
+            position: Vec3::new(1.0, 2.0, -3.0),
+        };
+        let m = measure_transport(&base, &ws, &vb, &qd);
+        let mut j = faer::Mat::<f64>::zeros(6, 14);
+        crate::kinematics::ee_jacobian(&ws, &mut j);
+        let zeta: Vec<f64> = vb.iter().chain(qd.iter()).copied().collect();
+        let ve: Vec<f64> = (0..6)
+            .map(|r| (0..14).map(|c| j[(r, c)] * zeta[c]).sum())
+            .collect();
+        assert!((m.surge_ee - ve[0]).abs() < 1e-12);
+        assert!((m.surge_base - 0.4).abs() < 1e-15);
+        assert!((m.base_heading - 0.7).abs() < 1e-12);
+        let g_ie = base.to_se3().compose(&ws.g_be);
+        let vi = g_ie.r * Vec3::new(ve[0], ve[1], ve[2]);
+        assert!((m.ee_velocity - vi).norm() < 1e-12);
+        assert!((m.psi_dot - heading_rate(&g_ie.r, &Vec3::new(ve[3], ve[4], ve[5]))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn gains_from_toml() {
+        let g: TransportGains = toml::from_str(r#"method = "method1""#).unwrap();
+        assert_eq!(g, TransportGains::method1());
+        let g: TransportGains =
+            toml::from_str("k_psi = 0.3\nk_1d = 0.1\nsurge_law = \"proportional_derivative\"")
+                .unwrap();
+        assert_eq!(g.method, TransportMethod::Method2);
+        assert_eq!((g.k_psi, g.k_1i, g.look_ahead), (0.3, 0.1, 2.0));
+        assert_eq!(g.surge_law, SurgeLaw::ProportionalDerivative);
+        let g: TransportGains = toml::from_str("").unwrap();
+        assert_eq!(g, TransportGains::method2());
+        assert_eq!(g.surge_source, SurgeSource::Base);
+        assert!(toml::from_str::<TransportGains>("kpsi = 1").is_err());
+        let e = toml::from_str::<TransportGains>("joint_sign = 2.0").unwrap_err();
+        assert!(e.to_string().contains("transport.joint_sign"), "{e}");
+        // Round trip through the serialised form.
+        let s = toml::to_string(&TransportGains::method1()).unwrap();
+        assert_eq!(
+            toml::from_str::<TransportGains>(&s).unwrap(),
+            TransportGains::method1()
+        );
+    }
+
+    /// Closed-loop transport run on the full hydrodynamic model with damped-pseudoinverse
+    /// allocation (λ = 0.1): the paper's scenario shape (start 3 m off a +X line, 180° turn onto
+    /// a −X line at t = 95 s). Returns (|e_y| at 90 s, |e_y| at 140 s, peak |u|).
+    fn closed_loop(gains: TransportGains, nonlinear: bool) -> (f64, f64, f64) {
+        use crate::allocation::damped_pinv;
+        use crate::control::dynamic::{DynamicController, DynamicGains};
+        use crate::dynamics::{ActuatorCommand, SimConfig, Simulator};
+        use crate::kinematics::thruster_matrix_owned;
+        let v = usm_paper();
+        let path: PathSpec = toml::from_str(
+            r#"segments = [
+                 { from = [0.0, 3.0], to = [1000.0, 3.0] },
+                 { from = [1000.0, 6.0], to = [-1000.0, 6.0], start_time = 95.0 },
+               ]"#,
+        )
+        .unwrap();
+        let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
+        let mut ctl = TransportController::new(&v, gains, &path).unwrap();
+        let dync = DynamicController::new(DynamicGains {
+            nonlinear,
+            ..DynamicGains::transport()
+        })
+        .unwrap();
+        let mut ws = KinWorkspace::new(&v);
+        let dt = 0.05;
+        let (mut e90, mut peak) = (f64::NAN, 0.0f64);
+        let mut e_end = f64::NAN;
+        let zero = vec![0.0; v.n_joints()];
+        for k in 0..=2800 {
+            let t = k as f64 * dt;
+            let st = sim.state().clone();
+            forward_kinematics(&v, &st.joint_angles, &mut ws);
+            let m = measure_transport(&st.pose, &ws, &st.base_twist, &st.joint_rates);
+            let out = ctl.step(t, &m, dt);
+            if k == 1800 {
+                e90 = out.los.cross_track.abs();
+            }
+            e_end = out.los.cross_track.abs();
+            let (m11, n) = sim.base_control_terms().unwrap();
+            let tau = dync.acceleration_control(&m11, &n, &out.a_b);
+            let tm = thruster_matrix_owned(&v, &ws);
+            let u = damped_pinv(&tm, &tau, &[1.0; 7], 0.1).unwrap();
+            peak = peak.max(u.iter().fold(0.0f64, |a, x| a.max(x.abs())));
+            let cmd = ActuatorCommand {
+                thrust: &u,
+                joint_ref: ctl.q_ref(),
+                joint_rate_ref: &zero,
+            };
+            if sim.step(dt, &cmd).is_err() {
+                return (f64::INFINITY, f64::INFINITY, peak);
+            }
+        }
+        (e90, e_end, peak)
+    }
+
+    #[test]
+    #[ignore = "closed-loop experiment on the dynamics (seconds); run with --ignored"]
+    fn closed_loop_transport_derived_sign_beats_paper_sign() {
+        // Evidence for USM-38's sign in closed loop (full hydrodynamics, unconstrained
+        // allocation, paper gains untuned for this model): with s_q = +1 the vehicle loses the
+        // path; with s_q = −1 it stays within about a metre (not a tuning result — the residual
+        // oscillation is for the scenario to study). Prints a table of the open choices.
+        for g in [TransportGains::method1(), TransportGains::method2()] {
+            let mut by_sign = [0.0; 2];
+            for src in [YawRateSource::FrontHeading, YawRateSource::BaseYawRate] {
+                for (sign, nl) in [(-1.0, true), (-1.0, false), (1.0, true)] {
+                    let gg = TransportGains {
+                        joint_sign: sign,
+                        yaw_rate_source: src,
+                        ..g.clone()
+                    };
+                    let (e90, e_end, peak) = closed_loop(gg, nl);
+                    eprintln!(
+                        "{:?} {src:?} sign {sign} n {nl}: |e_y|(90 s) = {e90:.3}, |e_y|(140 s) = {e_end:.3}, peak u = {peak:.1}",
+                        g.method
+                    );
+                    if src == YawRateSource::FrontHeading && nl {
+                        by_sign[usize::from(sign > 0.0)] = e_end;
+                    }
+                }
+            }
+            assert!(3.0 * by_sign[0] < by_sign[1], "{by_sign:?}");
+            assert!(by_sign[0] < 2.0, "{by_sign:?}");
+        }
+    }
+}
