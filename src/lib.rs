@@ -18,5 +18,7 @@ pub mod metrics;
 pub mod model;
 pub mod report;
 pub mod sampling;
+pub mod scenario;
 pub mod spatial;
 pub mod state;
+pub mod study;

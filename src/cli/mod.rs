@@ -4,6 +4,10 @@
 pub mod allocate;
 pub mod design;
 pub mod inspect;
+pub mod paper;
+pub mod simulate;
+pub mod sweep;
+pub mod tcm;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +29,20 @@ enum Command {
     Design(design::DesignCommand),
     /// Solve one thrust-allocation problem with one or all methods.
     Allocate(allocate::AllocateArgs),
+    /// Run one closed-loop scenario (transport or work mode) and write its time series,
+    /// summary and figure.
+    Simulate(simulate::SimulateArgs),
+    /// Regenerate the USM paper's simulations (three presets, allocator comparison) with
+    /// figures and comparison tables.
+    Paper(paper::PaperArgs),
+    /// Static configuration-space analysis of the thruster matrix: how often is T(q) singular.
+    Tcm(tcm::TcmArgs),
+    /// Run a batch study (parameter sweep) from a study file.
+    Sweep(sweep::SweepArgs),
+    /// Merge the outputs of sweep shards into one result.
+    Merge(sweep::MergeArgs),
+    /// Regenerate summary.md and plots of a sweep output directory.
+    Report(sweep::ReportArgs),
 }
 
 /// Parse `std::env::args` and run the chosen command.
@@ -34,6 +52,12 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Inspect(a) => inspect::run(a),
         Command::Design(c) => design::run(c),
         Command::Allocate(a) => allocate::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::Paper(a) => paper::run(a),
+        Command::Tcm(a) => tcm::run(a),
+        Command::Sweep(a) => sweep::run(a),
+        Command::Merge(a) => sweep::run_merge(a),
+        Command::Report(a) => sweep::run_report(a),
     }
 }
 

@@ -1,0 +1,231 @@
+//! `usm-study sweep STUDY.toml`, `usm-study merge DIR... --out DIR`, `usm-study report DIR`:
+//! the batch engine's commands (SPEC §7; schema in `docs/study-format.md`).
+//!
+//! Exit codes: 0 all cases ok or skipped, 1 some cases failed (the batch still completes),
+//! 2 bad input (study file, command line) or an I/O error.
+
+use super::tcm::Progress;
+use crate::study::doe::expand;
+use crate::study::engine::{axis_text, output_dir, resolve_case};
+use crate::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
+use anyhow::{anyhow, bail};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Study file (TOML).
+    pub study: PathBuf,
+    /// Worker threads (0: all cores). Results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    pub jobs: usize,
+    /// List the cases (id, hash, axis values) without running them.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Keep the cases already in the output's cases.partial.csv (matched by hash) and run the
+    /// rest.
+    #[arg(long)]
+    pub resume: bool,
+    /// Run only the cases with id mod N == I: `I/N`, or `slurm` to read
+    /// SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT (minus SLURM_ARRAY_TASK_MIN).
+    #[arg(long, value_parser = parse_shard)]
+    pub shard: Option<ShardArg>,
+    /// Output directory (default: the study's `output`, plus `shard-I-of-N` for shards).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Stop after running K cases, without final outputs (simulates an interruption).
+    #[arg(long, hide = true)]
+    pub max_cases: Option<usize>,
+}
+
+/// A `--shard` value.
+#[derive(Clone, Debug)]
+pub enum ShardArg {
+    /// Explicit `I/N`.
+    Fixed(usize, usize),
+    /// From the Slurm array environment.
+    Slurm,
+}
+
+fn parse_shard(s: &str) -> Result<ShardArg, String> {
+    if s == "slurm" {
+        return Ok(ShardArg::Slurm);
+    }
+    let (i, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("expected I/N (e.g. 0/4) or `slurm`, got '{s}'"))?;
+    let p = |x: &str| {
+        x.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("'{x}' is not a non-negative integer"))
+    };
+    let (i, n) = (p(i)?, p(n)?);
+    if n == 0 || i >= n {
+        return Err(format!("shard {i}/{n}: need 0 <= I < N"));
+    }
+    Ok(ShardArg::Fixed(i, n))
+}
+
+fn slurm_shard() -> anyhow::Result<(usize, usize)> {
+    let var = |k: &str| -> anyhow::Result<usize> {
+        std::env::var(k)
+            .map_err(|_| anyhow!("--shard slurm: {k} is not set (run inside `sbatch --array`)"))?
+            .trim()
+            .parse()
+            .map_err(|_| anyhow!("--shard slurm: {k} is not an integer"))
+    };
+    let id = var("SLURM_ARRAY_TASK_ID")?;
+    let count = var("SLURM_ARRAY_TASK_COUNT")?;
+    let min = var("SLURM_ARRAY_TASK_MIN").unwrap_or(0);
+    let i = id
+        .checked_sub(min)
+        .ok_or_else(|| anyhow!("--shard slurm: task id below the array minimum"))?;
+    if count == 0 || i >= count {
+        bail!("--shard slurm: task {i} of {count} (the array must be contiguous)");
+    }
+    Ok((i, count))
+}
+
+fn study_err(e: StudyError) -> anyhow::Error {
+    anyhow!(e.to_string())
+}
+
+/// Run `usm-study sweep`.
+pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
+    let study = load_study(&a.study).map_err(|e| anyhow!(e.to_string()))?;
+    let shard = match &a.shard {
+        None => None,
+        Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),
+        Some(ShardArg::Slurm) => Some(slurm_shard()?),
+    };
+    let opts = SweepOptions {
+        jobs: a.jobs,
+        resume: a.resume,
+        shard,
+        out: a.out.clone(),
+        max_cases: a.max_cases,
+    };
+    if a.dry_run {
+        let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
+        println!(
+            "study {} ({} mode{}): {} cases{}, output {}",
+            study.name,
+            study.mode,
+            if study.static_enabled {
+                " + static TCM"
+            } else {
+                ""
+            },
+            cases.len(),
+            shard.map_or(String::new(), |(i, n)| format!(" in shard {i}/{n}")),
+            output_dir(&study, &opts).display()
+        );
+        for c in &cases {
+            let vals: Vec<String> = study
+                .axes
+                .iter()
+                .zip(&c.values)
+                .map(|(ax, v)| format!("{}={}", ax.name, axis_text(v)))
+                .collect();
+            let hash = match resolve_case(&study, c) {
+                Ok(r) => r.hash,
+                Err(reason) => format!("(skipped: {reason})"),
+            };
+            println!("{:>6} {} {}", c.id, hash, vals.join(" "));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let total = expand(&study, shard).map(|c| c.len()).unwrap_or(0);
+    let progress = Progress::new("sweep", "cases", total, true);
+    let outcome = run_sweep(&study, &opts, &mut |ev| {
+        progress.update(ev.finished, ev.ran)
+    })
+    .map_err(study_err)?;
+    progress.finish();
+    eprintln!(
+        "[sweep] resumed {} cases, ran {}",
+        outcome.resumed, outcome.ran
+    );
+    if outcome.interrupted {
+        eprintln!(
+            "[sweep] stopped after {} cases (--max-cases); rerun with --resume to finish {}",
+            outcome.ran,
+            outcome.out.display()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    for w in &outcome.warnings {
+        eprintln!("[sweep] warning: {w}");
+    }
+    eprintln!(
+        "[sweep] {} cases: {} ok, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
+        outcome.in_shard,
+        outcome.ok,
+        outcome.failed,
+        outcome.skipped,
+        outcome.elapsed_s,
+        if outcome.elapsed_s > 0.0 {
+            outcome.ran as f64 / outcome.elapsed_s
+        } else {
+            0.0
+        },
+        outcome.out.display()
+    );
+    Ok(if outcome.failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Arguments of `merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Shard output directories (each with manifest.json and cases.partial.csv).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Output directory of the merged study.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Run `usm-study merge`.
+pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
+    let (m, warnings) = merge(&a.dirs, &a.out).map_err(study_err)?;
+    for w in &warnings {
+        eprintln!("[merge] warning: {w}");
+    }
+    eprintln!(
+        "[merge] {} directories: {} cases ({} ok, {} failed, {} skipped); wrote {}",
+        a.dirs.len(),
+        m.cases.in_output,
+        m.cases.ok,
+        m.cases.failed,
+        m.cases.skipped,
+        a.out.display()
+    );
+    Ok(if m.cases.failed > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// Arguments of `report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// A sweep output directory.
+    pub dir: PathBuf,
+}
+
+/// Run `usm-study report`.
+pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
+    let warnings = report(&a.dir).map_err(study_err)?;
+    for w in &warnings {
+        eprintln!("[report] warning: {w}");
+    }
+    eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,560 @@
+//! Scenario files (TOML): the design, the mode and its parameters, gains, allocation, physics
+//! and control rates, duration and metric settings — everything one closed-loop run needs.
+//!
+//! ```toml
+//! [scenario]
+//! name = "transport-method2"
+//! mode = "transport"          # transport | work
+//! design = "usm-paper"        # preset name or design file (relative to this file)
+//! duration = 140.0            # s
+//! dt = 0.01                   # physics step (RK4) [s]
+//! control_dt = 0.05           # control period [s]
+//! log_dt = 0.1                # logging period [s]
+//!
+//! [initial]                   # base pose at t = 0
+//! position = [0.0, -3.0, 0.0]
+//! yaw_deg = 0.0
+//!
+//! [path]                      # transport: LOS path (control::guidance::PathSpec)
+//! segments = [{ from = [0.0, 0.0], to = [200.0, 0.0] }]
+//!
+//! [setpoint]                  # work: end-effector pose in the inertial frame
+//! position = [3.5, 0.5, -0.3]
+//! rpy_deg = [0.0, 0.0, 20.0]
+//!
+//! [control]                   # transport: TransportGains keys; work: WorkGains keys
+//! [base_control]              # USM-33/34 gains (DynamicGains)
+//! [allocation]                # method, lambda, q, eps, weights, rate limits
+//! [servo]                     # joint servos
+//! [thrusters]                 # thruster dynamics
+//! [physics]                   # which effects, current
+//! [metrics]                   # thresholds, power model
+//! ```
+//!
+//! A `[design]` table (the design-file schema) may replace `scenario.design`; the sweep engine
+//! uses it to pass a modified design.
+
+use crate::allocation::{AllocSettings, Method, RateSettings};
+use crate::control::dynamic::DynamicGains;
+use crate::control::guidance::PathSpec;
+use crate::control::transport::TransportGains;
+use crate::control::work::WorkGains;
+use crate::dynamics::{DynOptions, ServoModel, SimConfig, ThrusterModel};
+use crate::metrics::trajectory::PowerModel;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// The two closed-loop modes of the USM paper (section V).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Path following along straight segments (USM-38…41).
+    Transport,
+    /// End-effector setpoint regulation with the base as secondary task (USM-42).
+    Work,
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Mode::Transport => "transport",
+            Mode::Work => "work",
+        })
+    }
+}
+
+/// `[scenario]`: identity, mode, rates and duration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSection {
+    /// Scenario name (used in outputs).
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// Transport or work mode.
+    pub mode: Mode,
+    /// Preset name or design file path (relative to the scenario file). Ignored when a
+    /// `[design]` table is present.
+    #[serde(default = "default_design")]
+    pub design: String,
+    /// Simulated time [s].
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    /// Physics (RK4) step [s].
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Control period [s]; a whole multiple of `dt`.
+    #[serde(default = "default_control_dt")]
+    pub control_dt: f64,
+    /// Logging period [s]; a whole multiple of `control_dt`.
+    #[serde(default = "default_log_dt")]
+    pub log_dt: f64,
+}
+
+fn default_name() -> String {
+    "scenario".into()
+}
+fn default_design() -> String {
+    "usm-paper".into()
+}
+fn default_duration() -> f64 {
+    140.0
+}
+fn default_dt() -> f64 {
+    0.01
+}
+fn default_control_dt() -> f64 {
+    0.05
+}
+fn default_log_dt() -> f64 {
+    0.1
+}
+
+/// `[initial]`: the state at t = 0 (at rest).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InitialSpec {
+    /// Base position in the inertial frame [m].
+    pub position: [f64; 3],
+    /// Base heading about inertial +z [deg].
+    pub yaw_deg: f64,
+    /// Joint angles [deg]; empty = straight.
+    pub joint_angles_deg: Vec<f64>,
+}
+
+impl Default for InitialSpec {
+    fn default() -> Self {
+        Self {
+            position: [0.0; 3],
+            yaw_deg: 0.0,
+            joint_angles_deg: Vec::new(),
+        }
+    }
+}
+
+/// `[setpoint]`: a time-invariant end-effector pose (work mode), inertial frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SetpointSpec {
+    /// End-effector position [m].
+    pub position: [f64; 3],
+    /// End-effector orientation as roll, pitch, yaw (ZYX) [deg].
+    #[serde(default)]
+    pub rpy_deg: [f64; 3],
+    /// Base position target of the secondary task [m]; default: the initial base position.
+    #[serde(default)]
+    pub base_position: Option<[f64; 3]>,
+}
+
+/// `[allocation]`: the thrust allocation method and its settings (SPEC §5, USM-37).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AllocationSpec {
+    /// pinv, qp, minimax or power.
+    pub method: Method,
+    /// Damping λ of the pseudoinverse.
+    pub lambda: f64,
+    /// Slack weight q.
+    pub q: f64,
+    /// Minimax regularisation ε.
+    pub eps: f64,
+    /// Usage weights w (W = diag(w)); empty = all ones.
+    pub weights: Vec<f64>,
+    /// Rate-change weights R (diag) of `‖u − u_prev‖²_R`; empty = none.
+    pub rate_weights: Vec<f64>,
+    /// Per-step change bound Δu [N]; 0 = none.
+    pub max_step: f64,
+}
+
+impl Default for AllocationSpec {
+    fn default() -> Self {
+        let s = AllocSettings::default();
+        Self {
+            method: Method::Qp,
+            lambda: s.lambda,
+            q: s.q,
+            eps: s.eps,
+            weights: Vec::new(),
+            rate_weights: Vec::new(),
+            max_step: 0.0,
+        }
+    }
+}
+
+impl AllocationSpec {
+    /// Solver settings for `m` thrusters.
+    pub fn settings(&self, m: usize) -> AllocSettings {
+        let rate = if self.rate_weights.is_empty() && self.max_step <= 0.0 {
+            None
+        } else {
+            Some(RateSettings {
+                weights: if self.rate_weights.is_empty() {
+                    vec![0.0; m]
+                } else {
+                    self.rate_weights.clone()
+                },
+                max_step: vec![
+                    if self.max_step > 0.0 {
+                        self.max_step
+                    } else {
+                        f64::INFINITY
+                    };
+                    m
+                ],
+            })
+        };
+        AllocSettings {
+            lambda: self.lambda,
+            q: self.q,
+            eps: self.eps,
+            rate,
+            ..AllocSettings::default()
+        }
+    }
+
+    /// Usage weights for `m` thrusters.
+    pub fn weights_for(&self, m: usize) -> Vec<f64> {
+        if self.weights.is_empty() {
+            vec![1.0; m]
+        } else {
+            self.weights.clone()
+        }
+    }
+}
+
+/// `[servo]`: joint servo model (SPEC §4).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ServoSpec {
+    /// `second_order` (ideal reference filter, hybrid dynamics) or `torque_pd`.
+    pub kind: String,
+    /// Natural frequency ω_n [rad/s] of the reference filter.
+    pub omega_n: f64,
+    /// Damping ratio of the reference filter.
+    pub zeta: f64,
+    /// PD proportional gain [N·m/rad].
+    pub kp: f64,
+    /// PD derivative gain [N·m·s/rad].
+    pub kd: f64,
+    /// PD torque limit [N·m].
+    pub torque_limit: f64,
+}
+
+impl Default for ServoSpec {
+    fn default() -> Self {
+        Self {
+            kind: "second_order".into(),
+            omega_n: 5.0,
+            zeta: 1.0,
+            kp: 200.0,
+            kd: 40.0,
+            torque_limit: 100.0,
+        }
+    }
+}
+
+/// `[thrusters]`: thruster dynamics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ThrusterSpec {
+    /// `ideal`, `lag`, `rate` or `model` (each thruster's own lag/rate from the design).
+    pub model: String,
+    /// Lag time constant [s] for `lag` (0 = each thruster's own).
+    pub time_constant: f64,
+    /// Rate limit [N/s] for `rate` (0 = each thruster's own).
+    pub rate_limit: f64,
+}
+
+impl Default for ThrusterSpec {
+    fn default() -> Self {
+        Self {
+            model: "ideal".into(),
+            time_constant: 0.0,
+            rate_limit: 0.0,
+        }
+    }
+}
+
+/// `[physics]`: which effects act, and the current.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PhysicsSpec {
+    /// Added mass (and its Kirchhoff term).
+    pub added_mass: bool,
+    /// Hydrodynamic damping.
+    pub drag: bool,
+    /// Weight and buoyancy.
+    pub restoring: bool,
+    /// Constant irrotational current, inertial frame [m/s].
+    pub current: [f64; 3],
+}
+
+impl Default for PhysicsSpec {
+    fn default() -> Self {
+        Self {
+            added_mass: true,
+            drag: true,
+            restoring: true,
+            current: [0.0; 3],
+        }
+    }
+}
+
+/// `[metrics]`: thresholds and the power model (SPEC §6).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MetricsSpec {
+    /// σ_min threshold of the scaled T(q) below which a configuration counts as singular.
+    pub threshold: f64,
+    /// Characteristic length for scaling moments [m]; 0 = half the vehicle length.
+    pub char_length: f64,
+    /// Cross-track band for convergence [m] (transport).
+    pub band: f64,
+    /// Position tolerance for settling [m] (work).
+    pub position_tolerance: f64,
+    /// Orientation tolerance for settling (roll excluded) [deg] (work).
+    pub orientation_tolerance_deg: f64,
+    /// Propeller diameter [m] of the power model.
+    pub propeller_diameter: f64,
+    /// Efficiency η of the power model.
+    pub efficiency: f64,
+    /// A thruster counts as saturated within this distance of a limit [N].
+    pub saturation_tolerance: f64,
+    /// Position magnitude [m] beyond which a run counts as diverged.
+    pub divergence_distance: f64,
+}
+
+impl Default for MetricsSpec {
+    fn default() -> Self {
+        let p = PowerModel::default();
+        Self {
+            threshold: 0.05,
+            char_length: 0.0,
+            band: 0.1,
+            position_tolerance: 0.02,
+            orientation_tolerance_deg: 2.0,
+            propeller_diameter: p.propeller_diameter,
+            efficiency: p.efficiency,
+            saturation_tolerance: 1e-3,
+            divergence_distance: 1e4,
+        }
+    }
+}
+
+/// A parsed scenario file. `control` stays a table until the mode decides its schema.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// Identity, mode, rates.
+    pub scenario: ScenarioSection,
+    /// Inline design (design-file schema); overrides `scenario.design`.
+    #[serde(default)]
+    pub design: Option<toml::Table>,
+    /// Initial state.
+    #[serde(default)]
+    pub initial: InitialSpec,
+    /// Transport path.
+    #[serde(default)]
+    pub path: Option<PathSpec>,
+    /// Work setpoint.
+    #[serde(default)]
+    pub setpoint: Option<SetpointSpec>,
+    /// Mode gains (TransportGains or WorkGains keys).
+    #[serde(default)]
+    pub control: toml::Table,
+    /// Base control gains (USM-33/34); defaults depend on the mode.
+    #[serde(default)]
+    pub base_control: Option<DynamicGains>,
+    /// Thrust allocation.
+    #[serde(default)]
+    pub allocation: AllocationSpec,
+    /// Joint servos.
+    #[serde(default)]
+    pub servo: ServoSpec,
+    /// Thruster dynamics.
+    #[serde(default)]
+    pub thrusters: ThrusterSpec,
+    /// Physical effects.
+    #[serde(default)]
+    pub physics: PhysicsSpec,
+    /// Metric settings.
+    #[serde(default)]
+    pub metrics: MetricsSpec,
+}
+
+/// Mode-specific gains, parsed from `[control]`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModeGains {
+    /// Transport (USM Table III and the choices of `control::transport`).
+    Transport(TransportGains),
+    /// Work mode (USM-42).
+    Work(WorkGains),
+}
+
+impl ScenarioFile {
+    /// Parse the `[control]` table for the mode; errors name the key.
+    pub fn mode_gains(&self) -> Result<ModeGains, String> {
+        let v = toml::Value::Table(self.control.clone());
+        match self.scenario.mode {
+            Mode::Transport => TransportGains::deserialize(v)
+                .map(ModeGains::Transport)
+                .map_err(|e| format!("control: {}", e.message().trim())),
+            Mode::Work => WorkGains::deserialize(v)
+                .map(ModeGains::Work)
+                .map_err(|e| format!("control: {}", e.message().trim())),
+        }
+    }
+
+    /// Base control gains: the file's, or the mode's default (transport: with the
+    /// nonlinear term; work: without, as in the paper).
+    pub fn base_gains(&self) -> DynamicGains {
+        self.base_control
+            .clone()
+            .unwrap_or(match self.scenario.mode {
+                Mode::Transport => DynamicGains::transport(),
+                Mode::Work => DynamicGains::work_mode(),
+            })
+    }
+
+    /// The simulator configuration.
+    pub fn sim_config(&self) -> Result<SimConfig, String> {
+        let servo = match self.servo.kind.as_str() {
+            "second_order" => ServoModel::SecondOrder {
+                omega_n: self.servo.omega_n,
+                zeta: self.servo.zeta,
+            },
+            "torque_pd" => ServoModel::TorquePd {
+                kp: self.servo.kp,
+                kd: self.servo.kd,
+                torque_limit: self.servo.torque_limit,
+            },
+            other => {
+                return Err(format!(
+                    "servo.kind: unknown servo '{other}'; valid: second_order, torque_pd"
+                ))
+            }
+        };
+        let opt = |x: f64| if x > 0.0 { Some(x) } else { None };
+        let thruster = match self.thrusters.model.as_str() {
+            "ideal" => ThrusterModel::Ideal,
+            "lag" => ThrusterModel::FirstOrder {
+                time_constant: opt(self.thrusters.time_constant),
+            },
+            "rate" => ThrusterModel::RateLimited {
+                rate_limit: opt(self.thrusters.rate_limit),
+            },
+            "model" => ThrusterModel::FromModel,
+            other => {
+                return Err(format!(
+                    "thrusters.model: unknown model '{other}'; valid: ideal, lag, rate, model"
+                ))
+            }
+        };
+        let p = &self.physics;
+        Ok(SimConfig {
+            options: DynOptions {
+                added_mass: p.added_mass,
+                drag: p.drag,
+                restoring: p.restoring,
+                current: p.current.iter().any(|c| *c != 0.0),
+            },
+            servo,
+            thruster,
+        })
+    }
+
+    /// The power model of the metrics section for water of density `rho`.
+    pub fn power_model(&self, rho: f64) -> PowerModel {
+        PowerModel {
+            propeller_diameter: self.metrics.propeller_diameter,
+            efficiency: self.metrics.efficiency,
+            rho,
+        }
+    }
+
+    /// Check rates, durations and mode-specific sections; errors name the key.
+    pub fn validate(&self) -> Result<(), String> {
+        let s = &self.scenario;
+        for (k, v) in [
+            ("scenario.duration", s.duration),
+            ("scenario.dt", s.dt),
+            ("scenario.control_dt", s.control_dt),
+            ("scenario.log_dt", s.log_dt),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(format!("{k} must be a finite number > 0, got {v}"));
+            }
+        }
+        let ratio = |a: f64, b: f64| {
+            let r = (a / b).round();
+            r >= 1.0 && (a - r * b).abs() <= 1e-9 * a.max(1.0)
+        };
+        if !ratio(s.control_dt, s.dt) {
+            return Err(format!(
+                "scenario.control_dt ({}) must be a whole multiple of scenario.dt ({})",
+                s.control_dt, s.dt
+            ));
+        }
+        if !ratio(s.log_dt, s.control_dt) {
+            return Err(format!(
+                "scenario.log_dt ({}) must be a whole multiple of scenario.control_dt ({})",
+                s.log_dt, s.control_dt
+            ));
+        }
+        if s.duration / s.dt > 5.0e7 {
+            return Err(format!(
+                "scenario.duration / scenario.dt = {:.0} steps is more than 5e7",
+                s.duration / s.dt
+            ));
+        }
+        let finite = |k: &str, xs: &[f64]| match xs.iter().find(|x| !x.is_finite()) {
+            Some(x) => Err(format!("{k} must be finite, got {x}")),
+            None => Ok(()),
+        };
+        finite("initial.position", &self.initial.position)?;
+        finite("initial.yaw_deg", &[self.initial.yaw_deg])?;
+        finite("initial.joint_angles_deg", &self.initial.joint_angles_deg)?;
+        finite("physics.current", &self.physics.current)?;
+        match s.mode {
+            Mode::Transport if self.path.is_none() => {
+                return Err("path: transport mode needs a [path] table".into())
+            }
+            Mode::Work if self.setpoint.is_none() => {
+                return Err("setpoint: work mode needs a [setpoint] table".into())
+            }
+            _ => {}
+        }
+        if let Some(sp) = &self.setpoint {
+            finite("setpoint.position", &sp.position)?;
+            finite("setpoint.rpy_deg", &sp.rpy_deg)?;
+        }
+        let m = &self.metrics;
+        for (k, v) in [
+            ("metrics.threshold", m.threshold),
+            ("metrics.band", m.band),
+            ("metrics.position_tolerance", m.position_tolerance),
+            (
+                "metrics.orientation_tolerance_deg",
+                m.orientation_tolerance_deg,
+            ),
+            ("metrics.propeller_diameter", m.propeller_diameter),
+            ("metrics.efficiency", m.efficiency),
+            ("metrics.divergence_distance", m.divergence_distance),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(format!("{k} must be a finite number > 0, got {v}"));
+            }
+        }
+        if !m.char_length.is_finite() || m.char_length < 0.0 {
+            return Err(format!(
+                "metrics.char_length must be finite and >= 0, got {}",
+                m.char_length
+            ));
+        }
+        self.mode_gains()?;
+        self.base_gains()
+            .validate()
+            .map_err(|e| format!("base_control.{e}"))?;
+        self.sim_config()?;
+        Ok(())
+    }
+}

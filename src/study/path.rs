@@ -1,0 +1,368 @@
+//! Parameter paths of sweep axes (`design.thruster[2].position[0]`, `control.W[3]`) and the
+//! `toml::Table` operations behind them: look-up, assignment with type coercion, and the
+//! flattened list of valid paths of a table.
+//!
+//! Grammar: `segment ('.' segment)*`, `segment = key ('[' index ']')*`, `key` made of ASCII
+//! letters, digits, `_` and `-`, `index` a decimal integer. A *pattern* is a path with every
+//! index replaced by `[]`; valid-name checks compare patterns, and index ranges are checked
+//! per case (an index beyond an array's length skips that case).
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+/// One step of a path.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Seg {
+    /// A table key.
+    Key(String),
+    /// An array index.
+    Index(usize),
+}
+
+/// A parsed parameter path.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct KeyPath(pub Vec<Seg>);
+
+impl fmt::Display for KeyPath {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, s) in self.0.iter().enumerate() {
+            match s {
+                Seg::Key(k) if i == 0 => f.write_str(k)?,
+                Seg::Key(k) => write!(f, ".{k}")?,
+                Seg::Index(n) => write!(f, "[{n}]")?,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Longest accepted path (characters) and largest accepted index.
+const MAX_LEN: usize = 512;
+const MAX_INDEX: usize = 1_000_000;
+
+impl KeyPath {
+    /// Parse a path; the error says what is wrong and where. Never panics.
+    pub fn parse(s: &str) -> Result<KeyPath, String> {
+        if s.is_empty() {
+            return Err("empty parameter path".into());
+        }
+        if s.len() > MAX_LEN {
+            return Err(format!("parameter path longer than {MAX_LEN} characters"));
+        }
+        let bytes = s.as_bytes();
+        let mut segs = Vec::new();
+        let mut i = 0;
+        let is_key = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'-';
+        loop {
+            let start = i;
+            while i < bytes.len() && is_key(bytes[i]) {
+                i += 1;
+            }
+            if i == start {
+                return Err(format!(
+                    "`{s}`: expected a key name at character {}",
+                    start + 1
+                ));
+            }
+            segs.push(Seg::Key(s[start..i].to_string()));
+            while i < bytes.len() && bytes[i] == b'[' {
+                let open = i;
+                i += 1;
+                let d0 = i;
+                while i < bytes.len() && bytes[i].is_ascii_digit() {
+                    i += 1;
+                }
+                if i == d0 || i >= bytes.len() || bytes[i] != b']' {
+                    return Err(format!(
+                        "`{s}`: expected `[index]` with a non-negative integer at character {}",
+                        open + 1
+                    ));
+                }
+                let n: usize = s[d0..i]
+                    .parse()
+                    .ok()
+                    .filter(|n| *n <= MAX_INDEX)
+                    .ok_or_else(|| format!("`{s}`: index too large at character {}", d0 + 1))?;
+                segs.push(Seg::Index(n));
+                i += 1;
+            }
+            if i == bytes.len() {
+                break;
+            }
+            if bytes[i] != b'.' {
+                return Err(format!(
+                    "`{s}`: unexpected character `{}` at position {}",
+                    s[i..].chars().next().unwrap_or('?'),
+                    i + 1
+                ));
+            }
+            i += 1;
+        }
+        Ok(KeyPath(segs))
+    }
+
+    /// The path with every index replaced by `[]`.
+    pub fn pattern(&self) -> String {
+        pattern_of(&self.0)
+    }
+
+    /// The first key.
+    pub fn head(&self) -> &str {
+        match self.0.first() {
+            Some(Seg::Key(k)) => k,
+            _ => "",
+        }
+    }
+
+    /// The path without its first segment.
+    pub fn tail(&self) -> KeyPath {
+        KeyPath(self.0.iter().skip(1).cloned().collect())
+    }
+}
+
+/// Pattern of a segment list (indices as `[]`).
+pub fn pattern_of(segs: &[Seg]) -> String {
+    let mut out = String::new();
+    for (i, s) in segs.iter().enumerate() {
+        match s {
+            Seg::Key(k) => {
+                if i > 0 {
+                    out.push('.');
+                }
+                out.push_str(k);
+            }
+            Seg::Index(_) => out.push_str("[]"),
+        }
+    }
+    out
+}
+
+/// The value at `path` in `table`, if any.
+pub fn get<'a>(table: &'a toml::Table, path: &[Seg]) -> Option<&'a toml::Value> {
+    let (first, rest) = path.split_first()?;
+    let Seg::Key(k) = first else { return None };
+    let mut v = table.get(k)?;
+    for s in rest {
+        v = match (s, v) {
+            (Seg::Key(k), toml::Value::Table(t)) => t.get(k)?,
+            (Seg::Index(i), toml::Value::Array(a)) => a.get(*i)?,
+            _ => return None,
+        };
+    }
+    Some(v)
+}
+
+/// Make `value` the type of `reference`: integral floats become integers where the reference
+/// is an integer, integers become floats where it is a float.
+pub fn coerce(value: toml::Value, reference: Option<&toml::Value>) -> toml::Value {
+    match (value, reference) {
+        (toml::Value::Float(x), Some(toml::Value::Integer(_)))
+            if x.fract() == 0.0 && x.abs() < 9.0e15 =>
+        {
+            toml::Value::Integer(x as i64)
+        }
+        (toml::Value::Integer(n), Some(toml::Value::Float(_))) => toml::Value::Float(n as f64),
+        (v, _) => v,
+    }
+}
+
+/// Set `path` in `table` to `value` (coerced to the type of the value it replaces). Missing
+/// tables along the way are created; an index must address an existing array element.
+/// `shown` is the path as the user wrote it, for messages.
+pub fn set(
+    table: &mut toml::Table,
+    path: &[Seg],
+    value: toml::Value,
+    shown: &str,
+) -> Result<(), String> {
+    let Some((Seg::Key(first), rest)) = path.split_first() else {
+        return Err(format!("`{shown}`: a path starts with a key"));
+    };
+    if rest.is_empty() {
+        let old = table.get(first);
+        let v = coerce(value, old);
+        table.insert(first.clone(), v);
+        return Ok(());
+    }
+    let next = table.entry(first.clone()).or_insert_with(|| match rest[0] {
+        Seg::Key(_) => toml::Value::Table(toml::Table::new()),
+        Seg::Index(_) => toml::Value::Array(Vec::new()),
+    });
+    set_in(next, rest, value, shown, first)
+}
+
+fn set_in(
+    node: &mut toml::Value,
+    path: &[Seg],
+    value: toml::Value,
+    shown: &str,
+    at: &str,
+) -> Result<(), String> {
+    let Some((seg, rest)) = path.split_first() else {
+        let v = coerce(value, Some(node));
+        *node = v;
+        return Ok(());
+    };
+    match (seg, node) {
+        (Seg::Key(k), toml::Value::Table(t)) => {
+            if rest.is_empty() {
+                let v = coerce(value, t.get(k));
+                t.insert(k.clone(), v);
+                return Ok(());
+            }
+            let next = t.entry(k.clone()).or_insert_with(|| match rest[0] {
+                Seg::Key(_) => toml::Value::Table(toml::Table::new()),
+                Seg::Index(_) => toml::Value::Array(Vec::new()),
+            });
+            set_in(next, rest, value, shown, &format!("{at}.{k}"))
+        }
+        (Seg::Index(i), toml::Value::Array(a)) => {
+            let len = a.len();
+            let Some(el) = a.get_mut(*i) else {
+                return Err(format!(
+                    "`{shown}`: index {i} is out of range, `{at}` has {len} element{}",
+                    if len == 1 { "" } else { "s" }
+                ));
+            };
+            set_in(el, rest, value, shown, &format!("{at}[{i}]"))
+        }
+        (Seg::Key(k), other) => Err(format!(
+            "`{shown}`: `{at}` is a {}, not a table with key `{k}`",
+            other.type_str()
+        )),
+        (Seg::Index(i), other) => Err(format!(
+            "`{shown}`: `{at}` is a {}, not an array to index with [{i}]",
+            other.type_str()
+        )),
+    }
+}
+
+/// Every pattern of `table` (tables recursed, arrays as `name` and `name[]…`), prefixed with
+/// `prefix`. Array patterns (those whose value is an array) are also put in `arrays`.
+pub fn flatten(
+    table: &toml::Table,
+    prefix: &str,
+    out: &mut BTreeSet<String>,
+    arrays: &mut BTreeSet<String>,
+) {
+    for (k, v) in table {
+        let p = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        flatten_value(v, p, out, arrays);
+    }
+}
+
+fn flatten_value(
+    v: &toml::Value,
+    p: String,
+    out: &mut BTreeSet<String>,
+    arrays: &mut BTreeSet<String>,
+) {
+    match v {
+        toml::Value::Table(t) => {
+            out.insert(p.clone());
+            flatten(t, &p, out, arrays);
+        }
+        toml::Value::Array(a) => {
+            out.insert(p.clone());
+            arrays.insert(p.clone());
+            for el in a {
+                flatten_value(el, format!("{p}[]"), out, arrays);
+            }
+        }
+        _ => {
+            out.insert(p);
+        }
+    }
+}
+
+/// Whether `pattern` is valid: in `names`, or below an array pattern (free-form arrays).
+pub fn pattern_allowed(pattern: &str, names: &BTreeSet<String>, arrays: &BTreeSet<String>) -> bool {
+    if names.contains(pattern) {
+        return true;
+    }
+    let mut p = pattern;
+    while let Some(i) = p.rfind(['.', '[']) {
+        p = &p[..i];
+        if arrays.contains(p) {
+            return true;
+        }
+    }
+    false
+}
+
+/// A pattern for display: `[]` shown as `[i]`.
+pub fn display_pattern(p: &str) -> String {
+    p.replace("[]", "[i]")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_and_display() {
+        let p = KeyPath::parse("design.thruster[2].position[0]").unwrap();
+        assert_eq!(p.to_string(), "design.thruster[2].position[0]");
+        assert_eq!(p.pattern(), "design.thruster[].position[]");
+        for bad in [
+            "", ".a", "a.", "a[", "a[x]", "a[1", "a..b", "a b", "a[1]x", "é",
+        ] {
+            assert!(KeyPath::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn set_get_coerce() {
+        let mut t: toml::Table = toml::from_str("a = 1\nb = [1.0, 2.0]\n[c]\nd = 0.5").unwrap();
+        set(
+            &mut t,
+            &KeyPath::parse("a").unwrap().0,
+            toml::Value::Float(3.0),
+            "a",
+        )
+        .unwrap();
+        assert_eq!(t["a"], toml::Value::Integer(3));
+        set(
+            &mut t,
+            &KeyPath::parse("b[1]").unwrap().0,
+            toml::Value::Integer(5),
+            "b[1]",
+        )
+        .unwrap();
+        assert_eq!(t["b"][1], toml::Value::Float(5.0));
+        assert!(set(
+            &mut t,
+            &KeyPath::parse("b[2]").unwrap().0,
+            toml::Value::Integer(5),
+            "b"
+        )
+        .is_err());
+        set(
+            &mut t,
+            &KeyPath::parse("x.y").unwrap().0,
+            toml::Value::Integer(5),
+            "x.y",
+        )
+        .unwrap();
+        assert_eq!(
+            get(&t, &KeyPath::parse("x.y").unwrap().0),
+            Some(&toml::Value::Integer(5))
+        );
+        assert!(set(
+            &mut t,
+            &KeyPath::parse("a.b").unwrap().0,
+            toml::Value::Integer(5),
+            "a.b"
+        )
+        .is_err());
+        let (mut names, mut arrays) = (BTreeSet::new(), BTreeSet::new());
+        flatten(&t, "", &mut names, &mut arrays);
+        assert!(names.contains("b[]") && names.contains("c.d") && arrays.contains("b"));
+        assert!(pattern_allowed("b[][]", &names, &arrays));
+        assert!(!pattern_allowed("c.e", &names, &arrays));
+    }
+}

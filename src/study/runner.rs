@@ -1,0 +1,106 @@
+//! The ONE adapter between the batch engine and the scenario module (`crate::scenario`).
+//!
+//! Everything the sweep needs from the closed-loop scenarios goes through this file:
+//!
+//! - [`default_table`]: every scenario-side key with its default for a mode, shaped like the
+//!   scenario side of a study file — a table with the sub-tables `scenario`, `control`,
+//!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
+//!   valid axis names and to reject unknown keys before anything runs.
+//! - [`Worker::run`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
+//!   case's fully resolved scenario-side table (same shape, overrides applied) and the case
+//!   seed; returns named scalar metrics and, when `log` is set, a trajectory table.
+//!
+//! Both delegate to `crate::scenario` (`default_table`, `run_case`); trajectories are turned
+//! into report tables here so that the scenario module stays free of polars.
+
+use crate::model::Vehicle;
+use crate::report::Table;
+
+/// The result of one dynamic case.
+#[derive(Clone, Debug, Default)]
+pub struct CaseOutcome {
+    /// Named scalar metrics, in a stable order. Names must not contain `=` or `;`.
+    pub metrics: Vec<(String, f64)>,
+    /// The trajectory (one row per logged step; a time column named `t` or `time` first),
+    /// when logging was requested.
+    pub trajectory: Option<Table>,
+    /// Why the run stopped early (diverged, …): the case is recorded as `failed` with this
+    /// reason, its metrics are kept.
+    pub failure: Option<String>,
+}
+
+/// Top-level tables of the scenario side of a study file (besides the batch engine's own
+/// `[static]`); must cover the top-level keys of [`default_table`].
+pub const SCENARIO_TABLES: [&str; 11] = [
+    "scenario",
+    "control",
+    "base_control",
+    "allocation",
+    "metrics",
+    "physics",
+    "initial",
+    "path",
+    "setpoint",
+    "servo",
+    "thrusters",
+];
+
+/// Scenario modes a study may name.
+pub const MODES: [&str; 3] = ["static", "transport", "work"];
+
+/// Whether `mode` runs a closed-loop scenario (as opposed to the static analysis).
+pub fn is_dynamic(mode: &str) -> bool {
+    mode != "static"
+}
+
+/// Every scenario-side key with its default for `mode` (see the module docs for the shape):
+/// `crate::scenario::default_table` for the dynamic modes.
+pub fn default_table(mode: &str) -> Result<toml::Table, String> {
+    match mode {
+        "static" => toml::from_str("[scenario]\nmode = \"static\"\n").map_err(|e| e.to_string()),
+        "transport" | "work" => crate::scenario::default_table(mode).map_err(|e| e.to_string()),
+        other => Err(format!(
+            "unknown scenario mode '{other}'; valid: {}",
+            MODES.join(", ")
+        )),
+    }
+}
+
+/// Per-worker state of the sweep (one per rayon worker thread): the place for cached
+/// workspaces and allocators of the scenario module.
+#[derive(Default)]
+pub struct Worker {}
+
+impl Worker {
+    /// A fresh worker.
+    pub fn new() -> Self {
+        Self {}
+    }
+
+    /// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case
+    /// seed, `log` asks for the trajectory. An `Err` (invalid settings) is recorded as a failed
+    /// case with the message as its reason; a run that stops early (diverges, NaN) returns its
+    /// metrics with `failure` naming the time and the cause.
+    pub fn run(
+        &mut self,
+        vehicle: &Vehicle,
+        scenario: &toml::Table,
+        seed: u64,
+        log: bool,
+    ) -> Result<CaseOutcome, String> {
+        let run =
+            crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
+        let trajectory = match run.trajectory {
+            Some(t) => Some(
+                crate::report::figures::trajectory_table(&t.names, &t.columns)
+                    .map_err(|e| e.to_string())?,
+            ),
+            None => None,
+        };
+        Ok(CaseOutcome {
+            metrics: run.metrics,
+            trajectory,
+            failure: run.failure,
+        })
+    }
+}

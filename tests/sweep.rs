@@ -1,0 +1,377 @@
+//! End-to-end tests of `usm-study sweep`, `merge`, `report` and `tcm` on small static studies.
+
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_usm-study");
+
+/// 12 cases: 3 link counts × 2 rules × 2 offsets, all valid.
+const STUDY12: &str = r#"
+[study]
+name = "t12"
+seed = 11
+
+[design.generator]
+links = 5
+
+[static]
+samples = 48
+sampling = "lhs"
+
+[[axis]]
+name = "design.links"
+values = [4, 5, 6]
+
+[[axis]]
+name = "design.thruster_rule"
+values = ["paper", "distributed"]
+
+[[axis]]
+name = "design.generator.longitudinal_offset"
+range = { start = 0.1, stop = 0.2, steps = 2 }
+"#;
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .output()
+        .expect("run usm-study")
+}
+
+fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut a = vec![
+        "sweep",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend_from_slice(extra);
+    run(&a)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn read(p: &Path) -> Vec<u8> {
+    std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn jobs_do_not_change_results() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "study.toml", STUDY12);
+    let o1 = sweep(&s, &d.path().join("j1"), &["--jobs", "1"]);
+    assert_eq!(o1.status.code(), Some(0), "{}", stderr(&o1));
+    let o2 = sweep(&s, &d.path().join("j2"), &["--jobs", "2"]);
+    assert_eq!(o2.status.code(), Some(0), "{}", stderr(&o2));
+    let a = read(&d.path().join("j1/cases.csv"));
+    assert_eq!(a, read(&d.path().join("j2/cases.csv")));
+    let text = String::from_utf8(a).unwrap();
+    assert_eq!(text.lines().count(), 13);
+    assert!(
+        text.lines().skip(1).all(|l| l.ends_with(",ok,\"\"")),
+        "{text}"
+    );
+    for f in [
+        "cases.parquet",
+        "summary.md",
+        "manifest.json",
+        "study.toml",
+        "plots/pareto.svg",
+    ] {
+        assert!(d.path().join("j1").join(f).is_file(), "{f}");
+    }
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&d.path().join("j2/manifest.json"))).unwrap();
+    assert_eq!(m["cases"]["ok"], 12);
+    assert_eq!(m["jobs"], 2);
+}
+
+#[test]
+fn shards_merged_equal_unsharded() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "study.toml", STUDY12);
+    let full = d.path().join("full");
+    assert_eq!(sweep(&s, &full, &["--jobs", "2"]).status.code(), Some(0));
+    let mut dirs = Vec::new();
+    for i in 0..3 {
+        let out = d.path().join(format!("s{i}"));
+        let o = sweep(&s, &out, &["--shard", &format!("{i}/3"), "--jobs", "1"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        dirs.push(out.to_str().unwrap().to_string());
+    }
+    let merged = d.path().join("merged");
+    let mut args = vec!["merge"];
+    args.extend(dirs.iter().map(String::as_str));
+    args.extend(["--out", merged.to_str().unwrap()]);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(
+        read(&full.join("cases.csv")),
+        read(&merged.join("cases.csv"))
+    );
+    assert!(merged.join("summary.md").is_file());
+    // Regenerating the report works from the directory alone.
+    std::fs::remove_file(merged.join("summary.md")).unwrap();
+    let o = run(&["report", merged.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(merged.join("summary.md").is_file());
+    // Shards of another study are refused.
+    let other = write(
+        d.path(),
+        "other.toml",
+        &STUDY12.replace("seed = 11", "seed = 12"),
+    );
+    let od = d.path().join("o0");
+    assert_eq!(
+        sweep(&other, &od, &["--shard", "0/3"]).status.code(),
+        Some(0)
+    );
+    let o = run(&[
+        "merge",
+        &dirs[1],
+        od.to_str().unwrap(),
+        "--out",
+        d.path().join("bad").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("another study"), "{}", stderr(&o));
+}
+
+#[test]
+fn interrupted_sweep_resumes_without_recomputing() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "study.toml", STUDY12);
+    let out = d.path().join("r");
+    let o = sweep(&s, &out, &["--jobs", "2", "--max-cases", "5"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!out.join("cases.csv").exists());
+    let partial = std::fs::read_to_string(out.join("cases.partial.csv")).unwrap();
+    assert_eq!(partial.lines().count(), 6);
+    // Simulate a row cut off by the interruption.
+    std::fs::write(out.join("cases.partial.csv"), format!("{partial}7,abc")).unwrap();
+    let o = sweep(&s, &out, &["--jobs", "2", "--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("resumed 5 cases, ran 7"),
+        "{}",
+        stderr(&o)
+    );
+    let m: serde_json::Value = serde_json::from_slice(&read(&out.join("manifest.json"))).unwrap();
+    assert_eq!(m["cases"]["resumed"], 5);
+    assert_eq!(m["cases"]["ran"], 7);
+    let full = d.path().join("full");
+    assert_eq!(sweep(&s, &full, &["--jobs", "1"]).status.code(), Some(0));
+    assert_eq!(read(&full.join("cases.csv")), read(&out.join("cases.csv")));
+    // A second resume recomputes nothing.
+    let o = sweep(&s, &out, &["--resume"]);
+    assert!(
+        stderr(&o).contains("resumed 12 cases, ran 0"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(read(&full.join("cases.csv")), read(&out.join("cases.csv")));
+}
+
+#[test]
+fn unknown_parameter_fails_before_running() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(
+        d.path(),
+        "study.toml",
+        &STUDY12.replace("design.generator.longitudinal_offset", "control.k_nope"),
+    );
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("unknown parameter `control.k_nope`"), "{e}");
+    assert!(
+        e.contains("valid names")
+            && e.contains("design.generator.links")
+            && e.contains("static.samples"),
+        "{e}"
+    );
+    assert!(e.contains("study.toml:22:1"), "{e}");
+    assert!(!out.exists(), "nothing may run");
+}
+
+#[test]
+fn malformed_files_name_file_line_and_key() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(
+        d.path(),
+        "bad.toml",
+        &format!("{STUDY12}\n[doe]\nkind = \"grid\"\ncases = 4\n"),
+    );
+    let o = sweep(&s, &d.path().join("o"), &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("bad.toml:") && e.contains("doe.cases"), "{e}");
+    let s = write(
+        d.path(),
+        "bad2.toml",
+        &STUDY12.replace("values = [4, 5, 6]", "values = [4, 5, 6"),
+    );
+    let o = sweep(&s, &d.path().join("o"), &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bad2.toml:"), "{}", stderr(&o));
+    let s = write(
+        d.path(),
+        "bad3.toml",
+        &STUDY12.replace("sampling = \"lhs\"", "sampling = \"lhs\"\nsampels = 3"),
+    );
+    let o = sweep(&s, &d.path().join("o"), &[]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.contains("bad3.toml:12:1") && e.contains("static.sampels"),
+        "{e}"
+    );
+}
+
+#[test]
+fn failing_and_invalid_cases_are_recorded() {
+    let d = tempfile::tempdir().unwrap();
+    let text = r#"
+[study]
+name = "f"
+
+[design.generator]
+links = 4
+
+[static]
+samples = 16
+
+[[axis]]
+name = "design.thruster_rule"
+values = ["paper", "none"]
+
+[[axis]]
+name = "design.radius"
+values = [0.085, -1.0]
+"#;
+    let s = write(d.path(), "f.toml", text);
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &["--jobs", "2"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 4);
+    assert!(rows[0].ends_with(",ok,\"\""), "{csv}");
+    assert!(
+        rows[1].contains(",skipped,") && rows[1].contains("radius"),
+        "{csv}"
+    );
+    assert!(
+        rows[2].contains(",failed,") && rows[2].contains("thruster"),
+        "{csv}"
+    );
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        md.contains("## Failed and skipped cases") && md.contains("| failed |"),
+        "{md}"
+    );
+}
+
+#[test]
+fn dry_run_lists_cases() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "study.toml", STUDY12);
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &["--dry-run"]);
+    assert_eq!(o.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(text.lines().count(), 13, "{text}");
+    assert!(text.contains("design.thruster_rule=distributed"), "{text}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn tcm_on_the_paper_design() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("tcm");
+    let o = run(&[
+        "tcm",
+        "usm-paper",
+        "--samples",
+        "300",
+        "--seed",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+        "--jobs",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for f in [
+        "samples.csv",
+        "samples.parquet",
+        "summary.json",
+        "sigma_min_hist.svg",
+        "sigma_min_slice.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let s: serde_json::Value = serde_json::from_slice(&read(&out.join("summary.json"))).unwrap();
+    assert_eq!(
+        s["straight"]["rank"], 5,
+        "the straight configuration is singular"
+    );
+    assert_eq!(s["straight"]["lost_axis"], "roll");
+    let f = s["singular_fraction"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&f));
+    assert_eq!(s["samples"], 300);
+    assert_eq!(
+        std::fs::read_to_string(out.join("samples.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        301
+    );
+    // Same result with one thread.
+    let out1 = d.path().join("tcm1");
+    let o = run(&[
+        "tcm",
+        "usm-paper",
+        "--samples",
+        "300",
+        "--seed",
+        "5",
+        "--out",
+        out1.to_str().unwrap(),
+        "--jobs",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        read(&out.join("samples.csv")),
+        read(&out1.join("samples.csv"))
+    );
+    assert_eq!(
+        read(&out.join("summary.json")),
+        read(&out1.join("summary.json"))
+    );
+}
+
+proptest! {
+    #[test]
+    fn axis_path_parser_never_panics(s in "\\PC{0,40}") {
+        let _ = usm_study::study::path::KeyPath::parse(&s);
+    }
+
+    #[test]
+    fn axis_path_roundtrip(s in "[a-z_]{1,6}(\\[[0-9]{1,3}\\])?(\\.[a-z_]{1,6}(\\[[0-9]{1,2}\\]){0,2}){0,3}") {
+        let p = usm_study::study::path::KeyPath::parse(&s).unwrap();
+        let again = usm_study::study::path::KeyPath::parse(&p.to_string()).unwrap();
+        prop_assert_eq!(p, again);
+    }
+}
