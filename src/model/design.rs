@@ -52,6 +52,7 @@
 use super::generator::{GeneratorSpec, ThrusterRule};
 use super::presets::{self, PRESETS};
 use super::{Body, Fluid, Hydro, Joint, ModelError, Thruster, Vehicle};
+use crate::diag::{line_col, one_line, write_located};
 use crate::spatial::{rot_axis_angle, Mat3, Mat6, Se3, Vec3};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
@@ -104,17 +105,14 @@ pub struct DesignError {
 
 impl fmt::Display for DesignError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.origin)?;
-        if let Some(line) = self.line {
-            write!(f, ":{line}")?;
-            if let Some(col) = self.column {
-                write!(f, ":{col}")?;
-            }
-        }
-        if !self.key.is_empty() {
-            write!(f, ": {}", self.key)?;
-        }
-        write!(f, ": {}", self.message)
+        write_located(
+            f,
+            &self.origin,
+            self.line,
+            self.column,
+            &self.key,
+            &self.message,
+        )
     }
 }
 
@@ -381,23 +379,6 @@ fn parent_path(p: &str) -> Option<&str> {
         return p.rfind('[').map(|i| &p[..i]);
     }
     p.rfind('.').map(|i| &p[..i])
-}
-
-/// 1-based line and column (in characters) of byte `offset` in `text`.
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let mut o = offset.min(text.len());
-    while !text.is_char_boundary(o) {
-        o -= 1;
-    }
-    let before = &text[..o];
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let column = before[line_start..].chars().count() + 1;
-    (line, column)
-}
-
-fn one_line(s: &str) -> String {
-    s.trim().replace('\n', "; ")
 }
 
 // ---------------------------------------------------------------------------------------

@@ -4,6 +4,7 @@
 //! Every error names the file, the 1-based line and column when known, and the key
 //! (`axis[2].name`). `deny_unknown_fields` everywhere; no `serde(flatten)`.
 
+use crate::diag::{line_col, one_line, write_located};
 use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -32,17 +33,14 @@ pub struct InputError {
 
 impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.origin)?;
-        if let Some(l) = self.line {
-            write!(f, ":{l}")?;
-            if let Some(c) = self.column {
-                write!(f, ":{c}")?;
-            }
-        }
-        if !self.key.is_empty() {
-            write!(f, ": {}", self.key)?;
-        }
-        write!(f, ": {}", self.message)
+        write_located(
+            f,
+            &self.origin,
+            self.line,
+            self.column,
+            &self.key,
+            &self.message,
+        )
     }
 }
 
@@ -214,21 +212,6 @@ impl Spans {
             .unwrap_or_default();
         self.at_offset(offset, &key, one_line(e.message()))
     }
-}
-
-fn one_line(s: &str) -> String {
-    s.trim().replace('\n', "; ")
-}
-
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let mut o = offset.min(text.len());
-    while !text.is_char_boundary(o) {
-        o -= 1;
-    }
-    let before = &text[..o];
-    let line = before.matches('\n').count() + 1;
-    let start = before.rfind('\n').map_or(0, |i| i + 1);
-    (line, before[start..].chars().count() + 1)
 }
 
 // ---------------------------------------------------------------------------------------
