@@ -9,8 +9,9 @@
 //! (USM-35), both supplied by the caller (the dynamics module), `V_b`, `V_r` twists in `F_b`
 //! [m/s, rad/s], `τ_c` the commanded base wrench `[f; m]` in `F_b` [N, N·m] for the thrust
 //! allocation. The nonlinear term is used only when [`DynamicGains::nonlinear`] is set (the
-//! paper's work mode drops it). In transport mode the acceleration comes directly from USM-40/41
-//! and only USM-33 is applied ([`DynamicController::acceleration_control`]).
+//! paper's work mode drops it). In transport mode the surge and yaw accelerations come directly
+//! from USM-40/41 and the other axes get USM-34 with a zero reference
+//! ([`DynamicController::transport_control`]).
 
 use super::{check_nonneg, ControlError};
 use crate::spatial::Vec6;
@@ -58,13 +59,14 @@ impl DynamicGains {
         }
     }
 
-    /// Transport mode: USM-33 with the nonlinear term ("we apply the dynamic control law in
-    /// (33)"); `K_p`, `K_i` unused since `a^b` comes from USM-40/41.
+    /// Transport mode (interpretation, see [`super::transport`]): USM-33 **without** the
+    /// nonlinear term, as in the paper's own work-mode simulation, and the paper's
+    /// `K_p = diag(1, 1, 1, 0, 1, 1)` used on the axes transport does not command (sway 1,
+    /// heave 1, roll 0, pitch 1: [`DynamicController::transport_control`]); surge and yaw come
+    /// from USM-40/41, so `K_p,0`, `K_p,5` and `K_i` are unused. The paper-literal form is
+    /// `nonlinear = true, kp = [0, 0, 0, 0, 0, 0]`.
     pub fn transport() -> Self {
-        Self {
-            nonlinear: true,
-            ..Self::work_mode()
-        }
+        Self::work_mode()
     }
 
     /// Check the values; errors name `dynamic.<key>`.
@@ -271,10 +273,37 @@ mod tests {
         let v_b = Vec6::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.0);
         let out = ctl.velocity_control(&m, &n, &v_b, &Vec6::zeros(), 0.1);
         assert_eq!(out.tau_c, Vec6::new(-1.0, 0.0, 0.0, 0.0, 0.0, 0.0));
-        // Transport: τ = M a + n.
-        let t = DynamicController::new(DynamicGains::transport()).unwrap();
+        // With the nonlinear term: τ = M a + n.
+        let t = DynamicController::new(DynamicGains {
+            nonlinear: true,
+            ..DynamicGains::transport()
+        })
+        .unwrap();
         let a = Vec6::new(0.1, 0.0, 0.0, 0.0, 0.0, -0.2);
         assert_eq!(t.acceleration_control(&m, &n, &a), m * a + n);
+    }
+
+    #[test]
+    fn transport_control_damps_only_the_free_axes() {
+        // Surge and yaw pass through from USM-40/41; sway, heave, pitch get −K_p v (K_p = 1),
+        // roll nothing (K_p = 0); no n by default.
+        let t = DynamicController::new(DynamicGains::transport()).unwrap();
+        let m = Matrix6::identity() * 2.0;
+        let n = Vec6::repeat(5.0);
+        let a = Vec6::new(0.1, 0.0, 0.0, 0.0, 0.0, -0.2);
+        let v = Vec6::new(0.5, 0.2, -0.1, 0.3, 0.05, 0.4);
+        let (tau, used) = t.transport_control(&m, &n, &a, &v);
+        let expect = Vec6::new(0.1, -0.2, 0.1, 0.0, -0.05, -0.2);
+        assert!((used - expect).norm() < 1e-15, "{used}");
+        assert!((tau - m * expect).norm() < 1e-15);
+        // The literal reading (K_p = 0, with n) is τ = M a + n.
+        let lit = DynamicController::new(DynamicGains {
+            kp: [0.0; 6],
+            nonlinear: true,
+            ..DynamicGains::transport()
+        })
+        .unwrap();
+        assert_eq!(lit.transport_control(&m, &n, &a, &v).0, m * a + n);
     }
 
     #[test]

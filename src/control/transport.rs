@@ -28,8 +28,38 @@
 //!   acceleration (z of `F_b`). `ψ̇` is, by default, the rate of the same heading ψ (the front
 //!   link's, [`YawRateSource::FrontHeading`]) so that the law is a PD on one signal; the base
 //!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]).
-//! - All other components of `a^b` are zero; `τ_c = M_11 a^b (+ n)` follows in
-//!   [`super::dynamic::DynamicController::acceleration_control`] (USM-33).
+//! - The other components of `a^b`: the paper says they are "set to zero". We read this as
+//!   USM-34 with a zero reference on those axes, `a_i = −K_p,i v_b,i` (sway, heave, roll,
+//!   pitch; the paper's `K_p = diag(1,1,1,0,1,1)`), applied with `τ_c = M_11 a^b` in
+//!   [`super::dynamic::DynamicController::transport_control`], without `n` by default
+//!   ([`super::dynamic::DynamicGains::transport`]). Both are interpretation choices, justified
+//!   below; the literal form is `base_control.nonlinear = true, kp = [0, 0, 0, 0, 0, 0]`.
+//!
+//! # Interpretation choices and why (results/paper/FINDINGS.md has the numbers)
+//!
+//! - **Zero-velocity feedback on the uncommanded axes.** With `n` included and those
+//!   accelerations literally zero, USM-33 makes sway, heave and pitch pure integrators
+//!   (`v̇ = 0`): the sideslip the joint motion kicks in at the start (≈ −0.1 m/s at the tail)
+//!   is never removed, so the heading converges but the course does not, and the cross-track
+//!   error settles at `≈ Δ tan(crab)` instead of zero. A real vehicle damps this through
+//!   cross-flow drag, which `n` cancels; `K_p` towards zero velocity restores it.
+//! - **No `n` (τ_c = M_11 a^b).** With exact feedback linearisation every hydrodynamic force on
+//!   the base is cancelled — including the lateral force of the bent body, which is how bending
+//!   the joints (USM-38) steers a vehicle through water. The base yaw then obeys `ψ̈_b = a_6`
+//!   only, and with quasi-static joints (`ψ − ψ_r = (ψ_b − ψ_r)/(1 + 4k_ψ)`), straight-line
+//!   LOS `ė_y = U ψ_b`, `ψ_r = −e_y/Δ`, USM-41 gives the cubic
+//!   `s³ + b s² + (a + bU/Δ) s + aU/Δ` with `a = k_6p/(1+4k_ψ)`, `b = k_6d/(1+4k_ψ)`. With the
+//!   Table III gains its roots are `0.040 ± 0.248i` for Method 1 (unstable: the simulated
+//!   limit cycle of ±1.7 m with 40 N saturations) and `−0.014 ± 0.142i` for Method 2 (a 44 s
+//!   oscillation decaying over ~70 s: the simulated one). The Table III gains were tuned
+//!   (trial and error) on Vortex, whose hydrodynamics the controller's model does not cancel
+//!   exactly, so we keep the hydrodynamics in the loop, as the paper's own work-mode
+//!   simulation does. No gain is changed.
+//! - `ψ̇` in USM-41 is the front-heading rate (one signal for the PD); the base yaw rate
+//!   changes little (Method 1 converges slower, Method 2 a little faster on segment 0).
+//! - The initial 40 N burst (first 0.5 s) is the servo (ω_n = 5 rad/s) snapping the joints to
+//!   `k_ψ(ψ − ψ_r) ≈ 0.44 rad` while USM-41's `k_6d` term reacts to the head's resulting yaw
+//!   rate; ω_n = 1 rad/s halves it. We keep the servo and report it.
 
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
 use super::{

@@ -404,8 +404,9 @@ impl ScenarioFile {
         }
     }
 
-    /// Base control gains: the file's, or the mode's default (transport: with the
-    /// nonlinear term; work: without, as in the paper).
+    /// Base control gains: the file's, or the mode's default
+    /// ([`DynamicGains::transport`], [`DynamicGains::work_mode`]). A partial `[base_control]`
+    /// table fills the missing keys from the work-mode defaults (`nonlinear = false`).
     pub fn base_gains(&self) -> DynamicGains {
         self.base_control
             .clone()
