@@ -63,7 +63,9 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
         "# The USM paper's simulations, regenerated\n\n\
          Regenerate with `cargo run --release -- paper --out results/paper`.\n\
          Each directory holds `summary.json` (metrics, allocation counts, timing) and\n\
-         `figure.svg` (laid out like the paper's Fig. 8 / Fig. 9).\n",
+         `figure.svg` (laid out like the paper's Fig. 8 / Fig. 9). Transport runs last the\n\
+         paper's 140 s, which leaves 45 s after the segment commanded at 95 s: a NaN\n\
+         convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n",
     );
     let mut failed = false;
     let mut rows: Vec<(String, Vec<(String, f64)>)> = Vec::new();
