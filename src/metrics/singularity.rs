@@ -126,6 +126,30 @@ pub fn sigma_min_scaled(t: &Matrix6xX<f64>, char_length: f64) -> Result<f64, Sin
     Ok(scaled_svd(t, char_length).0[5])
 }
 
+/// σ_min of `T_L` (SPEC §6) from the eigenvalues of the 6×6 Gram matrix `T_L T_Lᵀ`, without
+/// heap allocation (for logging inside a simulation loop). Accurate to about
+/// `√ε · σ_max` ≈ 1e-8·σ_max, ample for comparing with singularity thresholds of 1e-2; use
+/// [`sigma_min_scaled`] where exact small singular values matter. NaN if `t` is not finite
+/// or `char_length` is not positive.
+pub fn sigma_min_scaled_gram(t: &Matrix6xX<f64>, char_length: f64) -> f64 {
+    if !(char_length.is_finite() && char_length > 0.0) {
+        return f64::NAN;
+    }
+    let mut gram = nalgebra::Matrix6::<f64>::zeros();
+    for col in t.column_iter() {
+        let mut c: Vector6<f64> = col.into_owned();
+        for i in 3..6 {
+            c[i] /= char_length;
+        }
+        gram += c * c.transpose();
+    }
+    if !gram.iter().all(|x| x.is_finite()) {
+        return f64::NAN;
+    }
+    let ev = gram.symmetric_eigenvalues();
+    ev.min().max(0.0).sqrt()
+}
+
 /// Fraction of samples whose σ_min is below `threshold` (SPEC §6, "how often T is singular");
 /// 0 for an empty slice. NaN samples count as singular.
 pub fn singular_fraction(sigma_mins: &[f64], threshold: f64) -> f64 {
@@ -322,5 +346,23 @@ mod tests {
     fn singular_fraction_counts() {
         assert_eq!(singular_fraction(&[0.0, 0.5, 1.0, f64::NAN], 0.6), 0.75);
         assert_eq!(singular_fraction(&[], 0.6), 0.0);
+    }
+
+    #[test]
+    fn gram_sigma_min_matches_svd_to_its_precision() {
+        // sqrt(eps)·σ_max bounds the Gram route's error; 1e-6 is far above it and far
+        // below any singularity threshold in use.
+        let v = crate::model::presets::usm_paper();
+        let mut ws = crate::kinematics::KinWorkspace::new(&v);
+        for k in 0..8 {
+            let mut q = vec![0.0; 8];
+            q[k] = 0.3 * (k as f64 + 1.0) / 8.0;
+            crate::kinematics::forward_kinematics(&v, &q, &mut ws);
+            let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
+            let a = sigma_min_scaled(&t, 1.65).unwrap();
+            let b = sigma_min_scaled_gram(&t, 1.65);
+            assert!((a - b).abs() < 1e-6, "joint {k}: {a} vs {b}");
+        }
+        assert!(sigma_min_scaled_gram(&Matrix6xX::zeros(3), 0.0).is_nan());
     }
 }

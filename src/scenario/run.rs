@@ -13,7 +13,7 @@ use crate::control::transport::{measure_transport, TransportController};
 use crate::control::work::{WorkController, WorkTarget};
 use crate::dynamics::{ActuatorCommand, SimError, SimState, Simulator};
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
-use crate::metrics::singularity::sigma_min_scaled;
+use crate::metrics::singularity::sigma_min_scaled_gram;
 use crate::metrics::trajectory::{
     energy_metrics, segment_tracking, settling_time, singularity_exposure,
 };
@@ -503,7 +503,7 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
             for (x, th) in state.thrust.iter().zip(&v.thrusters) {
                 put(power.power(x.clamp(th.u_min, th.u_max)));
             }
-            put(sigma_min_scaled(&t_mat, char_length).unwrap_or(f64::NAN));
+            put(sigma_min_scaled_gram(&t_mat, char_length));
             put(alloc.s.norm());
             put(status_code(&alloc.status));
             traj.push_row(&row);
