@@ -909,7 +909,8 @@ pub fn run_sweep(
     };
     write_manifest(&out, &manifest)?;
     if opts.shard.is_none() {
-        outcome.warnings = finish_report(&out, &table, &manifest, Some(study));
+        // Inside the sweep's pool, so the best/worst reruns respect --jobs.
+        outcome.warnings = pool.install(|| finish_report(&out, &table, &manifest, Some(study)));
     }
     Ok(outcome)
 }
@@ -1105,7 +1106,8 @@ fn rerun_extremes(
     };
     let ids = table.i64("case_id").map_err(|e| e.to_string())?;
     let all = expand(study, None)?;
-    for (label, row) in [("best", best), ("worst", worst)] {
+    // The two reruns are independent: run them side by side.
+    let rerun = |label: &str, row: usize| -> Result<(), String> {
         let id = ids[row] as usize;
         let case = all.get(id).ok_or("case id out of range")?;
         let r = resolve_case(study, case)?;
@@ -1114,8 +1116,10 @@ fn rerun_extremes(
             write_csv(&t, &out.join(format!("trajectory_{label}.csv")))
                 .map_err(|e| e.to_string())?;
         }
-    }
-    Ok(())
+        Ok(())
+    };
+    let (a, b) = rayon::join(|| rerun("best", best), || rerun("worst", worst));
+    a.and(b)
 }
 
 /// Merge shard outputs into `out`: check they come from the same study, concatenate their raw
