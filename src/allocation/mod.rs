@@ -25,7 +25,7 @@
 mod attainable;
 mod conic;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 use std::fmt;
 use std::str::FromStr;

@@ -37,7 +37,7 @@ pub(crate) fn bent_t(seed: u64) -> Matrix6xX<f64> {
 }
 
 /// A straight USM: 7 thrusters on the body x axis, roll row of T identically zero (rank 5).
-fn straight_t() -> Matrix6xX<f64> {
+pub(crate) fn straight_t() -> Matrix6xX<f64> {
     let dirs = [
         [1.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],

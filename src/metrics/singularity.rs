@@ -234,27 +234,10 @@ mod tests {
         (a - b).abs() <= tol * (1.0 + b.abs())
     }
 
-    /// A straight USM: 7 thrusters on the body x axis, so no thruster makes a roll moment.
+    /// A straight USM: 7 thrusters on the body x axis, so no thruster makes a roll moment
+    /// (the allocation tests' fixture).
     fn straight_usm() -> Matrix6xX<f64> {
-        let dirs = [
-            [1.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, 1.0],
-            [0.6, 0.0, 0.8],
-        ];
-        let xs = [0.2, 1.8, 0.4, 1.6, 0.6, 1.4, 1.0];
-        let mut t = Matrix6xX::zeros(7);
-        for j in 0..7 {
-            let d = nalgebra::Vector3::from(dirs[j]);
-            let p = nalgebra::Vector3::new(xs[j], 0.0, 0.0);
-            let mo = p.cross(&d);
-            t.fixed_view_mut::<3, 1>(0, j).copy_from(&d);
-            t.fixed_view_mut::<3, 1>(3, j).copy_from(&mo);
-        }
-        t
+        crate::allocation::tests::straight_t()
     }
 
     #[test]
