@@ -300,17 +300,7 @@ impl Figure {
     /// Renders the figure to an SVG document.
     pub fn render_svg(&self) -> Result<String> {
         self.validate()?;
-        let mut buf = String::new();
-        {
-            let root = SVGBackend::with_string(&mut buf, self.size).into_drawing_area();
-            draw_figure(self, &root)
-                .and_then(|()| root.present().map_err(Into::into))
-                .map_err(|e| ReportError::Plot {
-                    figure: self.title.clone(),
-                    message: e.to_string(),
-                })?;
-        }
-        Ok(buf)
+        render_to_svg(self.size, &self.title, |root| draw_figure(self, root))
     }
 
     /// Renders the figure and writes it to `path` atomically.
@@ -327,6 +317,26 @@ fn check_size(size: (u32, u32)) -> std::result::Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// Draw onto a fresh SVG canvas of `size` pixels and return the document; drawing errors
+/// become [`ReportError::Plot`] naming the figure `title`.
+fn render_to_svg(
+    size: (u32, u32),
+    title: &str,
+    draw: impl FnOnce(&Area<'_>) -> DrawResult,
+) -> Result<String> {
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, size).into_drawing_area();
+        draw(&root)
+            .and_then(|()| root.present().map_err(Into::into))
+            .map_err(|e| ReportError::Plot {
+                figure: title.to_string(),
+                message: e.to_string(),
+            })?;
+    }
+    Ok(buf)
 }
 
 fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
@@ -916,17 +926,7 @@ impl Heatmap {
     /// Renders the heat map to an SVG document.
     pub fn render_svg(&self) -> Result<String> {
         self.validate()?;
-        let mut buf = String::new();
-        {
-            let root = SVGBackend::with_string(&mut buf, self.size).into_drawing_area();
-            self.draw(&root)
-                .and_then(|()| root.present().map_err(Into::into))
-                .map_err(|e| ReportError::Plot {
-                    figure: self.title.clone(),
-                    message: e.to_string(),
-                })?;
-        }
-        Ok(buf)
+        render_to_svg(self.size, &self.title, |root| self.draw(root))
     }
 
     /// Renders the heat map and writes it to `path` atomically.

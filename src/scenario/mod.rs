@@ -33,12 +33,8 @@ use crate::model::Vehicle;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-/// Built-in scenarios: (name, TOML text).
-pub const PRESETS: [(&str, &str); 3] = [
-    ("transport-method1", TRANSPORT_METHOD1),
-    ("transport-method2", TRANSPORT_METHOD2),
-    ("work-setpoint", WORK_SETPOINT),
-];
+/// Names of the built-in scenarios.
+pub const PRESETS: [&str; 3] = ["transport-method1", "transport-method2", "work-setpoint"];
 
 const TRANSPORT_COMMON: &str = r#"
 [initial]
@@ -58,9 +54,18 @@ segments = [
 method = "qp"
 "#;
 
-const TRANSPORT_METHOD1: &str = r#"
+/// A transport preset: USM Table III row `method` (1: regulate the end-effector surge,
+/// 2: the base surge), the paper's 140 s, then [`TRANSPORT_COMMON`].
+fn transport_preset(method: u8) -> String {
+    let what = if method == 1 {
+        "the end-effector surge"
+    } else {
+        "the base surge"
+    };
+    format!(
+        r#"
 [scenario]
-name = "transport-method1"
+name = "transport-method{method}"
 mode = "transport"
 design = "usm-paper"
 duration = 140.0
@@ -69,24 +74,11 @@ control_dt = 0.05
 log_dt = 0.1
 
 [control]
-# USM Table III, Method 1: regulate the end-effector surge.
-method = "method1"
-"#;
-
-const TRANSPORT_METHOD2: &str = r#"
-[scenario]
-name = "transport-method2"
-mode = "transport"
-design = "usm-paper"
-duration = 140.0
-dt = 0.01
-control_dt = 0.05
-log_dt = 0.1
-
-[control]
-# USM Table III, Method 2: regulate the base surge.
-method = "method2"
-"#;
+# USM Table III, Method {method}: regulate {what}.
+method = "method{method}"
+{TRANSPORT_COMMON}"#
+    )
+}
 
 const WORK_SETPOINT: &str = r#"
 [scenario]
@@ -125,18 +117,17 @@ lambda = 0.1
 
 /// The TOML text of a preset, or `None`.
 pub fn preset_text(name: &str) -> Option<String> {
-    PRESETS.iter().find(|(n, _)| *n == name).map(|(n, t)| {
-        if n.starts_with("transport") {
-            format!("{t}{TRANSPORT_COMMON}")
-        } else {
-            t.to_string()
-        }
-    })
+    match name {
+        "transport-method1" => Some(transport_preset(1)),
+        "transport-method2" => Some(transport_preset(2)),
+        "work-setpoint" => Some(WORK_SETPOINT.to_string()),
+        _ => None,
+    }
 }
 
 /// Names of the presets.
 pub fn preset_names() -> Vec<&'static str> {
-    PRESETS.iter().map(|(n, _)| *n).collect()
+    PRESETS.to_vec()
 }
 
 /// Where a scenario came from: a preset or a file (whose directory anchors relative paths).
