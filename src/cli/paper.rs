@@ -3,9 +3,8 @@
 //! with their figures, summaries and a comparison table.
 
 use super::fmt_num;
-use super::simulate::write_outputs;
+use super::simulate::{set_allocation_method, write_outputs};
 use crate::allocation::Method;
-use crate::control::transport::yaw_joint_mask;
 use crate::scenario::{load_table, parse_table, preset_names, resolve_design, run_scenario};
 use anyhow::Context;
 use clap::Args;
@@ -86,26 +85,14 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
     for (dir, preset, method) in &runs {
         let (mut table, src) = load_table(preset)?;
         if let Some(m) = method {
-            if let Some(t) = table
-                .entry("allocation")
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()))
-                .as_table_mut()
-            {
-                t.insert("method".into(), toml::Value::String(m.name().into()));
-            }
+            set_allocation_method(&mut table, *m);
         }
         let file = parse_table(&table, &src.origin)?;
         let v = resolve_design(&file, &src)?;
         let r = run_scenario(&v, &file)?;
         let out = a.out.join(dir);
         std::fs::create_dir_all(&out)?;
-        let yaw: Vec<usize> = yaw_joint_mask(&v)
-            .iter()
-            .enumerate()
-            .filter(|(_, y)| **y)
-            .map(|(i, _)| i)
-            .collect();
-        write_outputs(&r, &out, &yaw, true, &v.name)?;
+        write_outputs(&r, &out, &v, true)?;
         if !a.timeseries {
             for f in ["timeseries.csv", "timeseries.parquet"] {
                 let _ = std::fs::remove_file(out.join(f));

@@ -3,6 +3,7 @@
 use super::fmt_num;
 use crate::allocation::Method;
 use crate::control::transport::yaw_joint_mask;
+use crate::model::Vehicle;
 use crate::report::figures::{run_figure, trajectory_table};
 use crate::report::{write_csv, write_parquet};
 use crate::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
@@ -51,12 +52,7 @@ pub fn parse_override(s: &str) -> anyhow::Result<(KeyPath, toml::Value)> {
 pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     let (mut table, src) = load_table(&a.scenario)?;
     if let Some(m) = a.allocation {
-        let alloc = table
-            .entry("allocation")
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        if let Some(t) = alloc.as_table_mut() {
-            t.insert("method".into(), toml::Value::String(m.name().into()));
-        }
+        set_allocation_method(&mut table, m);
     }
     for s in &a.set {
         let (path, value) = parse_override(s)?;
@@ -78,13 +74,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         file.allocation.method.name()
     );
     let r = run_scenario(&vehicle, &file)?;
-    let yaw: Vec<usize> = yaw_joint_mask(&vehicle)
-        .iter()
-        .enumerate()
-        .filter(|(_, y)| **y)
-        .map(|(i, _)| i)
-        .collect();
-    write_outputs(&r, &out, &yaw, !a.no_plots, &vehicle.name)?;
+    write_outputs(&r, &out, &vehicle, !a.no_plots)?;
     print_summary(&r);
     eprintln!("[simulate] wrote {}", out.display());
     match &r.failure {
@@ -98,15 +88,26 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// Set `allocation.method` in a scenario table (the `--allocation` override).
+pub fn set_allocation_method(table: &mut toml::Table, m: Method) {
+    if let Some(t) = table
+        .entry("allocation")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+        .as_table_mut()
+    {
+        t.insert("method".into(), toml::Value::String(m.name().into()));
+    }
+}
+
 /// Write `timeseries.csv`, `timeseries.parquet`, `summary.json` and (optionally) the
-/// paper-style figure `figure.svg` of a run into `out`.
+/// paper-style figure `figure.svg` of a run of `vehicle` into `out`.
 pub fn write_outputs(
     r: &RunResult,
     out: &std::path::Path,
-    yaw_joints: &[usize],
+    vehicle: &Vehicle,
     plots: bool,
-    design: &str,
 ) -> anyhow::Result<()> {
+    let design = vehicle.name.as_str();
     let table = trajectory_table(&r.trajectory.names, &r.trajectory.columns)?;
     write_csv(&table, &out.join("timeseries.csv"))?;
     write_parquet(&table, &out.join("timeseries.parquet"))?;
@@ -143,7 +144,17 @@ pub fn write_outputs(
     std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
     std::fs::rename(&tmp, out.join("summary.json"))?;
     if plots && table.n_rows() > 0 {
-        let fig = run_figure(&table, yaw_joints, &format!("{} ({} mode)", r.name, r.mode))?;
+        let yaw_joints: Vec<usize> = yaw_joint_mask(vehicle)
+            .iter()
+            .enumerate()
+            .filter(|(_, y)| **y)
+            .map(|(i, _)| i)
+            .collect();
+        let fig = run_figure(
+            &table,
+            &yaw_joints,
+            &format!("{} ({} mode)", r.name, r.mode),
+        )?;
         fig.write_svg(&out.join("figure.svg"))?;
     }
     Ok(())
