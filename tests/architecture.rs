@@ -1,0 +1,732 @@
+//! The shape of the house, checked on the source itself (issue 9): dependencies between the
+//! files of `src/` run one way (no import cycles), no source file grows past the size we can
+//! read in one sitting, and the library exposes no command-line layer.
+//!
+//! File X depends on file Y when X names an item defined in Y, through a `use` or a path in
+//! code (`crate::…`, `super::…`, a module alias). Re-exports (`pub use`) are followed to the
+//! file that defines the item, so a facade `mod.rs` is not a dependency of itself. Run with
+//! `cargo test --release --test architecture -- --nocapture` to see the graph's size.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Longest source file we accept in `src/` (test files included), in lines.
+const MAX_FILE_LINES: usize = 700;
+
+/// Blank out comments, string and character literals, keeping line structure.
+fn strip(text: &str) -> String {
+    let b = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        if c == b'/' && b.get(i + 1) == Some(&b'/') {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+        } else if c == b'/' && b.get(i + 1) == Some(&b'*') {
+            i += 2;
+            while i + 1 < b.len() && !(b[i] == b'*' && b[i + 1] == b'/') {
+                if b[i] == b'\n' {
+                    out.push('\n');
+                }
+                i += 1;
+            }
+            i += 2;
+        } else if c == b'r' && (b.get(i + 1) == Some(&b'"') || b.get(i + 1) == Some(&b'#')) {
+            let mut j = i + 1;
+            let mut hashes = 0;
+            while b.get(j) == Some(&b'#') {
+                hashes += 1;
+                j += 1;
+            }
+            if b.get(j) != Some(&b'"') {
+                out.push('r');
+                i += 1;
+                continue;
+            }
+            j += 1;
+            loop {
+                if j >= b.len() {
+                    break;
+                }
+                if b[j] == b'"' && (0..hashes).all(|k| b.get(j + 1 + k) == Some(&b'#')) {
+                    j += 1 + hashes;
+                    break;
+                }
+                if b[j] == b'\n' {
+                    out.push('\n');
+                }
+                j += 1;
+            }
+            out.push_str("\"\"");
+            i = j;
+        } else if c == b'"' {
+            i += 1;
+            while i < b.len() && b[i] != b'"' {
+                if b[i] == b'\\' {
+                    i += 1;
+                }
+                if i < b.len() && b[i] == b'\n' {
+                    out.push('\n');
+                }
+                i += 1;
+            }
+            i += 1;
+            out.push_str("\"\"");
+        } else if c == b'\'' {
+            // A character literal ('x', '\n', '\u{..}') or a lifetime ('a).
+            let close = if b.get(i + 1) == Some(&b'\\') {
+                (i + 2..b.len().min(i + 12)).find(|&k| b[k] == b'\'')
+            } else if b.get(i + 2) == Some(&b'\'') {
+                Some(i + 2)
+            } else {
+                None
+            };
+            match close {
+                Some(k) => {
+                    out.push_str("' '");
+                    i = k + 1;
+                }
+                None => {
+                    out.push('\'');
+                    i += 1;
+                }
+            }
+        } else {
+            // Copy one whole UTF-8 character.
+            let len = match c {
+                0x00..=0x7f => 1,
+                0xc0..=0xdf => 2,
+                0xe0..=0xef => 3,
+                _ => 4,
+            };
+            out.push_str(&text[i..(i + len).min(text.len())]);
+            i += len;
+        }
+    }
+    out
+}
+
+/// Identifiers, `::` and single punctuation characters.
+fn tokens(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let cs: Vec<char> = text.chars().collect();
+    let mut i = 0;
+    while i < cs.len() {
+        let c = cs[i];
+        if c.is_alphanumeric() || c == '_' {
+            let s = i;
+            while i < cs.len() && (cs[i].is_alphanumeric() || cs[i] == '_') {
+                i += 1;
+            }
+            out.push(cs[s..i].iter().collect());
+        } else if c == ':' && cs.get(i + 1) == Some(&':') {
+            out.push("::".into());
+            i += 2;
+        } else {
+            if !c.is_whitespace() {
+                out.push(c.to_string());
+            }
+            i += 1;
+        }
+    }
+    out
+}
+
+fn is_ident(s: &str) -> bool {
+    s.chars()
+        .next()
+        .is_some_and(|c| c.is_alphabetic() || c == '_')
+}
+
+type ModPath = Vec<String>;
+
+struct SourceFile {
+    module: ModPath,
+    toks: Vec<String>,
+    defs: BTreeSet<String>,
+}
+
+/// Walk `mod` declarations from a crate root, mapping each file to its module path.
+fn load_tree(path: &Path, module: ModPath, files: &mut BTreeMap<PathBuf, SourceFile>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let toks = tokens(&strip(&text));
+    let owner = matches!(
+        path.file_name().and_then(|f| f.to_str()),
+        Some("mod.rs" | "lib.rs" | "main.rs")
+    );
+    let dir = path.parent().unwrap().to_path_buf();
+    let base = if owner {
+        dir.clone()
+    } else {
+        path.with_extension("")
+    };
+    let mut defs = BTreeSet::new();
+    let mut children = Vec::new();
+    for (i, t) in toks.iter().enumerate() {
+        let next = toks.get(i + 1).map(String::as_str).unwrap_or("");
+        let item = matches!(
+            t.as_str(),
+            "struct" | "enum" | "fn" | "trait" | "type" | "const" | "static" | "union" | "mod"
+        );
+        if item && is_ident(next) && !matches!(next, "fn" | "mut" | "unsafe" | "extern") {
+            defs.insert(next.to_string());
+        }
+        if t == "macro_rules" && next == "!" {
+            if let Some(n) = toks.get(i + 2) {
+                defs.insert(n.clone());
+            }
+        }
+        if t == "mod" && is_ident(next) && toks.get(i + 2).map(String::as_str) == Some(";") {
+            // `#[path = "x"]` just before: the attribute's string is blanked, so read the
+            // original text of this declaration's line range instead.
+            children.push(next.to_string());
+        }
+    }
+    // #[path] attributes, from the raw text.
+    let mut path_attr: BTreeMap<String, PathBuf> = BTreeMap::new();
+    let raw: Vec<&str> = text.lines().collect();
+    for (i, line) in raw.iter().enumerate() {
+        let l = line.trim();
+        if let Some(rest) = l.strip_prefix("#[path = \"") {
+            let p = rest.split('"').next().unwrap();
+            for decl in raw.iter().skip(i + 1).take(3) {
+                let d = decl
+                    .trim()
+                    .trim_start_matches("pub ")
+                    .trim_start_matches("pub(crate) ");
+                if let Some(name) = d.strip_prefix("mod ").and_then(|n| n.strip_suffix(';')) {
+                    path_attr.insert(name.trim().to_string(), dir.join(p));
+                    break;
+                }
+            }
+        }
+    }
+    files.insert(
+        path.to_path_buf(),
+        SourceFile {
+            module: module.clone(),
+            toks,
+            defs,
+        },
+    );
+    for name in children {
+        let child = path_attr.get(&name).cloned().unwrap_or_else(|| {
+            let flat = base.join(format!("{name}.rs"));
+            if flat.exists() {
+                flat
+            } else {
+                base.join(&name).join("mod.rs")
+            }
+        });
+        if child.exists() {
+            let mut m = module.clone();
+            m.push(name);
+            load_tree(&child, m, files);
+        }
+    }
+}
+
+/// One leaf of a `use` tree: its segments and the name it binds.
+fn use_leaves(toks: &[String], prefix: &[String], out: &mut Vec<(Vec<String>, String)>) {
+    // Split at top-level commas.
+    let mut depth = 0;
+    let mut start = 0;
+    let mut parts = Vec::new();
+    for (i, t) in toks.iter().enumerate() {
+        match t.as_str() {
+            "{" => depth += 1,
+            "}" => depth -= 1,
+            "," if depth == 0 => {
+                parts.push(&toks[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    parts.push(&toks[start..]);
+    for part in parts {
+        let mut segs = prefix.to_vec();
+        let mut k = 0;
+        while k < part.len() {
+            match part[k].as_str() {
+                "::" => {}
+                "{" => {
+                    let end = part.len() - 1; // the matching '}' closes the part
+                    use_leaves(&part[k + 1..end], &segs, out);
+                    segs.clear();
+                    break;
+                }
+                "as" => {
+                    if let Some(alias) = part.get(k + 1) {
+                        if segs.last().map(String::as_str) == Some("self") {
+                            segs.pop();
+                        }
+                        out.push((segs.clone(), alias.clone()));
+                    }
+                    segs.clear();
+                    break;
+                }
+                s => segs.push(s.to_string()),
+            }
+            k += 1;
+        }
+        if segs.len() > prefix.len() || (!segs.is_empty() && segs.last().unwrap() == "self") {
+            if segs.last().map(String::as_str) == Some("self") {
+                segs.pop();
+            }
+            let name = segs.last().cloned().unwrap_or_default();
+            out.push((segs, name));
+        }
+    }
+}
+
+struct Graph {
+    files: BTreeMap<PathBuf, SourceFile>,
+    by_module: BTreeMap<ModPath, PathBuf>,
+    reexports: BTreeMap<PathBuf, BTreeMap<String, ModPath>>,
+}
+
+impl Graph {
+    fn absolute(&self, segs: &[String], module: &ModPath) -> Option<ModPath> {
+        let first = segs.first()?.as_str();
+        if first == "crate" {
+            return Some(segs.to_vec());
+        }
+        let mut cur = module.clone();
+        let mut rest = segs;
+        if first == "self" || first == "super" {
+            while let Some(s) = rest.first() {
+                match s.as_str() {
+                    "super" => {
+                        cur.pop();
+                    }
+                    "self" => {}
+                    _ => break,
+                }
+                rest = &rest[1..];
+            }
+            cur.extend(rest.iter().cloned());
+            return Some(cur);
+        }
+        let mut child = cur.clone();
+        child.push(first.to_string());
+        if self.by_module.contains_key(&child) {
+            cur.extend(segs.iter().cloned());
+            return Some(cur);
+        }
+        None
+    }
+
+    /// The file defining the item at an absolute path (None for a module or an unknown name).
+    fn resolve(&self, path: &[String], depth: usize) -> Option<PathBuf> {
+        if depth > 16 || self.by_module.contains_key(path) {
+            return None;
+        }
+        let k = (1..path.len())
+            .rev()
+            .find(|&k| self.by_module.contains_key(&path[..k]))?;
+        let file = &self.by_module[&path[..k]];
+        let name = &path[k];
+        if self.files[file].defs.contains(name) || name == "*" {
+            return Some(file.clone());
+        }
+        let target = self.reexports.get(file)?.get(name)?;
+        let mut full = target.clone();
+        full.extend(path[k + 1..].iter().cloned());
+        self.resolve(&full, depth + 1)
+    }
+}
+
+/// Build the file-level dependency graph of the crate rooted at `root`.
+fn dependency_graph(root: &Path) -> (BTreeMap<PathBuf, BTreeSet<PathBuf>>, usize) {
+    let mut files = BTreeMap::new();
+    load_tree(root, vec!["crate".into()], &mut files);
+    let by_module = files
+        .iter()
+        .map(|(p, f)| (f.module.clone(), p.clone()))
+        .collect();
+    let mut g = Graph {
+        files,
+        by_module,
+        reexports: BTreeMap::new(),
+    };
+    // Pass 1: use statements, aliases and re-exports.
+    let mut uses: BTreeMap<PathBuf, Vec<(ModPath, String, bool)>> = BTreeMap::new();
+    for (p, f) in &g.files {
+        let t = &f.toks;
+        let mut list = Vec::new();
+        for i in 0..t.len() {
+            if t[i] != "use" || (i > 0 && t[i - 1] == "::") {
+                continue;
+            }
+            let public =
+                i > 0 && (t[i - 1] == "pub" || (t[i - 1] == ")" && i >= 4 && t[i - 4] == "pub"));
+            let end = (i..t.len()).find(|&k| t[k] == ";").unwrap_or(t.len());
+            let mut leaves = Vec::new();
+            use_leaves(&t[i + 1..end], &[], &mut leaves);
+            for (segs, alias) in leaves {
+                if let Some(abs) = g.absolute(&segs, &f.module) {
+                    list.push((abs, alias, public));
+                }
+            }
+        }
+        uses.insert(p.clone(), list);
+    }
+    for (p, list) in &uses {
+        let map = list
+            .iter()
+            .filter(|(_, _, public)| *public)
+            .map(|(abs, alias, _)| (alias.clone(), abs.clone()))
+            .collect();
+        g.reexports.insert(p.clone(), map);
+    }
+    // Pass 2: edges.
+    let mut edges: BTreeMap<PathBuf, BTreeSet<PathBuf>> = BTreeMap::new();
+    let mut n_edges = 0;
+    for (p, f) in &g.files {
+        let t = &f.toks;
+        // Token ranges of use statements, to tell a re-export's own mention from a use in code.
+        let mut in_use = vec![false; t.len()];
+        for i in 0..t.len() {
+            if t[i] == "use" && (i == 0 || t[i - 1] != "::") {
+                let end = (i..t.len()).find(|&k| t[k] == ";").unwrap_or(t.len());
+                in_use[i..end].iter_mut().for_each(|x| *x = true);
+            }
+        }
+        let mut paths: Vec<ModPath> = Vec::new();
+        let mut aliases: BTreeMap<&str, &ModPath> = BTreeMap::new();
+        for (abs, alias, public) in &uses[p] {
+            let used_in_code =
+                (0..t.len()).any(|k| !in_use[k] && t[k] == *alias && (k == 0 || t[k - 1] != "::"));
+            if !public || used_in_code {
+                paths.push(abs.clone());
+            }
+            if g.by_module.contains_key(abs) {
+                aliases.insert(alias.as_str(), abs);
+            }
+        }
+        // Paths in code: crate::/super::/self:: and module aliases.
+        let mut k = 0;
+        while k < t.len() {
+            let head = t[k].as_str();
+            let starts = !in_use[k]
+                && (k == 0 || t[k - 1] != "::")
+                && t.get(k + 1).map(String::as_str) == Some("::")
+                && (matches!(head, "crate" | "super" | "self") || aliases.contains_key(head));
+            if !starts {
+                k += 1;
+                continue;
+            }
+            let mut segs = vec![head.to_string()];
+            let mut j = k + 1;
+            while t.get(j).map(String::as_str) == Some("::")
+                && t.get(j + 1).is_some_and(|s| is_ident(s))
+            {
+                segs.push(t[j + 1].clone());
+                j += 2;
+            }
+            let abs = match aliases.get(head) {
+                Some(m) if !matches!(head, "crate" | "super" | "self") => {
+                    let mut a = (*m).clone();
+                    a.extend(segs[1..].iter().cloned());
+                    Some(a)
+                }
+                _ => g.absolute(&segs, &f.module),
+            };
+            if let Some(a) = abs {
+                paths.push(a);
+            }
+            k = j;
+        }
+        let set = edges.entry(p.clone()).or_default();
+        for path in paths {
+            if let Some(d) = g.resolve(&path, 0) {
+                if d != *p && set.insert(d) {
+                    n_edges += 1;
+                }
+            }
+        }
+    }
+    (edges, n_edges)
+}
+
+/// Strongly connected components of more than one file (Tarjan).
+fn cycles(edges: &BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> Vec<Vec<PathBuf>> {
+    struct T<'a> {
+        e: &'a BTreeMap<PathBuf, BTreeSet<PathBuf>>,
+        index: BTreeMap<&'a PathBuf, usize>,
+        low: BTreeMap<&'a PathBuf, usize>,
+        stack: Vec<&'a PathBuf>,
+        on: BTreeSet<&'a PathBuf>,
+        out: Vec<Vec<PathBuf>>,
+    }
+    fn visit<'a>(s: &mut T<'a>, v: &'a PathBuf) {
+        let n = s.index.len();
+        s.index.insert(v, n);
+        s.low.insert(v, n);
+        s.stack.push(v);
+        s.on.insert(v);
+        if let Some(ws) = s.e.get(v) {
+            for w in ws {
+                if !s.index.contains_key(w) {
+                    visit(s, w);
+                    let lw = s.low[w];
+                    let lv = s.low.get_mut(v).unwrap();
+                    *lv = (*lv).min(lw);
+                } else if s.on.contains(w) {
+                    let iw = s.index[w];
+                    let lv = s.low.get_mut(v).unwrap();
+                    *lv = (*lv).min(iw);
+                }
+            }
+        }
+        if s.low[v] == s.index[v] {
+            let mut comp = Vec::new();
+            loop {
+                let w = s.stack.pop().unwrap();
+                s.on.remove(w);
+                comp.push(w.clone());
+                if w == v {
+                    break;
+                }
+            }
+            if comp.len() > 1 {
+                comp.sort();
+                s.out.push(comp);
+            }
+        }
+    }
+    let mut s = T {
+        e: edges,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: vec![],
+        on: BTreeSet::new(),
+        out: vec![],
+    };
+    for v in edges.keys() {
+        if !s.index.contains_key(v) {
+            visit(&mut s, v);
+        }
+    }
+    s.out
+}
+
+fn describe(edges: &BTreeMap<PathBuf, BTreeSet<PathBuf>>, found: &[Vec<PathBuf>]) -> String {
+    let mut msg = String::new();
+    for comp in found {
+        msg.push_str("cycle:\n");
+        for f in comp {
+            for d in edges[f].iter().filter(|d| comp.contains(d)) {
+                msg.push_str(&format!("    {} -> {}\n", f.display(), d.display()));
+            }
+        }
+    }
+    msg
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn no_import_cycles_between_library_files() {
+    let (edges, n) = dependency_graph(&root().join("src/lib.rs"));
+    println!("library: {} files, {n} edges", edges.len());
+    if std::env::var_os("USM_PRINT_EDGES").is_some() {
+        for (f, ds) in &edges {
+            for d in ds {
+                println!("{} -> {}", f.display(), d.display());
+            }
+        }
+    }
+    assert!(
+        edges.len() > 20,
+        "the module walk found only {} files",
+        edges.len()
+    );
+    let found = cycles(&edges);
+    assert!(found.is_empty(), "{}", describe(&edges, &found));
+}
+
+#[test]
+fn no_import_cycles_between_binary_files() {
+    let (edges, _) = dependency_graph(&root().join("src/main.rs"));
+    let found = cycles(&edges);
+    assert!(found.is_empty(), "{}", describe(&edges, &found));
+}
+
+#[test]
+fn the_checker_sees_a_cycle_when_there_is_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::create_dir_all(src.join("a")).unwrap();
+    std::fs::write(src.join("lib.rs"), "pub mod a;\npub mod b;\n").unwrap();
+    std::fs::write(src.join("a/mod.rs"), "pub mod x;\npub use x::X;\n").unwrap();
+    std::fs::write(
+        src.join("a/x.rs"),
+        "use crate::b::{self, Y};\npub struct X(Y);\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("b.rs"),
+        "pub struct Y;\npub fn f(_: crate::a::X) {}\n",
+    )
+    .unwrap();
+    let (edges, n) = dependency_graph(&src.join("lib.rs"));
+    assert_eq!(n, 2, "{edges:?}");
+    assert_eq!(cycles(&edges).len(), 1);
+    // Without the back edge the re-export alone is no dependency.
+    std::fs::write(src.join("b.rs"), "pub struct Y;\n").unwrap();
+    let (edges, n) = dependency_graph(&src.join("lib.rs"));
+    assert_eq!(n, 1, "{edges:?}");
+    assert!(cycles(&edges).is_empty());
+}
+
+#[test]
+fn no_source_file_over_the_size_limit() {
+    let (edges, _) = dependency_graph(&root().join("src/lib.rs"));
+    let (bin, _) = dependency_graph(&root().join("src/main.rs"));
+    let long: Vec<String> = edges
+        .keys()
+        .chain(bin.keys())
+        .filter_map(|p| {
+            let n = std::fs::read_to_string(p).unwrap().lines().count();
+            (n > MAX_FILE_LINES).then(|| format!("{} ({n} lines)", p.display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "files over {MAX_FILE_LINES} lines: {long:?}"
+    );
+}
+
+#[test]
+fn the_library_has_no_command_line_layer() {
+    let (edges, _) = dependency_graph(&root().join("src/lib.rs"));
+    for p in edges.keys() {
+        let text = strip(&std::fs::read_to_string(p).unwrap());
+        let toks = tokens(&text);
+        for w in toks.windows(2) {
+            let uses_crate =
+                w[1] == "::" && matches!(w[0].as_str(), "clap" | "anyhow" | "indicatif");
+            assert!(
+                !uses_crate,
+                "{} uses {} (only the binary may)",
+                p.display(),
+                w[0]
+            );
+        }
+        assert!(
+            !p.starts_with(root().join("src/cli")),
+            "{} is in the library",
+            p.display()
+        );
+    }
+}
+
+/// Longest non-test function we accept, in lines.
+const MAX_FN_LINES: usize = 120;
+
+/// Flat checklists allowed past the limit: one check per line, nothing to name in between.
+const LONG_FN_ALLOWED: &[(&str, &str)] = &[("src/model/mod.rs", "validate")];
+
+/// `(name, first line, line count)` of every function of a file outside test code.
+fn functions(text: &str) -> Vec<(String, usize, usize)> {
+    let s = strip(text);
+    let lines: Vec<&str> = s.lines().collect();
+    let mut out = Vec::new();
+    let mut test_depth: Option<i64> = None; // brace depth at which a `mod tests {` opened
+    let mut depth: i64 = 0;
+    for (i, line) in lines.iter().enumerate() {
+        let toks = tokens(line);
+        let is_test_mod =
+            toks.windows(2).any(|w| w[0] == "mod" && w[1] == "tests") && line.contains('{');
+        if is_test_mod && test_depth.is_none() {
+            test_depth = Some(depth);
+        }
+        let fn_at = toks
+            .windows(2)
+            .position(|w| w[0] == "fn" && is_ident(&w[1]));
+        let attr_test = lines[i.saturating_sub(3)..i]
+            .iter()
+            .any(|l| l.contains("#[test]"));
+        if let (Some(p), None, false) = (fn_at, test_depth, attr_test) {
+            // Find the body's opening brace (or a `;` for a declaration) and match it.
+            let mut d = 0i64;
+            let mut opened = false;
+            let start = line.find(&format!("fn {}", toks[p + 1])).unwrap_or(0);
+            'scan: for (j, l) in lines.iter().enumerate().skip(i) {
+                let from = if j == i { start } else { 0 };
+                for c in l[from..].chars() {
+                    match c {
+                        '{' => {
+                            d += 1;
+                            opened = true;
+                        }
+                        '}' => d -= 1,
+                        ';' if !opened => break 'scan,
+                        _ => {}
+                    }
+                    if opened && d == 0 {
+                        out.push((toks[p + 1].clone(), i + 1, j - i + 1));
+                        break 'scan;
+                    }
+                }
+            }
+        }
+        for c in line.chars() {
+            match c {
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if test_depth == Some(depth) {
+                        test_depth = None;
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+fn is_test_file(p: &Path) -> bool {
+    let name = p.file_name().and_then(|f| f.to_str()).unwrap_or("");
+    name == "tests.rs"
+        || name.ends_with("_tests.rs")
+        || p.components().any(|c| c.as_os_str() == "tests")
+}
+
+#[test]
+fn no_function_over_the_size_limit() {
+    let (lib, _) = dependency_graph(&root().join("src/lib.rs"));
+    let (bin, _) = dependency_graph(&root().join("src/main.rs"));
+    let mut long = Vec::new();
+    for p in lib.keys().chain(bin.keys()).filter(|p| !is_test_file(p)) {
+        let rel = p
+            .strip_prefix(root())
+            .unwrap()
+            .to_string_lossy()
+            .to_string();
+        for (name, line, n) in functions(&std::fs::read_to_string(p).unwrap()) {
+            let allowed = LONG_FN_ALLOWED.iter().any(|(f, g)| *f == rel && *g == name);
+            if n > MAX_FN_LINES && !allowed {
+                long.push(format!("{rel}:{line} {name} ({n} lines)"));
+            }
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "functions over {MAX_FN_LINES} lines: {long:#?}"
+    );
+}
+
+#[test]
+fn the_function_measure_skips_tests_and_counts_bodies() {
+    let src = "fn a() {\n    let x = 1;\n}\ntrait T { fn d(&self); }\n#[cfg(test)]\nmod tests {\n    fn b() {\n    }\n}\nfn c() { }\n";
+    let f = functions(src);
+    assert_eq!(f, vec![("a".to_string(), 1, 3), ("c".to_string(), 10, 1)]);
+}
