@@ -22,7 +22,7 @@
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
 //! - [`engine`]: running, resuming and sharding a sweep.
-//! - [`merge`]: merging shard outputs.
+//! - [`shards`]: merging shard outputs.
 
 pub mod axes;
 pub mod cases;
@@ -32,7 +32,6 @@ pub mod error;
 pub mod finish;
 pub mod hash;
 pub mod manifest;
-pub mod merge;
 pub mod parse;
 pub mod path;
 pub mod plots;
@@ -40,6 +39,7 @@ pub mod records;
 pub mod runner;
 pub mod schema;
 pub mod selection;
+pub mod shards;
 pub mod spans;
 pub mod static_table;
 pub mod static_tcm;
@@ -49,7 +49,7 @@ pub mod worker;
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use error::{InputError, StudyError};
 pub use finish::report;
-pub use merge::merge;
+pub use shards::merge;
 pub use parse::load_study;
 pub use records::CaseStatus;
 pub use schema::{DoeKind, Study};
