@@ -29,11 +29,12 @@ use super::error::StudyError;
 use super::finish::finish_report;
 use super::manifest::{git_commit, now_rfc3339, write_manifest, AxisInfo, Counts, Manifest};
 use super::records::{
-    axis_text, compact, final_table, raw_schema, CaseStatus, Row, StatusCounts, HASH,
+    axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE,
+    STUDY_COPY,
 };
 use super::schema::Study;
 use super::worker::Worker;
-use crate::report::{read_csv_typed, write_csv, write_parquet, ColumnKind, CsvAppender, Table};
+use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 
 /// Options of a sweep run.
 #[derive(Clone, Debug, Default)]
@@ -124,9 +125,9 @@ pub fn run_sweep(
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
     let out = output_dir(study, opts);
     std::fs::create_dir_all(&out).map_err(|e| StudyError::io(&out, e))?;
-    std::fs::write(out.join("study.toml"), &study.text).map_err(|e| StudyError::io(&out, e))?;
+    std::fs::write(out.join(STUDY_COPY), &study.text).map_err(|e| StudyError::io(&out, e))?;
     let schema = raw_schema(study);
-    let partial = out.join("cases.partial.csv");
+    let partial = out.join(PARTIAL_FILE);
     let (mut appender, done) = open_partial(&partial, &schema, opts.resume)?;
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -156,7 +157,8 @@ pub fn run_sweep(
         outcome.elapsed_s = t0.elapsed().as_secs_f64();
         return Ok(outcome);
     }
-    let table = write_final_tables(&partial, &schema, &streamed.plan_hashes, &out)?;
+    let raw = compact(&read_csv_typed(&partial, &schema)?, Some(&streamed.plan_hashes))?;
+    let table = write_tables(&raw, &out)?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;
@@ -332,23 +334,6 @@ fn process(
         }
     };
     Msg::Row(Box::new(row))
-}
-
-/// Compact the partial file (keeping this plan's rows) and write `cases.csv` and
-/// `cases.parquet`; returns the final table.
-fn write_final_tables(
-    partial: &Path,
-    schema: &[(String, ColumnKind)],
-    plan_hashes: &HashSet<String>,
-    out: &Path,
-) -> Result<Table, StudyError> {
-    let raw = read_csv_typed(partial, schema)?;
-    let raw = compact(&raw, Some(plan_hashes))?;
-    write_csv(&raw, partial)?;
-    let table = final_table(&raw)?;
-    write_csv(&table, &out.join("cases.csv"))?;
-    write_parquet(&table, &out.join("cases.parquet"))?;
-    Ok(table)
 }
 
 /// The manifest of a finished sweep, without its shard, throughput and counts.

@@ -7,7 +7,7 @@ use super::cases::resolve_case;
 use super::doe::expand;
 use super::error::StudyError;
 use super::manifest::{read_manifest, Manifest};
-use super::records::{final_table, CASE_ID};
+use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
@@ -49,18 +49,21 @@ fn rerun_extremes(
     let ids = table.i64(CASE_ID).map_err(|e| e.to_string())?;
     let all = expand(study, None)?;
     // The two reruns are independent: run them side by side.
-    let rerun = |label: &str, row: usize| -> Result<(), String> {
+    let rerun = |which: Extreme, row: usize| -> Result<(), String> {
         let id = ids[row] as usize;
         let case = all.get(id).ok_or("case id out of range")?;
         let r = resolve_case(study, case)?;
         let (_, traj) = Worker::new().evaluate(study, case, &r, true);
         if let Some(t) = traj {
-            write_csv(&t, &out.join(format!("trajectory_{label}.csv")))
+            write_csv(&t, &out.join(which.trajectory_file()))
                 .map_err(|e| e.to_string())?;
         }
         Ok(())
     };
-    let (a, b) = rayon::join(|| rerun("best", best), || rerun("worst", worst));
+    let (a, b) = rayon::join(
+        || rerun(Extreme::Best, best),
+        || rerun(Extreme::Worst, worst),
+    );
     a.and(b)
 }
 
@@ -68,13 +71,13 @@ fn rerun_extremes(
 /// `cases.csv`) and `manifest.json`.
 pub fn report(dir: &Path) -> Result<Vec<String>, StudyError> {
     let m = read_manifest(dir)?;
-    let pq = dir.join("cases.parquet");
+    let pq = dir.join(CASES_PARQUET);
     let table = if pq.is_file() {
         crate::report::read_parquet(&pq)?
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
         let schema = m.schema().map_err(StudyError::Input)?;
-        final_table(&read_csv_typed(&dir.join("cases.partial.csv"), &schema)?)?
+        final_table(&read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
     Ok(write_report(dir, &table, &m))
 }

@@ -12,6 +12,9 @@ use super::runner::Mode;
 use super::schema::{DoeKind, ReportSettings};
 use crate::report::ColumnKind;
 
+/// The manifest's file name in an output directory.
+pub const MANIFEST_FILE: &str = "manifest.json";
+
 fn kind_of(s: &str) -> Option<ColumnKind> {
     Some(match s {
         "f64" => ColumnKind::F64,
@@ -169,13 +172,13 @@ pub fn git_commit() -> Option<String> {
 /// Write `manifest.json` into `dir`.
 pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), StudyError> {
     let text = serde_json::to_string_pretty(m).map_err(|e| StudyError::Other(e.to_string()))?;
-    let p = dir.join("manifest.json");
+    let p = dir.join(MANIFEST_FILE);
     std::fs::write(&p, text + "\n").map_err(|e| StudyError::io(&p, e))
 }
 
 /// Read `manifest.json` of an output directory.
 pub fn read_manifest(dir: &Path) -> Result<Manifest, StudyError> {
-    let p = dir.join("manifest.json");
+    let p = dir.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&p).map_err(|e| {
         StudyError::Input(format!(
             "{}: {e} (is {} a finished sweep output? an unfinished one can be completed with --resume)",

@@ -17,7 +17,7 @@ use super::path::{flatten, pattern_allowed};
 use super::runner::{self, Mode};
 use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
 use super::spans::Spans;
-use super::static_table::{static_default_table, static_spec};
+use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::model::design::{load_design_table, parse_design_table};
 
 #[derive(Deserialize)]
@@ -246,7 +246,7 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
     let mut own = toml::Table::new();
     for (k, t) in [
         ("scenario", &file.scenario),
-        ("static", &file.static_),
+        (STATIC_TABLE, &file.static_),
         ("control", &file.control),
         ("base_control", &file.base_control),
         ("allocation", &file.allocation),
@@ -266,7 +266,7 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
     let static_enabled = mode == Mode::Static || file.static_.is_some();
     let mut defaults = runner::default_table(mode).map_err(|m| spans.err("scenario.mode", m))?;
     if static_enabled {
-        defaults.insert("static".into(), toml::Value::Table(static_default_table()));
+        defaults.insert(STATIC_TABLE.into(), toml::Value::Table(static_default_table()));
     }
     let (mut sc_names, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&defaults, "", &mut sc_names, &mut sc_arrays);
@@ -284,7 +284,7 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
     // Static settings of the base must parse.
     if static_enabled {
         if let Err(m) = static_spec(&reference, 0) {
-            return Err(spans.err("static", m));
+            return Err(spans.err(STATIC_TABLE, m));
         }
     }
     Ok(ScenarioSide {

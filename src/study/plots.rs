@@ -11,7 +11,7 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::records::file_stem_safe;
+use super::records::{file_stem_safe, Extreme};
 use super::selection::{levels, mean, thin, Front};
 use crate::report::{
     heatmap, read_csv, scatter_labelled, ColourScale, ColumnData, ColumnKind, Figure,
@@ -168,12 +168,12 @@ pub(crate) fn heatmaps(
 /// `timeseries.svg` from `trajectory_best.csv` / `trajectory_worst.csv` in `dir`, when
 /// either exists.
 pub(crate) fn timeseries_plot(dir: &Path, plots: &Path, warnings: &mut Vec<String>) {
-    let trajs: Vec<(&str, Table)> = ["best", "worst"]
+    let trajs: Vec<(&str, Table)> = Extreme::BOTH
         .iter()
-        .filter_map(|l| {
-            let p = dir.join(format!("trajectory_{l}.csv"));
+        .filter_map(|e| {
+            let p = dir.join(e.trajectory_file());
             p.is_file()
-                .then(|| read_csv(&p).ok().map(|t| (*l, t)))
+                .then(|| read_csv(&p).ok().map(|t| (e.label(), t)))
                 .flatten()
         })
         .collect();

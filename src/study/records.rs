@@ -7,11 +7,14 @@
 
 use std::collections::{HashMap, HashSet};
 use std::fmt;
+use std::path::Path;
 use std::str::FromStr;
 
 use super::error::StudyError;
 use super::schema::Study;
-use crate::report::{format_f64, Column, ColumnData, ColumnKind, Table, Value};
+use crate::report::{
+    format_f64, write_csv, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
+};
 
 /// How a case ended (the `status` column: `ok`, `failed`, `skipped`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -84,6 +87,42 @@ impl StatusCounts {
             c.add(s);
         }
         Ok(c)
+    }
+}
+
+/// The raw rows, appended as cases finish, compacted at the end.
+pub const PARTIAL_FILE: &str = "cases.partial.csv";
+/// The final table as CSV.
+pub const CASES_CSV: &str = "cases.csv";
+/// The final table as Parquet.
+pub const CASES_PARQUET: &str = "cases.parquet";
+/// The copy of the study file in an output directory.
+pub const STUDY_COPY: &str = "study.toml";
+
+/// The best or the worst case by the objective (their trajectories are rerun for the report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extreme {
+    /// The best case.
+    Best,
+    /// The worst case.
+    Worst,
+}
+
+impl Extreme {
+    /// Both, best first.
+    pub const BOTH: [Extreme; 2] = [Extreme::Best, Extreme::Worst];
+
+    /// `best` or `worst` (series label and file-name part).
+    pub fn label(self) -> &'static str {
+        match self {
+            Extreme::Best => "best",
+            Extreme::Worst => "worst",
+        }
+    }
+
+    /// The file holding the case's trajectory: `trajectory_<label>.csv`.
+    pub fn trajectory_file(self) -> String {
+        format!("trajectory_{}.csv", self.label())
     }
 }
 
@@ -346,6 +385,16 @@ pub fn final_table(raw: &Table) -> Result<Table, StudyError> {
         cols.extend(get(n));
     }
     Ok(Table::from_columns(cols)?)
+}
+
+/// Write compacted raw rows to the partial file of `out` and the final table to
+/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table.
+pub fn write_tables(raw: &Table, out: &Path) -> Result<Table, StudyError> {
+    write_csv(raw, &out.join(PARTIAL_FILE))?;
+    let table = final_table(raw)?;
+    write_csv(&table, &out.join(CASES_CSV))?;
+    write_parquet(&table, &out.join(CASES_PARQUET))?;
+    Ok(table)
 }
 
 /// Packed scenario metrics (one cell per row) as columns `(name, values)`, in order of first

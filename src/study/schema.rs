@@ -7,6 +7,7 @@ use std::str::FromStr;
 
 use super::path::KeyPath;
 use super::runner::{Mode, SCENARIO_TABLES};
+use super::static_table::STATIC_TABLE;
 use crate::sampling::Sampling;
 
 /// Largest number of cases of a study.
@@ -234,5 +235,5 @@ pub const GENERATOR_KEYS: [&str; 13] = [
 
 /// Whether `key` is a scenario-side top-level table (including `static`).
 pub fn is_scenario_table(key: &str) -> bool {
-    key == "static" || SCENARIO_TABLES.contains(&key)
+    key == STATIC_TABLE || SCENARIO_TABLES.contains(&key)
 }

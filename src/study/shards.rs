@@ -7,8 +7,8 @@ use super::error::StudyError;
 use super::finish::finish_report;
 use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manifest};
 use super::parse::load_study;
-use super::records::{compact, final_table, StatusCounts};
-use crate::report::{read_csv_typed, write_csv, write_parquet, Table};
+use super::records::{compact, write_tables, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use crate::report::{read_csv_typed, Table};
 
 /// Merge shard outputs into `out`: check they come from the same study, concatenate their raw
 /// rows, sort by case id, deduplicate by hash, and write the final tables, manifest and report.
@@ -26,16 +26,13 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
     let schema = m0.schema().map_err(StudyError::Input)?;
     let mut tables = Vec::new();
     for d in dirs {
-        tables.push(read_csv_typed(&d.join("cases.partial.csv"), &schema)?);
+        tables.push(read_csv_typed(&d.join(PARTIAL_FILE), &schema)?);
     }
     let raw = compact(&Table::concat(&tables)?, None)?;
     std::fs::create_dir_all(out).map_err(|e| StudyError::io(out, e))?;
-    write_csv(&raw, &out.join("cases.partial.csv"))?;
-    let table = final_table(&raw)?;
-    write_csv(&table, &out.join("cases.csv"))?;
-    write_parquet(&table, &out.join("cases.parquet"))?;
-    if let Ok(text) = std::fs::read_to_string(first_dir.join("study.toml")) {
-        std::fs::write(out.join("study.toml"), text).map_err(|e| StudyError::io(out, e))?;
+    let table = write_tables(&raw, out)?;
+    if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
+        std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
     }
     let mut m = m0.clone();
     m.start_time = start_time;

@@ -7,6 +7,9 @@ use serde::Deserialize;
 use super::static_tcm::StaticSpec;
 use crate::sampling::Sampling;
 
+/// The key of the `[static]` table in study files and resolved scenario-side tables.
+pub const STATIC_TABLE: &str = "static";
+
 /// The keys of `[static]`, all optional.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -39,7 +42,7 @@ pub fn static_default_table() -> toml::Table {
 /// configurations are kept (`worst = 0`): sweeps record only the aggregate metrics.
 pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, String> {
     let t = scenario
-        .get("static")
+        .get(STATIC_TABLE)
         .cloned()
         .unwrap_or(toml::Value::Table(toml::Table::new()));
     let f = StaticFile::deserialize(t).map_err(|e| format!("[static]: {}", e.message().trim()))?;

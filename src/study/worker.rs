@@ -8,7 +8,7 @@ use super::doe::Case;
 use super::records::{pack_metrics, CaseStatus, Row, DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner;
 use super::schema::Study;
-use super::static_table::static_spec;
+use super::static_table::{static_spec, STATIC_TABLE};
 use super::static_tcm::{analyse, StaticSummary};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
@@ -155,7 +155,7 @@ fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
 /// The closed-loop run into the packed scenario metrics; returns the trajectory (with `log`).
 fn dynamic_phase(v: &Vehicle, r: &Resolved, log: bool, row: &mut Row) -> Option<Table> {
     let mut sc = r.scenario.clone();
-    sc.remove("static");
+    sc.remove(STATIC_TABLE);
     match runner::run_case(v, &sc, r.seed, log) {
         Ok(out) => {
             if let Some(f) = &out.failure {
