@@ -339,4 +339,3 @@ fn distribution_spec(
     };
     Ok(AxisSpec::Distribution(dist))
 }
-

@@ -29,8 +29,8 @@ use super::error::StudyError;
 use super::finish::finish_report;
 use super::manifest::{git_commit, now_rfc3339, write_manifest, AxisInfo, Counts, Manifest};
 use super::records::{
-    axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE,
-    STUDY_COPY,
+    axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH,
+    PARTIAL_FILE, STUDY_COPY,
 };
 use super::schema::Study;
 use super::worker::Worker;
@@ -157,7 +157,10 @@ pub fn run_sweep(
         outcome.elapsed_s = t0.elapsed().as_secs_f64();
         return Ok(outcome);
     }
-    let raw = compact(&read_csv_typed(&partial, &schema)?, Some(&streamed.plan_hashes))?;
+    let raw = compact(
+        &read_csv_typed(&partial, &schema)?,
+        Some(&streamed.plan_hashes),
+    )?;
     let table = write_tables(&raw, &out)?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();

@@ -55,8 +55,7 @@ fn rerun_extremes(
         let r = resolve_case(study, case)?;
         let (_, traj) = Worker::new().evaluate(study, case, &r, true);
         if let Some(t) = traj {
-            write_csv(&t, &out.join(which.trajectory_file()))
-                .map_err(|e| e.to_string())?;
+            write_csv(&t, &out.join(which.trajectory_file())).map_err(|e| e.to_string())?;
         }
         Ok(())
     };

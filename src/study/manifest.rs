@@ -118,7 +118,10 @@ impl Manifest {
     /// The manifest's record of a raw schema (`[name, kind]` pairs); [`Manifest::schema`]
     /// reads it back.
     pub fn columns_of(schema: &[(String, ColumnKind)]) -> Vec<[String; 2]> {
-        schema.iter().map(|(n, k)| [n.clone(), k.to_string()]).collect()
+        schema
+            .iter()
+            .map(|(n, k)| [n.clone(), k.to_string()])
+            .collect()
     }
 
     /// The raw schema.
@@ -188,4 +191,3 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, StudyError> {
     })?;
     serde_json::from_str(&text).map_err(|e| StudyError::Input(format!("{}: {e}", p.display())))
 }
-

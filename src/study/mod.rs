@@ -18,7 +18,7 @@
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
 //! - [`records`]: case status, row, columns of the raw and final tables.
 //! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
-//! - [`manifest`]: `manifest.json`.
+//! - [`manifest`]: the `manifest.json` of an output directory.
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
 //! - [`engine`]: running, resuming and sharding a sweep.
@@ -49,8 +49,8 @@ pub mod worker;
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use error::{InputError, StudyError};
 pub use finish::report;
-pub use shards::merge;
 pub use parse::load_study;
 pub use records::CaseStatus;
 pub use schema::{DoeKind, Study};
+pub use shards::merge;
 pub use static_tcm::{analyse, StaticSpec, StaticSummary};

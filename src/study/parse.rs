@@ -61,7 +61,6 @@ struct DoeFile {
     cases: Option<usize>,
 }
 
-
 fn merge_into(base: &mut toml::Table, over: &toml::Table) {
     for (k, v) in over {
         match (base.get_mut(k), v) {
@@ -148,7 +147,13 @@ pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
     let side = scenario_side(&file, &spans)?;
     let names = valid_names(&design, generator, side.names, side.arrays, side.reference);
     let doe = parse_doe(file.doe.as_ref(), &spans)?;
-    let axes = parse_axes(file.axis.as_deref().unwrap_or_default(), &names, &design, doe, &spans)?;
+    let axes = parse_axes(
+        file.axis.as_deref().unwrap_or_default(),
+        &names,
+        &design,
+        doe,
+        &spans,
+    )?;
     let output = meta
         .output
         .as_ref()
@@ -266,7 +271,10 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
     let static_enabled = mode == Mode::Static || file.static_.is_some();
     let mut defaults = runner::default_table(mode).map_err(|m| spans.err("scenario.mode", m))?;
     if static_enabled {
-        defaults.insert(STATIC_TABLE.into(), toml::Value::Table(static_default_table()));
+        defaults.insert(
+            STATIC_TABLE.into(),
+            toml::Value::Table(static_default_table()),
+        );
     }
     let (mut sc_names, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&defaults, "", &mut sc_names, &mut sc_arrays);
@@ -368,4 +376,3 @@ fn parse_doe(d: Option<&DoeFile>, spans: &Spans) -> Result<Doe, InputError> {
         }
     }
 }
-

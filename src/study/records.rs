@@ -83,7 +83,11 @@ impl StatusCounts {
     /// The counts of the `status` column of `table` (other texts are not counted).
     pub fn of_table(table: &Table) -> Result<Self, StudyError> {
         let mut c = StatusCounts::default();
-        for s in table.str(STATUS)?.iter().filter_map(|s| CaseStatus::parse(s)) {
+        for s in table
+            .str(STATUS)?
+            .iter()
+            .filter_map(|s| CaseStatus::parse(s))
+        {
             c.add(s);
         }
         Ok(c)

@@ -232,7 +232,6 @@ pub const GENERATOR_KEYS: [&str; 13] = [
     "cd_cross",
 ];
 
-
 /// Whether `key` is a scenario-side top-level table (including `static`).
 pub fn is_scenario_table(key: &str) -> bool {
     key == STATIC_TABLE || SCENARIO_TABLES.contains(&key)

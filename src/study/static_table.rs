@@ -28,7 +28,10 @@ pub fn static_default_table() -> toml::Table {
     let mut t = toml::Table::new();
     t.insert("samples".into(), toml::Value::Integer(d.samples as i64));
     t.insert("threshold".into(), toml::Value::Float(d.threshold));
-    t.insert("sampling".into(), toml::Value::String(d.sampling.to_string()));
+    t.insert(
+        "sampling".into(),
+        toml::Value::String(d.sampling.to_string()),
+    );
     t.insert(
         "char_length".into(),
         toml::Value::Float(d.char_length.unwrap_or(0.0)),

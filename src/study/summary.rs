@@ -202,7 +202,11 @@ fn pareto_section(c: &Ctx, f: &Front, md: &mut String) {
         f.front.len(),
         f.rows.len()
     );
-    let _ = writeln!(md, "{}", c.header(&format!("| case | {x} | {y} |"), "|---|---|---|"));
+    let _ = writeln!(
+        md,
+        "{}",
+        c.header(&format!("| case | {x} | {y} |"), "|---|---|---|")
+    );
     for &k in f.front.iter().take(50) {
         let r = f.rows[k];
         let _ = writeln!(
