@@ -143,18 +143,26 @@ pub const REASON: &str = "reason";
 /// first and the last two last.
 pub const RAW_HEAD: [&str; 4] = [CASE_ID, HASH, STATUS, REASON];
 
+/// Number of thrusters of the built design.
+pub const DESIGN_THRUSTERS: &str = "design_thrusters";
+/// Fraction of joint configurations with σ_min below the threshold ("how often T is
+/// singular").
+pub const TCM_SINGULAR_FRACTION: &str = "tcm_singular_fraction";
+/// σ_min of the straight configuration `q = 0`.
+pub const TCM_STRAIGHT_SIGMA_MIN: &str = "tcm_straight_sigma_min";
+
 /// Columns describing the built design (always present).
 pub const DESIGN_COLUMNS: [&str; 5] = [
     "design_bodies",
     "design_joints",
-    "design_thrusters",
+    DESIGN_THRUSTERS,
     "design_length_m",
     "design_mass_kg",
 ];
 
 /// Static TCM metric columns (present when the static analysis runs).
 pub const TCM_COLUMNS: [&str; 15] = [
-    "tcm_singular_fraction",
+    TCM_SINGULAR_FRACTION,
     "tcm_rank_deficient_fraction",
     "tcm_sigma_min_min",
     "tcm_sigma_min_p05",
@@ -162,7 +170,7 @@ pub const TCM_COLUMNS: [&str; 15] = [
     "tcm_sigma_min_mean",
     "tcm_kappa_p50",
     "tcm_kappa_p95",
-    "tcm_straight_sigma_min",
+    TCM_STRAIGHT_SIGMA_MIN,
     "tcm_lost_surge",
     "tcm_lost_sway",
     "tcm_lost_heave",

@@ -5,7 +5,9 @@
 use std::collections::HashSet;
 
 use super::manifest::Manifest;
-use super::records::{CaseStatus, RAW_HEAD, STATUS};
+use super::records::{
+    CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
+};
 use crate::report::{pareto_front, ColumnData, ColumnKind, Table};
 
 /// Most points drawn per scatter panel (a deterministic stride through the rows beyond it),
@@ -46,7 +48,7 @@ impl Selection {
         for m in &metrics {
             // Larger is better for conditioning (σ_min) and for run outcomes.
             if m.starts_with("tcm_sigma_min")
-                || m == "tcm_straight_sigma_min"
+                || m == TCM_STRAIGHT_SIGMA_MIN
                 || m.starts_with("sigma_min")
                 || matches!(
                     m.as_str(),
@@ -63,20 +65,17 @@ impl Selection {
             .clone()
             .filter(|o| has(o))
             .or_else(|| energy.clone())
-            .or_else(|| has("tcm_singular_fraction").then(|| "tcm_singular_fraction".to_string()))
+            .or_else(|| has(TCM_SINGULAR_FRACTION).then(|| TCM_SINGULAR_FRACTION.to_string()))
             .or_else(|| metrics.first().cloned());
         let pareto = match &manifest.report.pareto {
             Some([x, y]) if has(x) && has(y) => Some((x.clone(), y.clone())),
             _ => {
-                let x =
-                    energy.or_else(|| has("design_thrusters").then(|| "design_thrusters".into()));
+                let x = energy.or_else(|| has(DESIGN_THRUSTERS).then(|| DESIGN_THRUSTERS.into()));
                 let y = metrics
                     .iter()
                     .find(|m| m.contains("singular") && !m.starts_with("tcm_"))
                     .cloned()
-                    .or_else(|| {
-                        has("tcm_singular_fraction").then(|| "tcm_singular_fraction".into())
-                    });
+                    .or_else(|| has(TCM_SINGULAR_FRACTION).then(|| TCM_SINGULAR_FRACTION.into()));
                 x.zip(y)
             }
         };
