@@ -5,8 +5,10 @@
 //! 2 bad input (study file, command line) or an I/O error.
 
 use super::tcm::Progress;
+use crate::study::cases::resolve_case;
 use crate::study::doe::expand;
-use crate::study::engine::{axis_text, output_dir, resolve_case};
+use crate::study::engine::output_dir;
+use crate::study::records::axis_text;
 use crate::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 use anyhow::{anyhow, bail};
 use clap::Args;

@@ -36,7 +36,7 @@ pub struct TcmArgs {
     /// Preset name (usm-paper, uvms-planar) or path to a design file (TOML).
     pub design: String,
     /// Number of joint configurations sampled within the joint limits.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = crate::study::static_tcm::DEFAULT_SAMPLES)]
     pub samples: usize,
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]
@@ -64,7 +64,7 @@ pub struct TcmArgs {
     #[arg(long, default_value_t = 41)]
     pub resolution: usize,
     /// Number of worst (lowest σ_min) configurations reported.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = crate::study::static_tcm::DEFAULT_WORST)]
     pub worst: usize,
 }
 

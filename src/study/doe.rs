@@ -19,15 +19,6 @@ pub struct Case {
     pub values: Vec<toml::Value>,
 }
 
-/// Number of grid values of an axis (1 for distributions, which grids reject).
-pub fn grid_len(spec: &AxisSpec) -> usize {
-    match spec {
-        AxisSpec::Values(v) => v.len(),
-        AxisSpec::Range { steps, .. } => steps.unwrap_or(1),
-        AxisSpec::Distribution(_) => 1,
-    }
-}
-
 fn range_value(start: f64, stop: f64, log: bool, t: f64) -> f64 {
     if log {
         (start.ln() + (stop.ln() - start.ln()) * t).exp()
@@ -98,7 +89,7 @@ pub fn sampled_value(a: &Axis, u: f64) -> toml::Value {
 /// Number of cases of the study.
 pub fn case_count(study: &Study) -> usize {
     match study.doe {
-        Doe::Grid => study.axes.iter().map(|a| grid_len(&a.spec)).product(),
+        Doe::Grid => study.axes.iter().map(|a| a.spec.grid_len()).product(),
         Doe::Sampled { cases, .. } => cases,
     }
 }
@@ -200,14 +191,5 @@ pub fn inverse_normal_cdf(p: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn normal_quantiles() {
-        assert!(inverse_normal_cdf(0.5).abs() < 1e-6);
-        assert!((inverse_normal_cdf(0.975) - 1.959964).abs() < 1e-5);
-        assert!((inverse_normal_cdf(0.01) + 2.326348).abs() < 1e-5);
-        assert!(inverse_normal_cdf(0.0).is_finite());
-    }
-}
+#[path = "doe_tests.rs"]
+mod tests;

@@ -2,57 +2,55 @@
 //! engine with resume and shards, the static configuration-space TCM analysis, and the sweep
 //! report.
 //!
-//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
-//! - [`schema`]: study files (TOML) → validated [`Study`].
-//! - [`doe`]: grid and sampled designs of experiments → cases.
+//! Modules in dependency order (each uses only modules above it):
+//!
+//! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
+//! - [`hash`]: canonical text of TOML tables and the study and case hashes.
+//! - [`spans`]: key positions in a study file, for located errors.
 //! - [`path`]: parameter paths of sweep axes and table edits.
-//! - [`engine`]: running, resuming, sharding, merging; final tables and manifest.
-//! - [`runner`]: the single adapter to the scenario module.
-//! - [`summary`]: `summary.md` and plots.
+//! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
+//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
+//! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
+//! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
+//! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
+//! - [`parse`]: study files (TOML) → validated [`Study`].
+//! - [`doe`]: grid and sampled designs of experiments → cases.
+//! - [`cases`]: a case's overrides applied, its seed and hashes.
+//! - [`records`]: case status, row, columns of the raw and final tables.
+//! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
+//! - [`manifest`]: the `manifest.json` of an output directory.
+//! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
+//! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
+//! - [`engine`]: running, resuming and sharding a sweep.
+//! - [`shards`]: merging shard outputs.
 
+pub mod axes;
+pub mod cases;
 pub mod doe;
 pub mod engine;
+pub mod error;
+pub mod finish;
+pub mod hash;
+pub mod manifest;
+pub mod parse;
 pub mod path;
+pub mod plots;
+pub mod records;
 pub mod runner;
 pub mod schema;
+pub mod selection;
+pub mod shards;
+pub mod spans;
+pub mod static_table;
 pub mod static_tcm;
 pub mod summary;
+pub mod worker;
 
-pub use engine::{merge, report, run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
-pub use schema::{load_study, InputError, Study};
+pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
+pub use error::{InputError, StudyError};
+pub use finish::report;
+pub use parse::load_study;
+pub use records::CaseStatus;
+pub use schema::{DoeKind, Study};
+pub use shards::merge;
 pub use static_tcm::{analyse, StaticSpec, StaticSummary};
-
-use std::path::PathBuf;
-
-/// Errors of the batch engine. [`StudyError::is_input`] tells bad input (exit code 2) from
-/// other failures.
-#[derive(Debug, thiserror::Error)]
-pub enum StudyError {
-    /// A problem with the study file, with its position.
-    #[error("{0}")]
-    Study(#[from] InputError),
-    /// Other bad input (command-line values, output directories that do not fit).
-    #[error("{0}")]
-    Input(String),
-    /// Reading or writing a result file.
-    #[error(transparent)]
-    Report(#[from] crate::report::ReportError),
-    /// File system.
-    #[error("{path}: {message}", path = .path.display())]
-    Io {
-        /// The path concerned.
-        path: PathBuf,
-        /// What went wrong.
-        message: String,
-    },
-    /// Anything else.
-    #[error("{0}")]
-    Other(String),
-}
-
-impl StudyError {
-    /// Whether this is bad input (study file or command line).
-    pub fn is_input(&self) -> bool {
-        matches!(self, StudyError::Study(_) | StudyError::Input(_))
-    }
-}

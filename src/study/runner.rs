@@ -2,16 +2,20 @@
 //!
 //! Everything the sweep needs from the closed-loop scenarios goes through this file:
 //!
+//! - [`Mode`]: the scenario modes a study may name.
 //! - [`default_table`]: every scenario-side key with its default for a mode, shaped like the
 //!   scenario side of a study file — a table with the sub-tables `scenario`, `control`,
 //!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
 //!   valid axis names and to reject unknown keys before anything runs.
-//! - [`Worker::run`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
+//! - [`run_case`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
 //!   case's fully resolved scenario-side table (same shape, overrides applied) and the case
 //!   seed; returns named scalar metrics and, when `log` is set, a trajectory table.
 //!
 //! Both delegate to `crate::scenario` (`default_table`, `run_case`); trajectories are turned
 //! into report tables here so that the scenario module stays free of polars.
+
+use std::fmt;
+use std::str::FromStr;
 
 use crate::model::Vehicle;
 use crate::report::Table;
@@ -45,62 +49,92 @@ pub const SCENARIO_TABLES: [&str; 11] = [
     "thrusters",
 ];
 
-/// Scenario modes a study may name.
-pub const MODES: [&str; 3] = ["static", "transport", "work"];
+/// The scenario mode of a study (`scenario.mode`; written as lower-case text in study files
+/// and manifests).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Only the static TCM analysis (the default).
+    #[default]
+    Static,
+    /// Closed-loop transport along a path.
+    Transport,
+    /// Closed-loop work at a set point.
+    Work,
+}
 
-/// Whether `mode` runs a closed-loop scenario (as opposed to the static analysis).
-pub fn is_dynamic(mode: &str) -> bool {
-    mode != "static"
+impl Mode {
+    /// Every mode, in the order listed in messages.
+    pub const ALL: [Mode; 3] = [Mode::Static, Mode::Transport, Mode::Work];
+
+    /// The name as written in study files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Mode::Static => "static",
+            Mode::Transport => "transport",
+            Mode::Work => "work",
+        }
+    }
+
+    /// Whether the mode runs a closed-loop scenario (as opposed to the static analysis).
+    pub fn is_dynamic(self) -> bool {
+        self != Mode::Static
+    }
+}
+
+impl fmt::Display for Mode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for Mode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Mode::ALL
+            .into_iter()
+            .find(|m| m.as_str() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Mode::ALL.iter().map(|m| m.as_str()).collect();
+                format!("unknown scenario mode '{s}'; valid: {}", names.join(", "))
+            })
+    }
 }
 
 /// Every scenario-side key with its default for `mode` (see the module docs for the shape):
 /// `crate::scenario::default_table` for the dynamic modes.
-pub fn default_table(mode: &str) -> Result<toml::Table, String> {
+pub fn default_table(mode: Mode) -> Result<toml::Table, String> {
     match mode {
-        "static" => toml::from_str("[scenario]\nmode = \"static\"\n").map_err(|e| e.to_string()),
-        "transport" | "work" => crate::scenario::default_table(mode).map_err(|e| e.to_string()),
-        other => Err(format!(
-            "unknown scenario mode '{other}'; valid: {}",
-            MODES.join(", ")
-        )),
+        Mode::Static => {
+            toml::from_str("[scenario]\nmode = \"static\"\n").map_err(|e| e.to_string())
+        }
+        Mode::Transport | Mode::Work => {
+            crate::scenario::default_table(mode.as_str()).map_err(|e| e.to_string())
+        }
     }
 }
 
-/// Per-worker state of the sweep (one per rayon worker thread): the place for cached
-/// workspaces and allocators of the scenario module.
-#[derive(Default)]
-pub struct Worker {}
-
-impl Worker {
-    /// A fresh worker.
-    pub fn new() -> Self {
-        Self {}
-    }
-
-    /// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case
-    /// seed, `log` asks for the trajectory. An `Err` (invalid settings) is recorded as a failed
-    /// case with the message as its reason; a run that stops early (diverges, NaN) returns its
-    /// metrics with `failure` naming the time and the cause.
-    pub fn run(
-        &mut self,
-        vehicle: &Vehicle,
-        scenario: &toml::Table,
-        seed: u64,
-        log: bool,
-    ) -> Result<CaseOutcome, String> {
-        let run =
-            crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
-        let trajectory = match run.trajectory {
-            Some(t) => Some(
-                crate::report::figures::trajectory_table(&t.names, &t.columns)
-                    .map_err(|e| e.to_string())?,
-            ),
-            None => None,
-        };
-        Ok(CaseOutcome {
-            metrics: run.metrics,
-            trajectory,
-            failure: run.failure,
-        })
-    }
+/// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case seed,
+/// `log` asks for the trajectory. An `Err` (invalid settings) is recorded as a failed case with
+/// the message as its reason; a run that stops early (diverges, NaN) returns its metrics with
+/// `failure` naming the time and the cause.
+pub fn run_case(
+    vehicle: &Vehicle,
+    scenario: &toml::Table,
+    seed: u64,
+    log: bool,
+) -> Result<CaseOutcome, String> {
+    let run = crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
+    let trajectory = match run.trajectory {
+        Some(t) => Some(
+            crate::report::figures::trajectory_table(&t.names, &t.columns)
+                .map_err(|e| e.to_string())?,
+        ),
+        None => None,
+    };
+    Ok(CaseOutcome {
+        metrics: run.metrics,
+        trajectory,
+        failure: run.failure,
+    })
 }

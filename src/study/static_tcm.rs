@@ -33,8 +33,19 @@ pub const CHUNK: usize = 4096;
 /// `samples × joints` 32-bit integers); use Sobol for more.
 pub const MAX_LHS_SAMPLES: usize = 2_000_000;
 
+/// Default number of joint configurations sampled (`[static] samples` in study files,
+/// `tcm --samples`): the singular fraction then has a standard error of at most 1.6 %, and one
+/// case costs about 30 ms (one SVD of `T` per sample).
+pub const DEFAULT_SAMPLES: usize = 1000;
+
 /// Default threshold on the scaled σ_min below which `T` counts as (near-)singular.
 pub const DEFAULT_THRESHOLD: f64 = 0.02;
+
+/// Default design of experiments in joint space.
+pub const DEFAULT_SAMPLING: Sampling = Sampling::Sobol;
+
+/// Default number of lowest-σ_min configurations kept (`tcm --worst`).
+pub const DEFAULT_WORST: usize = 10;
 
 /// Quantile levels reported for σ_min and κ.
 pub const QUANTILES: [f64; 7] = [0.01, 0.05, 0.10, 0.25, 0.50, 0.75, 0.95];
@@ -67,41 +78,44 @@ pub enum StaticError {
     Threads(String),
 }
 
-/// Settings of a static analysis.
+/// Settings of a static analysis. [`Default`] gives every setting its documented default;
+/// the `[static]` table of study files and the `tcm` command start from it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StaticSpec {
-    /// Number of joint configurations sampled (≥ 1).
+    /// Number of joint configurations sampled (≥ 1; default [`DEFAULT_SAMPLES`]).
     pub samples: usize,
-    /// Seed of the sampler.
+    /// Seed of the sampler (default 0).
     pub seed: u64,
-    /// Threshold on the scaled σ_min (dimensionless, N per N) below which `T` counts as singular.
+    /// Threshold on the scaled σ_min (dimensionless, N per N) below which `T` counts as
+    /// singular (≥ 0; default [`DEFAULT_THRESHOLD`]).
     pub threshold: f64,
-    /// Design of experiments in joint space.
+    /// Design of experiments in joint space (default [`DEFAULT_SAMPLING`]).
     pub sampling: Sampling,
-    /// Characteristic length `L` [m] dividing the moment rows; `None`: half the vehicle length.
+    /// Characteristic length `L` [m] dividing the moment rows (> 0); `None` (the default):
+    /// half the vehicle length.
     pub char_length: Option<f64>,
-    /// Relative rank tolerance (see [`DEFAULT_RANK_REL_TOL`]).
+    /// Relative rank tolerance (≥ 0; default [`DEFAULT_RANK_REL_TOL`]).
     pub rank_rel_tol: f64,
-    /// How many lowest-σ_min configurations to keep.
+    /// How many lowest-σ_min configurations to keep (default [`DEFAULT_WORST`]).
     pub worst: usize,
 }
 
 impl Default for StaticSpec {
     fn default() -> Self {
         Self {
-            samples: 1000,
+            samples: DEFAULT_SAMPLES,
             seed: 0,
             threshold: DEFAULT_THRESHOLD,
-            sampling: Sampling::Sobol,
+            sampling: DEFAULT_SAMPLING,
             char_length: None,
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
-            worst: 10,
+            worst: DEFAULT_WORST,
         }
     }
 }
 
 impl StaticSpec {
-    /// Check the settings.
+    /// Check the settings; the error names the key that is wrong.
     pub fn validate(&self) -> Result<(), StaticError> {
         let bad = |key, message: String| Err(StaticError::Setting { key, message });
         if self.samples == 0 {
@@ -308,21 +322,6 @@ fn map_joint(v: &Vehicle, u: &[f64], q: &mut [f64]) {
     }
 }
 
-/// Run `f` on a local pool of `threads` workers (0: all cores), or inline for 1.
-pub(crate) fn with_threads<R: Send>(
-    threads: usize,
-    f: impl FnOnce() -> R + Send,
-) -> Result<R, String> {
-    if threads == 1 {
-        return Ok(f());
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())?;
-    Ok(pool.install(f))
-}
-
 /// Quantile at level `p` of sorted values (linear interpolation, "type 7"); `inf` propagates.
 pub fn quantile_sorted(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
@@ -391,13 +390,10 @@ pub fn analyse(
             message: format!("the vehicle's half-length {l} m is not usable; give char_length"),
         });
     }
-    let n_joints = vehicle.n_joints();
-    let sampler =
-        Sampler::new(spec.sampling, spec.samples, n_joints, spec.seed).map_err(|message| {
-            StaticError::Setting {
-                key: "sampling",
-                message,
-            }
+    let sampler = Sampler::new(spec.sampling, spec.samples, vehicle.n_joints(), spec.seed)
+        .map_err(|message| StaticError::Setting {
+            key: "sampling",
+            message,
         })?;
     let eval = Eval {
         v: vehicle,
@@ -405,21 +401,7 @@ pub fn analyse(
         tol: spec.rank_rel_tol,
         threshold: spec.threshold,
     };
-    let pool = if threads == 1 {
-        None
-    } else {
-        Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .map_err(|e| StaticError::Threads(e.to_string()))?,
-        )
-    };
-    let mut sigmas = Vec::with_capacity(spec.samples);
-    let mut kappas = Vec::with_capacity(spec.samples);
-    let mut worst: Vec<SampleEval> = Vec::new();
-    let mut counts = [0usize; 6];
-    let (mut below, mut deficient) = (0usize, 0usize);
+    let pool = local_pool(threads)?;
     let run_chunk = |range: std::ops::Range<usize>| -> Vec<Result<SampleEval, StaticError>> {
         let one = |s: &mut Scratch, i: usize| {
             sampler.point(i, &mut s.u);
@@ -441,64 +423,118 @@ pub fn analyse(
             }),
         }
     };
-    let mut body = || -> Result<(), StaticError> {
-        let mut start = 0;
-        while start < spec.samples {
-            let end = (start + CHUNK).min(spec.samples);
-            for r in run_chunk(start..end) {
-                let e = r?;
-                sigmas.push(e.sigma_min);
-                kappas.push(e.kappa);
-                // NaN counts as singular.
-                if e.sigma_min.is_nan() || e.sigma_min < spec.threshold {
-                    below += 1;
-                }
-                if e.rank < 6 {
-                    deficient += 1;
-                }
-                if let Some(a) = e.lost_axis {
-                    if let Some(k) = AXIS_NAMES.iter().position(|n| *n == a) {
-                        counts[k] += 1;
-                    }
-                }
-                sink(&e).map_err(StaticError::Sink)?;
-                keep_worst(&mut worst, e, spec.worst);
-            }
-            start = end;
-            progress(start);
+    let mut tally = Tally::new(spec);
+    let mut start = 0;
+    while start < spec.samples {
+        let end = (start + CHUNK).min(spec.samples);
+        for r in run_chunk(start..end) {
+            tally.add(r?, sink)?;
         }
+        start = end;
+        progress(start);
+    }
+    let straight = eval.at(&mut Scratch::new(vehicle), 0)?;
+    Ok(tally.summary(vehicle, spec, l, straight))
+}
+
+/// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
+fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, StaticError> {
+    if threads == 1 {
+        return Ok(None);
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map(Some)
+        .map_err(|e| StaticError::Threads(e.to_string()))
+}
+
+/// The running aggregates of [`analyse`], fed in sample-index order.
+struct Tally {
+    threshold: f64,
+    keep: usize,
+    sigmas: Vec<f64>,
+    kappas: Vec<f64>,
+    worst: Vec<SampleEval>,
+    counts: [usize; 6],
+    below: usize,
+    deficient: usize,
+}
+
+impl Tally {
+    fn new(spec: &StaticSpec) -> Self {
+        Self {
+            threshold: spec.threshold,
+            keep: spec.worst,
+            sigmas: Vec::with_capacity(spec.samples),
+            kappas: Vec::with_capacity(spec.samples),
+            worst: Vec::new(),
+            counts: [0; 6],
+            below: 0,
+            deficient: 0,
+        }
+    }
+
+    /// Count sample `e` and hand it to `sink`.
+    fn add(
+        &mut self,
+        e: SampleEval,
+        sink: &mut dyn FnMut(&SampleEval) -> Result<(), String>,
+    ) -> Result<(), StaticError> {
+        self.sigmas.push(e.sigma_min);
+        self.kappas.push(e.kappa);
+        // NaN counts as singular.
+        if e.sigma_min.is_nan() || e.sigma_min < self.threshold {
+            self.below += 1;
+        }
+        if e.rank < 6 {
+            self.deficient += 1;
+        }
+        if let Some(a) = e.lost_axis {
+            if let Some(k) = AXIS_NAMES.iter().position(|n| *n == a) {
+                self.counts[k] += 1;
+            }
+        }
+        sink(&e).map_err(StaticError::Sink)?;
+        keep_worst(&mut self.worst, e, self.keep);
         Ok(())
-    };
-    body()?;
-    let mut s = Scratch::new(vehicle);
-    let straight = eval.at(&mut s, 0)?;
-    let n = spec.samples as f64;
-    Ok(StaticSummary {
-        design: vehicle.name.clone(),
-        joints: vehicle.joints.iter().map(|j| j.name.clone()).collect(),
-        thrusters: vehicle.n_thrusters(),
-        samples: spec.samples,
-        seed: spec.seed,
-        sampling: spec.sampling.to_string(),
-        threshold: spec.threshold,
-        char_length: l,
-        rank_rel_tol: spec.rank_rel_tol,
-        singular_fraction: below as f64 / n,
-        rank_deficient_fraction: deficient as f64 / n,
-        sigma_min: distribution(sigmas),
-        kappa: distribution(kappas),
-        worst,
-        lost_axes: AXIS_NAMES
-            .iter()
-            .zip(counts)
-            .map(|(axis, count)| AxisCount {
-                axis,
-                count,
-                fraction: count as f64 / n,
-            })
-            .collect(),
-        straight,
-    })
+    }
+
+    fn summary(
+        self,
+        vehicle: &Vehicle,
+        spec: &StaticSpec,
+        l: f64,
+        straight: SampleEval,
+    ) -> StaticSummary {
+        let n = spec.samples as f64;
+        StaticSummary {
+            design: vehicle.name.clone(),
+            joints: vehicle.joints.iter().map(|j| j.name.clone()).collect(),
+            thrusters: vehicle.n_thrusters(),
+            samples: spec.samples,
+            seed: spec.seed,
+            sampling: spec.sampling.to_string(),
+            threshold: spec.threshold,
+            char_length: l,
+            rank_rel_tol: spec.rank_rel_tol,
+            singular_fraction: self.below as f64 / n,
+            rank_deficient_fraction: self.deficient as f64 / n,
+            sigma_min: distribution(self.sigmas),
+            kappa: distribution(self.kappas),
+            worst: self.worst,
+            lost_axes: AXIS_NAMES
+                .iter()
+                .zip(self.counts)
+                .map(|(axis, count)| AxisCount {
+                    axis,
+                    count,
+                    fraction: count as f64 / n,
+                })
+                .collect(),
+            straight,
+        }
+    }
 }
 
 /// Keep the `k` lowest-σ_min samples, ascending, ties by index (NaN counts as lowest).
@@ -594,7 +630,10 @@ pub fn slice_grid(
                 .collect()
         }
     };
-    let sigma_min = with_threads(threads, compute).map_err(StaticError::Threads)??;
+    let sigma_min = match local_pool(threads)? {
+        None => compute()?,
+        Some(pool) => pool.install(compute)?,
+    };
     Ok(SliceGrid {
         joint_x: i,
         joint_y: j,
@@ -648,76 +687,5 @@ pub fn influential_joints(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::presets::usm_paper;
-
-    fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
-        let v = usm_paper();
-        let spec = StaticSpec {
-            samples,
-            seed: 7,
-            sampling,
-            ..Default::default()
-        };
-        let mut rows = Vec::new();
-        let s = analyse(
-            &v,
-            &spec,
-            threads,
-            &mut |e| {
-                rows.push(e.clone());
-                Ok(())
-            },
-            &|_| {},
-        )
-        .unwrap();
-        (s, rows)
-    }
-
-    #[test]
-    fn deterministic_across_threads() {
-        for m in [Sampling::Sobol, Sampling::Lhs, Sampling::Random] {
-            let (a, ra) = run(1, 5000, m);
-            let (b, rb) = run(3, 5000, m);
-            assert_eq!(a, b);
-            assert_eq!(ra, rb);
-            assert!(ra.iter().enumerate().all(|(i, r)| r.index == i));
-        }
-    }
-
-    #[test]
-    fn paper_straight_is_singular_in_roll() {
-        let (s, _) = run(1, 300, Sampling::Sobol);
-        assert_eq!(s.straight.rank, 5);
-        assert_eq!(s.straight.lost_axis, Some("roll"));
-        assert!((0.0..=1.0).contains(&s.singular_fraction));
-        assert!(s.worst.windows(2).all(|w| w[0].sigma_min <= w[1].sigma_min));
-        assert_eq!(s.worst.len(), 10);
-        let total: usize = s.lost_axes.iter().map(|a| a.count).sum();
-        assert!(total >= (s.singular_fraction * 300.0).round() as usize);
-    }
-
-    #[test]
-    fn quantiles() {
-        let v = vec![3.0, 1.0, 2.0, 4.0];
-        let d = distribution(v);
-        assert_eq!(d.min, 1.0);
-        assert_eq!(d.max, 4.0);
-        assert_eq!(quantile_sorted(&[1.0, 2.0, 3.0, 4.0], 0.5), 2.5);
-        assert_eq!(quantile_sorted(&[1.0, f64::INFINITY], 0.5), f64::INFINITY);
-        assert_eq!(quantile_sorted(&[1.0, f64::INFINITY], 0.0), 1.0);
-    }
-
-    #[test]
-    fn slice_and_influence() {
-        let v = usm_paper();
-        let spec = StaticSpec::default();
-        let (i, j) = influential_joints(&v, &spec).unwrap().unwrap();
-        assert!(i < j && v.joints[i].axis.z.abs() > 0.9 && v.joints[j].axis.z.abs() > 0.9);
-        let g = slice_grid(&v, &spec, i, j, 9, 2).unwrap();
-        assert_eq!(g.sigma_min.len(), 81);
-        assert_eq!(g, slice_grid(&v, &spec, i, j, 9, 1).unwrap());
-        assert!(slice_grid(&v, &spec, 0, 0, 9, 1).is_err());
-    }
-}
+#[path = "static_tcm_tests.rs"]
+mod tests;

@@ -1,0 +1,341 @@
+//! The `[[axis]]` entries of a study file → validated [`Axis`] values: which table and key
+//! each edits (checked against the valid parameter names), and its values, range or
+//! distribution.
+
+use std::collections::BTreeSet;
+
+use serde::Deserialize;
+
+use super::error::InputError;
+use super::path::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
+use super::schema::{
+    is_scenario_table, Axis, AxisSpec, Dist, Doe, Target, GENERATOR_KEYS, MAX_CASES,
+};
+use super::spans::Spans;
+use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct AxisFile {
+    name: String,
+    values: Option<Vec<toml::Value>>,
+    range: Option<RangeFile>,
+    distribution: Option<DistFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RangeFile {
+    start: f64,
+    stop: f64,
+    steps: Option<usize>,
+    log: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DistFile {
+    kind: String,
+    low: Option<f64>,
+    high: Option<f64>,
+    mean: Option<f64>,
+    std: Option<f64>,
+}
+
+const THRUSTER_KEYS: [&str; 10] = [
+    "name",
+    "body",
+    "position",
+    "position[]",
+    "direction",
+    "direction[]",
+    "u_min",
+    "u_max",
+    "time_constant",
+    "rate_limit",
+];
+
+/// Valid parameter names: patterns, array patterns, and the reference table per side.
+pub(crate) struct Names {
+    design: BTreeSet<String>,
+    design_arrays: BTreeSet<String>,
+    scenario: BTreeSet<String>,
+    scenario_arrays: BTreeSet<String>,
+    /// Scenario defaults merged under the study's own values (reference types).
+    pub(crate) scenario_ref: toml::Table,
+    generator: bool,
+}
+
+impl Names {
+    fn list(&self) -> String {
+        let mut v: Vec<String> = self
+            .design
+            .iter()
+            .map(|p| format!("design.{}", display_pattern(p)))
+            .collect();
+        if self.generator {
+            v.extend(GENERATOR_KEYS.iter().map(|k| format!("design.{k} (alias)")));
+        }
+        v.extend(self.scenario.iter().map(|p| display_pattern(p)));
+        v.join(", ")
+    }
+}
+
+/// The names sweep axes may edit: the design's keys (with the generator aliases and the
+/// thruster list) and the scenario side's.
+pub(crate) fn valid_names(
+    design: &toml::Table,
+    generator: bool,
+    scenario: BTreeSet<String>,
+    scenario_arrays: BTreeSet<String>,
+    scenario_ref: toml::Table,
+) -> Names {
+    let (mut d_names, mut d_arrays) = (BTreeSet::new(), BTreeSet::new());
+    flatten(design, "", &mut d_names, &mut d_arrays);
+    let mut extra: Vec<String> = vec![
+        "name".into(),
+        "fluid".into(),
+        "fluid.rho".into(),
+        "fluid.g".into(),
+        "fluid.current".into(),
+        "fluid.current[]".into(),
+    ];
+    extra.extend(THRUSTER_KEYS.iter().map(|k| format!("thruster[].{k}")));
+    if generator {
+        extra.extend(GENERATOR_KEYS.iter().map(|k| format!("generator.{k}")));
+        extra.push("generator.link_length[]".into());
+        extra.push("generator.link_mass[]".into());
+        extra.push("thruster".into());
+    }
+    d_names.extend(extra);
+    Names {
+        design: d_names,
+        design_arrays: d_arrays,
+        scenario,
+        scenario_arrays,
+        scenario_ref,
+        generator,
+    }
+}
+
+/// The axes, with the checks that span them (unique names, Sobol dimensions, grid size).
+pub(crate) fn parse_axes(
+    files: &[AxisFile],
+    names: &Names,
+    design: &toml::Table,
+    doe: Doe,
+    spans: &Spans,
+) -> Result<Vec<Axis>, InputError> {
+    let mut axes = Vec::new();
+    for (i, a) in files.iter().enumerate() {
+        let axis = validate_axis(a, i, names, design, doe, spans)?;
+        if axes.iter().any(|b: &Axis| b.name == axis.name) {
+            return Err(spans.err(&format!("axis[{i}].name"), "duplicate axis name"));
+        }
+        axes.push(axis);
+    }
+    if let Doe::Sampled { kind, .. } = doe {
+        if kind == Sampling::Sobol && axes.len() > MAX_SOBOL_DIMS {
+            return Err(spans.err(
+                "doe.kind",
+                format!("sobol supports at most {MAX_SOBOL_DIMS} axes"),
+            ));
+        }
+    }
+    if doe == Doe::Grid {
+        let mut n: usize = 1;
+        for a in &axes {
+            n = n.saturating_mul(a.spec.grid_len());
+        }
+        if n > MAX_CASES {
+            return Err(spans.err(
+                "axis",
+                format!("the grid has {n} cases, more than {MAX_CASES}"),
+            ));
+        }
+    }
+    Ok(axes)
+}
+
+fn validate_axis(
+    a: &AxisFile,
+    i: usize,
+    names: &Names,
+    design: &toml::Table,
+    doe: Doe,
+    spans: &Spans,
+) -> Result<Axis, InputError> {
+    let unknown = || {
+        spans.err(
+            &format!("axis[{i}].name"),
+            format!(
+                "unknown parameter `{}`; valid names: {}",
+                a.name,
+                names.list()
+            ),
+        )
+    };
+    let (target, reference) = axis_target(a, i, names, design, spans)?.ok_or_else(unknown)?;
+    let integer = matches!(reference, Some(toml::Value::Integer(_)));
+    let spec = match (&a.values, &a.range, &a.distribution) {
+        (Some(v), None, None) => values_spec(v, i, spans)?,
+        (None, Some(r), None) => range_spec(r, i, doe, spans)?,
+        (None, None, Some(d)) => distribution_spec(d, i, doe, spans)?,
+        _ => {
+            return Err(spans.err(
+                &format!("axis[{i}]"),
+                "needs exactly one of `values = [...]`, `range = { start, stop, steps }` or `distribution = { kind, ... }`",
+            ))
+        }
+    };
+    let numeric = match &spec {
+        AxisSpec::Values(v) => v
+            .iter()
+            .all(|x| matches!(x, toml::Value::Integer(_) | toml::Value::Float(_))),
+        _ => true,
+    };
+    Ok(Axis {
+        name: a.name.clone(),
+        target,
+        spec,
+        numeric,
+        integer,
+    })
+}
+
+/// The table and key an axis edits, with the key's reference value (its type decides
+/// integer rounding); `None` when the name is not a valid parameter.
+fn axis_target(
+    a: &AxisFile,
+    i: usize,
+    names: &Names,
+    design: &toml::Table,
+    spans: &Spans,
+) -> Result<Option<(Target, Option<toml::Value>)>, InputError> {
+    let path = KeyPath::parse(&a.name).map_err(|m| spans.err(&format!("axis[{i}].name"), m))?;
+    if path.head() == "design" {
+        let mut rest = path.tail();
+        if names.generator {
+            if let Some(Seg::Key(k)) = rest.0.first() {
+                if GENERATOR_KEYS.contains(&k.as_str()) {
+                    rest.0.insert(0, Seg::Key("generator".into()));
+                }
+            }
+        }
+        if rest.0.is_empty()
+            || !pattern_allowed(&rest.pattern(), &names.design, &names.design_arrays)
+        {
+            return Ok(None);
+        }
+        let reference = super::path::get(design, &rest.0)
+            .cloned()
+            .or_else(|| (rest.pattern() == "generator.links").then_some(toml::Value::Integer(5)));
+        Ok(Some((Target::Design(rest), reference)))
+    } else if is_scenario_table(path.head()) {
+        if !pattern_allowed(&path.pattern(), &names.scenario, &names.scenario_arrays) {
+            return Ok(None);
+        }
+        let reference = super::path::get(&names.scenario_ref, &path.0).cloned();
+        Ok(Some((Target::Scenario(path), reference)))
+    } else {
+        Ok(None)
+    }
+}
+
+/// `values = [...]`: non-empty, finite.
+fn values_spec(v: &[toml::Value], i: usize, spans: &Spans) -> Result<AxisSpec, InputError> {
+    if v.is_empty() {
+        return Err(spans.err(&format!("axis[{i}].values"), "needs at least one value"));
+    }
+    if let Some(j) = v
+        .iter()
+        .position(|x| matches!(x, toml::Value::Float(f) if !f.is_finite()))
+    {
+        return Err(spans.err(&format!("axis[{i}].values[{j}]"), "must be finite"));
+    }
+    Ok(AxisSpec::Values(v.to_vec()))
+}
+
+/// `range = { start, stop, steps, log }`: finite ends, positive for `log`, `steps` for grids.
+fn range_spec(r: &RangeFile, i: usize, doe: Doe, spans: &Spans) -> Result<AxisSpec, InputError> {
+    let key = |f: &str| format!("axis[{i}].{f}");
+    if !(r.start.is_finite() && r.stop.is_finite()) {
+        return Err(spans.err(&key("range"), "start and stop must be finite"));
+    }
+    let log = r.log.unwrap_or(false);
+    if log && !(r.start > 0.0 && r.stop > 0.0) {
+        return Err(spans.err(&key("range.log"), "a log range needs start, stop > 0"));
+    }
+    match (doe, r.steps) {
+        (Doe::Grid, None) => {
+            return Err(spans.err(&key("range"), "grid designs need `steps` (>= 1)"))
+        }
+        (_, Some(0)) => return Err(spans.err(&key("range.steps"), "must be >= 1")),
+        _ => {}
+    }
+    Ok(AxisSpec::Range {
+        start: r.start,
+        stop: r.stop,
+        steps: r.steps,
+        log,
+    })
+}
+
+/// `distribution = { kind, ... }` (sampled designs only): the kind's parameters, finite and
+/// in range, and no others.
+fn distribution_spec(
+    d: &DistFile,
+    i: usize,
+    doe: Doe,
+    spans: &Spans,
+) -> Result<AxisSpec, InputError> {
+    if doe == Doe::Grid {
+        return Err(spans.err(
+            &format!("axis[{i}].distribution"),
+            "distributions need a sampled design ([doe] kind = \"random\" | \"lhs\" | \"sobol\")",
+        ));
+    }
+    let dk = |f: &str| format!("axis[{i}].distribution.{f}");
+    let need = |v: Option<f64>, f: &str| {
+        v.filter(|x| x.is_finite())
+            .ok_or_else(|| spans.err(&dk(f), format!("`{f}` is required and must be finite")))
+    };
+    let forbid = |v: Option<f64>, f: &str| match v {
+        Some(_) => Err(spans.err(&dk(f), format!("not a parameter of kind \"{}\"", d.kind))),
+        None => Ok(()),
+    };
+    let dist = match d.kind.as_str() {
+        "uniform" | "loguniform" => {
+            forbid(d.mean, "mean")?;
+            forbid(d.std, "std")?;
+            let (lo, hi) = (need(d.low, "low")?, need(d.high, "high")?);
+            if lo >= hi {
+                return Err(spans.err(&dk("high"), "needs low < high"));
+            }
+            if d.kind == "uniform" {
+                Dist::Uniform(lo, hi)
+            } else {
+                if lo <= 0.0 {
+                    return Err(spans.err(&dk("low"), "loguniform needs low > 0"));
+                }
+                Dist::LogUniform(lo, hi)
+            }
+        }
+        "normal" => {
+            forbid(d.low, "low")?;
+            forbid(d.high, "high")?;
+            let (m, s) = (need(d.mean, "mean")?, need(d.std, "std")?);
+            if s <= 0.0 {
+                return Err(spans.err(&dk("std"), "must be > 0"));
+            }
+            Dist::Normal(m, s)
+        }
+        other => {
+            return Err(spans.err(
+                &dk("kind"),
+                format!("unknown distribution '{other}'; valid: uniform, loguniform, normal"),
+            ))
+        }
+    };
+    Ok(AxisSpec::Distribution(dist))
+}

@@ -1,0 +1,76 @@
+//! Resolving a case: the study's design and scenario-side tables with the case's axis values
+//! applied, its seed and its hashes.
+
+use super::doe::Case;
+use super::hash::{case_hashes, unresolved_case_hash};
+use super::path::{set, Seg};
+use super::schema::{Study, Target};
+use crate::model::design::{design_to_toml, parse_design_table};
+use crate::sampling::derive_seed;
+
+/// A case with every override applied.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resolved {
+    /// Design table.
+    pub design: toml::Table,
+    /// Scenario-side table (defaults filled in).
+    pub scenario: toml::Table,
+    /// Case seed `derive_seed(study_seed, case_id)`.
+    pub seed: u64,
+    /// Stable case hash (hex, 128 bits).
+    pub hash: String,
+    /// Hash of the design table alone (vehicle cache key).
+    pub design_hash: String,
+}
+
+/// Apply a case's overrides to the study's tables. `Err` is the reason the case is skipped
+/// (an index beyond an array, a design the generator cannot build for thruster overrides).
+pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
+    let mut design = study.design.clone();
+    let mut scenario = study.scenario_full.clone();
+    let mut thruster_edits = Vec::new();
+    for (a, v) in study.axes.iter().zip(&case.values) {
+        match &a.target {
+            Target::Design(p) => {
+                if matches!(p.0.first(), Some(Seg::Key(k)) if k == "thruster") {
+                    thruster_edits.push((a, p, v));
+                } else {
+                    set(&mut design, &p.0, v.clone(), &a.name)?;
+                }
+            }
+            Target::Scenario(p) => set(&mut scenario, &p.0, v.clone(), &a.name)?,
+        }
+    }
+    if !thruster_edits.is_empty() && study.generator && !design.contains_key("thruster") {
+        // Write the generated thrusters out so that they can be edited one by one.
+        let v = parse_design_table(&design, "generated design").map_err(|e| e.to_string())?;
+        let explicit: toml::Table =
+            toml::from_str(&design_to_toml(&v)).map_err(|e| e.to_string())?;
+        if let Some(t) = explicit.get("thruster") {
+            design.insert("thruster".into(), t.clone());
+        } else {
+            design.insert("thruster".into(), toml::Value::Array(Vec::new()));
+        }
+    }
+    for (a, p, v) in thruster_edits {
+        set(&mut design, &p.0, v.clone(), &a.name)?;
+    }
+    let seed = derive_seed(study.seed, case.id as u64);
+    let (hash, design_hash) = case_hashes(&design, &scenario, seed);
+    Ok(Resolved {
+        design,
+        scenario,
+        seed,
+        hash,
+        design_hash,
+    })
+}
+
+/// The hash of a case: its resolved hash, or for a case whose overrides do not apply a hash
+/// of the study, the id and the axis values.
+pub fn case_hash(study: &Study, case: &Case, resolved: &Result<Resolved, String>) -> String {
+    match resolved {
+        Ok(r) => r.hash.clone(),
+        Err(_) => unresolved_case_hash(&study.hash, case.id, &case.values),
+    }
+}

@@ -1,0 +1,193 @@
+//! `manifest.json`: provenance (tool, version, git commit, study file and hash), counts,
+//! timings, the raw schema and the report settings of a sweep output; with the clock and git
+//! helpers that fill it in.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::error::StudyError;
+use super::records::StatusCounts;
+use super::runner::Mode;
+use super::schema::{DoeKind, ReportSettings};
+use crate::report::ColumnKind;
+
+/// The manifest's file name in an output directory.
+pub const MANIFEST_FILE: &str = "manifest.json";
+
+fn kind_of(s: &str) -> Option<ColumnKind> {
+    Some(match s {
+        "f64" => ColumnKind::F64,
+        "i64" => ColumnKind::I64,
+        "str" => ColumnKind::Str,
+        "bool" => ColumnKind::Bool,
+        _ => return None,
+    })
+}
+
+/// An axis as recorded in the manifest.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct AxisInfo {
+    /// Name (column).
+    pub name: String,
+    /// Numeric column.
+    pub numeric: bool,
+}
+
+/// Case counts of a manifest.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
+pub struct Counts {
+    /// Cases of the study.
+    pub planned: usize,
+    /// Cases in this output (shard or merge).
+    pub in_output: usize,
+    /// `ok` rows.
+    pub ok: usize,
+    /// `failed` rows.
+    pub failed: usize,
+    /// `skipped` rows.
+    pub skipped: usize,
+    /// Cases taken from a previous run.
+    pub resumed: usize,
+    /// Cases run by this invocation.
+    pub ran: usize,
+}
+
+impl Counts {
+    /// Counts with the status counts `s`.
+    pub fn with_status(self, s: StatusCounts) -> Self {
+        Counts {
+            ok: s.ok,
+            failed: s.failed,
+            skipped: s.skipped,
+            ..self
+        }
+    }
+}
+
+/// `manifest.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Tool name.
+    pub tool: String,
+    /// Tool version.
+    pub tool_version: String,
+    /// `git rev-parse HEAD` of the working directory, when available.
+    pub git_commit: Option<String>,
+    /// Study name.
+    pub study_name: String,
+    /// Description.
+    pub description: String,
+    /// Study file (absolute when known).
+    pub study_file: String,
+    /// Study hash.
+    pub study_hash: String,
+    /// Study seed.
+    pub seed: u64,
+    /// Scenario mode.
+    pub mode: Mode,
+    /// Whether the static analysis ran.
+    pub static_analysis: bool,
+    /// Design of experiments (`grid`, `sobol`, …).
+    pub doe: DoeKind,
+    /// Start time (UTC, RFC 3339).
+    pub start_time: String,
+    /// End time (UTC, RFC 3339).
+    pub end_time: String,
+    /// Wall time [s].
+    pub elapsed_s: f64,
+    /// Cases run per second of wall time.
+    pub throughput_cases_per_s: f64,
+    /// Worker threads.
+    pub jobs: usize,
+    /// `[index, count]` for a shard.
+    pub shard: Option<[usize; 2]>,
+    /// Merged output directories (for `merge`).
+    pub merged_from: Vec<String>,
+    /// Case counts.
+    pub cases: Counts,
+    /// Raw (partial-file) schema: `[name, kind]`.
+    pub columns: Vec<[String; 2]>,
+    /// Axes.
+    pub axes: Vec<AxisInfo>,
+    /// Report settings.
+    pub report: ReportSettings,
+}
+
+impl Manifest {
+    /// The manifest's record of a raw schema (`[name, kind]` pairs); [`Manifest::schema`]
+    /// reads it back.
+    pub fn columns_of(schema: &[(String, ColumnKind)]) -> Vec<[String; 2]> {
+        schema
+            .iter()
+            .map(|(n, k)| [n.clone(), k.to_string()])
+            .collect()
+    }
+
+    /// The raw schema.
+    pub fn schema(&self) -> Result<Vec<(String, ColumnKind)>, String> {
+        self.columns
+            .iter()
+            .map(|[n, k]| {
+                kind_of(k)
+                    .map(|k| (n.clone(), k))
+                    .ok_or_else(|| format!("unknown column kind `{k}`"))
+            })
+            .collect()
+    }
+}
+
+/// Current UTC time as RFC 3339 (seconds).
+pub fn now_rfc3339() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs() as i64);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Civil from days (H. Hinnant).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+/// `git rev-parse HEAD` of the working directory, when available.
+pub fn git_commit() -> Option<String> {
+    let out = std::process::Command::new("git")
+        .args(["rev-parse", "HEAD"])
+        .stderr(std::process::Stdio::null())
+        .output()
+        .ok()?;
+    let s = String::from_utf8(out.stdout).ok()?.trim().to_string();
+    (out.status.success() && s.len() >= 7).then_some(s)
+}
+
+/// Write `manifest.json` into `dir`.
+pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), StudyError> {
+    let text = serde_json::to_string_pretty(m).map_err(|e| StudyError::Other(e.to_string()))?;
+    let p = dir.join(MANIFEST_FILE);
+    std::fs::write(&p, text + "\n").map_err(|e| StudyError::io(&p, e))
+}
+
+/// Read `manifest.json` of an output directory.
+pub fn read_manifest(dir: &Path) -> Result<Manifest, StudyError> {
+    let p = dir.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&p).map_err(|e| {
+        StudyError::Input(format!(
+            "{}: {e} (is {} a finished sweep output? an unfinished one can be completed with --resume)",
+            p.display(),
+            dir.display()
+        ))
+    })?;
+    serde_json::from_str(&text).map_err(|e| StudyError::Input(format!("{}: {e}", p.display())))
+}

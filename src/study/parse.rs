@@ -1,0 +1,378 @@
+//! Study files (TOML) → validated [`Study`]: the file schema, the valid parameter names, and
+//! the checks, one phase per part of the file (name, design, scenario side, design of
+//! experiments, axes). The format is documented in `docs/study-format.md`.
+//!
+//! Every error names the file, the 1-based line and column when known, and the key
+//! (`axis[2].name`). `deny_unknown_fields` everywhere; no `serde(flatten)`.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::axes::{parse_axes, valid_names, AxisFile};
+use super::error::InputError;
+use super::hash::study_hash;
+use super::path::{flatten, pattern_allowed};
+use super::runner::{self, Mode};
+use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
+use super::spans::Spans;
+use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
+use crate::model::design::{load_design_table, parse_design_table};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StudyFile {
+    study: StudyMeta,
+    design: toml::Table,
+    scenario: Option<toml::Table>,
+    #[serde(rename = "static")]
+    static_: Option<toml::Table>,
+    control: Option<toml::Table>,
+    base_control: Option<toml::Table>,
+    allocation: Option<toml::Table>,
+    metrics: Option<toml::Table>,
+    physics: Option<toml::Table>,
+    initial: Option<toml::Table>,
+    path: Option<toml::Table>,
+    setpoint: Option<toml::Table>,
+    servo: Option<toml::Table>,
+    thrusters: Option<toml::Table>,
+    axis: Option<Vec<AxisFile>>,
+    doe: Option<DoeFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StudyMeta {
+    name: String,
+    description: Option<String>,
+    seed: Option<u64>,
+    output: Option<String>,
+    objective: Option<String>,
+    pareto: Option<[String; 2]>,
+    maximise: Option<Vec<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DoeFile {
+    kind: String,
+    cases: Option<usize>,
+}
+
+fn merge_into(base: &mut toml::Table, over: &toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge_into(b, o),
+            _ => {
+                base.insert(k.clone(), v.clone());
+            }
+        }
+    }
+}
+
+/// Read and validate a study file.
+pub fn load_study(path: &Path) -> Result<Study, InputError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        origin: origin.clone(),
+        line: None,
+        column: None,
+        key: String::new(),
+        message: format!("cannot read the study file: {e}"),
+    })?;
+    parse_study(&text, path)
+}
+
+fn base_design(
+    d: &toml::Table,
+    dir: &Path,
+    spans: &Spans,
+) -> Result<(toml::Table, String), InputError> {
+    if let Some(f) = d.get("file") {
+        if let Some(k) = d.keys().find(|k| *k != "file") {
+            return Err(spans.err(
+                &format!("design.{k}"),
+                "cannot be combined with `design.file`",
+            ));
+        }
+        let f = f.as_str().ok_or_else(|| {
+            spans.err(
+                "design.file",
+                "must be a string (a path relative to the study file)",
+            )
+        })?;
+        let p = dir.join(f);
+        let arg = p.display().to_string();
+        if !p.is_file() {
+            return Err(spans.err("design.file", format!("no design file {arg}")));
+        }
+        let t = load_design_table(&arg).map_err(InputError::from)?;
+        return Ok((t, arg));
+    }
+    if let Some(p) = d.get("preset") {
+        if let Some(k) = d.keys().find(|k| *k != "preset" && *k != "name") {
+            return Err(spans.err(
+                &format!("design.{k}"),
+                "not allowed with `design.preset` (only `name`); sweep axes may still edit the \
+                 preset's keys, e.g. design.thruster[2].position",
+            ));
+        }
+        let p = p
+            .as_str()
+            .ok_or_else(|| spans.err("design.preset", "must be a string"))?;
+        let mut t = load_design_table(p).map_err(|e| spans.err("design.preset", e.message))?;
+        if let Some(n) = d.get("name") {
+            t.insert("name".into(), n.clone());
+        }
+        return Ok((t, format!("preset {p}")));
+    }
+    let mut t = d.clone();
+    if !t.contains_key("name") {
+        t.insert("name".into(), toml::Value::String("design".into()));
+    }
+    Ok((t, format!("{} [design]", spans.origin)))
+}
+
+/// Parse and validate study text; `path` locates relative design files and names the origin.
+pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
+    let origin = path.display().to_string();
+    let spans = Spans::parse(text, &origin)?;
+    let file: StudyFile = toml::from_str(text).map_err(|e| spans.serde(&e))?;
+    let meta = &file.study;
+    check_name(&meta.name, &spans)?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let (design, generator) = check_design(&file, dir, &spans)?;
+    let side = scenario_side(&file, &spans)?;
+    let names = valid_names(&design, generator, side.names, side.arrays, side.reference);
+    let doe = parse_doe(file.doe.as_ref(), &spans)?;
+    let axes = parse_axes(
+        file.axis.as_deref().unwrap_or_default(),
+        &names,
+        &design,
+        doe,
+        &spans,
+    )?;
+    let output = meta
+        .output
+        .as_ref()
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new("results/sweeps").join(&meta.name));
+    let hash = study_hash(text, &design);
+    Ok(Study {
+        path: path.to_path_buf(),
+        text: text.to_string(),
+        name: meta.name.clone(),
+        description: meta.description.clone().unwrap_or_default(),
+        seed: meta.seed.unwrap_or(0),
+        output,
+        design,
+        generator,
+        scenario: side.own,
+        scenario_full: names.scenario_ref,
+        mode: side.mode,
+        static_enabled: side.static_enabled,
+        axes,
+        doe,
+        report: ReportSettings {
+            objective: meta.objective.clone(),
+            pareto: meta.pareto.clone(),
+            maximise: meta.maximise.clone().unwrap_or_default(),
+        },
+        hash,
+    })
+}
+
+/// `study.name` names the output directory: non-empty, letters, digits, `_`, `-` and `.`.
+fn check_name(name: &str, spans: &Spans) -> Result<(), InputError> {
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
+        || name.starts_with('.')
+    {
+        return Err(spans.err(
+            "study.name",
+            "must be non-empty and use only letters, digits, `_`, `-` and `.` (it names the output directory)",
+        ));
+    }
+    Ok(())
+}
+
+/// The base design table, checked by the design parser; `(table, uses the generator)`.
+fn check_design(
+    file: &StudyFile,
+    dir: &Path,
+    spans: &Spans,
+) -> Result<(toml::Table, bool), InputError> {
+    let (design, design_origin) = base_design(&file.design, dir, spans)?;
+    let generator = design.contains_key("generator");
+    if let Err(e) = parse_design_table(&design, &design_origin) {
+        return Err(if file.design.contains_key("file") {
+            // Re-parse the file for a positioned error.
+            let f = file
+                .design
+                .get("file")
+                .and_then(|v| v.as_str())
+                .unwrap_or_default();
+            match crate::model::design::load_design(&dir.join(f).display().to_string()) {
+                Err(e2) => e2.into(),
+                Ok(_) => e.into(),
+            }
+        } else {
+            let key = if e.key.is_empty() {
+                "design".to_string()
+            } else {
+                format!("design.{}", e.key)
+            };
+            spans.err(&key, e.message)
+        });
+    }
+    Ok((design, generator))
+}
+
+/// The scenario side of a study file, checked against the mode's defaults.
+struct ScenarioSide {
+    /// The study's own scenario-side tables, as written.
+    own: toml::Table,
+    /// Scenario mode.
+    mode: Mode,
+    /// Whether the static analysis runs.
+    static_enabled: bool,
+    /// The mode's defaults (with `[static]` when enabled) merged under `own`.
+    reference: toml::Table,
+    /// Key patterns of the defaults and of `own`, with their array patterns.
+    names: BTreeSet<String>,
+    arrays: BTreeSet<String>,
+}
+
+fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputError> {
+    let mut own = toml::Table::new();
+    for (k, t) in [
+        ("scenario", &file.scenario),
+        (STATIC_TABLE, &file.static_),
+        ("control", &file.control),
+        ("base_control", &file.base_control),
+        ("allocation", &file.allocation),
+        ("metrics", &file.metrics),
+        ("physics", &file.physics),
+        ("initial", &file.initial),
+        ("path", &file.path),
+        ("setpoint", &file.setpoint),
+        ("servo", &file.servo),
+        ("thrusters", &file.thrusters),
+    ] {
+        if let Some(t) = t {
+            own.insert(k.into(), toml::Value::Table(t.clone()));
+        }
+    }
+    let mode = parse_mode(file, spans)?;
+    let static_enabled = mode == Mode::Static || file.static_.is_some();
+    let mut defaults = runner::default_table(mode).map_err(|m| spans.err("scenario.mode", m))?;
+    if static_enabled {
+        defaults.insert(
+            STATIC_TABLE.into(),
+            toml::Value::Table(static_default_table()),
+        );
+    }
+    let (mut sc_names, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
+    flatten(&defaults, "", &mut sc_names, &mut sc_arrays);
+    // Reject unknown keys of the study's own scenario-side tables.
+    let (mut own_names, mut own_arrays) = (BTreeSet::new(), BTreeSet::new());
+    flatten(&own, "", &mut own_names, &mut own_arrays);
+    if let Some(p) = own_names
+        .iter()
+        .find(|p| !pattern_allowed(p, &sc_names, &sc_arrays))
+    {
+        return Err(unknown_scenario_key(p, mode, &sc_names, spans));
+    }
+    let mut reference = defaults;
+    merge_into(&mut reference, &own);
+    // Static settings of the base must parse.
+    if static_enabled {
+        if let Err(m) = static_spec(&reference, 0) {
+            return Err(spans.err(STATIC_TABLE, m));
+        }
+    }
+    Ok(ScenarioSide {
+        own,
+        mode,
+        static_enabled,
+        reference,
+        names: sc_names.union(&own_names).cloned().collect(),
+        arrays: sc_arrays.union(&own_arrays).cloned().collect(),
+    })
+}
+
+/// `scenario.mode` (default `static`).
+fn parse_mode(file: &StudyFile, spans: &Spans) -> Result<Mode, InputError> {
+    let Some(v) = file.scenario.as_ref().and_then(|s| s.get("mode")) else {
+        return Ok(Mode::Static);
+    };
+    if let Some(m) = v.as_str().and_then(|m| m.parse::<Mode>().ok()) {
+        return Ok(m);
+    }
+    Err(spans.err(
+        "scenario.mode",
+        format!(
+            "must be one of {}, got {v}",
+            Mode::ALL
+                .iter()
+                .map(|m| format!("\"{m}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    ))
+}
+
+/// The error for an unknown scenario-side key `p`, listing its valid siblings.
+fn unknown_scenario_key(
+    p: &str,
+    mode: Mode,
+    valid: &BTreeSet<String>,
+    spans: &Spans,
+) -> InputError {
+    let parent = p.rfind('.').map_or("", |i| &p[..i]);
+    let siblings: Vec<String> = valid
+        .iter()
+        .filter(|n| n.rfind('.').map_or("", |i| &n[..i]) == parent && !n.contains("[]"))
+        .map(|n| n.rsplit('.').next().unwrap_or(n).to_string())
+        .collect();
+    spans.err(
+        p,
+        format!(
+            "unknown key for scenario mode \"{mode}\"; valid keys here: {}",
+            if siblings.is_empty() {
+                "(none)".to_string()
+            } else {
+                siblings.join(", ")
+            }
+        ),
+    )
+}
+
+/// `[doe]` (default: grid).
+fn parse_doe(d: Option<&DoeFile>, spans: &Spans) -> Result<Doe, InputError> {
+    let Some(d) = d else {
+        return Ok(Doe::Grid);
+    };
+    let kind: DoeKind = d.kind.parse().map_err(|m| spans.err("doe.kind", m))?;
+    match kind.sampling() {
+        None => {
+            if d.cases.is_some() {
+                return Err(spans.err("doe.cases", "only for sampled designs (random, lhs, sobol)"));
+            }
+            Ok(Doe::Grid)
+        }
+        Some(kind) => {
+            let cases = d
+                .cases
+                .ok_or_else(|| spans.err("doe", "sampled designs need `cases = N`"))?;
+            if cases == 0 || cases > MAX_CASES {
+                return Err(spans.err("doe.cases", format!("must be in 1..={MAX_CASES}")));
+            }
+            Ok(Doe::Sampled { kind, cases })
+        }
+    }
+}

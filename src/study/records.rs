@@ -1,0 +1,440 @@
+//! Result records of a sweep: the case status, the columns of the raw (partial) and final
+//! tables, one finished case as a [`Row`], and the table operations between them (compaction
+//! and the final table with the scenario metrics unpacked).
+//!
+//! The text of these tables is the contract with resumed runs, merges and reports: statuses
+//! and column names are written and read only through the items here.
+
+use std::collections::{HashMap, HashSet};
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use super::error::StudyError;
+use super::schema::Study;
+use crate::report::{
+    format_f64, write_csv, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
+};
+
+/// How a case ended (the `status` column: `ok`, `failed`, `skipped`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CaseStatus {
+    /// Every metric was computed.
+    Ok,
+    /// The analysis or the run failed (the reason says why; metrics computed so far are kept).
+    Failed,
+    /// The case could not be set up (an override that does not apply, an invalid design).
+    Skipped,
+}
+
+impl CaseStatus {
+    /// Every status, in table order.
+    pub const ALL: [CaseStatus; 3] = [CaseStatus::Ok, CaseStatus::Failed, CaseStatus::Skipped];
+
+    /// The text in the `status` column.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CaseStatus::Ok => "ok",
+            CaseStatus::Failed => "failed",
+            CaseStatus::Skipped => "skipped",
+        }
+    }
+
+    /// The status of a `status` cell; `None` for any other text.
+    pub fn parse(s: &str) -> Option<Self> {
+        CaseStatus::ALL.into_iter().find(|c| c.as_str() == s)
+    }
+}
+
+impl fmt::Display for CaseStatus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for CaseStatus {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        CaseStatus::parse(s).ok_or_else(|| format!("unknown case status `{s}`"))
+    }
+}
+
+/// Cases by status.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StatusCounts {
+    /// `ok` cases.
+    pub ok: usize,
+    /// `failed` cases.
+    pub failed: usize,
+    /// `skipped` cases.
+    pub skipped: usize,
+}
+
+impl StatusCounts {
+    /// Count one case.
+    pub fn add(&mut self, s: CaseStatus) {
+        match s {
+            CaseStatus::Ok => self.ok += 1,
+            CaseStatus::Failed => self.failed += 1,
+            CaseStatus::Skipped => self.skipped += 1,
+        }
+    }
+
+    /// The counts of the `status` column of `table` (other texts are not counted).
+    pub fn of_table(table: &Table) -> Result<Self, StudyError> {
+        let mut c = StatusCounts::default();
+        for s in table
+            .str(STATUS)?
+            .iter()
+            .filter_map(|s| CaseStatus::parse(s))
+        {
+            c.add(s);
+        }
+        Ok(c)
+    }
+}
+
+/// The raw rows, appended as cases finish, compacted at the end.
+pub const PARTIAL_FILE: &str = "cases.partial.csv";
+/// The final table as CSV.
+pub const CASES_CSV: &str = "cases.csv";
+/// The final table as Parquet.
+pub const CASES_PARQUET: &str = "cases.parquet";
+/// The copy of the study file in an output directory.
+pub const STUDY_COPY: &str = "study.toml";
+
+/// The best or the worst case by the objective (their trajectories are rerun for the report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extreme {
+    /// The best case.
+    Best,
+    /// The worst case.
+    Worst,
+}
+
+impl Extreme {
+    /// Both, best first.
+    pub const BOTH: [Extreme; 2] = [Extreme::Best, Extreme::Worst];
+
+    /// `best` or `worst` (series label and file-name part).
+    pub fn label(self) -> &'static str {
+        match self {
+            Extreme::Best => "best",
+            Extreme::Worst => "worst",
+        }
+    }
+
+    /// The file holding the case's trajectory: `trajectory_<label>.csv`.
+    pub fn trajectory_file(self) -> String {
+        format!("trajectory_{}.csv", self.label())
+    }
+}
+
+/// Case id column (i64, dense from 0).
+pub const CASE_ID: &str = "case_id";
+/// Case hash column (hex).
+pub const HASH: &str = "hash";
+/// Status column (see [`CaseStatus`]).
+pub const STATUS: &str = "status";
+/// Reason column (why a case failed or was skipped; one line).
+pub const REASON: &str = "reason";
+
+/// Fixed leading columns of the raw (partial) table; the final table has the first two
+/// first and the last two last.
+pub const RAW_HEAD: [&str; 4] = [CASE_ID, HASH, STATUS, REASON];
+
+/// Number of thrusters of the built design.
+pub const DESIGN_THRUSTERS: &str = "design_thrusters";
+/// Fraction of joint configurations with σ_min below the threshold ("how often T is
+/// singular").
+pub const TCM_SINGULAR_FRACTION: &str = "tcm_singular_fraction";
+/// σ_min of the straight configuration `q = 0`.
+pub const TCM_STRAIGHT_SIGMA_MIN: &str = "tcm_straight_sigma_min";
+
+/// Columns describing the built design (always present).
+pub const DESIGN_COLUMNS: [&str; 5] = [
+    "design_bodies",
+    "design_joints",
+    DESIGN_THRUSTERS,
+    "design_length_m",
+    "design_mass_kg",
+];
+
+/// Static TCM metric columns (present when the static analysis runs).
+pub const TCM_COLUMNS: [&str; 15] = [
+    TCM_SINGULAR_FRACTION,
+    "tcm_rank_deficient_fraction",
+    "tcm_sigma_min_min",
+    "tcm_sigma_min_p05",
+    "tcm_sigma_min_p50",
+    "tcm_sigma_min_mean",
+    "tcm_kappa_p50",
+    "tcm_kappa_p95",
+    TCM_STRAIGHT_SIGMA_MIN,
+    "tcm_lost_surge",
+    "tcm_lost_sway",
+    "tcm_lost_heave",
+    "tcm_lost_roll",
+    "tcm_lost_pitch",
+    "tcm_lost_yaw",
+];
+
+/// Raw column packing the scenario metrics of dynamic modes (`name=value;…`).
+pub const SCENARIO_METRICS_COLUMN: &str = "scenario_metrics";
+
+/// The raw (partial-file) schema of a study.
+pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
+    let mut s: Vec<(String, ColumnKind)> = vec![
+        (CASE_ID.into(), ColumnKind::I64),
+        (HASH.into(), ColumnKind::Str),
+        (STATUS.into(), ColumnKind::Str),
+        (REASON.into(), ColumnKind::Str),
+    ];
+    for a in &study.axes {
+        let k = if a.numeric {
+            ColumnKind::F64
+        } else {
+            ColumnKind::Str
+        };
+        s.push((a.name.clone(), k));
+    }
+    s.extend(
+        DESIGN_COLUMNS
+            .iter()
+            .map(|c| (c.to_string(), ColumnKind::F64)),
+    );
+    if study.static_enabled {
+        s.extend(TCM_COLUMNS.iter().map(|c| (c.to_string(), ColumnKind::F64)));
+    }
+    if study.mode.is_dynamic() {
+        s.push((SCENARIO_METRICS_COLUMN.into(), ColumnKind::Str));
+    }
+    s
+}
+
+/// Number of design and TCM metric columns of a study's rows.
+pub fn metric_count(study: &Study) -> usize {
+    DESIGN_COLUMNS.len()
+        + if study.static_enabled {
+            TCM_COLUMNS.len()
+        } else {
+            0
+        }
+}
+
+/// Text of a non-numeric axis value.
+pub fn axis_text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+fn axis_number(v: &toml::Value) -> f64 {
+    match v {
+        toml::Value::Float(f) => *f,
+        toml::Value::Integer(i) => *i as f64,
+        _ => f64::NAN,
+    }
+}
+
+/// A message on one line (newlines become spaces), as the `reason` column holds it.
+pub fn one_line(s: &str) -> String {
+    s.replace(['\n', '\r'], " ")
+}
+
+/// A name made safe for a file name: ASCII letters, digits, `-` and `_` kept, anything else
+/// replaced by `_`.
+pub fn file_stem_safe(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Scenario metrics packed into one cell: `name=value;…`, with `=`, `;` and white space in
+/// names replaced by `_` and values in the tables' float format.
+pub fn pack_metrics(metrics: &[(String, f64)]) -> String {
+    let mut packed = String::new();
+    for (name, x) in metrics {
+        let clean: String = name
+            .chars()
+            .map(|c| {
+                if c == '=' || c == ';' || c.is_whitespace() {
+                    '_'
+                } else {
+                    c
+                }
+            })
+            .collect();
+        if !packed.is_empty() {
+            packed.push(';');
+        }
+        packed.push_str(&clean);
+        packed.push('=');
+        packed.push_str(&format_f64(*x));
+    }
+    packed
+}
+
+/// One finished case, as written to the partial file.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Case id.
+    pub id: usize,
+    /// Case hash.
+    pub hash: String,
+    /// How the case ended.
+    pub status: CaseStatus,
+    /// Why it failed or was skipped (single line).
+    pub reason: String,
+    /// Axis values.
+    pub axes: Vec<toml::Value>,
+    /// Design and TCM metrics, in raw-schema order (NaN when not computed).
+    pub metrics: Vec<f64>,
+    /// Packed scenario metrics (see [`pack_metrics`]).
+    pub scenario: String,
+}
+
+impl Row {
+    /// An `ok` row without metrics (NaN) for case `id` of `study`.
+    pub fn new(study: &Study, id: usize, hash: String, axes: Vec<toml::Value>) -> Self {
+        Row {
+            id,
+            hash,
+            status: CaseStatus::Ok,
+            reason: String::new(),
+            axes,
+            metrics: vec![f64::NAN; metric_count(study)],
+            scenario: String::new(),
+        }
+    }
+
+    /// Mark the row as ended with `status` for `reason` (made one line).
+    pub fn end(&mut self, status: CaseStatus, reason: &str) {
+        self.status = status;
+        self.reason = one_line(reason);
+    }
+
+    /// The cells in raw-schema order; `texts` are the axis values as text.
+    pub fn values<'a>(&'a self, study: &Study, texts: &'a [String]) -> Vec<Value<'a>> {
+        let mut v: Vec<Value<'a>> = vec![
+            Value::I64(self.id as i64),
+            Value::Str(&self.hash),
+            Value::Str(self.status.as_str()),
+            Value::Str(&self.reason),
+        ];
+        for ((a, x), t) in study.axes.iter().zip(&self.axes).zip(texts) {
+            v.push(if a.numeric {
+                Value::F64(axis_number(x))
+            } else {
+                Value::Str(t)
+            });
+        }
+        v.extend(self.metrics.iter().map(|m| Value::F64(*m)));
+        if study.mode.is_dynamic() {
+            v.push(Value::Str(&self.scenario));
+        }
+        v
+    }
+}
+
+/// Sort raw rows by case id, drop duplicates (by hash, first kept) and, when `keep` is
+/// given, rows whose hash is not in it.
+pub fn compact(raw: &Table, keep: Option<&HashSet<String>>) -> Result<Table, StudyError> {
+    let ids = raw.i64(CASE_ID)?;
+    let hashes = raw.str(HASH)?;
+    let mut order: Vec<usize> = (0..raw.n_rows())
+        .filter(|&i| keep.is_none_or(|k| k.contains(&hashes[i])))
+        .collect();
+    order.sort_by(|&a, &b| {
+        ids[a]
+            .cmp(&ids[b])
+            .then(hashes[a].cmp(&hashes[b]))
+            .then(a.cmp(&b))
+    });
+    let mut seen = HashSet::new();
+    order.retain(|&i| seen.insert(hashes[i].as_str()));
+    Ok(raw.select_rows(&order)?)
+}
+
+/// The final table from compacted raw rows: `case_id`, `hash`, axes and metrics (scenario
+/// metrics unpacked into columns in order of first appearance), `status`, `reason`.
+pub fn final_table(raw: &Table) -> Result<Table, StudyError> {
+    let mut cols: Vec<Column> = Vec::new();
+    let get = |n: &str| raw.column(n).cloned();
+    for n in [CASE_ID, HASH] {
+        cols.extend(get(n));
+    }
+    let mut packed: Option<&[String]> = None;
+    for c in &raw.columns {
+        if RAW_HEAD.contains(&c.name.as_str()) {
+            continue;
+        }
+        if c.name == SCENARIO_METRICS_COLUMN {
+            packed = Some(raw.str(&c.name)?);
+            continue;
+        }
+        cols.push(c.clone());
+    }
+    if let Some(p) = packed {
+        for (n, d) in unpack_metrics(p) {
+            if raw.column(&n).is_some() || cols.iter().any(|c| c.name == n) {
+                continue;
+            }
+            cols.push(Column {
+                name: n,
+                data: ColumnData::F64(d),
+            });
+        }
+    }
+    for n in [STATUS, REASON] {
+        cols.extend(get(n));
+    }
+    Ok(Table::from_columns(cols)?)
+}
+
+/// Write compacted raw rows to the partial file of `out` and the final table to
+/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table.
+pub fn write_tables(raw: &Table, out: &Path) -> Result<Table, StudyError> {
+    write_csv(raw, &out.join(PARTIAL_FILE))?;
+    let table = final_table(raw)?;
+    write_csv(&table, &out.join(CASES_CSV))?;
+    write_parquet(&table, &out.join(CASES_PARQUET))?;
+    Ok(table)
+}
+
+/// Packed scenario metrics (one cell per row) as columns `(name, values)`, in order of first
+/// appearance; NaN where a row lacks a metric or its value does not parse.
+fn unpack_metrics(cells: &[String]) -> Vec<(String, Vec<f64>)> {
+    let mut names: Vec<String> = Vec::new();
+    let mut index: HashMap<String, usize> = HashMap::new();
+    let parsed: Vec<Vec<(usize, f64)>> = cells
+        .iter()
+        .map(|s| {
+            s.split(';')
+                .filter(|x| !x.is_empty())
+                .filter_map(|kv| {
+                    let (k, v) = kv.split_once('=')?;
+                    let i = *index.entry(k.to_string()).or_insert_with(|| {
+                        names.push(k.to_string());
+                        names.len() - 1
+                    });
+                    Some((i, v.parse::<f64>().unwrap_or(f64::NAN)))
+                })
+                .collect()
+        })
+        .collect();
+    let mut data = vec![vec![f64::NAN; cells.len()]; names.len()];
+    for (r, kvs) in parsed.iter().enumerate() {
+        for &(i, x) in kvs {
+            data[i][r] = x;
+        }
+    }
+    names.into_iter().zip(data).collect()
+}

@@ -1,0 +1,77 @@
+//! The `[static]` table of study files ↔ [`StaticSpec`]: the table of defaults the schema
+//! offers as axis names, and the settings of a resolved case. Every default comes from
+//! [`StaticSpec::default`], so a study file and `usm-study tcm` agree.
+
+use serde::Deserialize;
+
+use super::static_tcm::StaticSpec;
+use crate::sampling::Sampling;
+
+/// The key of the `[static]` table in study files and resolved scenario-side tables.
+pub const STATIC_TABLE: &str = "static";
+
+/// The keys of `[static]`, all optional.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StaticFile {
+    samples: Option<usize>,
+    threshold: Option<f64>,
+    sampling: Option<String>,
+    char_length: Option<f64>,
+    rank_rel_tol: Option<f64>,
+}
+
+/// Defaults of the `[static]` table, from [`StaticSpec::default`] (`char_length = 0`: half
+/// the vehicle length, or `metrics.char_length` when that is > 0).
+pub fn static_default_table() -> toml::Table {
+    let d = StaticSpec::default();
+    let mut t = toml::Table::new();
+    t.insert("samples".into(), toml::Value::Integer(d.samples as i64));
+    t.insert("threshold".into(), toml::Value::Float(d.threshold));
+    t.insert(
+        "sampling".into(),
+        toml::Value::String(d.sampling.to_string()),
+    );
+    t.insert(
+        "char_length".into(),
+        toml::Value::Float(d.char_length.unwrap_or(0.0)),
+    );
+    t.insert("rank_rel_tol".into(), toml::Value::Float(d.rank_rel_tol));
+    t
+}
+
+/// The static-analysis settings of a resolved scenario-side table (`[static]`, with
+/// `metrics.char_length` as the fallback characteristic length), seeded with `seed`. No
+/// configurations are kept (`worst = 0`): sweeps record only the aggregate metrics.
+pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, String> {
+    let t = scenario
+        .get(STATIC_TABLE)
+        .cloned()
+        .unwrap_or(toml::Value::Table(toml::Table::new()));
+    let f = StaticFile::deserialize(t).map_err(|e| format!("[static]: {}", e.message().trim()))?;
+    let d = StaticSpec::default();
+    let sampling: Sampling = match &f.sampling {
+        Some(s) => s.parse().map_err(|m| format!("static.sampling: {m}"))?,
+        None => d.sampling,
+    };
+    let metrics_l = scenario
+        .get("metrics")
+        .and_then(|m| m.get("char_length"))
+        .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+        .filter(|l| *l > 0.0);
+    let char_length = match f.char_length {
+        Some(l) if l != 0.0 => Some(l),
+        _ => metrics_l,
+    };
+    let spec = StaticSpec {
+        samples: f.samples.unwrap_or(d.samples),
+        seed,
+        threshold: f.threshold.unwrap_or(d.threshold),
+        sampling,
+        char_length,
+        rank_rel_tol: f.rank_rel_tol.unwrap_or(d.rank_rel_tol),
+        worst: 0,
+    };
+    spec.validate().map_err(|e| e.to_string())?;
+    Ok(spec)
+}

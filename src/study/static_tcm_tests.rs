@@ -1,0 +1,74 @@
+//! Tests of the static TCM analysis: determinism across threads, the paper design's singular
+//! straight configuration, quantiles, slices and joint influence.
+
+use super::*;
+use crate::model::presets::usm_paper;
+
+fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
+    let v = usm_paper();
+    let spec = StaticSpec {
+        samples,
+        seed: 7,
+        sampling,
+        ..Default::default()
+    };
+    let mut rows = Vec::new();
+    let s = analyse(
+        &v,
+        &spec,
+        threads,
+        &mut |e| {
+            rows.push(e.clone());
+            Ok(())
+        },
+        &|_| {},
+    )
+    .unwrap();
+    (s, rows)
+}
+
+#[test]
+fn deterministic_across_threads() {
+    for m in [Sampling::Sobol, Sampling::Lhs, Sampling::Random] {
+        let (a, ra) = run(1, 5000, m);
+        let (b, rb) = run(3, 5000, m);
+        assert_eq!(a, b);
+        assert_eq!(ra, rb);
+        assert!(ra.iter().enumerate().all(|(i, r)| r.index == i));
+    }
+}
+
+#[test]
+fn paper_straight_is_singular_in_roll() {
+    let (s, _) = run(1, 300, Sampling::Sobol);
+    assert_eq!(s.straight.rank, 5);
+    assert_eq!(s.straight.lost_axis, Some("roll"));
+    assert!((0.0..=1.0).contains(&s.singular_fraction));
+    assert!(s.worst.windows(2).all(|w| w[0].sigma_min <= w[1].sigma_min));
+    assert_eq!(s.worst.len(), 10);
+    let total: usize = s.lost_axes.iter().map(|a| a.count).sum();
+    assert!(total >= (s.singular_fraction * 300.0).round() as usize);
+}
+
+#[test]
+fn quantiles() {
+    let v = vec![3.0, 1.0, 2.0, 4.0];
+    let d = distribution(v);
+    assert_eq!(d.min, 1.0);
+    assert_eq!(d.max, 4.0);
+    assert_eq!(quantile_sorted(&[1.0, 2.0, 3.0, 4.0], 0.5), 2.5);
+    assert_eq!(quantile_sorted(&[1.0, f64::INFINITY], 0.5), f64::INFINITY);
+    assert_eq!(quantile_sorted(&[1.0, f64::INFINITY], 0.0), 1.0);
+}
+
+#[test]
+fn slice_and_influence() {
+    let v = usm_paper();
+    let spec = StaticSpec::default();
+    let (i, j) = influential_joints(&v, &spec).unwrap().unwrap();
+    assert!(i < j && v.joints[i].axis.z.abs() > 0.9 && v.joints[j].axis.z.abs() > 0.9);
+    let g = slice_grid(&v, &spec, i, j, 9, 2).unwrap();
+    assert_eq!(g.sigma_min.len(), 81);
+    assert_eq!(g, slice_grid(&v, &spec, i, j, 9, 1).unwrap());
+    assert!(slice_grid(&v, &spec, 0, 0, 9, 1).is_err());
+}

@@ -1,0 +1,172 @@
+//! Evaluating one resolved case into a [`Row`]: build the vehicle (cached per worker), record
+//! the design columns, run the static TCM analysis and the closed-loop scenario as the study
+//! asks. A panic, an invalid design or a failed run becomes the row's status and reason; it
+//! never aborts the sweep.
+
+use super::cases::Resolved;
+use super::doe::Case;
+use super::records::{pack_metrics, CaseStatus, Row, DESIGN_COLUMNS, TCM_COLUMNS};
+use super::runner;
+use super::schema::Study;
+use super::static_table::{static_spec, STATIC_TABLE};
+use super::static_tcm::{analyse, StaticSummary};
+use crate::model::design::parse_design_table;
+use crate::model::Vehicle;
+use crate::report::Table;
+use crate::sampling::derive_seed;
+
+/// Per-worker state of a sweep (one per rayon worker): a one-entry vehicle cache keyed by
+/// the design hash, so consecutive cases of one design build it once.
+#[derive(Default)]
+pub struct Worker {
+    cache: Option<(String, Vehicle)>,
+}
+
+impl Worker {
+    /// A fresh worker.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Evaluate a resolved case; returns the row and (with `log`) the trajectory.
+    pub fn evaluate(
+        &mut self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        log: bool,
+    ) -> (Row, Option<Table>) {
+        let mut row = Row::new(study, case.id, r.hash.clone(), case.values.clone());
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            self.evaluate_phases(study, case, r, log, &mut row)
+        }));
+        match result {
+            Ok(traj) => (row, traj),
+            Err(p) => {
+                let msg = p
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| p.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "unknown panic".into());
+                row.end(CaseStatus::Failed, &format!("panic: {msg}"));
+                self.cache = None;
+                (row, None)
+            }
+        }
+    }
+
+    fn evaluate_phases(
+        &mut self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        log: bool,
+        row: &mut Row,
+    ) -> Option<Table> {
+        let v = self.vehicle(case, r, row)?;
+        row.metrics[..DESIGN_COLUMNS.len()].copy_from_slice(&design_metrics(v));
+        if study.static_enabled {
+            static_phase(v, r, row)?;
+        }
+        if study.mode.is_dynamic() {
+            return dynamic_phase(v, r, log, row);
+        }
+        None
+    }
+
+    /// The case's vehicle, built unless cached; `None` (the row skipped) for an invalid design.
+    fn vehicle(&mut self, case: &Case, r: &Resolved, row: &mut Row) -> Option<&Vehicle> {
+        let cached = matches!(&self.cache, Some((h, _)) if *h == r.design_hash);
+        if !cached {
+            match parse_design_table(&r.design, &format!("case {} design", case.id)) {
+                Ok(v) => self.cache = Some((r.design_hash.clone(), v)),
+                Err(e) => {
+                    row.end(CaseStatus::Skipped, &format!("invalid design: {e}"));
+                    return None;
+                }
+            }
+        }
+        self.cache.as_ref().map(|(_, v)| v)
+    }
+}
+
+/// The [`DESIGN_COLUMNS`] of a vehicle.
+fn design_metrics(v: &Vehicle) -> [f64; 5] {
+    [
+        v.bodies.len() as f64,
+        v.n_joints() as f64,
+        v.n_thrusters() as f64,
+        v.total_length(),
+        v.total_mass(),
+    ]
+}
+
+/// The static TCM analysis into the [`TCM_COLUMNS`]; `None` when the row ended.
+fn static_phase(v: &Vehicle, r: &Resolved, row: &mut Row) -> Option<()> {
+    let spec = match static_spec(&r.scenario, derive_seed(r.seed, 1)) {
+        Ok(s) => s,
+        Err(m) => {
+            row.end(CaseStatus::Skipped, &m);
+            return None;
+        }
+    };
+    match analyse(v, &spec, 1, &mut |_| Ok(()), &|_| {}) {
+        Ok(s) => {
+            row.metrics[DESIGN_COLUMNS.len()..].copy_from_slice(&tcm_metrics(&s));
+            Some(())
+        }
+        Err(e) => {
+            row.end(CaseStatus::Failed, &e.to_string());
+            None
+        }
+    }
+}
+
+/// The [`TCM_COLUMNS`] of a static summary.
+fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
+    let q = |p| s.sigma_min_quantile(p).unwrap_or(f64::NAN);
+    let kq = |p: f64| {
+        s.kappa
+            .quantiles
+            .iter()
+            .find(|(l, _)| *l == p)
+            .map_or(f64::NAN, |x| x.1)
+    };
+    let lost = |k: usize| s.lost_axes[k].fraction;
+    [
+        s.singular_fraction,
+        s.rank_deficient_fraction,
+        s.sigma_min.min,
+        q(0.05),
+        q(0.5),
+        s.sigma_min.mean,
+        kq(0.5),
+        kq(0.95),
+        s.straight.sigma_min,
+        lost(0),
+        lost(1),
+        lost(2),
+        lost(3),
+        lost(4),
+        lost(5),
+    ]
+}
+
+/// The closed-loop run into the packed scenario metrics; returns the trajectory (with `log`).
+fn dynamic_phase(v: &Vehicle, r: &Resolved, log: bool, row: &mut Row) -> Option<Table> {
+    let mut sc = r.scenario.clone();
+    sc.remove(STATIC_TABLE);
+    match runner::run_case(v, &sc, r.seed, log) {
+        Ok(out) => {
+            if let Some(f) = &out.failure {
+                row.end(CaseStatus::Failed, f);
+            }
+            row.scenario = pack_metrics(&out.metrics);
+            out.trajectory
+        }
+        Err(m) => {
+            row.end(CaseStatus::Failed, &m);
+            None
+        }
+    }
+}
