@@ -108,7 +108,7 @@ pub fn write_outputs(
     plots: bool,
 ) -> anyhow::Result<()> {
     let design = vehicle.name.as_str();
-    let table = trajectory_table(&r.trajectory.names, &r.trajectory.columns)?;
+    let table = trajectory_table(&r.trajectory)?;
     write_csv(&table, &out.join("timeseries.csv"))?;
     write_parquet(&table, &out.join("timeseries.parquet"))?;
     let metrics: serde_json::Map<String, serde_json::Value> = r
@@ -133,9 +133,9 @@ pub fn write_outputs(
         "failure": r.failure.as_ref().map(|(t, c)| json!({"time": t, "cause": c})),
         "metrics": metrics,
         "allocation": {
-            "steps": r.allocation_counts[0],
-            "slack_active": r.allocation_counts[1],
-            "solver_failures": r.allocation_counts[2],
+            "steps": r.allocation_counts.steps,
+            "slack_active": r.allocation_counts.slack_active,
+            "solver_failures": r.allocation_counts.solver_failures,
         },
         "timing": r.timing,
     });
@@ -152,6 +152,7 @@ pub fn write_outputs(
             .collect();
         let fig = run_figure(
             &table,
+            r.mode,
             &yaw_joints,
             &format!("{} ({} mode)", r.name, r.mode),
         )?;
