@@ -132,11 +132,7 @@ pub fn write_outputs(
         "status": if r.failure.is_some() { "failed" } else { "ok" },
         "failure": r.failure.as_ref().map(|(t, c)| json!({"time": t, "cause": c})),
         "metrics": metrics,
-        "allocation": {
-            "steps": r.allocation_counts.steps,
-            "slack_active": r.allocation_counts.slack_active,
-            "solver_failures": r.allocation_counts.solver_failures,
-        },
+        "allocation": r.allocation_counts,
         "timing": r.timing,
     });
     let text = serde_json::to_string_pretty(&summary)?;

@@ -223,3 +223,18 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
             .to_degrees(),
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::segment_runs;
+
+    #[test]
+    fn segment_runs_split_at_every_change() {
+        assert_eq!(segment_runs(&[]), vec![]);
+        assert_eq!(segment_runs(&[0.0]), vec![(0, 1)]);
+        assert_eq!(
+            segment_runs(&[0.0, 0.0, 1.0, 1.0, 1.0, 0.0]),
+            vec![(0, 2), (2, 5), (5, 6)]
+        );
+    }
+}
