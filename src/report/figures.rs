@@ -29,6 +29,11 @@ fn indexed(t: &Table, family: fn(usize) -> Channel) -> Vec<(usize, Vec<f64>)> {
         .collect()
 }
 
+/// Radians to degrees, element by element.
+fn degrees(v: Vec<f64>) -> Vec<f64> {
+    v.into_iter().map(f64::to_degrees).collect()
+}
+
 fn line(name: &str, x: &[f64], y: Vec<f64>, colour: usize) -> Series {
     Series::new(name, x.to_vec(), y).colour(Colour::Palette(colour))
 }
@@ -46,7 +51,6 @@ fn thruster_panel(t: &Table, time: &[f64], label: &str) -> Panel {
 /// angles (`yaw_joints`: their indices), (d) thruster forces.
 pub fn transport_figure(t: &Table, yaw_joints: &[usize], title: &str) -> Result<Figure> {
     let time = col(t, Channel::T)?;
-    let deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
     let pos = Panel::new("(a) Y position", "time [s]", "y [m]")
         .with_series(line("desired", &time, col(t, Channel::PathY)?, 0).dashed())
         .with_series(line(
@@ -64,7 +68,7 @@ pub fn transport_figure(t: &Table, yaw_joints: &[usize], title: &str) -> Result<
         joints = joints.with_series(line(
             &format!("yaw joint {}", i + 1),
             &time,
-            deg(col(t, Channel::Q(k))?),
+            degrees(col(t, Channel::Q(k))?),
             i,
         ));
     }
@@ -100,40 +104,45 @@ fn tracking_panel(
 /// references, (e) joint angles, (f) thruster forces.
 pub fn work_figure(t: &Table, title: &str) -> Result<Figure> {
     let time = col(t, Channel::T)?;
-    let deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
-    let same = |v: Vec<f64>| v;
     let pose = |a: Pose| (a.suffix(), Channel::EePose(a), Channel::Setpoint(a));
     let twist = |a: Twist| (a.suffix(), Channel::BaseTwist(a), Channel::TwistRef(a));
-    let pos = Panel::new("(a) End-effector position", "time [s]", "position [m]");
-    let pos = tracking_panel(t, &time, pos, [Pose::X, Pose::Y, Pose::Z].map(pose), same)?;
-    let ori = Panel::new("(b) End-effector orientation", "time [s]", "angle [deg]");
-    let angles = [Pose::Roll, Pose::Pitch, Pose::Yaw].map(pose);
-    let ori = tracking_panel(t, &time, ori, angles, deg)?;
-    let lin = Panel::new("(c) Base linear velocity", "time [s]", "velocity [m/s]");
-    let lin = tracking_panel(
-        t,
-        &time,
-        lin,
-        [Twist::U, Twist::V, Twist::W].map(twist),
-        same,
-    )?;
-    let angv = Panel::new("(d) Base angular velocity", "time [s]", "rate [rad/s]");
-    let angv = tracking_panel(
-        t,
-        &time,
-        angv,
-        [Twist::P, Twist::Q, Twist::R].map(twist),
-        same,
-    )?;
+    let same: fn(Vec<f64>) -> Vec<f64> = |v| v;
+    let tracking = [
+        (
+            "(a) End-effector position",
+            "position [m]",
+            [Pose::X, Pose::Y, Pose::Z].map(pose),
+            same,
+        ),
+        (
+            "(b) End-effector orientation",
+            "angle [deg]",
+            [Pose::Roll, Pose::Pitch, Pose::Yaw].map(pose),
+            degrees,
+        ),
+        (
+            "(c) Base linear velocity",
+            "velocity [m/s]",
+            [Twist::U, Twist::V, Twist::W].map(twist),
+            same,
+        ),
+        (
+            "(d) Base angular velocity",
+            "rate [rad/s]",
+            [Twist::P, Twist::Q, Twist::R].map(twist),
+            same,
+        ),
+    ];
+    let mut f = Figure::new(title);
+    for (label, y_label, pairs, scale) in tracking {
+        let p = Panel::new(label, "time [s]", y_label);
+        f = f.with_panel(tracking_panel(t, &time, p, pairs, scale)?);
+    }
     let mut joints = Panel::new("(e) Joint angles", "time [s]", "angle [deg]");
     for (k, q) in indexed(t, Channel::Q) {
-        joints = joints.with_series(line(&format!("q{}", k + 1), &time, deg(q), k));
+        joints = joints.with_series(line(&format!("q{}", k + 1), &time, degrees(q), k));
     }
-    let mut f = Figure::new(title)
-        .with_panel(pos)
-        .with_panel(ori)
-        .with_panel(lin)
-        .with_panel(angv)
+    f = f
         .with_panel(joints)
         .with_panel(thruster_panel(t, &time, "(f) Thruster forces"));
     f.layout = (3, 2);

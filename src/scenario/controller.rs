@@ -50,9 +50,9 @@ pub(crate) enum ModeController {
         path: PathSpec,
         signals: TransportSignals,
     },
-    /// End-effector setpoint regulation.
+    /// End-effector setpoint regulation (boxed: the work law's workspace is large).
     Work {
-        law: WorkController,
+        law: Box<WorkController>,
         target: WorkTarget,
         signals: WorkSignals,
     },
@@ -136,7 +136,7 @@ impl ModeController {
                     base_position: Vec3::from(sp.base_position.unwrap_or(file.initial.position)),
                 };
                 ModeController::Work {
-                    law,
+                    law: Box::new(law),
                     target,
                     signals: WorkSignals::default(),
                 }
