@@ -1,19 +1,12 @@
-//! The error of a scenario: invalid settings (nothing ran) or a run that stopped early.
+//! The error of a scenario: invalid settings, found before anything runs. A run that stops
+//! early is not an error: it is a result with its failure (`RunResult::failure`).
 
 use thiserror::Error;
 
-/// A problem with a scenario: bad settings (before running) or a failed run.
+/// A problem with a scenario's settings or its design; nothing ran.
 #[derive(Debug, Error)]
 pub enum ScenarioError {
-    /// The scenario or its design is invalid; nothing ran.
+    /// The scenario or its design is invalid (the message names the key).
     #[error("{0}")]
     Invalid(String),
-    /// The run stopped early; what was simulated up to then is in the partial result.
-    #[error("run stopped at t = {time:.3} s: {cause}")]
-    Stopped {
-        /// Simulation time of the failure [s].
-        time: f64,
-        /// What went wrong (the offending quantity).
-        cause: String,
-    },
 }

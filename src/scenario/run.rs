@@ -126,12 +126,11 @@ impl ClosedLoop<'_> {
     /// (except after the last period).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
         let t = k as f64 * self.file.scenario.control_dt;
-        let clock = &mut rec.timing;
-        let measured = timed!(clock.control_s, self.measure(t))?;
-        let terms = timed!(clock.dynamics_s, self.sim.base_control_terms())
+        let measured = timed!(rec.timing.control_s, self.measure(t))?;
+        let terms = timed!(rec.timing.dynamics_s, self.sim.base_control_terms())
             .map_err(|e| (t, e.to_string()))?;
-        timed!(clock.control_s, self.control(t, &measured, &terms));
-        timed!(clock.allocation_s, self.allocate(t))?;
+        timed!(rec.timing.control_s, self.control(t, &measured, &terms));
+        timed!(rec.timing.allocation_s, self.allocate(t))?;
         rec.counts.count(&self.alloc.status);
         timed!(rec.timing.logging_s, rec.observe(k, t, self));
         if k == self.n_control {
