@@ -7,7 +7,9 @@
 
 use usm_study::dynamics::{ActuatorCommand, SimConfig, Simulator};
 use usm_study::model::presets::usm_paper;
-use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
+use usm_study::scenario::{
+    load_table, parse_table, resolve_design, run_scenario, Channel, RunResult,
+};
 
 /// Run a preset, extended from the paper's 140 s to 170 s so that convergence within 60 s
 /// of the segment commanded at 95 s can be judged, with `overrides` applied.
@@ -31,15 +33,15 @@ fn run(preset: &str, overrides: &[(&str, &str, toml::Value)]) -> RunResult {
     r
 }
 
-fn m(r: &RunResult, k: &str) -> f64 {
+fn metric(r: &RunResult, k: &str) -> f64 {
     r.metric(k).unwrap_or_else(|| panic!("metric {k}"))
 }
 
 /// Peak |thrust| over the samples with `t` in `[a, b)`.
 fn peak_thrust(r: &RunResult, a: f64, b: f64) -> f64 {
-    let t = r.trajectory.col("t").unwrap();
+    let t = r.trajectory.get(Channel::T).unwrap();
     let cols: Vec<&[f64]> = (0..7)
-        .map(|j| r.trajectory.col(&format!("u_{j}")).unwrap())
+        .map(|j| r.trajectory.get(Channel::U(j)).unwrap())
         .collect();
     (0..t.len())
         .filter(|&i| t[i] >= a && t[i] < b)
@@ -52,32 +54,32 @@ fn transport_both_methods_converge_with_qp() {
     let r1 = run("transport-method1", &[]);
     let r2 = run("transport-method2", &[]);
     for (name, r) in [("method1", &r1), ("method2", &r2)] {
-        assert_eq!(m(r, "completed"), 1.0, "{name}");
-        assert_eq!(m(r, "segments_reached"), 2.0, "{name}");
+        assert_eq!(metric(r, "completed"), 1.0, "{name}");
+        assert_eq!(metric(r, "segments_reached"), 2.0, "{name}");
         // Converged (|e_y| < 0.1 m and staying) on both segments, 180° turn completed.
-        assert_eq!(m(r, "converged"), 1.0, "{name}");
-        assert!(m(r, "final_cross_track").abs() < 0.05, "{name}");
+        assert_eq!(metric(r, "converged"), 1.0, "{name}");
+        assert!(metric(r, "final_cross_track").abs() < 0.05, "{name}");
         // The QP never exceeds the ±40 N limits, and away from the start transient and the
         // turn the thrust is far below them.
-        assert!(m(r, "peak_thrust") <= 40.0 + 1e-6, "{name}");
+        assert!(metric(r, "peak_thrust") <= 40.0 + 1e-6, "{name}");
         let cruise = peak_thrust(r, 2.0, 95.0).max(peak_thrust(r, 125.0, 170.1));
         assert!(cruise < 10.0, "{name}: cruise peak {cruise}");
-        assert!(m(r, "base_cross_track_rms") < 0.2, "{name}");
+        assert!(metric(r, "base_cross_track_rms") < 0.2, "{name}");
     }
     // Method 1: within 60 s of each segment change, small overshoot.
     for k in 0..2 {
-        let c = m(&r1, &format!("seg{k}_convergence_time"));
+        let c = metric(&r1, &format!("seg{k}_convergence_time"));
         assert!(c < 40.0, "method1 seg{k}: {c}");
     }
-    assert!(m(&r1, "overshoot") < 0.2);
+    assert!(metric(&r1, "overshoot") < 0.2);
     // Method 2: converges, but slower than 60 s and with more overshoot than Method 1 —
     // the opposite of the paper's finding (reported, not tuned away).
     for k in 0..2 {
-        let c = m(&r2, &format!("seg{k}_convergence_time"));
+        let c = metric(&r2, &format!("seg{k}_convergence_time"));
         assert!(c > 60.0 && c < 75.0, "method2 seg{k}: {c}");
     }
-    assert!(m(&r2, "overshoot") > m(&r1, "overshoot"));
-    assert!(m(&r2, "convergence_time") > m(&r1, "convergence_time"));
+    assert!(metric(&r2, "overshoot") > metric(&r1, "overshoot"));
+    assert!(metric(&r2, "convergence_time") > metric(&r1, "convergence_time"));
 }
 
 #[test]
@@ -94,8 +96,8 @@ fn paper_literal_base_control_does_not_converge() {
     ];
     for preset in ["transport-method1", "transport-method2"] {
         let r = run(preset, &lit);
-        assert_eq!(m(&r, "converged"), 0.0, "{preset}");
-        assert!(m(&r, "final_cross_track").abs() < 5.0, "{preset}");
+        assert_eq!(metric(&r, "converged"), 0.0, "{preset}");
+        assert!(metric(&r, "final_cross_track").abs() < 5.0, "{preset}");
     }
 }
 

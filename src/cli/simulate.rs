@@ -108,7 +108,7 @@ pub fn write_outputs(
     plots: bool,
 ) -> anyhow::Result<()> {
     let design = vehicle.name.as_str();
-    let table = trajectory_table(&r.trajectory.names, &r.trajectory.columns)?;
+    let table = trajectory_table(&r.trajectory)?;
     write_csv(&table, &out.join("timeseries.csv"))?;
     write_parquet(&table, &out.join("timeseries.parquet"))?;
     let metrics: serde_json::Map<String, serde_json::Value> = r
@@ -132,11 +132,7 @@ pub fn write_outputs(
         "status": if r.failure.is_some() { "failed" } else { "ok" },
         "failure": r.failure.as_ref().map(|(t, c)| json!({"time": t, "cause": c})),
         "metrics": metrics,
-        "allocation": {
-            "steps": r.allocation_counts[0],
-            "slack_active": r.allocation_counts[1],
-            "solver_failures": r.allocation_counts[2],
-        },
+        "allocation": r.allocation_counts,
         "timing": r.timing,
     });
     let text = serde_json::to_string_pretty(&summary)?;
@@ -152,6 +148,7 @@ pub fn write_outputs(
             .collect();
         let fig = run_figure(
             &table,
+            r.mode,
             &yaw_joints,
             &format!("{} ({} mode)", r.name, r.mode),
         )?;

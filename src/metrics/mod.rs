@@ -1,4 +1,5 @@
 //! Metrics (SPEC §6): pure functions of a configuration set or a trajectory.
 
+pub mod run_summary;
 pub mod singularity;
 pub mod trajectory;

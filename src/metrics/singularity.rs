@@ -1,8 +1,9 @@
 //! Thruster-configuration-matrix (TCM) singularity metrics (SPEC §6).
 //!
-//! `T` (6×m, base frame, rows force x, y, z in N per N of thrust then moment x, y, z in N·m per N)
-//! is made dimensionally homogeneous by dividing its moment rows by a characteristic length `L`
-//! (m; callers default it to half the vehicle length): `T_L = diag(1, 1, 1, 1/L, 1/L, 1/L) T`.
+//! `T` (6 × n_thrusters, base frame, rows force x, y, z in N per N of thrust then moment x, y, z
+//! in N·m per N) is made dimensionally homogeneous by dividing its moment rows by a
+//! characteristic length `L` [m] (callers default it to half the vehicle length):
+//! `T_L = diag(1, 1, 1, 1/L, 1/L, 1/L) T`.
 //! The metrics are the singular values of `T_L`, σ_min, σ_max, the condition number, the rank under
 //! a relative tolerance, the lost wrench directions, and (with thrust limits) the attainable wrench
 //! along each base axis (an LP per axis, solved by [`crate::allocation::attainable_wrench`]).
@@ -39,7 +40,7 @@ pub enum SingularityError {
 pub struct LostDirection {
     /// The singular value (same units as `T_L`, N per N).
     pub sigma: f64,
-    /// Unit direction in the scaled wrench space `[f (N); m/L (N)]`, base frame, signed so that
+    /// Unit direction in the scaled wrench space `[f (N); moment/L (N)]`, base frame, signed so that
     /// its largest-magnitude component is positive.
     pub direction: [f64; 6],
     /// Name of the dominant axis of `direction`: `surge`, `sway`, `heave`, `roll`, `pitch`, `yaw`.
@@ -51,9 +52,9 @@ pub struct LostDirection {
 pub struct TcmMetrics {
     /// Characteristic length `L` used to scale the moment rows (m).
     pub char_length: f64,
-    /// The six singular values of `T_L`, descending (zeros appended when m < 6).
+    /// The six singular values of `T_L`, descending (zeros appended when n_thrusters < 6).
     pub singular_values: [f64; 6],
-    /// Smallest singular value σ_6 (0 when m < 6).
+    /// Smallest singular value σ_6 (0 when n_thrusters < 6).
     pub sigma_min: f64,
     /// Largest singular value σ_1.
     pub sigma_max: f64,
@@ -97,13 +98,14 @@ fn check_inputs(
     Ok(())
 }
 
-/// Singular values of `T_L` (SPEC §6), six of them, descending (zeros appended when m < 6).
+/// Singular values of `T_L` (SPEC §6), six of them, descending (zeros appended when
+/// n_thrusters < 6).
 /// `t` must be finite (checked by the public entry points).
 fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matrix6<f64>) {
-    let m = t.ncols();
+    let n_thrusters = t.ncols();
     // Pad to at least 6 columns so that U is a full 6×6 basis of the wrench space.
-    let mut tl = Matrix6xX::<f64>::zeros(m.max(6));
-    tl.columns_mut(0, m)
+    let mut tl = Matrix6xX::<f64>::zeros(n_thrusters.max(6));
+    tl.columns_mut(0, n_thrusters)
         .copy_from(&scale_moment_rows(t, char_length));
     let svd = tl.svd(true, false);
     let mut idx = [0usize, 1, 2, 3, 4, 5];
@@ -120,7 +122,7 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
 }
 
 /// Smallest singular value of `T_L` (SPEC §6), the cheap score for "how often T is singular"
-/// sampling. `char_length` in m, > 0.
+/// sampling. `char_length` [m], > 0.
 pub fn sigma_min_scaled(t: &Matrix6xX<f64>, char_length: f64) -> Result<f64, SingularityError> {
     check_inputs(t, char_length, 0.0)?;
     Ok(scaled_svd(t, char_length).0[5])
@@ -165,8 +167,8 @@ pub fn singular_fraction(sigma_mins: &[f64], threshold: f64) -> f64 {
 
 /// TCM singularity metrics without the attainable-wrench LPs (SPEC §6).
 ///
-/// `t`: 6×m, base frame; `char_length`: L in m (> 0); `rank_rel_tol`: relative rank tolerance
-/// (e.g. [`DEFAULT_RANK_REL_TOL`]).
+/// `t`: 6 × n_thrusters, base frame; `char_length`: L [m] (> 0); `rank_rel_tol`: relative rank
+/// tolerance (e.g. [`DEFAULT_RANK_REL_TOL`]).
 pub fn tcm_svd_metrics(
     t: &Matrix6xX<f64>,
     char_length: f64,

@@ -105,10 +105,10 @@ pub struct EnergyMetrics {
 /// [rad/s]. A thruster counts as saturated within `sat_tol` [N] of a limit.
 pub fn energy_metrics(
     t: &[f64],
-    thrust: &[Vec<f64>],
+    thrust: &[&[f64]],
     limits: &[(f64, f64)],
-    torque: &[Vec<f64>],
-    rate: &[Vec<f64>],
+    torque: &[&[f64]],
+    rate: &[&[f64]],
     model: &PowerModel,
     sat_tol: f64,
 ) -> EnergyMetrics {
@@ -129,7 +129,7 @@ pub fn energy_metrics(
     let peak_thrust = thrust
         .iter()
         .flat_map(|u| u.iter())
-        .fold(0.0f64, |m, x| m.max(x.abs()));
+        .fold(0.0f64, |peak, x| peak.max(x.abs()));
     let saturation_fraction = time_fraction(t, |k| {
         thrust
             .iter()
@@ -204,7 +204,7 @@ pub fn segment_tracking(t: &[f64], e_y: &[f64], band: f64) -> SegmentTracking {
             } else {
                 ee[0].abs()
             };
-            let mx = ee.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let mx = ee.iter().fold(0.0f64, |peak, e| peak.max(e.abs()));
             (t[c] - start, rms, mx)
         }
         None => (nan, nan, nan),
@@ -244,12 +244,13 @@ mod tests {
     #[test]
     fn energy_of_constant_thrust() {
         let t: Vec<f64> = (0..=100).map(|k| k as f64 * 0.1).collect();
-        let u = vec![vec![10.0; 101], vec![-5.0; 101]];
+        let (u0, u1) = (vec![10.0; 101], vec![-5.0; 101]);
+        let u = [u0.as_slice(), u1.as_slice()];
         let lim = [(-40.0, 40.0), (-5.0, 5.0)];
-        let tau = vec![vec![2.0; 101]];
-        let qd = vec![vec![-0.5; 101]];
+        let tau = vec![2.0; 101];
+        let qd = vec![-0.5; 101];
         let m = PowerModel::default();
-        let e = energy_metrics(&t, &u, &lim, &tau, &qd, &m, 1e-9);
+        let e = energy_metrics(&t, &u, &lim, &[&tau], &[&qd], &m, 1e-9);
         // Exact for constant signals over 10 s.
         assert!((e.thruster_energy - 10.0 * (m.power(10.0) + m.power(5.0))).abs() < 1e-9);
         assert!((e.effort_sq - 10.0 * 125.0).abs() < 1e-9);

@@ -1,29 +1,37 @@
 //! The paper-style figures of one closed-loop run, laid out like the USM paper's Fig. 8
-//! (transport mode) and Fig. 9 (work mode), from a trajectory table. Only column names are
-//! known here (`t`, `ee_y`, `u_0`, …, as written by the scenario module), no physics.
+//! (transport mode) and Fig. 9 (work mode), from a trajectory table. Columns are looked up
+//! by [`Channel`] (`t`, `ee_y`, `u_0`, … as named by [`Channel::name`]), no physics.
 
 use super::plot::{Colour, Figure, Panel, Series};
 use super::table::Table;
-use super::{ReportError, Result};
+use super::Result;
+use crate::scenario::channels::{Channel, Pose, Trajectory, Twist};
+use crate::scenario::config::Mode;
 
-/// A table from named f64 channels of equal length (a run's trajectory).
-pub fn trajectory_table(names: &[String], columns: &[Vec<f64>]) -> Result<Table> {
+/// A table of a run's trajectory: one f64 column per channel, named by [`Channel::name`], in
+/// the trajectory's column order.
+pub fn trajectory_table(traj: &Trajectory) -> Result<Table> {
     let mut t = Table::new();
-    for (n, c) in names.iter().zip(columns) {
-        t.push(n.clone(), c.clone())?;
+    for (c, x) in traj.iter() {
+        t.push(c.name(), x.to_vec())?;
     }
     Ok(t)
 }
 
-fn col(t: &Table, name: &str) -> Result<Vec<f64>> {
-    t.f64(name).map(|c| c.to_vec())
+fn col(t: &Table, c: Channel) -> Result<Vec<f64>> {
+    t.f64(&c.name()).map(|x| x.to_vec())
 }
 
-/// Columns named `prefix0`, `prefix1`, … in order.
-fn indexed(t: &Table, prefix: &str) -> Vec<(usize, Vec<f64>)> {
+/// The columns of an indexed family (`Channel::U` → `u_0`, `u_1`, …) in order.
+fn indexed(t: &Table, family: fn(usize) -> Channel) -> Vec<(usize, Vec<f64>)> {
     (0..)
-        .map_while(|k| t.f64(&format!("{prefix}{k}")).ok().map(|c| (k, c.to_vec())))
+        .map_while(|k| t.f64(&family(k).name()).ok().map(|c| (k, c.to_vec())))
         .collect()
+}
+
+/// Radians to degrees, element by element.
+fn degrees(v: Vec<f64>) -> Vec<f64> {
+    v.into_iter().map(f64::to_degrees).collect()
 }
 
 fn line(name: &str, x: &[f64], y: Vec<f64>, colour: usize) -> Series {
@@ -32,7 +40,7 @@ fn line(name: &str, x: &[f64], y: Vec<f64>, colour: usize) -> Series {
 
 fn thruster_panel(t: &Table, time: &[f64], label: &str) -> Panel {
     let mut p = Panel::new(label, "time [s]", "thrust [N]");
-    for (j, u) in indexed(t, "u_") {
+    for (j, u) in indexed(t, Channel::U) {
         p = p.with_series(line(&format!("T{}", j + 1), time, u, j));
     }
     p
@@ -42,21 +50,25 @@ fn thruster_panel(t: &Table, time: &[f64], label: &str) -> Panel {
 /// base against the desired path, (b) end-effector surge and sway velocities, (c) yaw joint
 /// angles (`yaw_joints`: their indices), (d) thruster forces.
 pub fn transport_figure(t: &Table, yaw_joints: &[usize], title: &str) -> Result<Figure> {
-    let time = col(t, "t")?;
-    let deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
+    let time = col(t, Channel::T)?;
     let pos = Panel::new("(a) Y position", "time [s]", "y [m]")
-        .with_series(line("desired", &time, col(t, "path_y")?, 0).dashed())
-        .with_series(line("end-effector", &time, col(t, "ee_y")?, 3))
-        .with_series(line("base", &time, col(t, "base_y")?, 2));
+        .with_series(line("desired", &time, col(t, Channel::PathY)?, 0).dashed())
+        .with_series(line(
+            "end-effector",
+            &time,
+            col(t, Channel::EePose(Pose::Y))?,
+            3,
+        ))
+        .with_series(line("base", &time, col(t, Channel::BasePose(Pose::Y))?, 2));
     let vel = Panel::new("(b) End-effector velocity", "time [s]", "velocity [m/s]")
-        .with_series(line("surge", &time, col(t, "ee_u")?, 0))
-        .with_series(line("sway", &time, col(t, "ee_v")?, 3));
+        .with_series(line("surge", &time, col(t, Channel::EeTwist(Twist::U))?, 0))
+        .with_series(line("sway", &time, col(t, Channel::EeTwist(Twist::V))?, 3));
     let mut joints = Panel::new("(c) Yaw joint angles", "time [s]", "angle [deg]");
     for (i, &k) in yaw_joints.iter().enumerate() {
         joints = joints.with_series(line(
             &format!("yaw joint {}", i + 1),
             &time,
-            deg(col(t, &format!("q_{k}"))?),
+            degrees(col(t, Channel::Q(k))?),
             i,
         ));
     }
@@ -70,45 +82,67 @@ pub fn transport_figure(t: &Table, yaw_joints: &[usize], title: &str) -> Result<
     Ok(f)
 }
 
+/// Add three `(label, actual, reference)` channel pairs to panel `p`, the reference dashed in
+/// the actual's colour, each series mapped through `scale`.
+fn tracking_panel(
+    t: &Table,
+    time: &[f64],
+    mut p: Panel,
+    pairs: [(&str, Channel, Channel); 3],
+    scale: fn(Vec<f64>) -> Vec<f64>,
+) -> Result<Panel> {
+    for (i, (label, actual, reference)) in pairs.into_iter().enumerate() {
+        p = p
+            .with_series(line(label, time, scale(col(t, actual)?), i))
+            .with_series(line("", time, scale(col(t, reference)?), i).dashed());
+    }
+    Ok(p)
+}
+
 /// Fig. 9 of the USM paper for one work-mode run: (a) end-effector position and (b)
 /// orientation against the setpoints, (c) base linear and (d) angular velocities against the
 /// references, (e) joint angles, (f) thruster forces.
 pub fn work_figure(t: &Table, title: &str) -> Result<Figure> {
-    let time = col(t, "t")?;
-    let deg = |v: Vec<f64>| v.into_iter().map(f64::to_degrees).collect::<Vec<_>>();
-    let mut pos = Panel::new("(a) End-effector position", "time [s]", "position [m]");
-    let mut ori = Panel::new("(b) End-effector orientation", "time [s]", "angle [deg]");
-    for (i, a) in ["x", "y", "z"].iter().enumerate() {
-        pos = pos
-            .with_series(line(a, &time, col(t, &format!("ee_{a}"))?, i))
-            .with_series(line("", &time, col(t, &format!("sp_{a}"))?, i).dashed());
-    }
-    for (i, a) in ["roll", "pitch", "yaw"].iter().enumerate() {
-        ori = ori
-            .with_series(line(a, &time, deg(col(t, &format!("ee_{a}"))?), i))
-            .with_series(line("", &time, deg(col(t, &format!("sp_{a}"))?), i).dashed());
-    }
-    let mut lin = Panel::new("(c) Base linear velocity", "time [s]", "velocity [m/s]");
-    for (i, a) in ["u", "v", "w"].iter().enumerate() {
-        lin = lin
-            .with_series(line(a, &time, col(t, &format!("base_{a}"))?, i))
-            .with_series(line("", &time, col(t, &format!("ref_{a}"))?, i).dashed());
-    }
-    let mut angv = Panel::new("(d) Base angular velocity", "time [s]", "rate [rad/s]");
-    for (i, a) in ["p", "q", "r"].iter().enumerate() {
-        angv = angv
-            .with_series(line(a, &time, col(t, &format!("base_{a}"))?, i))
-            .with_series(line("", &time, col(t, &format!("ref_{a}"))?, i).dashed());
+    let time = col(t, Channel::T)?;
+    let pose = |a: Pose| (a.suffix(), Channel::EePose(a), Channel::Setpoint(a));
+    let twist = |a: Twist| (a.suffix(), Channel::BaseTwist(a), Channel::TwistRef(a));
+    let same: fn(Vec<f64>) -> Vec<f64> = |v| v;
+    let tracking = [
+        (
+            "(a) End-effector position",
+            "position [m]",
+            [Pose::X, Pose::Y, Pose::Z].map(pose),
+            same,
+        ),
+        (
+            "(b) End-effector orientation",
+            "angle [deg]",
+            [Pose::Roll, Pose::Pitch, Pose::Yaw].map(pose),
+            degrees,
+        ),
+        (
+            "(c) Base linear velocity",
+            "velocity [m/s]",
+            [Twist::U, Twist::V, Twist::W].map(twist),
+            same,
+        ),
+        (
+            "(d) Base angular velocity",
+            "rate [rad/s]",
+            [Twist::P, Twist::Q, Twist::R].map(twist),
+            same,
+        ),
+    ];
+    let mut f = Figure::new(title);
+    for (label, y_label, pairs, scale) in tracking {
+        let p = Panel::new(label, "time [s]", y_label);
+        f = f.with_panel(tracking_panel(t, &time, p, pairs, scale)?);
     }
     let mut joints = Panel::new("(e) Joint angles", "time [s]", "angle [deg]");
-    for (k, q) in indexed(t, "q_") {
-        joints = joints.with_series(line(&format!("q{}", k + 1), &time, deg(q), k));
+    for (k, q) in indexed(t, Channel::Q) {
+        joints = joints.with_series(line(&format!("q{}", k + 1), &time, degrees(q), k));
     }
-    let mut f = Figure::new(title)
-        .with_panel(pos)
-        .with_panel(ori)
-        .with_panel(lin)
-        .with_panel(angv)
+    f = f
         .with_panel(joints)
         .with_panel(thruster_panel(t, &time, "(f) Thruster forces"));
     f.layout = (3, 2);
@@ -116,17 +150,10 @@ pub fn work_figure(t: &Table, title: &str) -> Result<Figure> {
     Ok(f)
 }
 
-/// The figure that fits the run: Fig. 8 when the table has a cross-track channel, Fig. 9 when
-/// it has setpoints.
-pub fn run_figure(t: &Table, yaw_joints: &[usize], title: &str) -> Result<Figure> {
-    if t.column("cross_track").is_some() {
-        transport_figure(t, yaw_joints, title)
-    } else if t.column("sp_x").is_some() {
-        work_figure(t, title)
-    } else {
-        Err(ReportError::InvalidFigure {
-            figure: title.to_string(),
-            detail: "the table has neither transport nor work-mode channels".into(),
-        })
+/// The figure of a run of `mode`: Fig. 8 for transport, Fig. 9 for work.
+pub fn run_figure(t: &Table, mode: Mode, yaw_joints: &[usize], title: &str) -> Result<Figure> {
+    match mode {
+        Mode::Transport => transport_figure(t, yaw_joints, title),
+        Mode::Work => work_figure(t, title),
     }
 }

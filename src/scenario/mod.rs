@@ -21,11 +21,19 @@
 //!   kp = [0, 0, 0, 0, 0, 0]` is the literal reading). A partial `[base_control]` table takes
 //!   its missing keys from the work-mode defaults.
 
+pub mod channels;
 pub mod config;
+mod controller;
+mod error;
+pub(crate) mod recorder;
 pub mod run;
+mod setup;
 
+pub use channels::{Channel, Trajectory};
 pub use config::{Mode, ScenarioFile};
-pub use run::{run_scenario, RunResult, ScenarioError, Timing, Trajectory};
+pub use error::ScenarioError;
+pub use recorder::{AllocationCounts, Timing};
+pub use run::{run_scenario, RunResult};
 
 use crate::diag::line_col;
 use crate::model::design::{load_design, parse_design_table};

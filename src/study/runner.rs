@@ -127,8 +127,7 @@ pub fn run_case(
     let run = crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
     let trajectory = match run.trajectory {
         Some(t) => Some(
-            crate::report::figures::trajectory_table(&t.names, &t.columns)
-                .map_err(|e| e.to_string())?,
+            crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?,
         ),
         None => None,
     };

@@ -1,0 +1,240 @@
+//! The summary metrics of one closed-loop run (SPEC §6): pure functions of its trajectory,
+//! looked up by [`Channel`], in a fixed order for the mode — the common effort, energy,
+//! singularity and allocation metrics, then the transport tracking or the work regulation
+//! metrics.
+
+use super::trajectory::{energy_metrics, segment_tracking, settling_time, singularity_exposure};
+use crate::control::wrap_angle;
+use crate::model::Vehicle;
+use crate::scenario::channels::{Channel, Pose, Trajectory};
+use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
+use crate::scenario::recorder::AllocationCounts;
+
+/// Named metrics in the order they are added.
+type Metrics = Vec<(String, f64)>;
+
+fn add(out: &mut Metrics, name: &str, x: f64) {
+    out.push((name.to_string(), x));
+}
+
+/// A channel's samples, empty if the run did not log it.
+fn channel(traj: &Trajectory, c: Channel) -> &[f64] {
+    traj.get(c).unwrap_or(&[])
+}
+
+/// The metrics of a run of `file` on `v` from its trajectory: the common ones, then the
+/// mode's. `failed` says whether the run stopped early; `counts` are its allocation outcomes.
+pub fn run_summary(
+    v: &Vehicle,
+    file: &ScenarioFile,
+    traj: &Trajectory,
+    failed: bool,
+    counts: &AllocationCounts,
+) -> Vec<(String, f64)> {
+    let mut out = Metrics::new();
+    common_metrics(&mut out, v, file, traj, failed, counts);
+    match file.scenario.mode {
+        Mode::Transport => transport_metrics(&mut out, &file.metrics, traj),
+        Mode::Work => work_metrics(&mut out, &file.metrics, traj),
+    }
+    out
+}
+
+/// Completion, energy and effort, σ_min of T(q) and allocation outcomes.
+fn common_metrics(
+    out: &mut Metrics,
+    v: &Vehicle,
+    file: &ScenarioFile,
+    traj: &Trajectory,
+    failed: bool,
+    counts: &AllocationCounts,
+) {
+    let t = channel(traj, Channel::T);
+    let limits: Vec<(f64, f64)> = v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect();
+    let e = energy_metrics(
+        t,
+        &traj.indexed(Channel::U),
+        &limits,
+        &traj.indexed(Channel::Tau),
+        &traj.indexed(Channel::Qd),
+        &file.power_model(v.fluid.rho),
+        file.metrics.saturation_tolerance,
+    );
+    add(out, "completed", if failed { 0.0 } else { 1.0 });
+    add(out, "simulated_time", t.last().copied().unwrap_or(0.0));
+    add(out, "thruster_energy", e.thruster_energy);
+    add(out, "effort_sq", e.effort_sq);
+    add(out, "effort_abs", e.effort_abs);
+    add(out, "joint_energy", e.joint_energy);
+    add(out, "peak_thrust", e.peak_thrust);
+    add(out, "saturation_fraction", e.saturation_fraction);
+    let sig = channel(traj, Channel::SigmaMin);
+    add(
+        out,
+        "singularity_exposure",
+        singularity_exposure(t, sig, file.metrics.threshold),
+    );
+    add(
+        out,
+        "sigma_min_min",
+        sig.iter().copied().fold(f64::INFINITY, f64::min),
+    );
+    add(
+        out,
+        "sigma_min_mean",
+        if sig.is_empty() {
+            f64::NAN
+        } else {
+            sig.iter().sum::<f64>() / sig.len() as f64
+        },
+    );
+    let steps = counts.steps.max(1) as f64;
+    add(out, "slack_fraction", counts.slack_active as f64 / steps);
+    add(out, "allocation_failures", counts.solver_failures as f64);
+}
+
+/// Index ranges `[a, b)` of the contiguous runs of equal values in `seg` (the samples during
+/// which one path segment was active).
+fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
+    let mut runs = Vec::new();
+    let mut a = 0;
+    for i in 1..=seg.len() {
+        if i == seg.len() || seg[i] != seg[a] {
+            runs.push((a, i));
+            a = i;
+        }
+    }
+    runs
+}
+
+/// Transport: convergence, overshoot and cross-track RMS per segment (after convergence)
+/// and over the run, the base's cross-track RMS, the final cross-track error.
+fn transport_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
+    let t = channel(traj, Channel::T);
+    let ey = channel(traj, Channel::CrossTrack);
+    let base_ct = channel(traj, Channel::BaseCrossTrack);
+    let runs = segment_runs(channel(traj, Channel::Segment));
+    let mut conv_max: f64 = 0.0;
+    let mut overshoot_max: f64 = 0.0;
+    let mut rms_sq = 0.0;
+    let mut rms_t = 0.0;
+    let mut base_sq = 0.0;
+    let mut all_converged = !runs.is_empty();
+    for (k, &(a, b)) in runs.iter().enumerate() {
+        let st = segment_tracking(&t[a..b], &ey[a..b], spec.band);
+        add(
+            out,
+            &format!("seg{k}_convergence_time"),
+            st.convergence_time,
+        );
+        add(out, &format!("seg{k}_overshoot"), st.overshoot);
+        add(out, &format!("seg{k}_cross_track_rms"), st.rms_after);
+        if st.convergence_time.is_nan() {
+            all_converged = false;
+        } else {
+            conv_max = conv_max.max(st.convergence_time);
+            let c0 = a + t[a..b]
+                .iter()
+                .position(|x| *x >= st.start + st.convergence_time)
+                .unwrap_or(0);
+            let span = t[b - 1] - t[c0];
+            rms_sq += st.rms_after * st.rms_after * span;
+            rms_t += span;
+            let bs: f64 = (c0 + 1..b)
+                .map(|i| {
+                    0.5 * (t[i] - t[i - 1])
+                        * (base_ct[i] * base_ct[i] + base_ct[i - 1] * base_ct[i - 1])
+                })
+                .sum();
+            base_sq += bs;
+        }
+        overshoot_max = overshoot_max.max(st.overshoot);
+    }
+    let rms = |sq: f64| {
+        if rms_t > 0.0 {
+            (sq / rms_t).sqrt()
+        } else {
+            f64::NAN
+        }
+    };
+    add(out, "segments_reached", runs.len() as f64);
+    add(out, "converged", if all_converged { 1.0 } else { 0.0 });
+    add(
+        out,
+        "convergence_time",
+        if all_converged { conv_max } else { f64::NAN },
+    );
+    add(out, "overshoot", overshoot_max);
+    add(out, "cross_track_rms", rms(rms_sq));
+    add(out, "base_cross_track_rms", rms(base_sq));
+    add(
+        out,
+        "final_cross_track",
+        ey.last().copied().unwrap_or(f64::NAN),
+    );
+}
+
+/// Work: final errors and settling times of the end-effector, the base's drift, and the
+/// end-effector roll about its setpoint over the second half of the run.
+fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
+    let t = channel(traj, Channel::T);
+    let ep = channel(traj, Channel::EePositionError);
+    let ea = channel(traj, Channel::EeOrientationError);
+    let last = |x: &[f64]| x.last().copied().unwrap_or(f64::NAN);
+    add(out, "final_position_error", last(ep));
+    add(out, "final_orientation_error_deg", last(ea).to_degrees());
+    add(
+        out,
+        "settling_time_position",
+        settling_time(t, ep, spec.position_tolerance),
+    );
+    add(
+        out,
+        "settling_time_orientation",
+        settling_time(t, ea, spec.orientation_tolerance_deg.to_radians()),
+    );
+    let bx = channel(traj, Channel::BasePose(Pose::X));
+    let by = channel(traj, Channel::BasePose(Pose::Y));
+    let bz = channel(traj, Channel::BasePose(Pose::Z));
+    let drift = if bx.is_empty() {
+        f64::NAN
+    } else {
+        let l = bx.len() - 1;
+        ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
+    };
+    add(out, "base_drift", drift);
+    // Roll of the end-effector about its setpoint over the second half of the run.
+    let er = channel(traj, Channel::EePose(Pose::Roll));
+    let sr = channel(traj, Channel::Setpoint(Pose::Roll));
+    let half = er.len() / 2;
+    let dev: Vec<f64> = er[half..]
+        .iter()
+        .zip(&sr[half..])
+        .map(|(a, b)| wrap_angle(a - b))
+        .collect();
+    let mean = dev.iter().sum::<f64>() / dev.len().max(1) as f64;
+    let var = dev.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / dev.len().max(1) as f64;
+    add(out, "ee_roll_std_deg", var.sqrt().to_degrees());
+    add(
+        out,
+        "ee_roll_max_deg",
+        dev.iter()
+            .fold(0.0f64, |peak, d| peak.max(d.abs()))
+            .to_degrees(),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::segment_runs;
+
+    #[test]
+    fn segment_runs_split_at_every_change() {
+        assert_eq!(segment_runs(&[]), vec![]);
+        assert_eq!(segment_runs(&[0.0]), vec![(0, 1)]);
+        assert_eq!(
+            segment_runs(&[0.0, 0.0, 1.0, 1.0, 1.0, 0.0]),
+            vec![(0, 2), (2, 5), (5, 6)]
+        );
+    }
+}

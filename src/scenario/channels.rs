@@ -1,0 +1,333 @@
+//! The logged channels of a closed-loop run as a type: every column of a trajectory is a
+//! [`Channel`], so a consumer (metrics, figures, the table writers) names the channel it reads
+//! by id and a renamed channel is a compile error instead of a missing column.
+//!
+//! [`Channel::name`] gives the column name written to `timeseries.csv` / `.parquet`;
+//! [`channel_layout`] gives the column order of a run. Units are SI, angles in rad; poses are
+//! in the inertial frame (ZYX Euler angles, SPEC §2), twists in the body's own frame.
+
+use super::config::Mode;
+
+/// A pose coordinate: position in the inertial frame [m] or a ZYX Euler angle [rad].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Pose {
+    /// Inertial x [m].
+    X,
+    /// Inertial y [m].
+    Y,
+    /// Inertial z [m].
+    Z,
+    /// Roll φ [rad].
+    Roll,
+    /// Pitch θ [rad].
+    Pitch,
+    /// Yaw ψ [rad].
+    Yaw,
+}
+
+impl Pose {
+    /// All six, in column order.
+    pub const ALL: [Pose; 6] = [
+        Pose::X,
+        Pose::Y,
+        Pose::Z,
+        Pose::Roll,
+        Pose::Pitch,
+        Pose::Yaw,
+    ];
+
+    /// The column-name suffix (`x`, …, `yaw`).
+    pub fn suffix(self) -> &'static str {
+        match self {
+            Pose::X => "x",
+            Pose::Y => "y",
+            Pose::Z => "z",
+            Pose::Roll => "roll",
+            Pose::Pitch => "pitch",
+            Pose::Yaw => "yaw",
+        }
+    }
+}
+
+/// A twist component in the body's own frame: linear (u, v, w) [m/s], angular (p, q, r)
+/// [rad/s].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Twist {
+    /// Surge u [m/s].
+    U,
+    /// Sway v [m/s].
+    V,
+    /// Heave w [m/s].
+    W,
+    /// Roll rate p [rad/s].
+    P,
+    /// Pitch rate q [rad/s].
+    Q,
+    /// Yaw rate r [rad/s].
+    R,
+}
+
+impl Twist {
+    /// All six, in column order (linear first).
+    pub const ALL: [Twist; 6] = [Twist::U, Twist::V, Twist::W, Twist::P, Twist::Q, Twist::R];
+
+    /// The column-name suffix (`u`, …, `r`).
+    pub fn suffix(self) -> &'static str {
+        match self {
+            Twist::U => "u",
+            Twist::V => "v",
+            Twist::W => "w",
+            Twist::P => "p",
+            Twist::Q => "q",
+            Twist::R => "r",
+        }
+    }
+}
+
+/// One logged channel of a closed-loop run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Channel {
+    /// Simulation time [s].
+    T,
+    /// Base pose in the inertial frame.
+    BasePose(Pose),
+    /// Base twist in the base frame.
+    BaseTwist(Twist),
+    /// End-effector pose in the inertial frame.
+    EePose(Pose),
+    /// End-effector twist in the end-effector frame.
+    EeTwist(Twist),
+    /// Transport: measured path angle ψ (USM-39) [rad].
+    Psi,
+    /// Transport: LOS reference angle ψ_r (USM-38) [rad].
+    PsiR,
+    /// Transport: cross-track error e_y of the end-effector (USM-38) [m].
+    CrossTrack,
+    /// Transport: along-track position on the active segment [m].
+    AlongTrack,
+    /// Transport: index of the active segment.
+    Segment,
+    /// Transport: heading error ψ_r − ψ [rad].
+    HeadingError,
+    /// Transport: surge error u_c − u [m/s].
+    SurgeError,
+    /// Transport: signed lateral offset of the base from the active segment (left positive) [m].
+    BaseCrossTrack,
+    /// Transport: inertial y of the path point nearest the end-effector [m].
+    PathY,
+    /// Work: end-effector setpoint pose in the inertial frame.
+    Setpoint(Pose),
+    /// Work: end-effector position error ‖p_e − p_d‖ [m].
+    EePositionError,
+    /// Work: end-effector pointing error (angle between the actual and desired x axes) [rad].
+    EeOrientationError,
+    /// Work: base velocity reference v_r (USM-42) in the base frame.
+    TwistRef(Twist),
+    /// Joint angle q_k [rad].
+    Q(usize),
+    /// Joint angle reference [rad].
+    QRef(usize),
+    /// Joint rate q̇_k [rad/s].
+    Qd(usize),
+    /// Joint torque τ_k [N·m].
+    Tau(usize),
+    /// Commanded (allocated) thrust of thruster j [N].
+    UCmd(usize),
+    /// Actual thrust of thruster j, clamped to its limits [N].
+    U(usize),
+    /// Shaft power of thruster j by momentum theory [W].
+    Power(usize),
+    /// Scaled σ_min of the thruster configuration matrix T(q) (SPEC §6).
+    SigmaMin,
+    /// Allocation slack norm ‖s‖ [N or N·m].
+    SlackNorm,
+    /// Allocation status code: 0 solved, 1 slack active, 2 bounds violated, 3 failed.
+    AllocStatus,
+}
+
+/// The transport-mode channels, in column order.
+const TRANSPORT: [Channel; 9] = [
+    Channel::Psi,
+    Channel::PsiR,
+    Channel::CrossTrack,
+    Channel::AlongTrack,
+    Channel::Segment,
+    Channel::HeadingError,
+    Channel::SurgeError,
+    Channel::BaseCrossTrack,
+    Channel::PathY,
+];
+
+impl Channel {
+    /// The column name in trajectory tables (`t`, `base_x`, `ee_u`, `cross_track`, `u_3`, …).
+    pub fn name(self) -> String {
+        let fixed = match self {
+            Channel::T => "t",
+            Channel::Psi => "psi",
+            Channel::PsiR => "psi_r",
+            Channel::CrossTrack => "cross_track",
+            Channel::AlongTrack => "along_track",
+            Channel::Segment => "segment",
+            Channel::HeadingError => "heading_error",
+            Channel::SurgeError => "surge_error",
+            Channel::BaseCrossTrack => "base_cross_track",
+            Channel::PathY => "path_y",
+            Channel::EePositionError => "ee_position_error",
+            Channel::EeOrientationError => "ee_orientation_error",
+            Channel::SigmaMin => "sigma_min",
+            Channel::SlackNorm => "slack_norm",
+            Channel::AllocStatus => "alloc_status",
+            Channel::BasePose(a) => return format!("base_{}", a.suffix()),
+            Channel::BaseTwist(a) => return format!("base_{}", a.suffix()),
+            Channel::EePose(a) => return format!("ee_{}", a.suffix()),
+            Channel::EeTwist(a) => return format!("ee_{}", a.suffix()),
+            Channel::Setpoint(a) => return format!("sp_{}", a.suffix()),
+            Channel::TwistRef(a) => return format!("ref_{}", a.suffix()),
+            Channel::Q(k) => return format!("q_{k}"),
+            Channel::QRef(k) => return format!("qref_{k}"),
+            Channel::Qd(k) => return format!("qd_{k}"),
+            Channel::Tau(k) => return format!("tau_{k}"),
+            Channel::UCmd(j) => return format!("ucmd_{j}"),
+            Channel::U(j) => return format!("u_{j}"),
+            Channel::Power(j) => return format!("power_{j}"),
+        };
+        fixed.to_string()
+    }
+}
+
+/// The channels of a run in column order: time, base and end-effector pose and twist, the
+/// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the per-thruster blocks
+/// (commanded, actual, power), then σ_min and the allocation outcome.
+pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Channel> {
+    let mut c = vec![Channel::T];
+    c.extend(Pose::ALL.map(Channel::BasePose));
+    c.extend(Twist::ALL.map(Channel::BaseTwist));
+    c.extend(Pose::ALL.map(Channel::EePose));
+    c.extend(Twist::ALL.map(Channel::EeTwist));
+    match mode {
+        Mode::Transport => c.extend(TRANSPORT),
+        Mode::Work => {
+            c.extend(Pose::ALL.map(Channel::Setpoint));
+            c.extend([Channel::EePositionError, Channel::EeOrientationError]);
+            c.extend(Twist::ALL.map(Channel::TwistRef));
+        }
+    }
+    for family in [Channel::Q, Channel::QRef, Channel::Qd, Channel::Tau] {
+        c.extend((0..n_joints).map(family));
+    }
+    for family in [Channel::UCmd, Channel::U, Channel::Power] {
+        c.extend((0..n_thrusters).map(family));
+    }
+    c.extend([Channel::SigmaMin, Channel::SlackNorm, Channel::AllocStatus]);
+    c
+}
+
+/// Column-oriented time series of one run: one f64 column per [`Channel`], all of equal
+/// length.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trajectory {
+    channels: Vec<Channel>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Trajectory {
+    /// An empty trajectory with the given channels, each column reserved for `capacity`
+    /// samples (so that appending up to that many rows does not allocate).
+    pub fn with_channels(channels: Vec<Channel>, capacity: usize) -> Self {
+        let columns = channels
+            .iter()
+            .map(|_| Vec::with_capacity(capacity))
+            .collect();
+        Self { channels, columns }
+    }
+
+    /// The channels, in column order.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// `(channel, samples)` in column order.
+    pub fn iter(&self) -> impl Iterator<Item = (Channel, &[f64])> {
+        self.channels
+            .iter()
+            .zip(&self.columns)
+            .map(|(c, x)| (*c, x.as_slice()))
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.columns.first().map_or(0, |c| c.len())
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// A channel's samples, if the run logged it.
+    pub fn get(&self, channel: Channel) -> Option<&[f64]> {
+        self.channels
+            .iter()
+            .position(|c| *c == channel)
+            .map(|i| self.columns[i].as_slice())
+    }
+
+    /// An indexed family in index order, e.g. `indexed(Channel::U)` for the actual thrusts
+    /// `u_0, u_1, …` (stops at the first index the run did not log).
+    pub fn indexed(&self, family: fn(usize) -> Channel) -> Vec<&[f64]> {
+        (0..).map_while(|k| self.get(family(k))).collect()
+    }
+
+    /// Append one sample of every channel (`row` in column order). Does not allocate while
+    /// the reserved capacity lasts.
+    pub fn push_row(&mut self, row: &[f64]) {
+        for (c, x) in self.columns.iter_mut().zip(row) {
+            c.push(*x);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scenario::channels::{channel_layout, Channel, Trajectory};
+    use crate::scenario::config::Mode;
+
+    #[test]
+    fn layout_names_are_the_published_columns() {
+        let names: Vec<String> = channel_layout(Mode::Transport, 1, 2)
+            .into_iter()
+            .map(Channel::name)
+            .collect();
+        let expected = "t base_x base_y base_z base_roll base_pitch base_yaw base_u base_v \
+            base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
+            ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
+            base_cross_track path_y q_0 qref_0 qd_0 tau_0 ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
+            sigma_min slack_norm alloc_status";
+        assert_eq!(names.join(" "), expected);
+        let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
+            .into_iter()
+            .map(Channel::name)
+            .collect();
+        let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
+            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r ucmd_0 u_0 power_0";
+        assert_eq!(work[25..42].join(" "), expected);
+    }
+
+    #[test]
+    fn channels_are_looked_up_by_id() {
+        let mut t = Trajectory::with_channels(channel_layout(Mode::Work, 2, 3), 4);
+        let row: Vec<f64> = (0..t.channels().len()).map(|i| i as f64).collect();
+        t.push_row(&row);
+        assert_eq!(t.len(), 1);
+        assert_eq!(t.get(Channel::T), Some(&[0.0][..]));
+        assert_eq!(t.get(Channel::CrossTrack), None);
+        let u = t.indexed(Channel::U);
+        assert_eq!(u.len(), 3);
+        let u0 = t
+            .channels()
+            .iter()
+            .position(|c| *c == Channel::U(0))
+            .unwrap();
+        assert_eq!(u[0], &[u0 as f64][..]);
+    }
+}

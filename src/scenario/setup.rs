@@ -1,0 +1,134 @@
+//! Setup of a closed-loop run: validate the file, put the vehicle in the file's current,
+//! build the simulator at the initial state, the controllers and the allocator, and size
+//! every buffer the loop needs once, so that no time step allocates.
+
+use super::config::ScenarioFile;
+use super::controller::{Command, ModeController};
+use super::error::ScenarioError;
+use crate::allocation::{Allocation, Allocator};
+use crate::control::dynamic::DynamicController;
+use crate::dynamics::{SimState, Simulator};
+use crate::kinematics::KinWorkspace;
+use crate::model::Vehicle;
+use crate::spatial::{Vec3, Vec6};
+use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
+
+/// Everything the closed loop owns: the plant, the controllers, the allocator and the
+/// per-period buffers. Built by [`ClosedLoop::new`]; stepped by `run::run_scenario`.
+pub(crate) struct ClosedLoop<'f> {
+    /// The scenario.
+    pub file: &'f ScenarioFile,
+    /// The design with the file's current (SPEC §4).
+    pub vehicle: Vehicle,
+    /// The physics.
+    pub sim: Simulator,
+    /// Base dynamic control (USM-33).
+    pub base_ctl: DynamicController,
+    /// The mode's guidance and kinematic control.
+    pub mode: ModeController,
+    /// Thrust allocation (USM-36/37).
+    pub allocator: Allocator,
+    /// Forward kinematics of the current joint angles.
+    pub ws: KinWorkspace,
+    /// Thruster configuration matrix T(q), base frame.
+    pub t_mat: Matrix6xX<f64>,
+    /// The latest allocation (u held until the next control period).
+    pub alloc: Allocation,
+    /// The latest command (held until the next control period).
+    pub cmd: Command,
+    /// Measured joint rates [rad/s].
+    pub qd_meas: Vec<f64>,
+    /// Physics steps per control period.
+    pub substeps: usize,
+    /// Control periods in the run (the loop visits 0..=n_control).
+    pub n_control: usize,
+}
+
+/// The initial state of the file on `v`: position, yaw and (optionally) joint angles.
+fn initial_state(v: &Vehicle, file: &ScenarioFile) -> Result<SimState, ScenarioError> {
+    let n_joints = v.n_joints();
+    let mut st = SimState::rest(v);
+    st.pose.position = Vec3::from(file.initial.position);
+    st.pose.orientation =
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), file.initial.yaw_deg.to_radians());
+    if !file.initial.joint_angles_deg.is_empty() {
+        if file.initial.joint_angles_deg.len() != n_joints {
+            return Err(ScenarioError::Invalid(format!(
+                "initial.joint_angles_deg has {} entries, the design has {n_joints} joints",
+                file.initial.joint_angles_deg.len()
+            )));
+        }
+        for (q, d) in st
+            .joint_angles
+            .iter_mut()
+            .zip(&file.initial.joint_angles_deg)
+        {
+            *q = d.to_radians();
+        }
+    }
+    Ok(st)
+}
+
+/// The allocator of the file's `[allocation]` table for the thrusters of `v`.
+fn allocator(v: &Vehicle, file: &ScenarioFile) -> Result<Allocator, ScenarioError> {
+    let n_thrusters = v.n_thrusters();
+    let u_min: Vec<f64> = v.thrusters.iter().map(|t| t.u_min).collect();
+    let u_max: Vec<f64> = v.thrusters.iter().map(|t| t.u_max).collect();
+    let spec = &file.allocation;
+    Allocator::new(
+        spec.method,
+        n_thrusters,
+        &u_min,
+        &u_max,
+        &spec.weights_for(n_thrusters),
+        spec.settings(n_thrusters),
+    )
+    .map_err(|e| ScenarioError::Invalid(format!("allocation: {e}")))
+}
+
+impl<'f> ClosedLoop<'f> {
+    /// Set up a run of `file` on `v`. Settings problems are [`ScenarioError::Invalid`].
+    pub fn new(v: &Vehicle, file: &'f ScenarioFile) -> Result<Self, ScenarioError> {
+        file.validate().map_err(ScenarioError::Invalid)?;
+        let s = &file.scenario;
+        let mut vehicle = v.clone();
+        vehicle.fluid.current = Vec3::from(file.physics.current);
+        let v = &vehicle;
+        let n_thrusters = v.n_thrusters();
+        if n_thrusters == 0 {
+            return Err(ScenarioError::Invalid(
+                "design: a closed-loop scenario needs at least one thruster".into(),
+            ));
+        }
+        let mut sim = Simulator::new(v, file.sim_config().map_err(ScenarioError::Invalid)?)
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+        sim.set_state(initial_state(v, file)?)
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+        let gains = file.mode_gains().map_err(ScenarioError::Invalid)?;
+        let base_ctl = DynamicController::new(file.base_gains())
+            .map_err(|e| ScenarioError::Invalid(format!("base_control.{e}")))?;
+        let q0 = sim.state().joint_angles.clone();
+        let mode = ModeController::new(v, file, gains, &q0)?;
+        let allocator = allocator(v, file)?;
+        let cmd = Command {
+            qd_ref: vec![0.0; q0.len()],
+            q_ref: q0,
+            tau_c: Vec6::zeros(),
+        };
+        Ok(Self {
+            ws: KinWorkspace::new(v),
+            t_mat: Matrix6xX::<f64>::zeros(n_thrusters),
+            alloc: Allocation::new(n_thrusters),
+            qd_meas: vec![0.0; v.n_joints()],
+            substeps: (s.control_dt / s.dt).round() as usize,
+            n_control: (s.duration / s.control_dt).round() as usize,
+            file,
+            sim,
+            base_ctl,
+            mode,
+            allocator,
+            cmd,
+            vehicle,
+        })
+    }
+}
