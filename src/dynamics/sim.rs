@@ -79,21 +79,20 @@ pub enum ThrusterModel {
     FromModel,
 }
 
-/// Simulator configuration: physical effects, servo and thruster models.
+/// Simulator configuration: physical effects, servo and thruster models. Each field's doc
+/// gives its default ([`Default`]); [`SimConfig::validate`] checks the model parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SimConfig {
-    /// Which effects enter the dynamics.
+    /// Which effects enter the dynamics. Default [`DynOptions::full`].
     pub options: DynOptions,
-    /// Joint servos.
+    /// Joint servos. Default ideal second-order servos with ω_n = 5 rad/s and ζ_n = 1
+    /// (inferred defaults: critically damped, well inside the joint modules' bandwidth).
     pub servo: ServoModel,
-    /// Thruster dynamics.
+    /// Thruster dynamics. Default [`ThrusterModel::Ideal`].
     pub thruster: ThrusterModel,
 }
 
 impl Default for SimConfig {
-    /// Full hydrodynamics, ideal second-order servos with ω_n = 5 rad/s and ζ_n = 1
-    /// (inferred defaults: critically damped, well inside the joint modules' bandwidth),
-    /// ideal thrusters.
     fn default() -> Self {
         Self {
             options: DynOptions::full(),
@@ -102,6 +101,44 @@ impl Default for SimConfig {
                 zeta: 1.0,
             },
             thruster: ThrusterModel::Ideal,
+        }
+    }
+}
+
+impl SimConfig {
+    /// Check the servo and thruster parameters (ranges as documented on [`ServoModel`] and
+    /// [`ThrusterModel`]); errors name `config.servo.<key>` / `config.thruster.<key>`, with
+    /// `time = 0`.
+    pub fn validate(&self) -> Result<(), SimError> {
+        match self.servo {
+            ServoModel::SecondOrder { omega_n, zeta } => {
+                positive("config.servo.omega_n", omega_n)?;
+                non_negative("config.servo.zeta", zeta)?;
+            }
+            ServoModel::TorquePd {
+                kp,
+                kd,
+                torque_limit,
+            } => {
+                non_negative("config.servo.kp", kp)?;
+                non_negative("config.servo.kd", kd)?;
+                if torque_limit.is_nan() || torque_limit <= 0.0 {
+                    return Err(config_err(
+                        "config.servo.torque_limit",
+                        format!("must be > 0, got {torque_limit}"),
+                    ));
+                }
+            }
+            ServoModel::Passive => {}
+        }
+        match self.thruster {
+            ThrusterModel::FirstOrder {
+                time_constant: Some(t),
+            } => positive("config.thruster.time_constant", t),
+            ThrusterModel::RateLimited {
+                rate_limit: Some(r),
+            } => positive("config.thruster.rate_limit", r),
+            _ => Ok(()),
         }
     }
 }
@@ -277,41 +314,11 @@ impl Simulator {
         vehicle
             .validate()
             .map_err(|e| config_err(&format!("vehicle.{}", e.key), e.message))?;
-        match cfg.servo {
-            ServoModel::SecondOrder { omega_n, zeta } => {
-                positive("config.servo.omega_n", omega_n)?;
-                non_negative("config.servo.zeta", zeta)?;
-            }
-            ServoModel::TorquePd {
-                kp,
-                kd,
-                torque_limit,
-            } => {
-                non_negative("config.servo.kp", kp)?;
-                non_negative("config.servo.kd", kd)?;
-                if torque_limit.is_nan() || torque_limit <= 0.0 {
-                    return Err(config_err(
-                        "config.servo.torque_limit",
-                        format!("must be > 0, got {torque_limit}"),
-                    ));
-                }
-            }
-            ServoModel::Passive => {}
-        }
+        cfg.validate()?;
         let (tc_override, rate_override, use_tc, use_rate) = match cfg.thruster {
             ThrusterModel::Ideal => (None, None, false, false),
-            ThrusterModel::FirstOrder { time_constant } => {
-                if let Some(t) = time_constant {
-                    positive("config.thruster.time_constant", t)?;
-                }
-                (time_constant, None, true, false)
-            }
-            ThrusterModel::RateLimited { rate_limit } => {
-                if let Some(r) = rate_limit {
-                    positive("config.thruster.rate_limit", r)?;
-                }
-                (None, rate_limit, false, true)
-            }
+            ThrusterModel::FirstOrder { time_constant } => (time_constant, None, true, false),
+            ThrusterModel::RateLimited { rate_limit } => (None, rate_limit, false, true),
             ThrusterModel::FromModel => (None, None, true, true),
         };
         let thr = vehicle
