@@ -20,14 +20,16 @@
 //!   energy and momentum;
 //! - `cholesky`: the one dense Cholesky factorisation of the crate (forward dynamics and the
 //!   kinematic-control pseudoinverse);
-//! - [`sim`]: actuator models (thrusters, joint servos), the Lie-group RK4 integrator and the
-//!   [`Simulator`];
+//! - [`config`]: the servo and thruster models and the [`SimConfig`] (defaults, `validate()`);
+//! - [`sim`]: the actuator dynamics (thruster lag and rate limit, servo laws), the Lie-group
+//!   RK4 integrator and the [`Simulator`];
 //! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`.
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
 
 pub mod algorithms;
 pub(crate) mod cholesky;
+pub mod config;
 pub mod hydro;
 pub mod inspect;
 mod passes;
@@ -42,8 +44,9 @@ pub use algorithms::{
     kinetic_energy, mass_matrix, restoring_generalized, solve_forward, solve_hybrid,
     spatial_momentum,
 };
+pub use config::{ServoModel, SimConfig, ThrusterModel};
 pub use inspect::{inspect_dynamics, DynamicsReport};
-pub use sim::{ActuatorCommand, ServoModel, SimConfig, SimState, Simulator, ThrusterModel};
+pub use sim::{ActuatorCommand, SimState, Simulator};
 pub use workspace::DynWorkspace;
 
 use thiserror::Error;
