@@ -8,7 +8,7 @@
 //!
 //! Each algorithm starts with the one position pass of the crate,
 //! [`forward_kinematics`] into `ws.kin` (Pinocchio's `forwardKinematics` filling `liMi` and
-//! `oMi`), then chains the staged passes of [`super::passes`]; frames and names as in
+//! `oMi`), then chains the staged passes of `dynamics::passes`; frames and names as in
 //! [`super::workspace`].
 //!
 //! # Panics

@@ -324,7 +324,7 @@ impl Simulator {
     }
 
     /// Inertial-frame spatial momentum about the inertial origin of the current state (see
-    /// [`spatial_momentum`](super::spatial_momentum)).
+    /// [`spatial_momentum`]).
     pub fn spatial_momentum(&mut self) -> Vec6 {
         self.load_zeta();
         spatial_momentum(
