@@ -38,10 +38,15 @@ impl BasePose {
     }
 }
 
-/// Configuration-dependent kinematic quantities, refreshed by [`forward_kinematics`].
+/// Configuration-dependent kinematic quantities, refreshed by [`forward_kinematics`]
+/// (Pinocchio's `Data` placements: one forward pass fills them, every later algorithm —
+/// Jacobians, `T(q)`, the dynamics passes — reuses them).
 #[derive(Clone, Debug)]
 pub struct KinWorkspace {
-    /// Body `i` frame in the base frame, `g_bi`.
+    /// Body `i` frame in its parent body's frame, `g_(i-1)i(q) = placement · Rot(axis, q)`
+    /// (body 0: in the base frame `F_b`, `g_b0`) — Pinocchio's `liMi`.
+    pub g_up: Vec<Se3>,
+    /// Body `i` frame in the base frame, `g_bi = g_b(i-1) g_(i-1)i` — Pinocchio's `oMi`.
     pub g_b: Vec<Se3>,
     /// End-effector frame in the base frame, `g_be`.
     pub g_be: Se3,
@@ -53,6 +58,7 @@ impl KinWorkspace {
     /// A workspace sized for `v`, at the zero configuration.
     pub fn new(v: &Vehicle) -> Self {
         let mut ws = Self {
+            g_up: vec![Se3::identity(); v.bodies.len()],
             g_b: vec![Se3::identity(); v.bodies.len()],
             g_be: Se3::identity(),
             joint_twist_b: vec![Vec6::zeros(); v.joints.len()],
@@ -63,21 +69,28 @@ impl KinWorkspace {
     }
 }
 
-/// Forward kinematics (USM-1…16): `g_bi = g_b0 g_01(q_1) ⋯ g_(i-1)i(q_i)` with
-/// `g_(k)(k+1)(q) = placement_k · Rot(axis_k, q)`, joint twists in the base frame, and the
-/// end-effector `g_be`. `q` in radians, one per joint.
+/// Forward kinematics (USM-1…16), the one position pass of the crate (Pinocchio's
+/// `forwardKinematics`): the parent-to-child placements
+/// `g_(k)(k+1)(q) = placement_k · Rot(axis_k, q)` into `ws.g_up`, their products
+/// `g_bi = g_b(i-1) g_(i-1)i` (so `g_bi = g_b0 g_01(q_1) ⋯ g_(i-1)i(q_i)`) into `ws.g_b`, the
+/// joint unit twists in the base frame `F_b` and the end-effector `g_be`. `q` in radians, one
+/// per joint.
 ///
 /// # Panics
 /// If `q.len()` differs from the joint count (a programming error; inputs from users are
 /// checked where they are parsed).
 pub fn forward_kinematics(v: &Vehicle, q: &[f64], ws: &mut KinWorkspace) {
     assert_eq!(q.len(), v.joints.len(), "joint vector length");
-    ws.g_b[0] = v.base.inverse();
+    let g0 = v.base.inverse();
+    ws.g_up[0] = g0;
+    ws.g_b[0] = g0;
     for (k, j) in v.joints.iter().enumerate() {
         let rot = Se3::new(rot_axis_angle(&j.axis, q[k]), Vec3::zeros());
-        let g = ws.g_b[k].compose(&j.placement).compose(&rot);
-        ws.joint_twist_b[k] = g.twist_to_parent(&stack(&Vec3::zeros(), &j.axis));
-        ws.g_b[k + 1] = g;
+        let g = j.placement.compose(&rot);
+        ws.g_up[k + 1] = g;
+        let gb = ws.g_b[k].compose(&g);
+        ws.joint_twist_b[k] = gb.twist_to_parent(&stack(&Vec3::zeros(), &j.axis));
+        ws.g_b[k + 1] = gb;
     }
     let last = v.bodies.len() - 1;
     ws.g_be = ws.g_b[last].compose(&v.end_effector);
@@ -136,8 +149,8 @@ pub fn thruster_column(v: &Vehicle, ws: &KinWorkspace, j: usize) -> Vec6 {
     stack(&d, &p.cross(&d))
 }
 
-/// The thruster configuration matrix `T(q)` (USM-26), 6×m in the base frame:
-/// `τ_b = T(q) u`. `out` must be 6×m.
+/// The thruster configuration matrix `T(q)` (USM-26), 6×n_thrusters in the base frame:
+/// `τ_b = T(q) u`. `out` must be 6×n_thrusters.
 pub fn thruster_matrix(v: &Vehicle, ws: &KinWorkspace, out: &mut Matrix6xX<f64>) {
     debug_assert_eq!(out.ncols(), v.thrusters.len());
     for j in 0..v.thrusters.len() {
@@ -155,7 +168,7 @@ pub fn thruster_matrix_owned(v: &Vehicle, ws: &KinWorkspace) -> Matrix6xX<f64> {
 /// The full generalised map of thrust (USM-25 extended to the joints): column `j` is the
 /// generalised force `J_g,iᵀ F_j` of a unit thrust of thruster `j` on body `i`, i.e. the base
 /// wrench `B_j` (rows 0..6) followed by the joint torques it induces (rows 6..6+n, N·m).
-/// `out` must be (6+n)×m.
+/// `out` must be (6+n)×n_thrusters.
 pub fn generalized_thrust_map(v: &Vehicle, ws: &KinWorkspace, out: &mut Mat<f64>) {
     let n = v.joints.len();
     for (j, t) in v.thrusters.iter().enumerate() {

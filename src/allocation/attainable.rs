@@ -12,7 +12,7 @@ use nalgebra::Matrix6xX;
 use serde::Serialize;
 
 use super::conic::clarabel_settings;
-use super::{check_bounds, check_t, AllocError};
+use super::error::{check_bounds, check_t, AllocError};
 
 /// Largest pure wrench along each base axis (SPEC §6). Index order surge, sway, heave (N), roll,
 /// pitch, yaw (N·m), base frame. `NaN` (serialised as `null`) where the programme failed or is
@@ -25,7 +25,7 @@ pub struct AttainableWrench {
     pub negative: [f64; 6],
 }
 
-/// Attainable wrench along `±e_k`, k = 0..5, for `T` (6×m, base frame, N and N·m per N of
+/// Attainable wrench along `±e_k`, k = 0..5, for `T` (6×n_thrusters, base frame, N and N·m per N of
 /// thrust) and bounds `u_min ≤ u ≤ u_max` (N) (SPEC §6). Errors only on bad input.
 pub fn attainable_wrench(
     t: &Matrix6xX<f64>,
@@ -33,16 +33,16 @@ pub fn attainable_wrench(
     u_max: &[f64],
 ) -> Result<AttainableWrench, AllocError> {
     check_t(t, None)?;
-    let m = t.ncols();
-    check_bounds(u_min, u_max, m)?;
+    let n_thrusters = t.ncols();
+    check_bounds(u_min, u_max, n_thrusters)?;
 
-    // x = [u (m); α], rows: 6 equalities [T, −d] x = 0, then 2m box rows.
-    let n = m + 1;
-    let rows = 6 + 2 * m;
+    // x = [u (n_thrusters); α], rows: 6 equalities [T, −d] x = 0, then 2·n_thrusters box rows.
+    let n = n_thrusters + 1;
+    let rows = 6 + 2 * n_thrusters;
     let mut colptr = Vec::with_capacity(n + 1);
     let mut rowval = Vec::new();
     let mut nz = Vec::new();
-    for j in 0..m {
+    for j in 0..n_thrusters {
         colptr.push(rowval.len());
         for i in 0..6 {
             rowval.push(i);
@@ -50,7 +50,7 @@ pub fn attainable_wrench(
         }
         rowval.push(6 + j);
         nz.push(1.0);
-        rowval.push(6 + m + j);
+        rowval.push(6 + n_thrusters + j);
         nz.push(-1.0);
     }
     colptr.push(rowval.len());
@@ -63,15 +63,15 @@ pub fn attainable_wrench(
     let a = CscMatrix::new(rows, n, colptr, rowval, nz.clone());
     let p = CscMatrix::zeros((n, n));
     let mut q = vec![0.0; n];
-    q[m] = -1.0;
+    q[n_thrusters] = -1.0;
     let mut b = vec![0.0; rows];
-    b[6..6 + m].copy_from_slice(u_max);
-    for (bj, &lo) in b[6 + m..].iter_mut().zip(u_min) {
+    b[6..6 + n_thrusters].copy_from_slice(u_max);
+    for (bj, &lo) in b[6 + n_thrusters..].iter_mut().zip(u_min) {
         *bj = -lo;
     }
     let cones = [
         SupportedConeT::ZeroConeT(6),
-        SupportedConeT::NonnegativeConeT(2 * m),
+        SupportedConeT::NonnegativeConeT(2 * n_thrusters),
     ];
     let mut out = AttainableWrench {
         positive: [f64::NAN; 6],
@@ -94,7 +94,7 @@ pub fn attainable_wrench(
                 sol.status,
                 SolverStatus::Solved | SolverStatus::AlmostSolved
             ) {
-                sol.x[m].max(0.0)
+                sol.x[n_thrusters].max(0.0)
             } else {
                 f64::NAN
             };

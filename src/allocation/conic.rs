@@ -1,24 +1,25 @@
 //! Clarabel formulations of the constrained allocation forms (SPEC §5).
 //!
-//! Clarabel solves `min ½xᵀPx + qᵀx` s.t. `Ax + s = b`, `s ∈ K`. The variables are
-//! `x = [u (m) | s (6, slack-kept form only) | t (1 for minimax, m for power)]` and the rows are, in
-//! order:
+//! Clarabel solves `min ½xᵀPx + qᵀx` s.t. `Ax + s = b`, `s ∈ K`. With `n_u` thrusters
+//! (`n_uhrusters` in the code) the variables are
+//! `x = [u (n_u) | s (6, slack-kept form only) | t (1 for minimax, n_u for power)]` and the rows
+//! are, in order:
 //! 1. slack-kept form only: `ZeroConeT(6)`, `T u − s = τ`;
-//! 2. `NonnegativeConeT`: `u_j ≤ hi_j` (m rows), `−u_j ≤ −lo_j` (m rows) and, for minimax,
-//!    `u_j − t ≤ 0` (m rows), `−u_j − t ≤ 0` (m rows);
-//! 3. power only: m × `PowerConeT(2/3)` on `(t_j, 1, u_j)`, i.e. `|u_j|^{3/2} ≤ t_j`.
+//! 2. `NonnegativeConeT`: `u_j ≤ hi_j` (n_u rows), `−u_j ≤ −lo_j` (n_u rows) and, for minimax,
+//!    `u_j − t ≤ 0` (n_u rows), `−u_j − t ≤ 0` (n_u rows);
+//! 3. power only: n_u × `PowerConeT(2/3)` on `(t_j, 1, u_j)`, i.e. `|u_j|^{3/2} ≤ t_j`.
 //!
 //! `P` carries the factor 2 that turns Clarabel's ½ into the module's ½-free objectives. In the
 //! slack-eliminated form `s = T u − τ` is substituted, giving `P_uu = 2(diag(c + r) + q TᵀT)` and
 //! `q_u = −2(q Tᵀτ + r ∘ u_prev)`; the constant `q‖τ‖² + Σ r_j u_prev,j²` is dropped.
-//! The sparsity pattern depends only on method, m and formulation (structural zeros are kept), so
+//! The sparsity pattern depends only on method, n_thrusters and formulation (structural zeros are kept), so
 //! one solver is built and its data updated in place (`update_P/q/A/b`) on every later step.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use nalgebra::{Matrix6xX, Vector6};
 
-use super::{Formulation, Method};
+use super::settings::{Formulation, Method};
 
 /// Inputs of one constrained allocation step.
 pub(crate) struct Params<'a> {
@@ -45,7 +46,7 @@ pub(crate) struct Outcome {
 /// Row and column layout of the conic problem.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Layout {
-    pub m: usize,
+    pub n_thrusters: usize,
     /// Number of variables.
     pub n: usize,
     /// Number of constraint rows.
@@ -117,7 +118,7 @@ pub(crate) fn status_text(s: SolverStatus) -> &'static str {
 impl ConicProblem {
     pub(crate) fn new(
         method: Method,
-        m: usize,
+        n_thrusters: usize,
         formulation: Formulation,
         reuse: bool,
         tol: f64,
@@ -126,33 +127,41 @@ impl ConicProblem {
             Formulation::SlackKept => 6,
             Formulation::SlackEliminated => 0,
         };
-        let n_t = match method {
+        let n_epi = match method {
             Method::Minimax => 1,
-            Method::Power => m,
+            Method::Power => n_thrusters,
             _ => 0,
         };
         let r_box = n_s;
-        let r_mm = r_box + 2 * m;
-        let n_mm = if method == Method::Minimax { 2 * m } else { 0 };
+        let r_mm = r_box + 2 * n_thrusters;
+        let n_mm = if method == Method::Minimax {
+            2 * n_thrusters
+        } else {
+            0
+        };
         let r_pow = r_mm + n_mm;
-        let n_pow = if method == Method::Power { 3 * m } else { 0 };
+        let n_pow = if method == Method::Power {
+            3 * n_thrusters
+        } else {
+            0
+        };
         let layout = Layout {
-            m,
-            n: m + n_s + n_t,
+            n_thrusters,
+            n: n_thrusters + n_s + n_epi,
             rows: r_pow + n_pow,
-            s0: (n_s > 0).then_some(m),
-            t0: m + n_s,
+            s0: (n_s > 0).then_some(n_thrusters),
+            t0: n_thrusters + n_s,
             r_box,
             r_mm,
             r_pow,
         };
-        let mut cones = Vec::with_capacity(2 + m);
+        let mut cones = Vec::with_capacity(2 + n_thrusters);
         if n_s > 0 {
             cones.push(SupportedConeT::ZeroConeT(6));
         }
-        cones.push(SupportedConeT::NonnegativeConeT(2 * m + n_mm));
+        cones.push(SupportedConeT::NonnegativeConeT(2 * n_thrusters + n_mm));
         if method == Method::Power {
-            for _ in 0..m {
+            for _ in 0..n_thrusters {
                 cones.push(SupportedConeT::PowerConeT(2.0 / 3.0));
             }
         }
@@ -162,12 +171,12 @@ impl ConicProblem {
             reuse,
             layout,
             p_colptr: Vec::with_capacity(layout.n + 1),
-            p_rowval: Vec::with_capacity(m * (m + 1) / 2 + n_s),
-            p_nz: Vec::with_capacity(m * (m + 1) / 2 + n_s),
+            p_rowval: Vec::with_capacity(n_thrusters * (n_thrusters + 1) / 2 + n_s),
+            p_nz: Vec::with_capacity(n_thrusters * (n_thrusters + 1) / 2 + n_s),
             q: Vec::with_capacity(layout.n),
             a_colptr: Vec::with_capacity(layout.n + 1),
-            a_rowval: Vec::with_capacity(m * 12 + 2 * m + n_s),
-            a_nz: Vec::with_capacity(m * 12 + 2 * m + n_s),
+            a_rowval: Vec::with_capacity(n_thrusters * 12 + 2 * n_thrusters + n_s),
+            a_nz: Vec::with_capacity(n_thrusters * 12 + 2 * n_thrusters + n_s),
             b: Vec::with_capacity(layout.rows),
             cones,
             settings: DefaultSettings {
@@ -201,22 +210,25 @@ impl ConicProblem {
     /// Fill pattern and values of P, q, A, b for `p` (buffers are cleared and refilled; after the
     /// first call their capacity suffices, so nothing is allocated).
     fn assemble(&mut self, p: &Params<'_>) {
+        self.assemble_objective(p);
+        self.assemble_constraints(p);
+        self.assemble_rhs(p);
+        debug_assert_eq!(self.q.len(), self.layout.n);
+        debug_assert_eq!(self.b.len(), self.layout.rows);
+    }
+
+    /// `P` (upper triangle, column-major) and `q`: the weights, rate and slack terms (with
+    /// `q TᵀT` in the slack-eliminated form), the minimax `t` and the power epigraph costs.
+    fn assemble_objective(&mut self, p: &Params<'_>) {
         let l = self.layout;
-        let m = l.m;
+        let n_thrusters = l.n_thrusters;
         let eliminated = self.formulation == Formulation::SlackEliminated;
         let (pc, pr, pv) = (&mut self.p_colptr, &mut self.p_rowval, &mut self.p_nz);
         pc.clear();
         pr.clear();
         pv.clear();
-        let (ac, ar, av) = (&mut self.a_colptr, &mut self.a_rowval, &mut self.a_nz);
-        ac.clear();
-        ar.clear();
-        av.clear();
         self.q.clear();
-        self.b.clear();
-
-        // ---- P (upper triangle, column-major) and q ----
-        for j in 0..m {
+        for j in 0..n_thrusters {
             pc.push(pr.len());
             let base = match self.method {
                 Method::Qp => p.w[j],
@@ -257,7 +269,7 @@ impl ConicProblem {
                 self.q.push(1.0);
             }
             Method::Power => {
-                for j in 0..m {
+                for j in 0..n_thrusters {
                     pc.push(pr.len());
                     self.q.push(p.w[j]);
                 }
@@ -265,9 +277,18 @@ impl ConicProblem {
             _ => {}
         }
         pc.push(pr.len());
+    }
 
-        // ---- A (column-major, rows ascending) ----
-        for j in 0..m {
+    /// `A` (column-major, rows ascending): `T u − s` (slack-kept form), the box rows, the
+    /// minimax rows and the power-cone rows, in the order of the module doc.
+    fn assemble_constraints(&mut self, p: &Params<'_>) {
+        let l = self.layout;
+        let n_thrusters = l.n_thrusters;
+        let (ac, ar, av) = (&mut self.a_colptr, &mut self.a_rowval, &mut self.a_nz);
+        ac.clear();
+        ar.clear();
+        av.clear();
+        for j in 0..n_thrusters {
             ac.push(ar.len());
             if l.s0.is_some() {
                 for i in 0..6 {
@@ -277,12 +298,12 @@ impl ConicProblem {
             }
             ar.push(l.r_box + j);
             av.push(1.0);
-            ar.push(l.r_box + m + j);
+            ar.push(l.r_box + n_thrusters + j);
             av.push(-1.0);
             if self.method == Method::Minimax {
                 ar.push(l.r_mm + j);
                 av.push(1.0);
-                ar.push(l.r_mm + m + j);
+                ar.push(l.r_mm + n_thrusters + j);
                 av.push(-1.0);
             }
             if self.method == Method::Power {
@@ -300,13 +321,13 @@ impl ConicProblem {
         match self.method {
             Method::Minimax => {
                 ac.push(ar.len());
-                for r in 0..2 * m {
+                for r in 0..2 * n_thrusters {
                     ar.push(l.r_mm + r);
                     av.push(-1.0);
                 }
             }
             Method::Power => {
-                for j in 0..m {
+                for j in 0..n_thrusters {
                     ac.push(ar.len());
                     ar.push(l.r_pow + 3 * j);
                     av.push(-1.0);
@@ -315,23 +336,26 @@ impl ConicProblem {
             _ => {}
         }
         ac.push(ar.len());
+    }
 
-        // ---- b ----
+    /// `b`: `τ` (slack-kept form), the bounds `hi`, `−lo`, and the cone constants.
+    fn assemble_rhs(&mut self, p: &Params<'_>) {
+        let l = self.layout;
+        let n_thrusters = l.n_thrusters;
+        self.b.clear();
         if l.s0.is_some() {
             self.b.extend_from_slice(p.tau.as_slice());
         }
         self.b.extend_from_slice(p.hi);
         self.b.extend(p.lo.iter().map(|x| -x));
         if self.method == Method::Minimax {
-            self.b.extend(std::iter::repeat_n(0.0, 2 * m));
+            self.b.extend(std::iter::repeat_n(0.0, 2 * n_thrusters));
         }
         if self.method == Method::Power {
-            for _ in 0..m {
+            for _ in 0..n_thrusters {
                 self.b.extend_from_slice(&[0.0, 1.0, 0.0]);
             }
         }
-        debug_assert_eq!(self.q.len(), l.n);
-        debug_assert_eq!(self.b.len(), l.rows);
     }
 
     /// Update the existing solver in place; false if that is not possible.
@@ -398,7 +422,7 @@ impl ConicProblem {
         solver.solve();
         let sol = &solver.solution;
         let status = sol.status;
-        let x = &sol.x[..self.layout.m];
+        let x = &sol.x[..self.layout.n_thrusters];
         let usable = matches!(status, SolverStatus::Solved | SolverStatus::AlmostSolved)
             && x.iter().all(|v| v.is_finite());
         if usable {

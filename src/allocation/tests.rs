@@ -70,13 +70,13 @@ fn run(
     hi: f64,
     settings: AllocSettings,
 ) -> (Allocation, Allocator) {
-    let m = t.ncols();
+    let n_thrusters = t.ncols();
     let mut a = Allocator::new(
         method,
-        m,
-        &vec![lo; m],
-        &vec![hi; m],
-        &vec![1.0; m],
+        n_thrusters,
+        &vec![lo; n_thrusters],
+        &vec![hi; n_thrusters],
+        &vec![1.0; n_thrusters],
         settings,
     )
     .expect("valid input");
@@ -96,7 +96,7 @@ fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) 
     let sol = conic.solution().expect("solved");
     let z = &sol.z;
     let x = &sol.x;
-    let m = l.m;
+    let n_thrusters = l.n_thrusters;
     let st = a.settings();
     let (lo, hi) = a.effective_bounds();
     let (lo, hi) = (lo.to_vec(), hi.to_vec());
@@ -104,7 +104,7 @@ fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) 
         .rate
         .as_ref()
         .map(|r| r.weights.clone())
-        .unwrap_or(vec![0.0; m]);
+        .unwrap_or(vec![0.0; n_thrusters]);
     let ts = t.transpose() * r.s;
     // Global scale, as Clarabel normalises its residuals: max(1, ‖x‖∞, ‖z‖∞, |objective|).
     let big = x
@@ -134,9 +134,9 @@ fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) 
         }
     }
     let mut sum_ab = 0.0;
-    for j in 0..m {
+    for j in 0..n_thrusters {
         let mu_up = z[l.r_box + j];
-        let mu_lo = z[l.r_box + m + j];
+        let mu_lo = z[l.r_box + n_thrusters + j];
         assert!(
             mu_up >= -TOL && mu_lo >= -TOL,
             "dual feasibility {mu_up} {mu_lo}"
@@ -160,7 +160,7 @@ fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) 
             Method::Qp => (2.0 * a.w[j] * r.u[j], 0.0),
             Method::Minimax => {
                 let al = z[l.r_mm + j];
-                let be = z[l.r_mm + m + j];
+                let be = z[l.r_mm + n_thrusters + j];
                 assert!(al >= -TOL && be >= -TOL);
                 let tt = x[l.t0];
                 assert!(
@@ -221,11 +221,11 @@ fn all_formulations() -> [AllocSettings; 3] {
 
 #[test]
 fn method_names_roundtrip() {
-    for m in Method::ALL {
-        assert_eq!(m.to_string().parse::<Method>().unwrap(), m);
-        let j = serde_json::to_string(&m).unwrap();
-        assert_eq!(j, format!("\"{m}\""));
-        assert_eq!(serde_json::from_str::<Method>(&j).unwrap(), m);
+    for method in Method::ALL {
+        assert_eq!(method.to_string().parse::<Method>().unwrap(), method);
+        let j = serde_json::to_string(&method).unwrap();
+        assert_eq!(j, format!("\"{method}\""));
+        assert_eq!(serde_json::from_str::<Method>(&j).unwrap(), method);
     }
     assert!("lsq".parse::<Method>().is_err());
     assert_eq!("QP".parse::<Method>().unwrap(), Method::Qp);
@@ -607,29 +607,29 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
     fn prop_no_panic_and_bounds_respected(
-        m in 1usize..10,
+        n_thrusters in 1usize..10,
         tvals in proptest::collection::vec(-2.0f64..2.0, 60),
         tauv in proptest::collection::vec(-60.0f64..60.0, 6),
         lov in proptest::collection::vec(-40.0f64..5.0, 10),
         width in proptest::collection::vec(0.0f64..50.0, 10),
         zero_col in proptest::option::of(0usize..10),
     ) {
-        let mut t = Matrix6xX::from_iterator(m, tvals.iter().copied().take(6 * m));
+        let mut t = Matrix6xX::from_iterator(n_thrusters, tvals.iter().copied().take(6 * n_thrusters));
         if let Some(c) = zero_col {
-            if c < m {
+            if c < n_thrusters {
                 t.column_mut(c).fill(0.0);
             }
         }
         let tau = Vector6::from_iterator(tauv.iter().copied());
-        let lo: Vec<f64> = lov[..m].to_vec();
+        let lo: Vec<f64> = lov[..n_thrusters].to_vec();
         let hi: Vec<f64> = lo.iter().zip(&width).map(|(l, w)| l + w).collect();
         for method in Method::ALL {
-            let r = allocate(method, &t, &tau, &lo, &hi, &vec![1.0; m], AllocSettings::default())
+            let r = allocate(method, &t, &tau, &lo, &hi, &vec![1.0; n_thrusters], AllocSettings::default())
                 .unwrap();
             prop_assert!(r.u.iter().all(|u| u.is_finite()));
             prop_assert!(r.objective.is_finite());
             if method != Method::Pinv {
-                for j in 0..m {
+                for j in 0..n_thrusters {
                     prop_assert!(r.u[j] >= lo[j] && r.u[j] <= hi[j], "{} {:?}", method, r);
                 }
             }

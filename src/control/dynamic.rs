@@ -18,24 +18,26 @@ use crate::spatial::Vec6;
 use nalgebra::Matrix6;
 use serde::{Deserialize, Serialize};
 
-/// Gains of USM-33/34. Defaults are the paper's work-mode values:
-/// `K_p = diag(1, 1, 1, 0, 1, 1)` (roll not controlled), `K_i = 0`, no nonlinear term.
+/// Gains of USM-33/34. Defaults ([`DynamicGains::work_mode`], given on each field) are the
+/// paper's work-mode values; [`DynamicGains::validate`] checks the ranges.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DynamicGains {
-    /// Diagonal of `K_p` [1/s], `[surge, sway, heave, roll, pitch, yaw]`.
+    /// Diagonal of `K_p` [1/s], `[surge, sway, heave, roll, pitch, yaw]`. Default
+    /// `[1, 1, 1, 0, 1, 1]` (roll not controlled).
     pub kp: [f64; 6],
-    /// Diagonal of `K_i` [1/s²].
+    /// Diagonal of `K_i` [1/s²]. Default 0.
     pub ki: [f64; 6],
-    /// Whether `τ_c` includes the nonlinear term `n` (USM-33/35).
+    /// Whether `τ_c` includes the nonlinear term `n` (USM-33/35). Default false.
     pub nonlinear: bool,
     /// Whether `a^b` includes the reference acceleration `V̇_r`, estimated by a first-order
     /// filtered backward difference of `V_r` (unless given explicitly, see
-    /// [`DynamicController::velocity_control_with_rate`]).
+    /// [`DynamicController::velocity_control_with_rate`]). Default true.
     pub feedforward: bool,
-    /// Time constant [s] of that filter (0 = raw backward difference).
+    /// Time constant [s] of that filter (0 = raw backward difference). Default 0.1 s.
     pub feedforward_time_constant: f64,
-    /// Bound on each component of `|∫Ṽ dt|` (anti-windup; `None` = unbounded).
+    /// Bound on each component of `|∫Ṽ dt|` (anti-windup; `None` = unbounded). Default
+    /// `None`.
     pub integral_limit: Option<f64>,
 }
 

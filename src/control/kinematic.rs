@@ -20,59 +20,19 @@
 //!
 //! Dimensions: `N = 6 + n` generalised velocities `ζ = [V_b; q̇]` (base twist in `F_b`, m/s and
 //! rad/s, then joint rates rad/s). Matrices are faer `Mat<f64>`; the small SPD systems are solved
-//! by an in-place Cholesky factorisation in preallocated buffers — nothing allocates per call.
+//! by the crate's one in-place Cholesky factorisation (`dynamics::cholesky`, any
+//! positive pivot accepted) in preallocated buffers — nothing allocates per call.
 //! A non-positive pivot (λ = 0 and a singular `J U Jᵀ`) is retried once with a tiny diagonal
 //! regularisation and counted ([`PinvWorkspace::regularised`]); if that also fails (non-finite
 //! input) the contribution is zero and counted ([`PinvWorkspace::failed`]).
 
 use super::{check_nonneg, orientation_error, ControlError};
+use crate::dynamics::cholesky;
 use crate::kinematics::BasePose;
 use crate::spatial::{stack, Mat3, Se3, Vec3, Vec6};
 use faer::{Mat, MatRef};
 use nalgebra::{Rotation3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
-
-/// In-place Cholesky `A = L Lᵀ` of the leading `m×m` block of the row-major buffer `a`
-/// (lower triangle overwritten with `L`). Returns `false` on a non-positive or non-finite pivot.
-fn cholesky_in_place(a: &mut [f64], m: usize) -> bool {
-    for j in 0..m {
-        let mut d = a[j * m + j];
-        for k in 0..j {
-            d -= a[j * m + k] * a[j * m + k];
-        }
-        if !d.is_finite() || d <= 0.0 {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j * m + j] = d;
-        for i in (j + 1)..m {
-            let mut s = a[i * m + j];
-            for k in 0..j {
-                s -= a[i * m + k] * a[j * m + k];
-            }
-            a[i * m + j] = s / d;
-        }
-    }
-    true
-}
-
-/// Solve `L Lᵀ x = b` in place with the factor from [`cholesky_in_place`].
-fn cholesky_solve(l: &[f64], m: usize, b: &mut [f64]) {
-    for i in 0..m {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[i * m + k] * b[k];
-        }
-        b[i] = s / l[i * m + i];
-    }
-    for i in (0..m).rev() {
-        let mut s = b[i];
-        for k in (i + 1)..m {
-            s -= l[k * m + i] * b[k];
-        }
-        b[i] = s / l[i * m + i];
-    }
-}
 
 /// Usage weight `u_c` of column `c` (1 when no weights are given).
 #[inline]
@@ -144,30 +104,32 @@ impl PinvWorkspace {
         check_nonneg("damping", lambda)
     }
 
-    /// Build and factor `A = J U Jᵀ + λ² I` (m×m). Returns false if it could not be factored.
+    /// Build and factor `A = J U Jᵀ + λ² I` (`task_dim`×`task_dim`, `task_dim` = rows of `J`). Returns false if it could not be factored.
     fn factor(&mut self, j: MatRef<'_, f64>, u: Option<&[f64]>, lambda: f64) -> bool {
-        let m = j.nrows();
+        let task_dim = j.nrows();
         let build = |a: &mut [f64], extra: f64| {
-            for r in 0..m {
+            for r in 0..task_dim {
                 for s in 0..=r {
                     let mut acc = 0.0;
                     for c in 0..j.ncols() {
                         acc += j[(r, c)] * weight(u, c) * j[(s, c)];
                     }
-                    a[r * m + s] = acc;
-                    a[s * m + r] = acc;
+                    a[r * task_dim + s] = acc;
+                    a[s * task_dim + r] = acc;
                 }
-                a[r * m + r] += lambda * lambda + extra;
+                a[r * task_dim + r] += lambda * lambda + extra;
             }
         };
         build(&mut self.a, 0.0);
-        if cholesky_in_place(&mut self.a, m) {
+        if cholesky::factor(&mut self.a, task_dim, 0.0).is_ok() {
             return true;
         }
         build(&mut self.a, 0.0);
-        let scale = (0..m).map(|r| self.a[r * m + r].abs()).fold(0.0, f64::max);
+        let scale = (0..task_dim)
+            .map(|r| self.a[r * task_dim + r].abs())
+            .fold(0.0, f64::max);
         build(&mut self.a, 1e-12 * scale.max(1.0));
-        if cholesky_in_place(&mut self.a, m) {
+        if cholesky::factor(&mut self.a, task_dim, 0.0).is_ok() {
             self.regularised += 1;
             true
         } else {
@@ -176,9 +138,9 @@ impl PinvWorkspace {
         }
     }
 
-    /// `out = J^# rhs = U Jᵀ (J U Jᵀ + λ² I)⁻¹ rhs` (USM-28/31). `j` is m×n (m ≤ `max_rows`),
-    /// `u` the usage weights (n, `None` = identity), `lambda` the damping λ ≥ 0, `rhs` of length
-    /// m, `out` of length n. Errors only on mismatched dimensions or invalid λ.
+    /// `out = J^# rhs = U Jᵀ (J U Jᵀ + λ² I)⁻¹ rhs` (USM-28/31). `j` is `task_dim`×n
+    /// (`task_dim` ≤ `max_rows`), `u` the usage weights (n, `None` = identity), `lambda` the
+    /// damping λ ≥ 0, `rhs` of length `task_dim`, `out` of length n. Errors only on mismatched dimensions or invalid λ.
     pub fn apply(
         &mut self,
         j: MatRef<'_, f64>,
@@ -188,15 +150,15 @@ impl PinvWorkspace {
         out: &mut [f64],
     ) -> Result<(), ControlError> {
         self.check(j, u, lambda)?;
-        let m = j.nrows();
-        if rhs.len() != m || out.len() != self.n {
+        let task_dim = j.nrows();
+        if rhs.len() != task_dim || out.len() != self.n {
             return Err(ControlError::new(
                 "rhs",
                 format!(
                     "lengths {} / {} do not match J ({}×{})",
                     rhs.len(),
                     out.len(),
-                    m,
+                    task_dim,
                     self.n
                 ),
             ));
@@ -205,11 +167,11 @@ impl PinvWorkspace {
             out.fill(0.0);
             return Ok(());
         }
-        self.y[..m].copy_from_slice(rhs);
-        cholesky_solve(&self.a, m, &mut self.y[..m]);
+        self.y[..task_dim].copy_from_slice(rhs);
+        cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
         for (c, o) in out.iter_mut().enumerate() {
             let mut acc = 0.0;
-            for r in 0..m {
+            for r in 0..task_dim {
                 acc += j[(r, c)] * self.y[r];
             }
             *o = weight(u, c) * acc;
@@ -217,7 +179,7 @@ impl PinvWorkspace {
         Ok(())
     }
 
-    /// The explicit `J^#` (n×m) into `out` (resized only if its shape differs).
+    /// The explicit `J^#` (n×`task_dim`) into `out` (resized only if its shape differs).
     pub fn pinv(
         &mut self,
         j: MatRef<'_, f64>,
@@ -226,9 +188,9 @@ impl PinvWorkspace {
         out: &mut Mat<f64>,
     ) -> Result<(), ControlError> {
         self.check(j, u, lambda)?;
-        let m = j.nrows();
-        if out.nrows() != self.n || out.ncols() != m {
-            *out = Mat::zeros(self.n, m);
+        let task_dim = j.nrows();
+        if out.nrows() != self.n || out.ncols() != task_dim {
+            *out = Mat::zeros(self.n, task_dim);
         }
         if !self.factor(j, u, lambda) {
             out.fill(0.0);
@@ -236,11 +198,11 @@ impl PinvWorkspace {
         }
         // Row c of J^# is u_c (A⁻¹ J[:, c])ᵀ.
         for c in 0..self.n {
-            for r in 0..m {
+            for r in 0..task_dim {
                 self.y[r] = j[(r, c)];
             }
-            cholesky_solve(&self.a, m, &mut self.y[..m]);
-            for r in 0..m {
+            cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
+            for r in 0..task_dim {
                 out[(c, r)] = weight(u, c) * self.y[r];
             }
         }
@@ -256,7 +218,7 @@ impl PinvWorkspace {
         out: &mut Mat<f64>,
     ) -> Result<(), ControlError> {
         self.check(j, u, lambda)?;
-        let (m, n) = (j.nrows(), self.n);
+        let (task_dim, n) = (j.nrows(), self.n);
         if out.nrows() != n || out.ncols() != n {
             *out = Mat::zeros(n, n);
         }
@@ -265,22 +227,22 @@ impl PinvWorkspace {
                 out[(a, b)] = if a == b { 1.0 } else { 0.0 };
             }
         }
-        if m == 0 || !self.factor(j, u, lambda) {
+        if task_dim == 0 || !self.factor(j, u, lambda) {
             return Ok(());
         }
         // (J^# J)[a, b] = u_a Σ_r J[r, a] (A⁻¹ J)[r, b]; solve A x = J[:, b] column by column.
         for b in 0..n {
-            for r in 0..m {
+            for r in 0..task_dim {
                 self.y[r] = j[(r, b)];
             }
-            cholesky_solve(&self.a, m, &mut self.y[..m]);
+            cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
             for a in 0..n {
                 let wa = weight(u, a);
                 if wa == 0.0 {
                     continue;
                 }
                 let mut acc = 0.0;
-                for r in 0..m {
+                for r in 0..task_dim {
                     acc += j[(r, a)] * self.y[r];
                 }
                 out[(a, b)] -= wa * acc;
@@ -291,7 +253,7 @@ impl PinvWorkspace {
 }
 
 /// Convenience: the explicit damped weighted pseudoinverse `J^# = U Jᵀ(J U Jᵀ + λ²I)⁻¹`
-/// (n×m) of an m×n `j` (allocates a workspace; for analysis and tests, not for time steps).
+/// (n×`task_dim`) of a `task_dim`×n `j` (allocates a workspace; for analysis and tests, not for time steps).
 pub fn damped_weighted_pinv(
     j: MatRef<'_, f64>,
     u: Option<&[f64]>,
@@ -432,34 +394,34 @@ impl Srmtp {
         self.null.as_ref()
     }
 
-    /// Push the next task in priority order: `j` its m×N Jacobian, `rate` the m-vector
-    /// `σ̇_d + Λ σ̃` (task units per second). Adds `N_{1…k−1} J^# rate` to `ζ` and stacks `j`
-    /// below the higher-priority tasks. Errors on mismatched dimensions or when the stacked
-    /// rows would exceed `max_rows`; nothing changes then.
+    /// Push the next task in priority order: `j` its `task_dim`×N Jacobian, `rate` the
+    /// `task_dim`-vector `σ̇_d + Λ σ̃` (task units per second). Adds `N_{1…k−1} J^# rate` to
+    /// `ζ` and stacks `j` below the higher-priority tasks. Errors on mismatched dimensions or
+    /// when the stacked rows would exceed `max_rows`; nothing changes then.
     pub fn push_task(
         &mut self,
         j: MatRef<'_, f64>,
         rate: &[f64],
         inv: TaskInverse,
     ) -> Result<(), ControlError> {
-        let m = j.nrows();
-        if j.ncols() != self.n || rate.len() != m {
+        let task_dim = j.nrows();
+        if j.ncols() != self.n || rate.len() != task_dim {
             return Err(ControlError::new(
                 "task",
                 format!(
                     "Jacobian {}×{} and rate of length {} do not fit N = {}",
-                    m,
+                    task_dim,
                     j.ncols(),
                     rate.len(),
                     self.n
                 ),
             ));
         }
-        if self.rows + m > self.max_rows {
+        if self.rows + task_dim > self.max_rows {
             return Err(ControlError::new(
                 "task",
                 format!(
-                    "stacking {m} more rows exceeds the {} rows the solver was built for",
+                    "stacking {task_dim} more rows exceeds the {} rows the solver was built for",
                     self.max_rows
                 ),
             ));
@@ -471,12 +433,12 @@ impl Srmtp {
         };
         self.pinv.apply(j, u, inv.damping, rate, &mut self.x)?;
         self.add_projected();
-        for r in 0..m {
+        for r in 0..task_dim {
             for c in 0..self.n {
                 self.stack[(self.rows + r, c)] = j[(r, c)];
             }
         }
-        self.rows += m;
+        self.rows += task_dim;
         self.null_dirty = true;
         Ok(())
     }
@@ -621,16 +583,16 @@ impl JointLimitTask {
     /// [rad]. Returns whether the active set grew.
     pub fn update(&mut self, q: &[f64], qd: &[f64], limits: &[(f64, f64)]) -> bool {
         let mut grew = false;
-        let m = self.settings.margin;
+        let margin = self.settings.margin;
         for i in 0..self.active.len() {
             if self.active[i] != 0 {
                 continue;
             }
             let (lo, hi) = limits[i];
-            if q[i] >= hi - m && qd[i] > 0.0 {
+            if q[i] >= hi - margin && qd[i] > 0.0 {
                 self.active[i] = 1;
                 grew = true;
-            } else if q[i] <= lo + m && qd[i] < 0.0 {
+            } else if q[i] <= lo + margin && qd[i] < 0.0 {
                 self.active[i] = -1;
                 grew = true;
             }
@@ -649,9 +611,9 @@ impl JointLimitTask {
                 self.jac[(row, 6 + i)] = 1.0;
                 let (lo, hi) = limits[i];
                 let rate = if self.active[i] > 0 {
-                    (hi - m - q[i]).min(0.0)
+                    (hi - margin - q[i]).min(0.0)
                 } else {
-                    (lo + m - q[i]).max(0.0)
+                    (lo + margin - q[i]).max(0.0)
                 };
                 self.rate[row] = self.settings.gain * rate;
                 self.count += 1;
@@ -677,216 +639,5 @@ impl JointLimitTask {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
-
-    fn random_mat(rng: &mut ChaCha8Rng, m: usize, n: usize) -> Mat<f64> {
-        Mat::from_fn(m, n, |_, _| rng.random_range(-1.0..1.0))
-    }
-
-    fn mul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-        Mat::from_fn(a.nrows(), b.ncols(), |i, j| {
-            (0..a.ncols()).map(|k| a[(i, k)] * b[(k, j)]).sum()
-        })
-    }
-
-    fn max_abs_diff_identity(a: &Mat<f64>) -> f64 {
-        let mut e: f64 = 0.0;
-        for i in 0..a.nrows() {
-            for j in 0..a.ncols() {
-                let t = if i == j { 1.0 } else { 0.0 };
-                e = e.max((a[(i, j)] - t).abs());
-            }
-        }
-        e
-    }
-
-    #[test]
-    fn pinv_right_inverse_as_damping_vanishes() {
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let j = random_mat(&mut rng, 6, 14);
-        let u: Vec<f64> = (0..14).map(|i| 0.2 + 0.1 * i as f64).collect();
-        let mut prev = f64::INFINITY;
-        for lambda in [1e-1, 1e-2, 1e-3, 1e-5] {
-            let p = damped_weighted_pinv(j.as_ref(), Some(&u), lambda).unwrap();
-            let e = max_abs_diff_identity(&mul(j.as_ref(), p.as_ref()));
-            // J J^# = I − λ²(JUJᵀ + λ²I)⁻¹: the defect shrinks like λ².
-            assert!(e < prev, "λ = {lambda}: {e}");
-            prev = e;
-        }
-        assert!(prev < 1e-8, "{prev}");
-        // λ = 0 is the exact weighted right inverse.
-        let p = damped_weighted_pinv(j.as_ref(), Some(&u), 0.0).unwrap();
-        assert!(max_abs_diff_identity(&mul(j.as_ref(), p.as_ref())) < 1e-10);
-    }
-
-    #[test]
-    fn pinv_matches_formula_and_apply() {
-        let mut rng = ChaCha8Rng::seed_from_u64(2);
-        let j = random_mat(&mut rng, 4, 9);
-        let u: Vec<f64> = (0..9).map(|_| rng.random_range(0.1..2.0)).collect();
-        let lambda = 0.3;
-        let p = damped_weighted_pinv(j.as_ref(), Some(&u), lambda).unwrap();
-        // Check (J U Jᵀ + λ²I) (U⁻¹ p)ᵀ... directly: J^# (J U Jᵀ + λ²I) = U Jᵀ.
-        let ud = Mat::from_fn(9, 9, |a, b| if a == b { u[a] } else { 0.0 });
-        let mut a = mul(mul(j.as_ref(), ud.as_ref()).as_ref(), j.transpose());
-        for i in 0..4 {
-            a[(i, i)] += lambda * lambda;
-        }
-        let lhs = mul(p.as_ref(), a.as_ref());
-        let rhs = mul(ud.as_ref(), j.transpose());
-        for r in 0..9 {
-            for c in 0..4 {
-                assert!((lhs[(r, c)] - rhs[(r, c)]).abs() < 1e-12);
-            }
-        }
-        let b = [0.3, -1.0, 0.5, 2.0];
-        let mut x = vec![0.0; 9];
-        let mut ws = PinvWorkspace::new(6, 9);
-        ws.apply(j.as_ref(), Some(&u), lambda, &b, &mut x).unwrap();
-        for r in 0..9 {
-            let e: f64 = (0..4).map(|c| p[(r, c)] * b[c]).sum();
-            assert!((x[r] - e).abs() < 1e-12);
-        }
-        // Mismatched dimensions are errors, not panics.
-        assert!(ws
-            .apply(j.as_ref(), Some(&u), lambda, &b[..3], &mut x)
-            .is_err());
-        assert!(ws
-            .apply(j.as_ref(), Some(&u[..8]), lambda, &b, &mut x)
-            .is_err());
-    }
-
-    #[test]
-    fn zero_usage_weight_freezes_coordinate() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let j = random_mat(&mut rng, 6, 14);
-        let mut u = vec![1.0; 14];
-        u[3] = 0.0; // base roll, as in the paper's W
-        u[9] = 0.0;
-        let mut ws = PinvWorkspace::new(6, 14);
-        let mut x = vec![0.0; 14];
-        ws.apply(
-            j.as_ref(),
-            Some(&u),
-            0.1,
-            &[1.0, -2.0, 0.5, 0.3, 0.1, -0.7],
-            &mut x,
-        )
-        .unwrap();
-        assert_eq!(x[3], 0.0);
-        assert_eq!(x[9], 0.0);
-        assert!(x.iter().map(|v| v.abs()).sum::<f64>() > 0.1);
-    }
-
-    #[test]
-    fn singular_jacobian_without_damping_is_regularised() {
-        let mut j = Mat::<f64>::zeros(2, 3);
-        j[(0, 0)] = 1.0;
-        j[(1, 0)] = 1.0; // rank 1
-        let mut ws = PinvWorkspace::new(2, 3);
-        let mut x = vec![0.0; 3];
-        ws.apply(j.as_ref(), None, 0.0, &[1.0, 1.0], &mut x)
-            .unwrap();
-        assert!(x.iter().all(|v| v.is_finite()));
-        assert_eq!(ws.regularised(), 1);
-        let mut jn = j.clone();
-        jn[(0, 1)] = f64::NAN;
-        ws.apply(jn.as_ref(), None, 0.1, &[1.0, 1.0], &mut x)
-            .unwrap();
-        assert_eq!(ws.failed(), 1);
-        assert!(x.iter().all(|v| *v == 0.0));
-    }
-
-    #[test]
-    fn srmtp_secondary_does_not_disturb_primary() {
-        let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let n = 14;
-        let j1 = random_mat(&mut rng, 6, n);
-        let j2 = random_mat(&mut rng, 3, n);
-        let j3 = random_mat(&mut rng, 2, n);
-        let u: Vec<f64> = (0..n).map(|_| rng.random_range(0.3..1.0)).collect();
-        let r1 = [0.2, -0.1, 0.3, 0.0, 0.05, -0.2];
-        let r2 = [1.0, 2.0, -1.5];
-        let r3 = [-3.0, 0.7];
-        let lambda = 1e-6;
-        let mut s = Srmtp::new(n, 11, &u, lambda).unwrap();
-        s.reset();
-        s.push_task(j1.as_ref(), &r1, TaskInverse::weighted(lambda))
-            .unwrap();
-        let z1 = s.zeta().to_vec();
-        // J_1 N_1 ≈ 0 (it is λ²(J U Jᵀ + λ²I)⁻¹ J_1).
-        let jn = mul(j1.as_ref(), s.null_projector());
-        let worst = (0..6)
-            .flat_map(|r| (0..n).map(move |c| (r, c)))
-            .map(|(r, c)| jn[(r, c)].abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-9, "{worst}");
-        s.push_task(j2.as_ref(), &r2, TaskInverse::plain(lambda))
-            .unwrap();
-        s.push_task(j3.as_ref(), &r3, TaskInverse::weighted(lambda))
-            .unwrap();
-        let z = s.zeta().to_vec();
-        let task =
-            |j: &Mat<f64>, z: &[f64], r: usize| -> f64 { (0..n).map(|c| j[(r, c)] * z[c]).sum() };
-        for (r, want) in r1.iter().enumerate() {
-            // Primary achieved exactly and unchanged by the lower tasks.
-            assert!((task(&j1, &z, r) - want).abs() < 1e-8);
-            assert!((task(&j1, &z, r) - task(&j1, &z1, r)).abs() < 1e-8);
-        }
-        // SRMTP as printed (USM-32) does not compensate J_2 ζ_1, so the lower tasks are not met
-        // exactly, only without disturbing the primary. With J_2 = J_1's first three rows the
-        // secondary is fully conflicting and contributes nothing beyond damping leakage.
-        let mut s2 = Srmtp::new(n, 9, &u, lambda).unwrap();
-        s2.reset();
-        s2.push_task(j1.as_ref(), &r1, TaskInverse::weighted(lambda))
-            .unwrap();
-        let j_conf = Mat::from_fn(3, n, |r, c| j1[(r, c)]);
-        s2.push_task(j_conf.as_ref(), &r2, TaskInverse::weighted(lambda))
-            .unwrap();
-        let diff: f64 = s2.zeta().iter().zip(&z1).map(|(a, b)| (a - b).abs()).sum();
-        assert!(diff < 1e-8, "{diff}");
-        // Exceeding the preallocated rows is an error, not a panic.
-        assert!(s
-            .push_task(j3.as_ref(), &r3, TaskInverse::weighted(lambda))
-            .is_err());
-    }
-
-    #[test]
-    fn base_position_jacobian_layout() {
-        let r = crate::spatial::rot_axis_angle(&Vec3::new(0.0, 0.6, 0.8), 0.4);
-        let mut j = Mat::from_fn(3, 10, |_, _| 9.0);
-        base_position_jacobian(&r, &mut j);
-        for a in 0..3 {
-            for c in 0..10 {
-                let e = if c < 3 { r[(a, c)] } else { 0.0 };
-                assert_eq!(j[(a, c)], e);
-            }
-        }
-    }
-
-    #[test]
-    fn joint_limit_task_activation() {
-        let mut t = JointLimitTask::new(
-            3,
-            JointLimitSettings {
-                enabled: true,
-                margin: 0.1,
-                gain: 2.0,
-            },
-        );
-        let lim = [(-1.0, 1.0); 3];
-        // Joint 0 near the top moving up: active. Joint 1 near the bottom moving away: not.
-        // Joint 2 past the band at the bottom moving down: active with a positive push-back.
-        assert!(t.update(&[0.95, -0.95, -0.98], &[0.1, 0.1, -0.1], &lim));
-        assert_eq!(t.count(), 2);
-        let j = t.jacobian();
-        assert_eq!(j[(0, 6)], 1.0);
-        assert_eq!(j[(1, 8)], 1.0);
-        assert!((t.rate()[0] - 2.0 * (0.9 - 0.95)).abs() < 1e-12);
-        assert!((t.rate()[1] - 2.0 * (-0.9 + 0.98)).abs() < 1e-12);
-        assert!(!t.update(&[0.95, -0.95, -0.98], &[0.1, 0.1, -0.1], &lim));
-    }
-}
+#[path = "kinematic_tests.rs"]
+mod tests;

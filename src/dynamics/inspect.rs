@@ -1,7 +1,8 @@
 //! The dynamics part of `usm-study inspect`: `M`, `h`, `ζ̇` and kinetic energy at one state,
 //! as a serialisable report (not a hot path: it allocates).
 
-use super::algorithms::{dynamics_terms, solve_forward, DynWorkspace};
+use super::algorithms::{dynamics_terms, solve_forward};
+use super::workspace::DynWorkspace;
 use super::{check_finite, DynError, DynOptions, SimState};
 use crate::model::Vehicle;
 use nalgebra::DMatrix;

@@ -12,19 +12,29 @@
 //! pure kernels on local 6-vectors under a thin driver):
 //! - [`hydro`]: pure kernels — cylinder strip-theory drag, coefficient damping, restoring
 //!   wrench — on one body's relative twist, in that body's frame;
-//! - [`algorithms`]: the workspace, composite-rigid-body mass matrix ([`mass_matrix`]),
-//!   recursive Newton–Euler bias forces ([`bias`]) and inverse dynamics, forward and hybrid
-//!   dynamics, energy and momentum;
-//! - [`sim`]: actuator models (thrusters, joint servos), the Lie-group RK4 integrator and the
-//!   [`Simulator`];
+//! - [`workspace`]: the [`DynWorkspace`] (per-body inertias, kernels and every buffer);
+//! - `passes`: the staged passes (CRBA, Newton–Euler forward pass, body wrenches, backward
+//!   pass) after the one position pass, [`crate::kinematics::forward_kinematics`];
+//! - [`algorithms`]: composite-rigid-body mass matrix ([`mass_matrix`]), recursive
+//!   Newton–Euler bias forces ([`bias`]) and inverse dynamics, forward and hybrid dynamics,
+//!   energy and momentum;
+//! - `cholesky`: the one dense Cholesky factorisation of the crate (forward dynamics and the
+//!   kinematic-control pseudoinverse);
+//! - [`config`]: the servo and thruster models and the [`SimConfig`] (defaults, `validate()`);
+//! - [`sim`]: the actuator dynamics (thruster lag and rate limit, servo laws), the Lie-group
+//!   RK4 integrator and the [`Simulator`];
 //! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`.
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
 
 pub mod algorithms;
+pub(crate) mod cholesky;
+pub mod config;
 pub mod hydro;
 pub mod inspect;
+mod passes;
 pub mod sim;
+pub mod workspace;
 
 #[cfg(test)]
 mod tests;
@@ -32,27 +42,32 @@ mod tests;
 pub use algorithms::{
     bias, damping_generalized, dynamics_terms, forward_dynamics, hybrid_dynamics, inverse_dynamics,
     kinetic_energy, mass_matrix, restoring_generalized, solve_forward, solve_hybrid,
-    spatial_momentum, DynWorkspace,
+    spatial_momentum,
 };
+pub use config::{ServoModel, SimConfig, ThrusterModel};
 pub use inspect::{inspect_dynamics, DynamicsReport};
-pub use sim::{ActuatorCommand, ServoModel, SimConfig, SimState, Simulator, ThrusterModel};
+pub use sim::{ActuatorCommand, SimState, Simulator};
+pub use workspace::DynWorkspace;
 
 use thiserror::Error;
 
 /// Which physical effects enter the dynamics (SPEC §4).
 ///
-/// `full()` is the paper's model; `rigid()` is the vehicle in vacuum (no added mass, no
-/// drag, no restoring forces, no current) — what `usm-study inspect --rigid` evaluates.
+/// `full()` is the paper's model and the default (every field on); `rigid()` is the vehicle
+/// in vacuum (no added mass, no drag, no restoring forces, no current) — what
+/// `usm-study inspect --rigid` evaluates. Any combination is valid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DynOptions {
     /// Add the added-mass inertia `M_A` of every body to `M` and its Kirchhoff velocity
-    /// term `V_r ×* (M_A V_r)` to the bias forces.
+    /// term `V_r ×* (M_A V_r)` to the bias forces. Default on.
     pub added_mass: bool,
     /// Hydrodynamic damping (strip-theory drag, linear damping, or `D_l`/`D_q` matrices).
+    /// Default on.
     pub drag: bool,
-    /// Weight at the centre of gravity and buoyancy at the centre of buoyancy.
+    /// Weight at the centre of gravity and buoyancy at the centre of buoyancy. Default on.
     pub restoring: bool,
     /// Use the vehicle's constant irrotational current `ν_c`; when off, the fluid is at rest.
+    /// Default on.
     pub current: bool,
 }
 

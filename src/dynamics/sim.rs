@@ -26,85 +26,12 @@
 use super::algorithms::{
     dynamics_terms, kinetic_energy, solve_forward, solve_hybrid, spatial_momentum,
 };
-use super::{check_finite, DynError, DynOptions, DynWorkspace, SimError};
+use super::config::{config_err, ServoModel, SimConfig, ThrusterModel};
+use super::{check_finite, DynError, DynWorkspace, SimError};
 use crate::kinematics::{generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};
 use nalgebra::{Matrix6, Quaternion, UnitQuaternion, Vector6};
-
-/// Joint servo model (SPEC §4 joint actuation).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ServoModel {
-    /// Ideal servos: the joints follow the second-order reference filter
-    /// `q̈ = ω_n²(q_r − q) − 2ζ_n ω_n q̇` exactly (hybrid dynamics); the torques needed are
-    /// recovered for energy accounting.
-    SecondOrder {
-        /// Natural frequency ω_n [rad/s], > 0.
-        omega_n: f64,
-        /// Damping ratio ζ_n [-], ≥ 0.
-        zeta: f64,
-    },
-    /// Torque-level PD servos, full forward dynamics:
-    /// `τ_q = sat(K_p(q_r − q) + K_d(q̇_r − q̇), ±torque_limit)`.
-    TorquePd {
-        /// Proportional gain K_p [N·m/rad], ≥ 0.
-        kp: f64,
-        /// Derivative gain K_d [N·m·s/rad], ≥ 0.
-        kd: f64,
-        /// Torque limit [N·m], > 0 (may be `f64::INFINITY`).
-        torque_limit: f64,
-    },
-    /// Torque-free joints (forward dynamics with zero joint torque): the free multibody.
-    Passive,
-}
-
-/// Thruster dynamics model (SPEC §2: optional lag and rate limit per thruster).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ThrusterModel {
-    /// Actual thrust = saturated command.
-    Ideal,
-    /// First-order lag; `Some(T)` [s] overrides every thruster's time constant, `None` uses
-    /// each thruster's own `Thruster::time_constant` (thrusters without one are ideal).
-    FirstOrder {
-        /// Global time constant override [s].
-        time_constant: Option<f64>,
-    },
-    /// Rate limit; `Some(r)` [N/s] overrides every thruster's, `None` uses each thruster's
-    /// own `Thruster::rate_limit` (thrusters without one are ideal).
-    RateLimited {
-        /// Global rate limit override [N/s].
-        rate_limit: Option<f64>,
-    },
-    /// Each thruster's own lag and rate limit from the model, whichever it has.
-    FromModel,
-}
-
-/// Simulator configuration: physical effects, servo and thruster models.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SimConfig {
-    /// Which effects enter the dynamics.
-    pub options: DynOptions,
-    /// Joint servos.
-    pub servo: ServoModel,
-    /// Thruster dynamics.
-    pub thruster: ThrusterModel,
-}
-
-impl Default for SimConfig {
-    /// Full hydrodynamics, ideal second-order servos with ω_n = 5 rad/s and ζ_n = 1
-    /// (inferred defaults: critically damped, well inside the joint modules' bandwidth),
-    /// ideal thrusters.
-    fn default() -> Self {
-        Self {
-            options: DynOptions::full(),
-            servo: ServoModel::SecondOrder {
-                omega_n: 5.0,
-                zeta: 1.0,
-            },
-            thruster: ThrusterModel::Ideal,
-        }
-    }
-}
 
 /// The integrated state of a [`Simulator`].
 #[derive(Clone, Debug, PartialEq)]
@@ -240,36 +167,6 @@ pub struct Simulator {
     last_accel: Vec<f64>,
 }
 
-fn config_err(quantity: &str, message: String) -> SimError {
-    SimError {
-        time: 0.0,
-        quantity: quantity.to_string(),
-        message,
-    }
-}
-
-fn positive(quantity: &str, x: f64) -> Result<(), SimError> {
-    if x.is_finite() && x > 0.0 {
-        Ok(())
-    } else {
-        Err(config_err(
-            quantity,
-            format!("must be finite and > 0, got {x}"),
-        ))
-    }
-}
-
-fn non_negative(quantity: &str, x: f64) -> Result<(), SimError> {
-    if x.is_finite() && x >= 0.0 {
-        Ok(())
-    } else {
-        Err(config_err(
-            quantity,
-            format!("must be finite and >= 0, got {x}"),
-        ))
-    }
-}
-
 impl Simulator {
     /// A simulator of `vehicle` (validated and copied) at [`SimState::rest`], `t = 0`.
     /// Errors (with `time = 0`) on an invalid vehicle or configuration.
@@ -277,41 +174,11 @@ impl Simulator {
         vehicle
             .validate()
             .map_err(|e| config_err(&format!("vehicle.{}", e.key), e.message))?;
-        match cfg.servo {
-            ServoModel::SecondOrder { omega_n, zeta } => {
-                positive("config.servo.omega_n", omega_n)?;
-                non_negative("config.servo.zeta", zeta)?;
-            }
-            ServoModel::TorquePd {
-                kp,
-                kd,
-                torque_limit,
-            } => {
-                non_negative("config.servo.kp", kp)?;
-                non_negative("config.servo.kd", kd)?;
-                if torque_limit.is_nan() || torque_limit <= 0.0 {
-                    return Err(config_err(
-                        "config.servo.torque_limit",
-                        format!("must be > 0, got {torque_limit}"),
-                    ));
-                }
-            }
-            ServoModel::Passive => {}
-        }
+        cfg.validate()?;
         let (tc_override, rate_override, use_tc, use_rate) = match cfg.thruster {
             ThrusterModel::Ideal => (None, None, false, false),
-            ThrusterModel::FirstOrder { time_constant } => {
-                if let Some(t) = time_constant {
-                    positive("config.thruster.time_constant", t)?;
-                }
-                (time_constant, None, true, false)
-            }
-            ThrusterModel::RateLimited { rate_limit } => {
-                if let Some(r) = rate_limit {
-                    positive("config.thruster.rate_limit", r)?;
-                }
-                (None, rate_limit, false, true)
-            }
+            ThrusterModel::FirstOrder { time_constant } => (time_constant, None, true, false),
+            ThrusterModel::RateLimited { rate_limit } => (None, rate_limit, false, true),
             ThrusterModel::FromModel => (None, None, true, true),
         };
         let thr = vehicle
@@ -457,7 +324,7 @@ impl Simulator {
     }
 
     /// Inertial-frame spatial momentum about the inertial origin of the current state (see
-    /// [`spatial_momentum`](super::spatial_momentum)).
+    /// [`spatial_momentum`]).
     pub fn spatial_momentum(&mut self) -> Vec6 {
         self.load_zeta();
         spatial_momentum(

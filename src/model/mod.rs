@@ -20,14 +20,17 @@ pub const RHO_SEAWATER: f64 = 1026.0;
 /// Gravitational acceleration [m/s²] (SPEC §1).
 pub const GRAVITY: f64 = 9.81;
 
-/// The fluid the vehicle moves in.
+/// The fluid the vehicle moves in. Each field's doc gives its default ([`Default`]); the
+/// ranges are checked by [`Vehicle::validate`] (`fluid.*` keys).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fluid {
-    /// Density ρ [kg/m³].
+    /// Density ρ [kg/m³], finite and > 0. Default [`RHO_SEAWATER`] = 1026.
     pub rho: f64,
-    /// Gravitational acceleration g [m/s²], acting along −z of the inertial frame.
+    /// Gravitational acceleration g [m/s²], acting along −z of the inertial frame; finite and
+    /// ≥ 0. Default [`GRAVITY`] = 9.81.
     pub g: f64,
-    /// Constant irrotational current ν_c, linear velocity in the inertial frame [m/s].
+    /// Constant irrotational current ν_c, linear velocity in the inertial frame [m/s], finite.
+    /// Default zero (still water).
     pub current: Vec3,
 }
 
@@ -301,6 +304,8 @@ impl Vehicle {
     }
 
     /// Check every physical requirement; the error names the key path of the first problem.
+    /// A flat checklist in the order of the fields (chain shape, fluid, then each body, joint
+    /// and thruster), kept in one function on purpose so that it reads as the list of rules.
     pub fn validate(&self) -> Result<(), ModelError> {
         if self.bodies.is_empty() {
             return Err(ModelError::new("body", "a design needs at least one body"));

@@ -1,0 +1,121 @@
+//! The workspace of the dynamics algorithms (Pinocchio's `Data`): every mutable quantity of
+//! [`super::algorithms`] lives here, sized once per vehicle, so that no algorithm allocates.
+//!
+//! Frames and names: `kin.g_up[i]` is body `i` in its parent's frame (body 0: in the base
+//! frame `F_b`); `kin.g_b[i]` is body `i` in `F_b`; `r_ii[i]` is body `i`'s orientation in
+//! the inertial frame `R_Ii`; `twist[i]`, `accel[i]`, `force[i]` are body `i`'s twist
+//! `[v; ω]`, spatial acceleration and wrench `[f; m]`, all in body `i`'s own frame (moments
+//! about its origin). Generalised vectors are ordered `[base (6, in F_b); joints (n)]`.
+
+use super::hydro::{DampingKernel, Restoring};
+use crate::kinematics::KinWorkspace;
+use crate::model::Vehicle;
+use crate::spatial::{Mat3, Mat6, Vec6};
+use faer::Mat;
+use nalgebra::{Matrix6, Vector6};
+
+/// Preallocated workspace of the dynamics algorithms for one vehicle (Pinocchio's `Data`).
+///
+/// Built by [`DynWorkspace::new`] from a vehicle; constant per-body quantities (spatial
+/// inertias, hydrodynamic kernels) are resolved then, so rebuild the workspace if the
+/// vehicle changes. Results of the last call stay readable in the public fields.
+#[derive(Clone, Debug)]
+pub struct DynWorkspace {
+    /// Kinematic quantities at the last configuration, filled by the one position pass
+    /// [`forward_kinematics`](crate::kinematics::forward_kinematics): `g_up` (body `i` in its
+    /// parent's frame), `g_b`, joint twists in `F_b`, `g_be`.
+    pub kin: KinWorkspace,
+    /// Body orientations in the inertial frame `R_Ii = R_Ib R_bi` (refreshed only by calls
+    /// that take a base pose and need it: restoring forces or current).
+    pub r_ii: Vec<Mat3>,
+    /// Rigid-body spatial inertia `I_RB,i` about body `i`'s origin, in its frame.
+    pub i_rb: Vec<Mat6>,
+    /// Added-mass spatial inertia `M_A,i` about body `i`'s origin, in its frame.
+    pub m_a: Vec<Mat6>,
+    /// `I_RB,i + M_A,i`.
+    pub i_tot: Vec<Mat6>,
+    /// Damping kernel of each body.
+    pub damping: Vec<DampingKernel>,
+    /// Hydrostatic parameters of each body.
+    pub restoring: Vec<Restoring>,
+    /// Composite inertia of bodies `i..` expressed in `F_b` (CRBA).
+    pub composite: Vec<Mat6>,
+    /// Body twists `V_i` in body frames [m/s, rad/s].
+    pub twist: Vec<Vec6>,
+    /// Body spatial accelerations `V̇_i` (body-frame derivative of the body twist).
+    pub accel: Vec<Vec6>,
+    /// Body wrenches of the last Newton–Euler pass [N, N·m].
+    pub force: Vec<Vec6>,
+    /// Mass matrix `M(q)` (USM-22), (6+n)×(6+n), from [`mass_matrix`](super::mass_matrix) /
+    /// [`dynamics_terms`](super::dynamics_terms).
+    pub mass: Mat<f64>,
+    /// Bias forces `h = C ζ + D ζ + N` (6+n), from [`bias`](super::bias) /
+    /// [`dynamics_terms`](super::dynamics_terms).
+    pub bias: Vec<f64>,
+    /// Generalised acceleration `ζ̇ = [V̇_b; q̈]` from
+    /// [`forward_dynamics`](super::forward_dynamics) /
+    /// [`hybrid_dynamics`](super::hybrid_dynamics).
+    pub zeta_dot: Vec<f64>,
+    /// Joint torques recovered by [`hybrid_dynamics`](super::hybrid_dynamics) [N·m].
+    pub joint_torque: Vec<f64>,
+    /// Generalised thrust map (6+n)×n_thrusters (column `j`: `J_g,iᵀ F_j` of a unit thrust of
+    /// thruster `j` on body `i`), for the simulator.
+    pub thrust_map: Mat<f64>,
+    /// Cholesky factor scratch, column-major lower triangle (`cholesky::factor`).
+    pub(super) chol: Vec<f64>,
+    /// Right-hand-side scratch (6+n).
+    pub(super) rhs: Vec<f64>,
+}
+
+impl DynWorkspace {
+    /// A workspace sized for `v`, with its per-body inertias and hydrodynamic kernels
+    /// resolved in `v.fluid`.
+    pub fn new(v: &Vehicle) -> Self {
+        let nb = v.bodies.len();
+        let nv = v.n_dof();
+        let rho = v.fluid.rho;
+        let i_rb: Vec<Mat6> = v.bodies.iter().map(|b| b.rigid_spatial_inertia()).collect();
+        let m_a: Vec<Mat6> = v.bodies.iter().map(|b| b.added_mass(rho)).collect();
+        let i_tot = i_rb.iter().zip(&m_a).map(|(a, b)| a + b).collect();
+        Self {
+            kin: KinWorkspace::new(v),
+            r_ii: vec![Mat3::identity(); nb],
+            i_rb,
+            m_a,
+            i_tot,
+            damping: v.bodies.iter().map(|b| DampingKernel::of(b, rho)).collect(),
+            restoring: v
+                .bodies
+                .iter()
+                .map(|b| Restoring::of(b, rho, v.fluid.g))
+                .collect(),
+            composite: vec![Mat6::zeros(); nb],
+            twist: vec![Vec6::zeros(); nb],
+            accel: vec![Vec6::zeros(); nb],
+            force: vec![Vec6::zeros(); nb],
+            mass: Mat::zeros(nv, nv),
+            bias: vec![0.0; nv],
+            zeta_dot: vec![0.0; nv],
+            joint_torque: vec![0.0; v.n_joints()],
+            thrust_map: Mat::zeros(nv, v.n_thrusters()),
+            chol: vec![0.0; nv * nv],
+            rhs: vec![0.0; nv],
+        }
+    }
+
+    /// Number of generalised velocities `6 + n`.
+    pub fn n_dof(&self) -> usize {
+        self.bias.len()
+    }
+
+    /// The base block `M_11` (6×6, whole-body inertia about the base origin in `F_b`) of the
+    /// last computed mass matrix (USM-33).
+    pub fn mass_base_block(&self) -> Matrix6<f64> {
+        Matrix6::from_fn(|r, c| self.mass[(r, c)])
+    }
+
+    /// The base rows `h_1 = n(R_Ib, q, ζ)` (6, in `F_b`) of the last computed bias (USM-33).
+    pub fn bias_base(&self) -> Vector6<f64> {
+        Vector6::from_column_slice(&self.bias[..6])
+    }
+}
