@@ -35,8 +35,10 @@ use anyhow::{bail, Context};
 use nalgebra::{Matrix6xX, Vector6};
 use serde::{Deserialize, Serialize};
 
-use super::Format;
-use crate::allocation::{AllocSettings, AllocStatus, Allocation, Allocator, Method, RateSettings};
+use super::format::Format;
+use usm_study::allocation::{
+    AllocSettings, AllocStatus, Allocation, Allocator, Method, RateSettings,
+};
 
 /// The status label of a failed solve.
 const FAILED: &str = "solver_failed";
@@ -174,7 +176,7 @@ fn build_case(raw: CaseFile) -> anyhow::Result<Case> {
     if let Some(p) = &raw.u_prev {
         probe.set_u_prev(p)?;
     }
-    crate::allocation::check_t(&t, Some(m))?;
+    usm_study::allocation::check_t(&t, Some(m))?;
     if let Some((i, v)) = raw.tau.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         bail!("`tau[{i}]` is not finite ({v})");
     }

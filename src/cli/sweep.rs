@@ -4,14 +4,14 @@
 //! Exit codes: 0 all cases ok or skipped, 1 some cases failed (the batch still completes),
 //! 2 bad input (study file, command line) or an I/O error.
 
-use super::tcm::Progress;
-use crate::study::doe::expand;
-use crate::study::engine::{axis_text, output_dir, resolve_case};
-use crate::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
+use super::progress::Progress;
 use anyhow::{anyhow, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use usm_study::study::doe::expand;
+use usm_study::study::engine::{axis_text, output_dir, resolve_case};
+use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
