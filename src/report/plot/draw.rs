@@ -2,17 +2,22 @@
 
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    ChartBuilder, Circle, DashedLineSeries, EmptyElement, IntoFont, LineSeries, PathElement,
-    RGBColor, Rectangle, SeriesLabelPosition, ShapeStyle, Text, BLACK, WHITE,
+    Cartesian2d, ChartBuilder, ChartContext, Circle, DashedLineSeries, EmptyElement, IntoFont,
+    LineSeries, PathElement, RGBColor, Rectangle, SVGBackend, SeriesLabelPosition, ShapeStyle,
+    Text, BLACK, WHITE,
 };
 use plotters::style::Color;
 
 use super::canvas::{
     auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult, FONT,
 };
-use super::spec::{Figure, LineStyle, Panel, PanelKind};
+use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
+
+/// A chart with `f64` axes on an SVG canvas.
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 use crate::report::atomic::atomic_write;
 use crate::report::error::Result;
 
@@ -189,7 +194,6 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
         .bold_line_style(RGBColor(225, 225, 225))
         .draw()?;
 
-    let inside = |p: &(f64, f64)| p.0 >= xr.0 && p.0 <= xr.1 && p.1 >= yr.0 && p.1 <= yr.1;
     let mut named = 0;
     for s in &panel.series {
         let rgb = s.colour.rgb();
@@ -199,57 +203,7 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
             stroke_width: 2,
         };
         let kind = s.kind.unwrap_or(panel.kind);
-        match kind {
-            PanelKind::Line => {
-                for poly in polylines(&s.x, &s.y, xr, yr) {
-                    if poly.len() == 1 {
-                        chart.draw_series(poly.iter().map(|&p| Circle::new(p, 2, rgb.filled())))?;
-                    } else if s.style == LineStyle::Dashed {
-                        chart.draw_series(DashedLineSeries::new(poly, 6, 4, line))?;
-                    } else {
-                        chart.draw_series(LineSeries::new(poly, line))?;
-                    }
-                }
-            }
-            PanelKind::Scatter => {
-                let pts: Vec<(f64, f64)> =
-                    finite_points(&s.x, &s.y).filter(|p| inside(p)).collect();
-                chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, rgb.filled())))?;
-            }
-            PanelKind::Bars { width } => {
-                let fill = rgb.mix(0.7).filled();
-                let clamp_x = |v: f64| v.clamp(xr.0, xr.1);
-                let clamp_y = |v: f64| v.clamp(yr.0, yr.1);
-                let corners: Vec<[(f64, f64); 2]> = finite_points(&s.x, &s.y)
-                    .map(|(x, y)| {
-                        [
-                            (clamp_x(x - 0.5 * width), clamp_y(0.0)),
-                            (clamp_x(x + 0.5 * width), clamp_y(y)),
-                        ]
-                    })
-                    .collect();
-                chart.draw_series(corners.iter().map(|c| Rectangle::new(*c, fill)))?;
-                chart.draw_series(
-                    corners
-                        .iter()
-                        .map(|c| Rectangle::new(*c, WHITE.stroke_width(1))),
-                )?;
-            }
-        }
-        if !s.labels.is_empty() {
-            let texts: Vec<_> = s
-                .x
-                .iter()
-                .zip(&s.y)
-                .zip(&s.labels)
-                .map(|((&x, &y), l)| ((x, y), l))
-                .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
-                .map(|(p, l)| {
-                    EmptyElement::at(p) + Text::new(l.clone(), (5, -14), (FONT, 11).into_font())
-                })
-                .collect();
-            chart.draw_series(texts)?;
-        }
+        draw_data(&mut chart, s, kind, line, (xr, yr))?;
         if !s.name.is_empty() {
             named += 1;
             let anno = chart.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
@@ -282,6 +236,69 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()?;
+    }
+    Ok(())
+}
+
+/// Draws the data of series `s` as `kind` (lines broken at non-finite values and clipped to
+/// the ranges, markers or bars inside them) and its point labels.
+fn draw_data(
+    chart: &mut Chart<'_, '_>,
+    s: &Series,
+    kind: PanelKind,
+    line: ShapeStyle,
+    (xr, yr): ((f64, f64), (f64, f64)),
+) -> DrawResult {
+    let rgb = s.colour.rgb();
+    let inside = |p: &(f64, f64)| p.0 >= xr.0 && p.0 <= xr.1 && p.1 >= yr.0 && p.1 <= yr.1;
+    match kind {
+        PanelKind::Line => {
+            for poly in polylines(&s.x, &s.y, xr, yr) {
+                if poly.len() == 1 {
+                    chart.draw_series(poly.iter().map(|&p| Circle::new(p, 2, rgb.filled())))?;
+                } else if s.style == LineStyle::Dashed {
+                    chart.draw_series(DashedLineSeries::new(poly, 6, 4, line))?;
+                } else {
+                    chart.draw_series(LineSeries::new(poly, line))?;
+                }
+            }
+        }
+        PanelKind::Scatter => {
+            let pts: Vec<(f64, f64)> = finite_points(&s.x, &s.y).filter(|p| inside(p)).collect();
+            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, rgb.filled())))?;
+        }
+        PanelKind::Bars { width } => {
+            let fill = rgb.mix(0.7).filled();
+            let clamp_x = |v: f64| v.clamp(xr.0, xr.1);
+            let clamp_y = |v: f64| v.clamp(yr.0, yr.1);
+            let corners: Vec<[(f64, f64); 2]> = finite_points(&s.x, &s.y)
+                .map(|(x, y)| {
+                    [
+                        (clamp_x(x - 0.5 * width), clamp_y(0.0)),
+                        (clamp_x(x + 0.5 * width), clamp_y(y)),
+                    ]
+                })
+                .collect();
+            chart.draw_series(corners.iter().map(|c| Rectangle::new(*c, fill)))?;
+            chart.draw_series(
+                corners
+                    .iter()
+                    .map(|c| Rectangle::new(*c, WHITE.stroke_width(1))),
+            )?;
+        }
+    }
+    if !s.labels.is_empty() {
+        let texts: Vec<_> =
+            s.x.iter()
+                .zip(&s.y)
+                .zip(&s.labels)
+                .map(|((&x, &y), l)| ((x, y), l))
+                .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
+                .map(|(p, l)| {
+                    EmptyElement::at(p) + Text::new(l.clone(), (5, -14), (FONT, 11).into_font())
+                })
+                .collect();
+        chart.draw_series(texts)?;
     }
     Ok(())
 }
