@@ -419,9 +419,7 @@ pub(crate) fn check_bounds(u_min: &[f64], u_max: &[f64], m: usize) -> Result<(),
     Ok(())
 }
 
-/// Checks a thruster configuration matrix `T` (6×m, base frame): at least one column, exactly
-/// `m` columns when `m` is given, every entry finite (the error names the entry).
-pub fn check_t(t: &Matrix6xX<f64>, m: Option<usize>) -> Result<(), AllocError> {
+pub(crate) fn check_t(t: &Matrix6xX<f64>, m: Option<usize>) -> Result<(), AllocError> {
     if t.ncols() == 0 {
         return Err(AllocError::NoThrusters);
     }
