@@ -7,16 +7,18 @@
 //!
 //! The physics and control formulation is `SPEC.md` (equations cited as USM-nn / AC-nn);
 //! modules follow the layout of `DESIGN.md`: data flows from [`model`] through
-//! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports.
+//! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports
+//! ([`report`]) through the output pipelines ([`pipeline`], [`study`]). The command-line
+//! interface is the binary's own (`src/cli/`), not part of this library.
 
 pub mod allocation;
-pub mod cli;
 pub mod control;
 pub mod diag;
 pub mod dynamics;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod pipeline;
 pub mod report;
 pub mod sampling;
 pub mod scenario;

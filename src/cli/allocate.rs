@@ -1,27 +1,6 @@
 //! `usm-study allocate`: solve one thrust-allocation case (SPEC §5, USM-36/37) with one or all
-//! methods and print the result as a table or JSON.
-//!
-//! The case file is JSON with these keys (unknown keys are rejected):
-//!
-//! | key | shape | meaning | default |
-//! |---|---|---|---|
-//! | `T` | [6][m] | thruster configuration matrix, rows force x, y, z (N/N) then moment x, y, z (N·m/N), base frame | required |
-//! | `tau` | [6] | commanded wrench (N, N·m), base frame | required |
-//! | `u_min`, `u_max` | [m] | thrust bounds (N) | −40, +40 |
-//! | `weights` | [m] | usage weights `W = diag(w)`, > 0 | 1 |
-//! | `lambda` | number | pinv damping λ (USM-37) | 0.1 |
-//! | `q` | number | slack weight | 1e4 |
-//! | `eps` | number | minimax regularisation ε | 1e-6 |
-//! | `u_prev` | [m] | previous thrust (N) for the rate terms | 0 |
-//! | `rate_weights` | [m] | rate weights `R = diag(r)` (`‖u − u_prev‖²_R`), ≥ 0 | 0 (when `rate_limit` is set) |
-//! | `rate_limit` | [m] | step limit `Δu` (N): `|u − u_prev| ≤ Δu`, > 0 | none (when `rate_weights` is set) |
-//!
-//! The rate terms apply to `qp`, `minimax` and `power` and are active when either `rate_weights`
-//! or `rate_limit` is present.
-//!
-//! JSON output is an object keyed by method name, each with `u`, `s`, `objective`, `status`
-//! (`solved`, `slack_active`, `bounds_violated`, `solver_failed`), `status_detail`,
-//! `solver_status`, `iterations` and `solve_time_us`.
+//! methods and print the result as a table or JSON. The case file and the JSON output are
+//! described in [`usm_study::pipeline::allocate`].
 //!
 //! Exit code: 0 when every requested method produced a result, 1 when a Clarabel solve failed (the
 //! clipped-pinv fallback is still printed). Bad input is an `Err` naming the file and the key.
@@ -29,17 +8,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
-use anyhow::{bail, Context};
-use nalgebra::{Matrix6xX, Vector6};
-use serde::{Deserialize, Serialize};
+use anyhow::Context;
 
-use super::Format;
-use crate::allocation::{AllocSettings, AllocStatus, Allocation, Allocator, Method, RateSettings};
-
-/// The status label of a failed solve.
-const FAILED: &str = "solver_failed";
+use super::format::Format;
+use usm_study::allocation::Method;
+use usm_study::pipeline::allocate::{read_case, solve_case, Case, Results, FAILED};
 
 /// Which method(s) to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -69,191 +43,6 @@ pub struct AllocateArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     pub format: Format,
-}
-
-/// The case file schema (see the module documentation).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CaseFile {
-    #[serde(rename = "T")]
-    t: Vec<Vec<f64>>,
-    tau: Vec<f64>,
-    u_min: Option<Vec<f64>>,
-    u_max: Option<Vec<f64>>,
-    weights: Option<Vec<f64>>,
-    lambda: Option<f64>,
-    q: Option<f64>,
-    eps: Option<f64>,
-    u_prev: Option<Vec<f64>>,
-    rate_weights: Option<Vec<f64>>,
-    rate_limit: Option<Vec<f64>>,
-}
-
-/// A validated case.
-struct Case {
-    t: Matrix6xX<f64>,
-    tau: Vector6<f64>,
-    u_min: Vec<f64>,
-    u_max: Vec<f64>,
-    weights: Vec<f64>,
-    u_prev: Option<Vec<f64>>,
-    settings: AllocSettings,
-}
-
-fn key_len(key: &str, v: &[f64], m: usize) -> anyhow::Result<()> {
-    if v.len() != m {
-        bail!(
-            "key `{key}` has {} entries, expected {m} (one per thruster, from the columns of `T`)",
-            v.len()
-        );
-    }
-    Ok(())
-}
-
-fn parse_case(path: &Path) -> anyhow::Result<Case> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read case file {}", path.display()))?;
-    let raw: CaseFile = serde_json::from_str(&text)
-        .with_context(|| format!("invalid case file {}", path.display()))?;
-    build_case(raw).with_context(|| format!("invalid case file {}", path.display()))
-}
-
-fn build_case(raw: CaseFile) -> anyhow::Result<Case> {
-    if raw.t.len() != 6 {
-        bail!(
-            "key `T` has {} rows, expected 6 (force x, y, z, moment x, y, z)",
-            raw.t.len()
-        );
-    }
-    let m = raw.t[0].len();
-    if m == 0 {
-        bail!("key `T` has no columns: at least one thruster is needed");
-    }
-    for (i, row) in raw.t.iter().enumerate() {
-        if row.len() != m {
-            bail!(
-                "key `T` row {i} has {} entries, row 0 has {m}: rows must be equally long",
-                row.len()
-            );
-        }
-    }
-    let t = Matrix6xX::from_fn(m, |i, j| raw.t[i][j]);
-    if raw.tau.len() != 6 {
-        bail!("key `tau` has {} entries, expected 6", raw.tau.len());
-    }
-    let tau = Vector6::from_column_slice(&raw.tau);
-    let u_min = raw.u_min.unwrap_or_else(|| vec![-40.0; m]);
-    let u_max = raw.u_max.unwrap_or_else(|| vec![40.0; m]);
-    let weights = raw.weights.unwrap_or_else(|| vec![1.0; m]);
-    key_len("u_min", &u_min, m)?;
-    key_len("u_max", &u_max, m)?;
-    key_len("weights", &weights, m)?;
-    if let Some(p) = &raw.u_prev {
-        key_len("u_prev", p, m)?;
-    }
-    let rate = match (raw.rate_weights, raw.rate_limit) {
-        (None, None) => None,
-        (w, l) => {
-            let weights = w.unwrap_or_else(|| vec![0.0; m]);
-            let max_step = l.unwrap_or_else(|| vec![f64::INFINITY; m]);
-            key_len("rate_weights", &weights, m)?;
-            key_len("rate_limit", &max_step, m)?;
-            Some(RateSettings { weights, max_step })
-        }
-    };
-    let d = AllocSettings::default();
-    let settings = AllocSettings {
-        lambda: raw.lambda.unwrap_or(d.lambda),
-        q: raw.q.unwrap_or(d.q),
-        eps: raw.eps.unwrap_or(d.eps),
-        rate,
-        ..d
-    };
-    // Validate values once (the library names the key and index).
-    let mut probe = Allocator::new(Method::Pinv, m, &u_min, &u_max, &weights, settings.clone())?;
-    if let Some(p) = &raw.u_prev {
-        probe.set_u_prev(p)?;
-    }
-    crate::allocation::check_t(&t, Some(m))?;
-    if let Some((i, v)) = raw.tau.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        bail!("`tau[{i}]` is not finite ({v})");
-    }
-    Ok(Case {
-        t,
-        tau,
-        u_min,
-        u_max,
-        weights,
-        u_prev: raw.u_prev,
-        settings,
-    })
-}
-
-/// One method's result as printed.
-#[derive(Debug, Clone, Serialize)]
-struct MethodResult {
-    u: Vec<f64>,
-    s: [f64; 6],
-    objective: f64,
-    status: &'static str,
-    status_detail: String,
-    solver_status: &'static str,
-    iterations: u32,
-    solve_time_us: f64,
-}
-
-impl MethodResult {
-    fn new(a: &Allocation, solve_time_us: f64) -> Self {
-        let mut s = [0.0; 6];
-        s.copy_from_slice(a.s.as_slice());
-        Self {
-            u: a.u.clone(),
-            s,
-            objective: a.objective,
-            status: AllocStatus::label(&a.status),
-            status_detail: a.status.to_string(),
-            solver_status: a.solver_status,
-            iterations: a.iterations,
-            solve_time_us,
-        }
-    }
-}
-
-/// Results in method order, serialised as a JSON object keyed by method name.
-struct Results(Vec<(Method, MethodResult)>);
-
-impl Serialize for Results {
-    fn serialize<S: serde::Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeMap;
-        let mut map = ser.serialize_map(Some(self.0.len()))?;
-        for (m, r) in &self.0 {
-            map.serialize_entry(m.name(), r)?;
-        }
-        map.end()
-    }
-}
-
-fn solve_case(case: &Case, methods: &[Method]) -> anyhow::Result<Results> {
-    let m = case.t.ncols();
-    let mut out = Vec::with_capacity(methods.len());
-    for &method in methods {
-        let mut alloc = Allocator::new(
-            method,
-            m,
-            &case.u_min,
-            &case.u_max,
-            &case.weights,
-            case.settings.clone(),
-        )?;
-        if let Some(p) = &case.u_prev {
-            alloc.set_u_prev(p)?;
-        }
-        let start = Instant::now();
-        let r = alloc.allocate(&case.t, &case.tau)?;
-        let us = start.elapsed().as_secs_f64() * 1e6;
-        out.push((method, MethodResult::new(&r, us)));
-    }
-    Ok(Results(out))
 }
 
 fn render_text(path: &Path, case: &Case, results: &Results) -> String {
@@ -318,7 +107,7 @@ fn render_text(path: &Path, case: &Case, results: &Results) -> String {
 /// print a table or JSON on stdout. Returns exit code 0, or 1 when a Clarabel solve failed; bad
 /// input is an `Err` whose message names the file and the key.
 pub fn run(args: &AllocateArgs) -> anyhow::Result<ExitCode> {
-    let case = parse_case(&args.input)?;
+    let case = read_case(&args.input)?;
     let methods: Vec<Method> = match args.method {
         MethodArg::Pinv => vec![Method::Pinv],
         MethodArg::Qp => vec![Method::Qp],
@@ -366,7 +155,7 @@ mod tests {
                 r#"{{"T": {T7}, "tau": [10, 2, -3, 0, 1, 0.5], "u_max": [40,40,40,40,40,40,40]}}"#
             ),
         );
-        let case = parse_case(&p).unwrap();
+        let case = read_case(&p).unwrap();
         let r = solve_case(&case, &Method::ALL).unwrap();
         assert_eq!(r.0.len(), 4);
         let json = serde_json::to_value(&r).unwrap();
@@ -423,7 +212,7 @@ mod tests {
         ];
         for (name, body, key) in cases {
             let p = write_case(&dir, name, &body);
-            let e = parse_case(&p).err().expect("must fail");
+            let e = anyhow::Error::from(read_case(&p).expect_err("must fail"));
             let chain = format!("{e:#}");
             assert!(chain.contains(name), "{chain}");
             assert!(chain.contains(key), "{chain}");

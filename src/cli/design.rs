@@ -1,9 +1,9 @@
 //! `usm-study design …`: presets and design files.
 
-use crate::model::design::{design_to_toml, load_design};
-use crate::model::presets::PRESETS;
 use clap::Subcommand;
 use std::process::ExitCode;
+use usm_study::model::design::{design_to_toml, load_design};
+use usm_study::model::presets::PRESETS;
 
 /// Design subcommands.
 #[derive(Debug, Subcommand)]

@@ -1,18 +1,17 @@
-//! `usm-study inspect DESIGN [--state STATE.json] [--format text|json] [--rigid]`.
+//! `usm-study inspect DESIGN [--state STATE.json] [--format text|json] [--rigid]`: the report
+//! of [`usm_study::pipeline::inspect`], printed as text or JSON.
 
-use super::{fmt_num, Format};
-use crate::dynamics::{inspect_dynamics, DynOptions, DynamicsReport, SimState};
-use crate::kinematics::{ee_jacobian, forward_kinematics, thruster_matrix_owned, KinWorkspace};
-use crate::metrics::singularity::{tcm_metrics, tcm_svd_metrics, LostDirection, TcmMetrics};
-use crate::model::design::load_design;
-use crate::model::Vehicle;
-use crate::state::{load_state, VehicleState};
+use super::format::Format;
 use anyhow::Context;
 use clap::Args;
-use faer::Mat;
-use serde::Serialize;
+use std::fmt::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use usm_study::model::design::load_design;
+use usm_study::model::{Hydro, Vehicle};
+use usm_study::pipeline::inspect::{inspect, InspectReport, KinematicsReport};
+use usm_study::report::fmt_num;
+use usm_study::state::{load_state, VehicleState};
 
 /// Arguments of `inspect`.
 #[derive(Debug, Args)]
@@ -35,75 +34,6 @@ pub struct InspectArgs {
     pub rigid: bool,
 }
 
-/// The kinematic part of the inspect report (stable JSON keys, SI units).
-#[derive(Debug, Serialize)]
-pub struct KinematicsReport {
-    /// Design name.
-    pub design: String,
-    /// Total mass [kg].
-    pub total_mass: f64,
-    /// Total length [m].
-    pub total_length: f64,
-    /// End-effector position in the inertial frame [m].
-    pub ee_position: [f64; 3],
-    /// End-effector orientation (maps end-effector vectors to inertial), rows.
-    pub ee_rotation: [[f64; 3]; 3],
-    /// End-effector geometric Jacobian (USM-18) in the end-effector frame, 6×(6+n) rows.
-    pub ee_jacobian: Vec<Vec<f64>>,
-    /// Thruster configuration matrix T(q) (USM-26) in the base frame, 6×m rows.
-    pub tcm: Vec<Vec<f64>>,
-    /// Singular values of T(q), unscaled, six, descending (zeros when m < 6).
-    pub tcm_singular_values: Vec<f64>,
-    /// Numerical rank of T(q) with the relative tolerance `rank_tol`.
-    pub tcm_rank: usize,
-    /// Wrench directions T(q) cannot produce, each labelled by its dominant base axis.
-    pub tcm_lost_directions: Vec<LostDirection>,
-    /// Metrics of the moment-scaled T(q) (SPEC §6): σ_min, κ, rank, attainable wrench.
-    pub tcm_scaled: TcmMetrics,
-}
-
-fn rows(m: &Mat<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|r| (0..m.ncols()).map(|c| m[(r, c)]).collect())
-        .collect()
-}
-
-/// Evaluate the kinematic report of `v` at `s`; `rank_tol` is relative to σ_max.
-pub fn kinematics_report(
-    v: &Vehicle,
-    s: &VehicleState,
-    rank_tol: f64,
-) -> anyhow::Result<KinematicsReport> {
-    let mut ws = KinWorkspace::new(v);
-    forward_kinematics(v, &s.q, &mut ws);
-    let g_ie = s.base.to_se3().compose(&ws.g_be);
-    let mut j = Mat::<f64>::zeros(6, v.n_dof());
-    ee_jacobian(&ws, &mut j);
-    let t = thruster_matrix_owned(v, &ws);
-    let m = t.ncols();
-    let u_min: Vec<f64> = v.thrusters.iter().map(|t| t.u_min).collect();
-    let u_max: Vec<f64> = v.thrusters.iter().map(|t| t.u_max).collect();
-    // A characteristic length of 1 m leaves T unscaled.
-    let raw = tcm_svd_metrics(&t, 1.0, rank_tol).context("analysing T(q)")?;
-    let scaled = tcm_metrics(&t, &u_min, &u_max, v.characteristic_length(), rank_tol)
-        .context("analysing the scaled T(q)")?;
-    Ok(KinematicsReport {
-        design: v.name.clone(),
-        total_mass: v.total_mass(),
-        total_length: v.total_length(),
-        ee_position: [g_ie.p.x, g_ie.p.y, g_ie.p.z],
-        ee_rotation: [0, 1, 2].map(|r| [0, 1, 2].map(|c| g_ie.r[(r, c)])),
-        ee_jacobian: rows(&j),
-        tcm: (0..6)
-            .map(|r| (0..m).map(|c| t[(r, c)]).collect())
-            .collect(),
-        tcm_singular_values: raw.singular_values.to_vec(),
-        tcm_rank: raw.rank,
-        tcm_lost_directions: raw.lost_directions,
-        tcm_scaled: scaled,
-    })
-}
-
 /// Run `inspect`.
 pub fn run(a: &InspectArgs) -> anyhow::Result<ExitCode> {
     if !(a.rank_tol.is_finite() && a.rank_tol >= 0.0) {
@@ -117,39 +47,33 @@ pub fn run(a: &InspectArgs) -> anyhow::Result<ExitCode> {
         Some(p) => load_state(p, &v)?,
         None => VehicleState::rest(&v),
     };
-    let k = kinematics_report(&v, &s, a.rank_tol)?;
-    let sim_state = SimState {
-        pose: s.base,
-        joint_angles: s.q.clone(),
-        base_twist: s.twist,
-        joint_rates: s.qd.clone(),
-        thrust: vec![0.0; v.n_thrusters()],
-    };
-    let options = if a.rigid {
-        DynOptions::rigid()
-    } else {
-        DynOptions::full()
-    };
-    let d = inspect_dynamics(&v, &sim_state, &s.generalized_forces, &options)
-        .context("evaluating the dynamics at the state")?;
+    let report = inspect(&v, &s, a.rank_tol, a.rigid)?;
     match a.format {
         Format::Json => {
-            let mut obj = serde_json::to_value(&k).context("serialising the report")?;
-            let dv = serde_json::to_value(&d).context("serialising the report")?;
-            if let (Some(o), serde_json::Value::Object(dm)) = (obj.as_object_mut(), dv) {
-                o.extend(dm);
-                o.insert("rigid".into(), serde_json::Value::Bool(a.rigid));
-            }
+            let obj = report.to_json().context("serialising the report")?;
             println!("{}", serde_json::to_string_pretty(&obj)?);
         }
-        Format::Text => print!("{}", text_report(&v, &k, &d, a.rigid)),
+        Format::Text => {
+            let mut o = String::new();
+            write_design(&mut o, &v, &report.kinematics);
+            write_kinematics(&mut o, &report.kinematics);
+            write_dynamics(&mut o, &report);
+            print!("{o}");
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: bool) -> String {
-    use std::fmt::Write;
-    let mut o = String::new();
+/// `[a, b, c]` of numbers in the short format.
+fn num_list(xs: &[f64]) -> String {
+    xs.iter()
+        .map(|x| fmt_num(*x))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The design: bodies, joints and thrusters.
+fn write_design(o: &mut String, v: &Vehicle, k: &KinematicsReport) {
     let _ = writeln!(o, "design {}", v.name);
     let _ = writeln!(
         o,
@@ -168,8 +92,8 @@ fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: boo
     );
     for (i, b) in v.bodies.iter().enumerate() {
         let hydro = match b.hydro {
-            crate::model::Hydro::Cylinder { .. } => "cyl",
-            crate::model::Hydro::Coefficients { .. } => "coeff",
+            Hydro::Cylinder { .. } => "cyl",
+            Hydro::Coefficients { .. } => "coeff",
         };
         let _ = writeln!(
             o,
@@ -212,6 +136,10 @@ fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: boo
             t.u_max
         );
     }
+}
+
+/// End-effector pose, `T(q)`, its singular values, lost directions and attainable wrench.
+fn write_kinematics(o: &mut String, k: &KinematicsReport) {
     let p = k.ee_position;
     let _ = writeln!(
         o,
@@ -237,8 +165,7 @@ fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: boo
             cells.join(" ")
         );
     }
-    let sv: Vec<String> = k.tcm_singular_values.iter().map(|x| fmt_num(*x)).collect();
-    let _ = writeln!(o, "singular values: {}", sv.join(", "));
+    let _ = writeln!(o, "singular values: {}", num_list(&k.tcm_singular_values));
     let _ = writeln!(o, "rank: {} of 6", k.tcm_rank);
     for l in &k.tcm_lost_directions {
         let dir: Vec<String> = l.direction.iter().map(|x| format!("{x:.3}")).collect();
@@ -269,10 +196,15 @@ fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: boo
             );
         }
     }
+}
+
+/// Mass matrix spectrum, kinetic energy, bias and acceleration.
+fn write_dynamics(o: &mut String, report: &InspectReport) {
+    let d = &report.dynamics;
     let _ = writeln!(
         o,
         "\ndynamics ({})",
-        if rigid {
+        if report.rigid {
             "rigid bodies in vacuum"
         } else {
             "added mass, drag, restoring forces, current"
@@ -288,9 +220,6 @@ fn text_report(v: &Vehicle, k: &KinematicsReport, d: &DynamicsReport, rigid: boo
         n = d.mass_matrix.len()
     );
     let _ = writeln!(o, "  kinetic energy: {} J", fmt_num(d.kinetic_energy));
-    let bias: Vec<String> = d.bias.iter().map(|x| fmt_num(*x)).collect();
-    let _ = writeln!(o, "  bias h: [{}]", bias.join(", "));
-    let acc: Vec<String> = d.acceleration.iter().map(|x| fmt_num(*x)).collect();
-    let _ = writeln!(o, "  acceleration: [{}]", acc.join(", "));
-    o
+    let _ = writeln!(o, "  bias h: [{}]", num_list(&d.bias));
+    let _ = writeln!(o, "  acceleration: [{}]", num_list(&d.acceleration));
 }

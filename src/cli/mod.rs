@@ -1,13 +1,18 @@
-//! The command-line interface: clap commands, output formatting and exit codes. This is the
-//! only module that prints.
+//! The command-line interface of the binary: clap commands, progress display, printing and
+//! exit codes. Each command turns its raw arguments into the library's validated settings,
+//! calls the library (the pipelines of `usm_study::pipeline` and `usm_study::study`), and
+//! prints the result. This is the only module that prints, and the only user of clap, anyhow
+//! and indicatif.
 
-pub mod allocate;
-pub mod design;
-pub mod inspect;
-pub mod paper;
-pub mod simulate;
-pub mod sweep;
-pub mod tcm;
+mod allocate;
+mod design;
+mod format;
+mod inspect;
+mod paper;
+mod progress;
+mod simulate;
+mod sweep;
+mod tcm;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -58,25 +63,5 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::run_merge(a),
         Command::Report(a) => sweep::run_report(a),
-    }
-}
-
-/// Output format shared by the commands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Format {
-    /// Human-readable text.
-    Text,
-    /// Machine-readable JSON with stable keys.
-    Json,
-}
-
-/// Format a number for tables: fixed width, sensible precision.
-pub(crate) fn fmt_num(x: f64) -> String {
-    if x == 0.0 {
-        "0".into()
-    } else if x.abs() >= 1e4 || x.abs() < 1e-3 {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.4}")
     }
 }

@@ -1,18 +1,15 @@
 //! `usm-study simulate SCENARIO [--out DIR] [--allocation METHOD] [--set key=value ...]`.
 
-use super::fmt_num;
-use crate::allocation::Method;
-use crate::control::transport::yaw_joint_mask;
-use crate::model::Vehicle;
-use crate::report::figures::{run_figure, trajectory_table};
-use crate::report::{write_csv, write_parquet};
-use crate::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
-use crate::study::path::{set, KeyPath};
 use anyhow::Context;
 use clap::Args;
-use serde_json::json;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use usm_study::allocation::Method;
+use usm_study::pipeline::create_dir;
+use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
+use usm_study::report::fmt_num;
+use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
+use usm_study::study::path::{set, KeyPath};
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
@@ -35,7 +32,7 @@ pub struct SimulateArgs {
 }
 
 /// Parse `key=value` with a TOML value (bare words become strings).
-pub fn parse_override(s: &str) -> anyhow::Result<(KeyPath, toml::Value)> {
+fn parse_override(s: &str) -> anyhow::Result<(KeyPath, toml::Value)> {
     let (k, v) = s
         .split_once('=')
         .with_context(|| format!("--set {s}: expected KEY=VALUE"))?;
@@ -64,7 +61,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&file.scenario.name));
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    create_dir(&out)?;
     eprintln!(
         "[simulate] {} ({} mode, design {}, {} s, allocation {})",
         file.scenario.name,
@@ -74,7 +71,11 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         file.allocation.method.name()
     );
     let r = run_scenario(&vehicle, &file)?;
-    write_outputs(&r, &out, &vehicle, !a.no_plots)?;
+    let files = RunFiles {
+        timeseries: true,
+        figure: !a.no_plots,
+    };
+    write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);
     eprintln!("[simulate] wrote {}", out.display());
     match &r.failure {
@@ -86,75 +87,6 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         }
         None => Ok(ExitCode::SUCCESS),
     }
-}
-
-/// Set `allocation.method` in a scenario table (the `--allocation` override).
-pub fn set_allocation_method(table: &mut toml::Table, m: Method) {
-    if let Some(t) = table
-        .entry("allocation")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
-        .as_table_mut()
-    {
-        t.insert("method".into(), toml::Value::String(m.name().into()));
-    }
-}
-
-/// Write `timeseries.csv`, `timeseries.parquet`, `summary.json` and (optionally) the
-/// paper-style figure `figure.svg` of a run of `vehicle` into `out`.
-pub fn write_outputs(
-    r: &RunResult,
-    out: &std::path::Path,
-    vehicle: &Vehicle,
-    plots: bool,
-) -> anyhow::Result<()> {
-    let design = vehicle.name.as_str();
-    let table = trajectory_table(&r.trajectory)?;
-    write_csv(&table, &out.join("timeseries.csv"))?;
-    write_parquet(&table, &out.join("timeseries.parquet"))?;
-    let metrics: serde_json::Map<String, serde_json::Value> = r
-        .metrics
-        .iter()
-        .map(|(k, v)| {
-            (
-                k.clone(),
-                if v.is_finite() {
-                    json!(v)
-                } else {
-                    json!(v.to_string())
-                },
-            )
-        })
-        .collect();
-    let summary = json!({
-        "scenario": r.name,
-        "mode": r.mode.to_string(),
-        "design": design,
-        "status": if r.failure.is_some() { "failed" } else { "ok" },
-        "failure": r.failure.as_ref().map(|(t, c)| json!({"time": t, "cause": c})),
-        "metrics": metrics,
-        "allocation": r.allocation_counts,
-        "timing": r.timing,
-    });
-    let text = serde_json::to_string_pretty(&summary)?;
-    let tmp = out.join(".summary.json.tmp");
-    std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, out.join("summary.json"))?;
-    if plots && table.n_rows() > 0 {
-        let yaw_joints: Vec<usize> = yaw_joint_mask(vehicle)
-            .iter()
-            .enumerate()
-            .filter(|(_, y)| **y)
-            .map(|(i, _)| i)
-            .collect();
-        let fig = run_figure(
-            &table,
-            r.mode,
-            &yaw_joints,
-            &format!("{} ({} mode)", r.name, r.mode),
-        )?;
-        fig.write_svg(&out.join("figure.svg"))?;
-    }
-    Ok(())
 }
 
 fn print_summary(r: &RunResult) {

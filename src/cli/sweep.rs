@@ -4,16 +4,16 @@
 //! Exit codes: 0 all cases ok or skipped, 1 some cases failed (the batch still completes),
 //! 2 bad input (study file, command line) or an I/O error.
 
-use super::tcm::Progress;
-use crate::study::cases::resolve_case;
-use crate::study::doe::expand;
-use crate::study::engine::output_dir;
-use crate::study::records::axis_text;
-use crate::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
+use super::progress::Progress;
 use anyhow::{anyhow, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use usm_study::study::cases::resolve_case;
+use usm_study::study::doe::expand;
+use usm_study::study::engine::output_dir;
+use usm_study::study::records::axis_text;
+use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]

@@ -243,20 +243,6 @@ pub fn one_line(s: &str) -> String {
     s.replace(['\n', '\r'], " ")
 }
 
-/// A name made safe for a file name: ASCII letters, digits, `-` and `_` kept, anything else
-/// replaced by `_`.
-pub fn file_stem_safe(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
-
 /// Scenario metrics packed into one cell: `name=value;…`, with `=`, `;` and white space in
 /// names replaced by `_` and values in the tables' float format.
 pub fn pack_metrics(metrics: &[(String, f64)]) -> String {

@@ -1,0 +1,69 @@
+//! The error type of the output pipelines.
+
+use std::path::PathBuf;
+
+use crate::dynamics::DynError;
+use crate::metrics::singularity::SingularityError;
+use crate::model::design::DesignError;
+use crate::report::ReportError;
+use crate::scenario::ScenarioError;
+use crate::study::static_tcm::StaticError;
+
+/// Why a pipeline stopped. Errors of the stages it calls pass through unchanged (same message,
+/// same source chain); file-system errors name the path.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// A design could not be loaded.
+    #[error(transparent)]
+    Design(#[from] DesignError),
+    /// A scenario could not be loaded, or its run could not start.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The static analysis of `T(q)` failed.
+    #[error(transparent)]
+    Static(#[from] StaticError),
+    /// A table or figure could not be built or written.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    /// A summary could not be serialised.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// The design has no thrusters, so there is no `T(q)` to analyse.
+    #[error("design `{design}` has no thrusters; there is no T(q) to analyse")]
+    NoThrusters {
+        /// Design name.
+        design: String,
+    },
+    /// An operation on the file system failed.
+    #[error("{action} {path}", path = .path.display())]
+    Io {
+        /// What was being done, e.g. "creating".
+        action: &'static str,
+        /// The file or directory.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The singularity metrics of `T(q)` could not be evaluated.
+    #[error("{what}")]
+    Singularity {
+        /// What was being analysed, e.g. "analysing T(q)".
+        what: &'static str,
+        /// The metric error.
+        #[source]
+        source: SingularityError,
+    },
+    /// The dynamics could not be evaluated at the given state.
+    #[error("evaluating the dynamics at the state")]
+    Dynamics(#[source] DynError),
+}
+
+/// Creates `dir` and its parents; errors name the directory.
+pub fn create_dir(dir: &std::path::Path) -> Result<(), PipelineError> {
+    std::fs::create_dir_all(dir).map_err(|source| PipelineError::Io {
+        action: "creating",
+        path: dir.to_path_buf(),
+        source,
+    })
+}

@@ -1,0 +1,21 @@
+//! Output pipelines of the single-run commands: each runs the library's computation and writes
+//! the command's files (CSV, Parquet, SVG, JSON, Markdown), so that the binary only parses
+//! arguments, calls one of these, and prints.
+//!
+//! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
+//! - [`simulate`]: the files of one closed-loop scenario run;
+//! - [`paper`]: the USM paper's simulations, their files and comparison tables;
+//! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
+//! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
+//!
+//! The batch sweep's pipeline lives in [`crate::study`]. No pipeline prints: progress and
+//! per-run outcomes reach the caller through callbacks.
+
+pub mod allocate;
+pub mod error;
+pub mod inspect;
+pub mod paper;
+pub mod simulate;
+pub mod tcm;
+
+pub use error::{create_dir, PipelineError};

@@ -1,0 +1,173 @@
+//! The `tcm` pipeline: static configuration-space analysis of the thruster configuration
+//! matrix (SPEC §6) — how often `T(q)` is singular over the joint space — and its files.
+//!
+//! Writes to the output directory:
+//! - `samples.csv`: one row per sample (streamed; memory stays bounded for any N):
+//!   `index`, `q1_rad … qn_rad`, `sigma_min` (scaled σ_min, N per N), `kappa`, `rank`,
+//!   `lost_axis` (empty unless σ_min < threshold or rank < 6);
+//! - `samples.parquet`: the same table, only when N ≤ [`PARQUET_MAX_ROWS`] (larger tables stay
+//!   CSV only);
+//! - `summary.json`: the [`StaticSummary`] plus the slice joints and the files written;
+//! - `sigma_min_hist.svg`: histogram of σ_min; `sigma_min_slice.svg`: σ_min over a 2-D slice
+//!   of joint space (the two most influential yaw joints, or the given pair; others 0).
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::error::{create_dir, PipelineError};
+use crate::model::Vehicle;
+use crate::report::{
+    atomic_write, heatmap, histogram, read_csv_typed, write_parquet, ColourScale, ColumnKind,
+    CsvAppender, Value,
+};
+use crate::study::static_tcm::{
+    analyse, influential_joints, slice_grid, StaticSpec, StaticSummary,
+};
+
+/// Largest sample count for which `samples.parquet` is written.
+pub const PARQUET_MAX_ROWS: usize = 200_000;
+
+/// What to analyse and where to write it (validated by the caller against the vehicle:
+/// `slice` holds two different joint indices below `n_joints`).
+#[derive(Clone, Debug)]
+pub struct TcmConfig {
+    /// Settings of the static analysis.
+    pub spec: StaticSpec,
+    /// Output directory (created if missing).
+    pub out: PathBuf,
+    /// Worker threads (0: all cores). Results do not depend on it.
+    pub jobs: usize,
+    /// Joints of the 2-D slice plot (0-based); `None`: the two most influential yaw joints.
+    pub slice: Option<(usize, usize)>,
+    /// Grid resolution of the slice plot per joint.
+    pub resolution: usize,
+}
+
+#[derive(Serialize)]
+struct SummaryFile<'a> {
+    #[serde(flatten)]
+    summary: &'a StaticSummary,
+    slice_joints: Option<[String; 2]>,
+    files: Vec<String>,
+}
+
+/// The `samples.csv` schema for `n` joints.
+fn sample_schema(n: usize) -> Vec<(String, ColumnKind)> {
+    let mut schema: Vec<(String, ColumnKind)> = vec![("index".into(), ColumnKind::I64)];
+    schema.extend((1..=n).map(|k| (format!("q{k}_rad"), ColumnKind::F64)));
+    schema.extend([
+        ("sigma_min".to_string(), ColumnKind::F64),
+        ("kappa".to_string(), ColumnKind::F64),
+        ("rank".to_string(), ColumnKind::I64),
+        ("lost_axis".to_string(), ColumnKind::Str),
+    ]);
+    schema
+}
+
+/// Runs the static analysis of `vehicle` and writes its files into `config.out` (see the module
+/// documentation). `progress` receives the number of samples done. Returns the summary.
+pub fn run_tcm(
+    vehicle: &Vehicle,
+    config: &TcmConfig,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<StaticSummary, PipelineError> {
+    if vehicle.n_thrusters() == 0 {
+        return Err(PipelineError::NoThrusters {
+            design: vehicle.name.clone(),
+        });
+    }
+    let spec = &config.spec;
+    spec.validate()?;
+    let out = &config.out;
+    create_dir(out)?;
+    let schema = sample_schema(vehicle.n_joints());
+    let csv_path = out.join("samples.csv");
+    let mut app = CsvAppender::create(&csv_path, &schema)?;
+    let mut sigmas: Vec<f64> = Vec::with_capacity(spec.samples);
+    let mut row: Vec<Value> = Vec::with_capacity(schema.len());
+    let summary = analyse(
+        vehicle,
+        spec,
+        config.jobs,
+        &mut |e| {
+            sigmas.push(e.sigma_min);
+            row.clear();
+            row.push(Value::I64(e.index as i64));
+            row.extend(e.q.iter().map(|q| Value::F64(*q)));
+            row.extend([
+                Value::F64(e.sigma_min),
+                Value::F64(e.kappa),
+                Value::I64(e.rank as i64),
+                Value::Str(e.lost_axis.unwrap_or("")),
+            ]);
+            app.append(&row).map_err(|e| e.to_string())
+        },
+        progress,
+    )?;
+    app.sync()?;
+    drop(app);
+    let mut files = vec!["samples.csv".to_string()];
+    if spec.samples <= PARQUET_MAX_ROWS {
+        let t = read_csv_typed(&csv_path, &schema)?;
+        write_parquet(&t, &out.join("samples.parquet"))?;
+        files.push("samples.parquet".into());
+    }
+    histogram(
+        &sigmas,
+        50,
+        &format!(
+            "{}: scaled σ_min of T(q), {} samples",
+            vehicle.name, spec.samples
+        ),
+        "σ_min [N/N]",
+    )
+    .write_svg(&out.join("sigma_min_hist.svg"))?;
+    files.push("sigma_min_hist.svg".into());
+    drop(sigmas);
+    let slice_joints = write_slice(vehicle, config, out, &mut files)?;
+    files.push("summary.json".into());
+    let json = serde_json::to_string_pretty(&SummaryFile {
+        summary: &summary,
+        slice_joints,
+        files,
+    })?;
+    atomic_write(&out.join("summary.json"), (json + "\n").as_bytes())?;
+    Ok(summary)
+}
+
+/// Writes `sigma_min_slice.svg` over the configured (or most influential) pair of joints and
+/// returns the pair's names; `None` when the vehicle has fewer than two joints.
+fn write_slice(
+    vehicle: &Vehicle,
+    config: &TcmConfig,
+    out: &Path,
+    files: &mut Vec<String>,
+) -> Result<Option<[String; 2]>, PipelineError> {
+    let pair = match config.slice {
+        Some(p) => Some(p),
+        None => influential_joints(vehicle, &config.spec)?,
+    };
+    let Some((i, j)) = pair else {
+        return Ok(None);
+    };
+    let g = slice_grid(vehicle, &config.spec, i, j, config.resolution, config.jobs)?;
+    let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
+    let (ni, nj) = (&vehicle.joints[i].name, &vehicle.joints[j].name);
+    heatmap(
+        deg(&g.x),
+        deg(&g.y),
+        g.sigma_min,
+        &format!(
+            "{}: σ_min over joints {i} ({ni}) and {j} ({nj}), others 0",
+            vehicle.name
+        ),
+        &format!("joint {i} ({ni}) [deg]"),
+        &format!("joint {j} ({nj}) [deg]"),
+        "σ_min [N/N]",
+        ColourScale::Viridis,
+    )?
+    .write_svg(&out.join("sigma_min_slice.svg"))?;
+    files.push("sigma_min_slice.svg".into());
+    Ok(Some([ni.clone(), nj.clone()]))
+}

@@ -1,0 +1,304 @@
+//! Rendering of a [`Figure`]: panels, ranges, clipping and series.
+
+use std::path::Path;
+
+use plotters::coord::types::RangedCoordf64;
+use plotters::element::DashedPathElement;
+use plotters::prelude::{
+    Cartesian2d, ChartBuilder, ChartContext, Circle, DashedLineSeries, EmptyElement, IntoFont,
+    LineSeries, PathElement, RGBColor, Rectangle, SVGBackend, SeriesLabelPosition, ShapeStyle,
+    Text, BLACK, WHITE,
+};
+use plotters::style::Color;
+
+use super::canvas::{
+    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult, FONT,
+};
+use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
+
+/// A chart with `f64` axes on an SVG canvas.
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+use crate::report::atomic::atomic_write;
+use crate::report::error::Result;
+
+impl Figure {
+    /// Renders the figure to an SVG document.
+    pub fn render_svg(&self) -> Result<String> {
+        self.validate()?;
+        render_to_svg(self.size, &self.title, |root| draw_figure(self, root))
+    }
+
+    /// Renders the figure and writes it to `path` atomically.
+    pub fn write_svg(&self, path: &Path) -> Result<()> {
+        atomic_write(path, self.render_svg()?.as_bytes())
+    }
+}
+
+fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
+    root.fill(&WHITE)?;
+    let body = if fig.title.is_empty() {
+        root.clone()
+    } else {
+        root.titled(&fig.title, (FONT, 22))?
+    };
+    let areas = body.split_evenly(fig.grid());
+    for (panel, area) in fig.panels.iter().zip(&areas) {
+        draw_panel(panel, area)?;
+    }
+    Ok(())
+}
+
+fn panel_ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
+    let mut xb = None;
+    let mut yb = None;
+    for s in &panel.series {
+        let pts: Vec<(f64, f64)> = finite_points(&s.x, &s.y).collect();
+        let sx = bounds(pts.iter().map(|p| p.0));
+        let sy = bounds(pts.iter().map(|p| p.1));
+        if let (PanelKind::Bars { width }, Some((x0, x1)), Some((y0, y1))) =
+            (s.kind.unwrap_or(panel.kind), sx, sy)
+        {
+            xb = merge_bounds(xb, Some((x0 - 0.5 * width, x1 + 0.5 * width)));
+            yb = merge_bounds(yb, Some((y0.min(0.0), y1.max(0.0))));
+        } else {
+            xb = merge_bounds(xb, sx);
+            yb = merge_bounds(yb, sy);
+        }
+    }
+    let x = panel.x_range.map(widen).unwrap_or_else(|| auto_range(xb));
+    let y = panel.y_range.map(widen).unwrap_or_else(|| auto_range(yb));
+    (x, y)
+}
+
+/// Clips the segment `p`–`q` to the box (Liang–Barsky). `None` if it lies outside.
+fn clip(
+    p: (f64, f64),
+    q: (f64, f64),
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> Option<((f64, f64), (f64, f64))> {
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    // (t, edge that set it: 0..4 = x min, x max, y min, y max; 4 = segment end).
+    let (mut t0, mut e0) = (0.0_f64, 4);
+    let (mut t1, mut e1) = (1.0_f64, 4);
+    let edges = [
+        (-dx, p.0 - xr.0, xr.0),
+        (dx, xr.1 - p.0, xr.1),
+        (-dy, p.1 - yr.0, yr.0),
+        (dy, yr.1 - p.1, yr.1),
+    ];
+    for (k, &(pk, qk, _)) in edges.iter().enumerate() {
+        if pk == 0.0 {
+            if qk < 0.0 {
+                return None;
+            }
+        } else {
+            let r = qk / pk;
+            if !r.is_finite() {
+                return None;
+            }
+            if pk < 0.0 && r > t0 {
+                (t0, e0) = (r, k);
+            } else if pk > 0.0 && r < t1 {
+                (t1, e1) = (r, k);
+            }
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    // Put a clipped end exactly on its edge (interpolation alone loses it for steep segments).
+    let at = |t: f64, edge: usize, end: (f64, f64)| {
+        if edge == 4 {
+            return end;
+        }
+        let (x, y) = (p.0 + t * dx, p.1 + t * dy);
+        let bound = edges[edge].2;
+        if edge < 2 {
+            (bound, y.clamp(yr.0, yr.1))
+        } else {
+            (x.clamp(xr.0, xr.1), bound)
+        }
+    };
+    Some((at(t0, e0, p), at(t1, e1, q)))
+}
+
+/// Splits a series into visible polylines: broken at non-finite values and clipped to the box.
+/// Isolated visible points become one-point polylines.
+fn polylines(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64)) -> Vec<Vec<(f64, f64)>> {
+    let inside = |p: (f64, f64)| p.0 >= xr.0 && p.0 <= xr.1 && p.1 >= yr.0 && p.1 <= yr.1;
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    for (&a, &b) in x.iter().zip(y) {
+        let p = (a, b);
+        if !(a.is_finite() && b.is_finite()) {
+            if !current.is_empty() {
+                out.push(std::mem::take(&mut current));
+            }
+            prev = None;
+            continue;
+        }
+        match prev {
+            None => {
+                if inside(p) {
+                    current.push(p);
+                }
+            }
+            Some(o) => match clip(o, p, xr, yr) {
+                Some((s, e)) => {
+                    if current.last() != Some(&s) {
+                        if !current.is_empty() {
+                            out.push(std::mem::take(&mut current));
+                        }
+                        current.push(s);
+                    }
+                    current.push(e);
+                }
+                None => {
+                    if !current.is_empty() {
+                        out.push(std::mem::take(&mut current));
+                    }
+                }
+            },
+        }
+        prev = Some(p);
+    }
+    if !current.is_empty() {
+        out.push(current);
+    }
+    out
+}
+
+fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
+    let (xr, yr) = panel_ranges(panel);
+    // Tick counts from the panel size (plotters rounds them to "nice" steps).
+    let (w, h) = area.dim_in_pixel();
+    let x_ticks = (w as usize / 50).clamp(3, 12);
+    let y_ticks = (h as usize / 40).clamp(3, 12);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 16))
+        .margin(10)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 14))
+        .x_labels(x_ticks)
+        .y_labels(y_ticks)
+        .max_light_lines(0)
+        .bold_line_style(RGBColor(225, 225, 225))
+        .draw()?;
+
+    let mut named = 0;
+    for s in &panel.series {
+        let rgb = s.colour.rgb();
+        let line = ShapeStyle {
+            color: rgb.to_rgba(),
+            filled: false,
+            stroke_width: 2,
+        };
+        let kind = s.kind.unwrap_or(panel.kind);
+        draw_data(&mut chart, s, kind, line, (xr, yr))?;
+        if !s.name.is_empty() {
+            named += 1;
+            let anno = chart.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
+            let anno = anno.label(s.name.as_str());
+            match (kind, s.style) {
+                (PanelKind::Line, LineStyle::Dashed) => {
+                    anno.legend(move |(x, y)| {
+                        DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 4, line)
+                    });
+                }
+                (PanelKind::Line, LineStyle::Solid) => {
+                    anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+                }
+                (PanelKind::Scatter, _) => {
+                    anno.legend(move |(x, y)| Circle::new((x + 10, y), 3, rgb.filled()));
+                }
+                (PanelKind::Bars { .. }, _) => {
+                    anno.legend(move |(x, y)| {
+                        Rectangle::new([(x + 4, y - 5), (x + 16, y + 5)], rgb.mix(0.7).filled())
+                    });
+                }
+            }
+        }
+    }
+    if panel.legend && named > 0 {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 12))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+    }
+    Ok(())
+}
+
+/// Draws the data of series `s` as `kind` (lines broken at non-finite values and clipped to
+/// the ranges, markers or bars inside them) and its point labels.
+fn draw_data(
+    chart: &mut Chart<'_, '_>,
+    s: &Series,
+    kind: PanelKind,
+    line: ShapeStyle,
+    (xr, yr): ((f64, f64), (f64, f64)),
+) -> DrawResult {
+    let rgb = s.colour.rgb();
+    let inside = |p: &(f64, f64)| p.0 >= xr.0 && p.0 <= xr.1 && p.1 >= yr.0 && p.1 <= yr.1;
+    match kind {
+        PanelKind::Line => {
+            for poly in polylines(&s.x, &s.y, xr, yr) {
+                if poly.len() == 1 {
+                    chart.draw_series(poly.iter().map(|&p| Circle::new(p, 2, rgb.filled())))?;
+                } else if s.style == LineStyle::Dashed {
+                    chart.draw_series(DashedLineSeries::new(poly, 6, 4, line))?;
+                } else {
+                    chart.draw_series(LineSeries::new(poly, line))?;
+                }
+            }
+        }
+        PanelKind::Scatter => {
+            let pts: Vec<(f64, f64)> = finite_points(&s.x, &s.y).filter(|p| inside(p)).collect();
+            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, rgb.filled())))?;
+        }
+        PanelKind::Bars { width } => {
+            let fill = rgb.mix(0.7).filled();
+            let clamp_x = |v: f64| v.clamp(xr.0, xr.1);
+            let clamp_y = |v: f64| v.clamp(yr.0, yr.1);
+            let corners: Vec<[(f64, f64); 2]> = finite_points(&s.x, &s.y)
+                .map(|(x, y)| {
+                    [
+                        (clamp_x(x - 0.5 * width), clamp_y(0.0)),
+                        (clamp_x(x + 0.5 * width), clamp_y(y)),
+                    ]
+                })
+                .collect();
+            chart.draw_series(corners.iter().map(|c| Rectangle::new(*c, fill)))?;
+            chart.draw_series(
+                corners
+                    .iter()
+                    .map(|c| Rectangle::new(*c, WHITE.stroke_width(1))),
+            )?;
+        }
+    }
+    if !s.labels.is_empty() {
+        let texts: Vec<_> =
+            s.x.iter()
+                .zip(&s.y)
+                .zip(&s.labels)
+                .map(|((&x, &y), l)| ((x, y), l))
+                .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
+                .map(|(p, l)| {
+                    EmptyElement::at(p) + Text::new(l.clone(), (5, -14), (FONT, 11).into_font())
+                })
+                .collect();
+        chart.draw_series(texts)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,28 @@
+//! Data-driven SVG figures (plotters, SVG backend, no font files).
+//!
+//! A [`Figure`] is a grid of [`Panel`]s, each holding [`Series`] of `(x, y)` data drawn as
+//! lines, markers or bars. [`histogram`] and [`scatter_labelled`] build common figures;
+//! [`Heatmap`] draws a grid of cells with a colour bar.
+//!
+//! Rendering rules, whatever the input:
+//! - non-finite values (NaN, ±inf) are skipped; a line breaks at them;
+//! - empty series and empty panels are drawn as empty axes on `[0, 1]`;
+//! - degenerate (constant or single-point) ranges are padded;
+//! - lines are clipped to the panel's range, markers outside it are not drawn;
+//! - text is native SVG `<text>` (no font files), and the output depends only on the
+//!   specification, so rendering twice gives identical bytes.
+//!
+//! Files are written atomically (temporary name in the same directory, then rename).
+
+mod canvas;
+mod charts;
+mod draw;
+mod heatmap;
+mod spec;
+
+pub use charts::{histogram, scatter_labelled, LabelledPoint};
+pub use heatmap::{heatmap, ColourScale, Heatmap};
+pub use spec::{Colour, Figure, LineStyle, Panel, PanelKind, Series};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,272 @@
+//! Figure specifications: [`Figure`] is a grid of [`Panel`]s holding [`Series`].
+
+use plotters::prelude::RGBColor;
+
+use super::canvas::check_size;
+use crate::report::error::{ReportError, Result};
+
+const GREY_RGB: RGBColor = RGBColor(170, 170, 170);
+/// Categorical palette (Tableau 10).
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// How a series' line is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LineStyle {
+    /// Continuous line.
+    #[default]
+    Solid,
+    /// Dashed line (6 px dashes, 4 px gaps).
+    Dashed,
+}
+
+/// Colour of a series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Colour {
+    /// Entry of the 10-colour categorical palette (index taken modulo 10).
+    Palette(usize),
+    /// Light grey, for background data.
+    Grey,
+}
+
+impl Default for Colour {
+    fn default() -> Self {
+        Colour::Palette(0)
+    }
+}
+
+impl Colour {
+    pub(super) fn rgb(self) -> RGBColor {
+        match self {
+            Colour::Palette(i) => PALETTE[i % PALETTE.len()],
+            Colour::Grey => GREY_RGB,
+        }
+    }
+}
+
+/// How the series of a panel are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum PanelKind {
+    /// Connected lines through the points in the given order.
+    #[default]
+    Line,
+    /// Markers (filled circles) at the points.
+    Scatter,
+    /// Vertical bars from 0 to `y`, centred on `x`, of the given width (x units).
+    Bars {
+        /// Bar width in x units.
+        width: f64,
+    },
+}
+
+/// One data series.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Series {
+    /// Legend entry; an empty name is left out of the legend.
+    pub name: String,
+    /// Abscissae (same length as `y`).
+    pub x: Vec<f64>,
+    /// Ordinates.
+    pub y: Vec<f64>,
+    /// Line stroke (for line series).
+    pub style: LineStyle,
+    /// Colour.
+    pub colour: Colour,
+    /// Overrides the panel's [`PanelKind`] for this series.
+    pub kind: Option<PanelKind>,
+    /// Text drawn next to each point (empty: no labels; otherwise one per point).
+    pub labels: Vec<String>,
+}
+
+impl Series {
+    /// A series with the given name and data, solid, palette colour 0, drawn as the panel says.
+    pub fn new(name: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Self {
+            name: name.into(),
+            x,
+            y,
+            ..Self::default()
+        }
+    }
+
+    /// Sets a dashed stroke.
+    pub fn dashed(mut self) -> Self {
+        self.style = LineStyle::Dashed;
+        self
+    }
+
+    /// Sets the colour.
+    pub fn colour(mut self, colour: Colour) -> Self {
+        self.colour = colour;
+        self
+    }
+
+    /// Draws this series as `kind` whatever the panel's kind.
+    pub fn kind(mut self, kind: PanelKind) -> Self {
+        self.kind = Some(kind);
+        self
+    }
+
+    /// Sets one text label per point.
+    pub fn labels(mut self, labels: Vec<String>) -> Self {
+        self.labels = labels;
+        self
+    }
+}
+
+/// One set of axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// Caption above the axes.
+    pub title: String,
+    /// X axis label, with units, e.g. `"time [s]"`.
+    pub x_label: String,
+    /// Y axis label, with units, e.g. `"thrust [N]"`.
+    pub y_label: String,
+    /// The data.
+    pub series: Vec<Series>,
+    /// Default drawing of the series.
+    pub kind: PanelKind,
+    /// Fixed x range `(min, max)`; `None`: from the data.
+    pub x_range: Option<(f64, f64)>,
+    /// Fixed y range `(min, max)`; `None`: from the data.
+    pub y_range: Option<(f64, f64)>,
+    /// Draw a legend of the named series (when there is at least one).
+    pub legend: bool,
+}
+
+impl Panel {
+    /// A line panel with a legend and automatic ranges.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Self {
+        Self {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series: Vec::new(),
+            kind: PanelKind::Line,
+            x_range: None,
+            y_range: None,
+            legend: true,
+        }
+    }
+
+    /// Adds a series.
+    pub fn with_series(mut self, series: Series) -> Self {
+        self.series.push(series);
+        self
+    }
+
+    /// Sets the default drawing kind.
+    pub fn kind(mut self, kind: PanelKind) -> Self {
+        self.kind = kind;
+        self
+    }
+}
+
+/// A figure: a title over a grid of panels, rendered to SVG.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// Title over the whole figure (empty: none).
+    pub title: String,
+    /// Panels, filled row by row into the layout.
+    pub panels: Vec<Panel>,
+    /// Grid `(rows, cols)`; a zero in either means automatic (near-square grid).
+    pub layout: (usize, usize),
+    /// Size in pixels `(width, height)`, each at least 50.
+    pub size: (u32, u32),
+}
+
+impl Figure {
+    /// An empty figure, automatic layout, 800 × 600 px.
+    pub fn new(title: impl Into<String>) -> Self {
+        Self {
+            title: title.into(),
+            panels: Vec::new(),
+            layout: (0, 0),
+            size: (800, 600),
+        }
+    }
+
+    /// Adds a panel.
+    pub fn with_panel(mut self, panel: Panel) -> Self {
+        self.panels.push(panel);
+        self
+    }
+
+    pub(super) fn invalid(&self, detail: String) -> ReportError {
+        ReportError::InvalidFigure {
+            figure: self.title.clone(),
+            detail,
+        }
+    }
+
+    pub(super) fn grid(&self) -> (usize, usize) {
+        let n = self.panels.len().max(1);
+        if self.layout.0 == 0 || self.layout.1 == 0 {
+            let cols = (1..=n).find(|c| c * c >= n).unwrap_or(n);
+            (n.div_ceil(cols), cols)
+        } else {
+            self.layout
+        }
+    }
+
+    pub(super) fn validate(&self) -> Result<()> {
+        check_size(self.size).map_err(|d| self.invalid(d))?;
+        let (rows, cols) = self.grid();
+        if rows.saturating_mul(cols) < self.panels.len() {
+            return Err(self.invalid(format!(
+                "{} panels do not fit a {rows}×{cols} layout",
+                self.panels.len()
+            )));
+        }
+        if rows > 64 || cols > 64 {
+            return Err(self.invalid(format!("layout {rows}×{cols} is too large")));
+        }
+        for (i, p) in self.panels.iter().enumerate() {
+            let at = |d: String| self.invalid(format!("panel {} `{}`: {d}", i + 1, p.title));
+            for r in [p.x_range, p.y_range].into_iter().flatten() {
+                if !(r.0.is_finite() && r.1.is_finite() && r.0 < r.1) {
+                    return Err(at(format!("range {r:?} must be finite with min < max")));
+                }
+            }
+            for s in &p.series {
+                if s.x.len() != s.y.len() {
+                    return Err(at(format!(
+                        "series `{}` has {} x and {} y values",
+                        s.name,
+                        s.x.len(),
+                        s.y.len()
+                    )));
+                }
+                if !s.labels.is_empty() && s.labels.len() != s.x.len() {
+                    return Err(at(format!(
+                        "series `{}` has {} labels for {} points",
+                        s.name,
+                        s.labels.len(),
+                        s.x.len()
+                    )));
+                }
+                if let PanelKind::Bars { width } = s.kind.unwrap_or(p.kind) {
+                    if !(width.is_finite() && width > 0.0) {
+                        return Err(at(format!("bar width {width} must be finite and > 0")));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
