@@ -87,10 +87,9 @@ pub fn run(a: &TcmArgs) -> anyhow::Result<ExitCode> {
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
             worst: a.worst,
         },
-        out: a
-            .out
-            .clone()
-            .unwrap_or_else(|| Path::new("results/tcm").join(usm_study::report::file_stem_safe(&vehicle.name))),
+        out: a.out.clone().unwrap_or_else(|| {
+            Path::new("results/tcm").join(usm_study::report::file_stem_safe(&vehicle.name))
+        }),
         jobs: a.jobs,
         slice: a.slice,
         resolution: a.resolution,

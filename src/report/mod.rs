@@ -36,7 +36,7 @@ pub use atomic::{atomic_write, file_stem_safe};
 pub use csv_append::CsvAppender;
 pub use error::{ReportError, Result};
 pub use markdown::MarkdownTable;
-pub use number::{fmt_num, format_f64};
+pub use number::{fmt_num, fmt_short, format_f64};
 pub use pareto::pareto_front;
 pub use plot::{
     heatmap, histogram, scatter_labelled, Colour, ColourScale, Figure, Heatmap, LabelledPoint,

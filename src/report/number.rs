@@ -1,5 +1,5 @@
 //! Number formatting: the float format of CSV files ([`format_f64`], polars' own) and the short
-//! display format of printed reports and Markdown tables ([`fmt_num`]).
+//! display formats of printed reports ([`fmt_num`]) and Markdown summaries ([`fmt_short`]).
 
 /// Formats a float exactly as the polars CSV writer does: the shortest decimal that parses back
 /// to the same `f64`; positional with at least one fractional digit when the decimal exponent
@@ -70,6 +70,21 @@ pub fn fmt_num(x: f64) -> String {
         format!("{x:.3e}")
     } else {
         format!("{x:.4}")
+    }
+}
+
+/// A number as Markdown summaries show it (a short, trimmed display style): 4 decimals without trailing zeros, scientific beyond
+/// [1e-3, 1e5), `–` for NaN.
+pub fn fmt_short(x: f64) -> String {
+    if x.is_nan() {
+        "–".into()
+    } else if x == 0.0 || (x.abs() >= 1e-3 && x.abs() < 1e5) {
+        format!("{x:.4}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        format!("{x:.3e}")
     }
 }
 

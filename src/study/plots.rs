@@ -12,8 +12,8 @@ use std::collections::HashSet;
 use std::path::Path;
 
 use super::records::Extreme;
-use crate::report::file_stem_safe;
 use super::selection::{levels, mean, thin, Front};
+use crate::report::file_stem_safe;
 use crate::report::{
     heatmap, read_csv, scatter_labelled, ColourScale, ColumnData, ColumnKind, Figure,
     LabelledPoint, Panel, PanelKind, Series, Table,

@@ -126,9 +126,7 @@ pub fn run_case(
 ) -> Result<CaseOutcome, String> {
     let run = crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
     let trajectory = match run.trajectory {
-        Some(t) => Some(
-            crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?,
-        ),
+        Some(t) => Some(crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?),
         None => None,
     };
     Ok(CaseOutcome {

@@ -8,7 +8,7 @@ use super::manifest::Manifest;
 use super::records::{
     CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
 };
-use crate::report::{pareto_front, ColumnData, ColumnKind, Table};
+use crate::report::{fmt_short, pareto_front, ColumnData, ColumnKind, Table};
 
 /// Most points drawn per scatter panel (a deterministic stride through the rows beyond it),
 /// so plots of 100 000-case sweeps stay small.
@@ -153,25 +153,10 @@ impl Selection {
     }
 }
 
-/// A number as the summary shows it: 4 decimals without trailing zeros, scientific beyond
-/// [1e-3, 1e5), `–` for NaN.
-pub(crate) fn fmt(x: f64) -> String {
-    if x.is_nan() {
-        "–".into()
-    } else if x == 0.0 || (x.abs() >= 1e-3 && x.abs() < 1e5) {
-        format!("{x:.4}")
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_string()
-    } else {
-        format!("{x:.3e}")
-    }
-}
-
 /// The text of a cell in a Markdown table (`|` escaped).
 pub(crate) fn cell_text(table: &Table, col: &str, row: usize) -> String {
     match table.column(col).map(|c| &c.data) {
-        Some(ColumnData::F64(v)) => fmt(v[row]),
+        Some(ColumnData::F64(v)) => fmt_short(v[row]),
         Some(ColumnData::I64(v)) => v[row].to_string(),
         Some(ColumnData::Str(v)) => v[row].replace('|', "\\|"),
         Some(ColumnData::Bool(v)) => v[row].to_string(),
@@ -196,7 +181,7 @@ pub(crate) fn levels(table: &Table, axis: &str, rows: &[usize]) -> Vec<(String, 
                     .iter()
                     .map(|&x| {
                         (
-                            fmt(x),
+                            fmt_short(x),
                             x,
                             rows.iter().copied().filter(|&r| v[r] == x).collect(),
                         )
@@ -215,7 +200,11 @@ pub(crate) fn levels(table: &Table, axis: &str, rows: &[usize]) -> Vec<(String, 
                         let (a, z) = (v[*rs.first()?], v[*rs.last()?]);
                         let mut rs = rs;
                         rs.sort_unstable();
-                        Some((format!("[{}, {}]", fmt(a), fmt(z)), 0.5 * (a + z), rs))
+                        Some((
+                            format!("[{}, {}]", fmt_short(a), fmt_short(z)),
+                            0.5 * (a + z),
+                            rs,
+                        ))
                     })
                     .collect()
             }

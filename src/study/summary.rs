@@ -14,8 +14,8 @@ use super::manifest::Manifest;
 use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::DoeKind;
-use super::selection::{cell_text, fmt, levels, mean, ok_rows, Front, Selection};
-use crate::report::Table;
+use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection};
+use crate::report::{fmt_short, MarkdownTable, Table};
 
 /// What every section of the summary reads.
 struct Ctx<'a> {
@@ -28,24 +28,18 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    /// A table header `| first… | axis… |` with its rule.
-    fn header(&self, first: &str, rule: &str) -> String {
-        let mut header = first.to_string();
-        let mut rule = rule.to_string();
-        for a in &self.axes {
-            let _ = write!(header, " {a} |");
-            rule.push_str("---|");
-        }
-        format!("{header}\n{rule}")
+    /// A table with the columns `first…` followed by one column per axis.
+    fn table(&self, first: &[&str]) -> MarkdownTable {
+        MarkdownTable::new(first.iter().copied().chain(self.axes.iter().copied()))
     }
 
-    /// The axis cells of row `r`.
-    fn axis_cells(&self, r: usize) -> String {
-        let mut line = String::new();
-        for a in &self.axes {
-            let _ = write!(line, " {} |", cell_text(self.table, a, r));
-        }
-        line
+    /// A row of [`Ctx::table`]: the cells `first`, then the axis values of case row `r`.
+    fn row(&self, t: &mut MarkdownTable, first: Vec<String>, r: Option<usize>) {
+        let axes = self.axes.iter().map(|a| match r {
+            Some(r) => cell_text(self.table, a, r),
+            None => "–".to_string(),
+        });
+        t.row(first.into_iter().chain(axes));
     }
 }
 
@@ -133,36 +127,25 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
 /// The best case by each metric (design columns aside).
 fn best_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "## Best case by each metric\n");
-    let _ = writeln!(
-        md,
-        "{}",
-        c.header("| metric | goal | case | value |", "|---|---|---|---|")
-    );
+    let mut t = c.table(&["metric", "goal", "case", "value"]);
     for metric in c.sel.metrics.iter().filter(|m| !m.starts_with("design_")) {
         let goal = if c.sel.maximise.contains(metric) {
             "max"
         } else {
             "min"
         };
-        match c.sel.best_row(c.table, metric, false) {
-            Some(r) => {
-                let _ = writeln!(
-                    md,
-                    "| `{metric}` | {goal} | #{} | {} |{}",
-                    c.ids[r],
-                    cell_text(c.table, metric, r),
-                    c.axis_cells(r)
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    md,
-                    "| `{metric}` | {goal} | – | – |{}",
-                    " – |".repeat(c.axes.len())
-                );
-            }
-        }
+        let best = c.sel.best_row(c.table, metric, false);
+        let (case, value) = match best {
+            Some(r) => (format!("#{}", c.ids[r]), cell_text(c.table, metric, r)),
+            None => ("–".into(), "–".into()),
+        };
+        c.row(
+            &mut t,
+            vec![format!("`{metric}`"), goal.into(), case, value],
+            best,
+        );
     }
+    md.push_str(&t.finish());
 }
 
 /// Main effects: the mean of each key metric at each level of each axis.
@@ -173,22 +156,22 @@ fn effects_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "\n## Effect of each axis\n\nMean of each key metric over the `ok` cases at each axis value.\n");
     for a in &c.axes {
         let _ = writeln!(md, "### `{a}`\n");
-        let mut h = "| value | cases |".to_string();
-        let mut r = "|---|---|".to_string();
-        for k in &c.key {
-            let _ = write!(h, " {k} |");
-            r.push_str("---|");
-        }
-        let _ = writeln!(md, "{h}\n{r}");
+        let header = ["value", "cases"]
+            .into_iter()
+            .chain(c.key.iter().map(String::as_str));
+        let mut t = MarkdownTable::new(header);
         for (label, _, rows) in levels(c.table, a, &c.ok_rows) {
-            let mut line = format!("| {} | {} |", label.replace('|', "\\|"), rows.len());
-            for k in &c.key {
-                let v = c.table.f64(k).map(|v| mean(v, &rows)).unwrap_or(f64::NAN);
-                let _ = write!(line, " {} |", fmt(v));
-            }
-            let _ = writeln!(md, "{line}");
+            let means = c
+                .key
+                .iter()
+                .map(|k| fmt_short(c.table.f64(k).map(|v| mean(v, &rows)).unwrap_or(f64::NAN)));
+            t.row(
+                [label.replace('|', "\\|"), rows.len().to_string()]
+                    .into_iter()
+                    .chain(means),
+            );
         }
-        let _ = writeln!(md);
+        let _ = writeln!(md, "{}", t.finish());
     }
 }
 
@@ -202,22 +185,17 @@ fn pareto_section(c: &Ctx, f: &Front, md: &mut String) {
         f.front.len(),
         f.rows.len()
     );
-    let _ = writeln!(
-        md,
-        "{}",
-        c.header(&format!("| case | {x} | {y} |"), "|---|---|---|")
-    );
+    let mut t = c.table(&["case", x, y]);
     for &k in f.front.iter().take(50) {
         let r = f.rows[k];
-        let _ = writeln!(
-            md,
-            "| #{} | {} | {} |{}",
-            c.ids[r],
-            fmt(f.xs[r]),
-            fmt(f.ys[r]),
-            c.axis_cells(r)
-        );
+        let first = vec![
+            format!("#{}", c.ids[r]),
+            fmt_short(f.xs[r]),
+            fmt_short(f.ys[r]),
+        ];
+        c.row(&mut t, first, Some(r));
     }
+    md.push_str(&t.finish());
 }
 
 /// Failed and skipped cases: grouped by reason, then the first 100.
@@ -238,20 +216,17 @@ fn failures_section(c: &Ctx, md: &mut String) {
             .entry((status[i].as_str(), reasons[i].as_str()))
             .or_default() += 1;
     }
-    let _ = writeln!(md, "| status | cases | reason |\n|---|---|---|");
+    let mut t = MarkdownTable::new(["status", "cases", "reason"]);
     for ((s, r), n) in &groups {
-        let _ = writeln!(md, "| {s} | {n} | {} |", r.replace('|', "\\|"));
+        t.row([s.to_string(), n.to_string(), r.replace('|', "\\|")]);
     }
-    let _ = writeln!(md, "\n| case | status | reason |\n|---|---|---|");
+    let _ = writeln!(md, "{}", t.finish());
+    let mut t = MarkdownTable::new(["case", "status", "reason"]);
     for &i in bad.iter().take(100) {
-        let _ = writeln!(
-            md,
-            "| #{} | {} | {} |",
-            c.ids[i],
-            status[i],
-            reasons[i].replace('|', "\\|")
-        );
+        let id = format!("#{}", c.ids[i]);
+        t.row([id, status[i].clone(), reasons[i].replace('|', "\\|")]);
     }
+    md.push_str(&t.finish());
     if bad.len() > 100 {
         let _ = writeln!(md, "\n({} more; see cases.csv)", bad.len() - 100);
     }
