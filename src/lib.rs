@@ -11,6 +11,8 @@
 //! ([`report`]) through the output pipelines ([`pipeline`], [`study`]). The command-line
 //! interface is the binary's own (`src/cli/`), not part of this library.
 
+#![warn(missing_docs)]
+
 pub mod allocation;
 pub mod control;
 pub mod diag;
