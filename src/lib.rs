@@ -12,7 +12,7 @@
 pub mod allocation;
 pub mod cli;
 pub mod control;
-pub mod diag;
+pub mod input;
 pub mod dynamics;
 pub mod kinematics;
 pub mod metrics;

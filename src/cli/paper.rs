@@ -87,7 +87,7 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
         if let Some(m) = method {
             set_allocation_method(&mut table, *m);
         }
-        let file = parse_table(&table, &src.origin)?;
+        let file = parse_table(&table, &src)?;
         let v = resolve_design(&file, &src)?;
         let r = run_scenario(&v, &file)?;
         let out = a.out.join(dir);

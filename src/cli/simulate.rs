@@ -7,7 +7,7 @@ use crate::model::Vehicle;
 use crate::report::figures::{run_figure, trajectory_table};
 use crate::report::{write_csv, write_parquet};
 use crate::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
-use crate::study::path::{set, KeyPath};
+use crate::input::keypath::{parse_override, set};
 use anyhow::Context;
 use clap::Args;
 use serde_json::json;
@@ -34,20 +34,6 @@ pub struct SimulateArgs {
     pub no_plots: bool,
 }
 
-/// Parse `key=value` with a TOML value (bare words become strings).
-pub fn parse_override(s: &str) -> anyhow::Result<(KeyPath, toml::Value)> {
-    let (k, v) = s
-        .split_once('=')
-        .with_context(|| format!("--set {s}: expected KEY=VALUE"))?;
-    let path = KeyPath::parse(k.trim()).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
-    let text = v.trim();
-    let value = toml::from_str::<toml::Table>(&format!("v = {text}"))
-        .ok()
-        .and_then(|mut t| t.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(text.to_string()));
-    Ok((path, value))
-}
-
 /// Run `simulate`.
 pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     let (mut table, src) = load_table(&a.scenario)?;
@@ -58,7 +44,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         let (path, value) = parse_override(s)?;
         set(&mut table, &path.0, value, s).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
     }
-    let file = parse_table(&table, &src.origin)?;
+    let file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
     let out = a
         .out

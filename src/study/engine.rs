@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use super::doe::{case_count, expand, Case};
-use super::path::{set, Seg};
+use crate::input::keypath::{set, Seg};
 use super::runner::{self, Worker};
 use super::schema::{hex, ReportSettings, Study, Target};
 use super::static_tcm::{analyse, StaticSpec};

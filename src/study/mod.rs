@@ -5,14 +5,12 @@
 //! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
 //! - [`schema`]: study files (TOML) → validated [`Study`].
 //! - [`doe`]: grid and sampled designs of experiments → cases.
-//! - [`path`]: parameter paths of sweep axes and table edits.
 //! - [`engine`]: running, resuming, sharding, merging; final tables and manifest.
 //! - [`runner`]: the single adapter to the scenario module.
 //! - [`summary`]: `summary.md` and plots.
 
 pub mod doe;
 pub mod engine;
-pub mod path;
 pub mod runner;
 pub mod schema;
 pub mod static_tcm;

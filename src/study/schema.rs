@@ -4,14 +4,14 @@
 //! Every error names the file, the 1-based line and column when known, and the key
 //! (`axis[2].name`). `deny_unknown_fields` everywhere; no `serde(flatten)`.
 
-use crate::diag::{line_col, one_line, write_located};
+use crate::input::located::{line_col, one_line, Located, Location};
 use std::collections::BTreeSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use super::path::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
+use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
 use super::runner;
 use crate::model::design::{load_design_table, parse_design_table, DesignError};
 use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
@@ -33,25 +33,28 @@ pub struct InputError {
 
 impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_located(
-            f,
-            &self.origin,
-            self.line,
-            self.column,
-            &self.key,
-            &self.message,
-        )
+        let at = Location {
+            origin: self.origin.clone(),
+            line: self.line,
+            column: self.column,
+            key: self.key.clone(),
+        };
+        Located {
+            at,
+            error: &self.message,
+        }
+        .fmt(f)
     }
 }
 
 impl From<DesignError> for InputError {
     fn from(e: DesignError) -> Self {
         InputError {
-            origin: e.origin,
-            line: e.line,
-            column: e.column,
-            key: e.key,
-            message: e.message,
+            origin: e.at.origin,
+            line: e.at.line,
+            column: e.at.column,
+            key: e.at.key,
+            message: e.error.message,
         }
     }
 }
@@ -551,12 +554,12 @@ pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
                 Ok(_) => e.into(),
             }
         } else {
-            let key = if e.key.is_empty() {
+            let key = if e.at.key.is_empty() {
                 "design".to_string()
             } else {
-                format!("design.{}", e.key)
+                format!("design.{}", e.at.key)
             };
-            spans.err(&key, e.message)
+            spans.err(&key, e.error.message)
         });
     }
 
@@ -794,7 +797,7 @@ fn base_design(
         let p = p
             .as_str()
             .ok_or_else(|| spans.err("design.preset", "must be a string"))?;
-        let mut t = load_design_table(p).map_err(|e| spans.err("design.preset", e.message))?;
+        let mut t = load_design_table(p).map_err(|e| spans.err("design.preset", e.error.message))?;
         if let Some(n) = d.get("name") {
             t.insert("name".into(), n.clone());
         }
@@ -841,7 +844,7 @@ fn validate_axis(
         {
             return Err(unknown());
         }
-        let reference = super::path::get(design, &rest.0)
+        let reference = crate::input::keypath::get(design, &rest.0)
             .cloned()
             .or_else(|| (rest.pattern() == "generator.links").then_some(toml::Value::Integer(5)));
         (Target::Design(rest), reference)
@@ -849,7 +852,7 @@ fn validate_axis(
         if !pattern_allowed(&path.pattern(), &names.scenario, &names.scenario_arrays) {
             return Err(unknown());
         }
-        let reference = super::path::get(&names.scenario_ref, &path.0).cloned();
+        let reference = crate::input::keypath::get(&names.scenario_ref, &path.0).cloned();
         (Target::Scenario(path.clone()), reference)
     } else {
         return Err(unknown());
