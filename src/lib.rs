@@ -12,8 +12,8 @@
 pub mod allocation;
 pub mod cli;
 pub mod control;
-pub mod input;
 pub mod dynamics;
+pub mod input;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;

@@ -168,7 +168,11 @@ mod tests {
         for text in [r#"{"bogus": 1}"#, "{\n\"base_position\": [0,0]}"] {
             let e = parse_state(text, &v, "s.json").unwrap_err();
             let line = text.lines().count();
-            assert_eq!((e.at.key.as_str(), e.at.line), ("", Some(line)), "{text}: {e}");
+            assert_eq!(
+                (e.at.key.as_str(), e.at.line),
+                ("", Some(line)),
+                "{text}: {e}"
+            );
             assert!(e.to_string().starts_with(&format!("s.json:{line}:")), "{e}");
         }
         let ok = parse_state(

@@ -3,11 +3,11 @@
 use super::fmt_num;
 use crate::allocation::Method;
 use crate::control::transport::yaw_joint_mask;
+use crate::input::keypath::{parse_override, set};
 use crate::model::Vehicle;
 use crate::report::figures::{run_figure, trajectory_table};
 use crate::report::{write_csv, write_parquet};
 use crate::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
-use crate::input::keypath::{parse_override, set};
 use anyhow::Context;
 use clap::Args;
 use serde_json::json;

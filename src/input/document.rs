@@ -1,71 +1,21 @@
 //! A TOML document as a located tree: every key path with the byte span of its key and
-//! value, built by deserialising the text into `toml::Spanned` nodes. It maps a serde error
-//! span to the key path it falls in, and a key path of a later semantic check back to its
-//! line, so design, scenario and study files report errors the same way.
+//! value, read from `toml_edit`'s parse tree (the parser `toml` itself uses, so serde error
+//! spans and these spans agree; `toml::Spanned` cannot be used for keys of implicit tables
+//! such as `a.b = 1`). It maps a serde error span to the key path it falls in, and a key
+//! path of a later semantic check back to its line, so design, scenario and study files
+//! report errors the same way.
 
 use super::keypath::{join_key, parent_path};
 use super::located::{line_col, one_line, InputError, KeyError, Located, Location};
-use serde::de::{DeserializeOwned, Deserializer, MapAccess, SeqAccess, Visitor};
-use serde::Deserialize;
-use std::fmt;
+use serde::de::DeserializeOwned;
 use std::ops::Range;
-use toml::Spanned;
-
-/// A generic TOML node that keeps the span of every key and value.
-enum Node {
-    Table(Vec<(Spanned<String>, Spanned<Node>)>),
-    Array(Vec<Spanned<Node>>),
-    Float(f64),
-    Other,
-}
-
-impl<'de> Deserialize<'de> for Node {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct NodeVisitor;
-        impl<'de> Visitor<'de> for NodeVisitor {
-            type Value = Node;
-            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str("any TOML value")
-            }
-            fn visit_bool<E>(self, _: bool) -> Result<Node, E> {
-                Ok(Node::Other)
-            }
-            fn visit_i64<E>(self, _: i64) -> Result<Node, E> {
-                Ok(Node::Other)
-            }
-            fn visit_u64<E>(self, _: u64) -> Result<Node, E> {
-                Ok(Node::Other)
-            }
-            fn visit_f64<E>(self, v: f64) -> Result<Node, E> {
-                Ok(Node::Float(v))
-            }
-            fn visit_str<E>(self, _: &str) -> Result<Node, E> {
-                Ok(Node::Other)
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<Node, A::Error> {
-                let mut v = Vec::new();
-                while let Some(x) = a.next_element()? {
-                    v.push(x);
-                }
-                Ok(Node::Array(v))
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut a: A) -> Result<Node, A::Error> {
-                let mut v = Vec::new();
-                while let Some(kv) = a.next_entry()? {
-                    v.push(kv);
-                }
-                Ok(Node::Table(v))
-            }
-        }
-        d.deserialize_any(NodeVisitor)
-    }
-}
+use toml_edit::{ImDocument, Item, Key, Table, Value};
 
 /// One node of the document: its key path, value span and key span.
 #[derive(Clone, Debug)]
 struct Entry {
     path: String,
-    value: Range<usize>,
+    value: Option<Range<usize>>,
     key: Option<Range<usize>>,
 }
 
@@ -113,9 +63,9 @@ impl Document {
             entries: Vec::new(),
             non_finite: Vec::new(),
         };
-        match toml::from_str::<Spanned<Node>>(text) {
+        match ImDocument::parse(text) {
             Ok(root) => {
-                doc.index(String::new(), &root, None);
+                doc.index_table("", root.as_table());
                 Ok(doc)
             }
             Err(e) => Err(doc.at_offset(
@@ -126,26 +76,55 @@ impl Document {
         }
     }
 
-    fn index(&mut self, path: String, node: &Spanned<Node>, key: Option<Range<usize>>) {
-        if !path.is_empty() {
-            self.entries.push(Entry {
-                path: path.clone(),
-                value: node.span(),
-                key,
-            });
+    fn push(&mut self, path: &str, value: Option<Range<usize>>, key: Option<&Key>) {
+        self.entries.push(Entry {
+            path: path.to_string(),
+            value,
+            key: key.and_then(Key::span),
+        });
+    }
+
+    fn index_table(&mut self, path: &str, t: &Table) {
+        for (k, item) in t.iter() {
+            self.index_item(&join_key(path, k), item, t.key(k));
         }
-        match node.get_ref() {
-            Node::Table(kvs) => {
-                for (k, v) in kvs {
-                    self.index(join_key(&path, k.get_ref()), v, Some(k.span()));
+    }
+
+    fn index_item(&mut self, path: &str, item: &Item, key: Option<&Key>) {
+        match item {
+            Item::None => {}
+            Item::Value(v) => self.index_value(path, v, key),
+            Item::Table(t) => {
+                self.push(path, t.span(), key);
+                self.index_table(path, t);
+            }
+            Item::ArrayOfTables(a) => {
+                self.push(path, a.span(), key);
+                for (i, t) in a.iter().enumerate() {
+                    let p = format!("{path}[{i}]");
+                    self.push(&p, t.span(), None);
+                    self.index_table(&p, t);
                 }
             }
-            Node::Array(items) => {
-                for (i, v) in items.iter().enumerate() {
-                    self.index(format!("{path}[{i}]"), v, None);
+        }
+    }
+
+    fn index_value(&mut self, path: &str, v: &Value, key: Option<&Key>) {
+        self.push(path, v.span(), key);
+        match v {
+            Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    self.index_value(&format!("{path}[{i}]"), x, None);
                 }
             }
-            Node::Float(x) if !x.is_finite() => self.non_finite.push((path, *x)),
+            Value::InlineTable(t) => {
+                for (k, x) in t.iter() {
+                    self.index_value(&join_key(path, k), x, t.key(k));
+                }
+            }
+            Value::Float(x) if !x.value().is_finite() => {
+                self.non_finite.push((path.to_string(), *x.value()));
+            }
             _ => {}
         }
     }
@@ -174,8 +153,9 @@ impl Document {
     pub fn locate(&self, path: &str) -> Option<usize> {
         let mut p = path;
         loop {
-            if let Some(e) = self.entries.iter().find(|e| e.path == p) {
-                return Some(e.key.as_ref().map_or(e.value.start, |k| k.start));
+            let found = self.entries.iter().find(|e| e.path == p);
+            if let Some(span) = found.and_then(|e| e.key.as_ref().or(e.value.as_ref())) {
+                return Some(span.start);
             }
             p = parent_path(p)?;
         }
@@ -186,7 +166,9 @@ impl Document {
         self.entries
             .iter()
             .flat_map(|e| {
-                std::iter::once(&e.value)
+                e.value
+                    .as_ref()
+                    .into_iter()
                     .chain(e.key.as_ref())
                     .map(move |s| (e, s))
             })
@@ -304,6 +286,11 @@ mod tests {
         assert_eq!(e.to_string(), "f.toml:3:1: b.c: bad");
         let generated = Document::parse_generated(TEXT, "mem").unwrap();
         assert_eq!(generated.location("b.c").line, None);
+        // Keys of implicit tables (dotted keys and headers) are located too.
+        let doc = Document::parse("x.y = 1\n[p.q]\nr = 2\n[[s.t]]\nu = 3\n", "f").unwrap();
+        for (key, line) in [("x.y", 1), ("p.q.r", 3), ("s.t[0].u", 5), ("s.t[0]", 4)] {
+            assert_eq!(doc.location(key).line, Some(line), "{key}");
+        }
     }
 
     #[test]
@@ -311,12 +298,12 @@ mod tests {
         let e = Document::parse("a = 1\nb = [1,\n", "f.toml").unwrap_err();
         assert_eq!(e.at.line, Some(3));
         assert!(e.error.starts_with("TOML syntax error"), "{e}");
-        #[derive(Deserialize, Debug)]
+        #[derive(serde::Deserialize, Debug)]
         #[allow(dead_code)]
         struct B {
             c: [f64; 3],
         }
-        #[derive(Deserialize, Debug)]
+        #[derive(serde::Deserialize, Debug)]
         #[allow(dead_code)]
         struct F {
             b: B,

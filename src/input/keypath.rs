@@ -416,10 +416,16 @@ mod tests {
     #[test]
     fn overrides_and_parents() {
         let (p, v) = parse_override("control.k_psi = 0.3").unwrap();
-        assert_eq!((p.to_string(), v), ("control.k_psi".into(), toml::Value::Float(0.3)));
+        assert_eq!(
+            (p.to_string(), v),
+            ("control.k_psi".into(), toml::Value::Float(0.3))
+        );
         let (_, v) = parse_override("allocation.method=qp").unwrap();
         assert_eq!(v, toml::Value::String("qp".into()));
-        assert!(matches!(parse_override("x"), Err(OverrideError::NoEquals(_))));
+        assert!(matches!(
+            parse_override("x"),
+            Err(OverrideError::NoEquals(_))
+        ));
         let e = parse_override("a..b=1").unwrap_err();
         assert!(e.to_string().starts_with("--set a..b=1: "), "{e}");
         assert_eq!(parent_path("a.b[2].c"), Some("a.b[2]"));

@@ -398,7 +398,9 @@ impl ScenarioFile {
     /// Parse the `[control]` table for the mode; errors name the key.
     pub fn mode_gains(&self) -> Result<ModeGains, KeyError> {
         match self.scenario.mode {
-            Mode::Transport => deserialize_table(&self.control, "control").map(ModeGains::Transport),
+            Mode::Transport => {
+                deserialize_table(&self.control, "control").map(ModeGains::Transport)
+            }
             Mode::Work => deserialize_table(&self.control, "control").map(ModeGains::Work),
         }
     }
@@ -500,7 +502,10 @@ impl ScenarioFile {
                 return Err(KeyError::new("path", "transport mode needs a [path] table"))
             }
             Mode::Work if self.setpoint.is_none() => {
-                return Err(KeyError::new("setpoint", "work mode needs a [setpoint] table"))
+                return Err(KeyError::new(
+                    "setpoint",
+                    "work mode needs a [setpoint] table",
+                ))
             }
             _ => {}
         }

@@ -226,7 +226,8 @@ fn lateral_offset(p: &Vec3, from: [f64; 2], to: [f64; 2]) -> f64 {
 /// singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
 pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, ScenarioError> {
     let started = Instant::now();
-    file.validate().map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    file.validate()
+        .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
     let s = &file.scenario;
     let mut vehicle = v.clone();
     vehicle.fluid.current = Vec3::from(file.physics.current);
@@ -238,8 +239,12 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
             "design: a closed-loop scenario needs at least one thruster".into(),
         ));
     }
-    let mut sim = Simulator::new(v, file.sim_config().map_err(|e| ScenarioError::Invalid(e.to_string()))?)
-        .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    let mut sim = Simulator::new(
+        v,
+        file.sim_config()
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?,
+    )
+    .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
     // Initial state.
     let mut st = SimState::rest(v);
     st.pose.position = Vec3::from(file.initial.position);
@@ -264,7 +269,9 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
         .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
 
     // Controllers.
-    let gains = file.mode_gains().map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    let gains = file
+        .mode_gains()
+        .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
     let mut base_ctl = DynamicController::new(file.base_gains())
         .map_err(|e| ScenarioError::Invalid(format!("base_control.{e}")))?;
     let mut transport = None;

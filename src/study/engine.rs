@@ -26,11 +26,11 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use super::doe::{case_count, expand, Case};
-use crate::input::keypath::{set, Seg};
 use super::runner::{self, Worker};
 use super::schema::{hex, ReportSettings, Study, Target};
 use super::static_tcm::{analyse, StaticSpec};
 use super::StudyError;
+use crate::input::keypath::{set, Seg};
 use crate::metrics::singularity::AXIS_NAMES;
 use crate::model::design::{design_to_toml, parse_design_table};
 use crate::model::Vehicle;

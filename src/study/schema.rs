@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
 use super::runner;
+use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
 use crate::model::design::{load_design_table, parse_design_table, DesignError};
 use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
 
@@ -797,7 +797,8 @@ fn base_design(
         let p = p
             .as_str()
             .ok_or_else(|| spans.err("design.preset", "must be a string"))?;
-        let mut t = load_design_table(p).map_err(|e| spans.err("design.preset", e.error.message))?;
+        let mut t =
+            load_design_table(p).map_err(|e| spans.err("design.preset", e.error.message))?;
         if let Some(n) = d.get("name") {
             t.insert("name".into(), n.clone());
         }

@@ -2,10 +2,8 @@
 //! lists, generator), their defaults and the consistency checks, each error placed at its
 //! key in the document.
 
-use super::schema::{
-    BodyRef, BodySpec, DesignFile, FrameSpec, HydroSpec, JointSpec, ThrusterSpec,
-};
 use super::error::{DesignError, DesignErrorKind, DesignFault};
+use super::schema::{BodyRef, BodySpec, DesignFile, FrameSpec, HydroSpec, JointSpec, ThrusterSpec};
 use crate::input::document::Document;
 use crate::model::generator::{GeneratorSpec, ThrusterRule};
 use crate::model::presets;
@@ -85,7 +83,7 @@ fn file_key(key: &str) -> String {
     format!("{parent}{last}")
 }
 
-fn vec3(a: [f64; 3]) -> Vec3 {
+pub(super) fn vec3(a: [f64; 3]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
 }
 

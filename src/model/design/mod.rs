@@ -57,9 +57,9 @@
 mod build;
 mod error;
 mod schema;
-mod write;
 #[cfg(test)]
 mod tests;
+mod write;
 
 pub use error::{DesignError, DesignErrorKind, DesignFault};
 pub use write::design_to_toml;

@@ -33,7 +33,7 @@ pub(super) fn fnum(x: f64) -> String {
     }
 }
 
-fn farr(v: &[f64]) -> String {
+pub(super) fn farr(v: &[f64]) -> String {
     let items: Vec<String> = v.iter().map(|x| fnum(*x)).collect();
     format!("[{}]", items.join(", "))
 }

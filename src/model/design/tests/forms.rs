@@ -181,7 +181,6 @@ fn generator_files() {
 
 /// Parse `text` expecting an error at `key` on `line`; returns the error.
 #[track_caller]
-
 #[test]
 fn example_designs_load() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/designs");

@@ -5,9 +5,14 @@ mod errors;
 mod forms;
 mod props;
 
+use super::build::{rot_rpy, vec3};
+use super::write::{deg, farr, fnum, rpy_of};
 use super::*;
+use crate::model::generator::{GeneratorSpec, ThrusterRule};
+use crate::model::presets::usm_paper;
 use crate::model::{Hydro, Thruster};
-use crate::spatial::Se3;
+use crate::spatial::{Se3, Vec3};
+use std::ops::Range;
 
 /// Compare two vehicles field by field with an absolute tolerance (relative for big
 /// values); `Err` names the first difference.
@@ -95,7 +100,7 @@ fn se3(key: &str, x: &Se3, y: &Se3, tol: f64) -> Result<(), String> {
 /// [`close`] for the hydrodynamic models of one body (`key` = `body[i].hydro`).
 fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> {
     let k = |f: &str| format!("{key}.{f}");
-    match (&x.hydro, &y.hydro) {
+    match (x, y) {
         (
             Hydro::Cylinder {
                 cd_x,
@@ -114,12 +119,7 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 axial_added_mass_ratio: ar,
             },
         ) => {
-            nums(
-                &k("cd"),
-                &[*cd_x, *cd_y, *cd_z],
-                &[*cx, *cy, *cz],
-                tol,
-            )?;
+            nums(&k("cd"), &[*cd_x, *cd_y, *cd_z], &[*cx, *cy, *cz], tol)?;
             nums(&k("linear_damping"), linear_damping, ld, tol)?;
             num(&k("axial"), *axial_added_mass_ratio, *ar, tol)?;
             if strips != s {
@@ -138,19 +138,9 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 quadratic: q,
             },
         ) => {
-            nums(
-                &k("added_mass"),
-                added_mass.as_slice(),
-                am.as_slice(),
-                tol,
-            )?;
+            nums(&k("added_mass"), added_mass.as_slice(), am.as_slice(), tol)?;
             nums(&k("linear"), linear.as_slice(), l.as_slice(), tol)?;
-            nums(
-                &k("quadratic"),
-                quadratic.as_slice(),
-                q.as_slice(),
-                tol,
-            )?;
+            nums(&k("quadratic"), quadratic.as_slice(), q.as_slice(), tol)?;
         }
         _ => return Err(k("kind")),
     }

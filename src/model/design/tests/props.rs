@@ -2,6 +2,7 @@
 
 use super::*;
 use proptest::prelude::*;
+use std::fmt::Write as _;
 
 fn arb_spec() -> impl Strategy<Value = GeneratorSpec> {
     (2usize..=12)
