@@ -167,10 +167,10 @@ pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
             .map_err(|e| ScenarioError::Invalid(format!("{arg}: {e}")))?;
         (
             text,
-            path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            Some(path.parent().map(Path::to_path_buf).unwrap_or_default()),
         )
     } else if let Some(t) = preset_text(arg) {
-        (t, PathBuf::from("."))
+        (t, None)
     } else {
         return Err(ScenarioError::Invalid(format!(
             "{arg}: no such scenario file, and not a preset (presets: {})",
@@ -180,18 +180,24 @@ pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     parse_source(&text, arg, dir)
 }
 
-/// A scenario's text as a table and its [`Source`]; a syntax error names its line.
+/// A scenario's text as a table and its [`Source`]. `dir` is the directory of a file the
+/// user wrote (its errors name lines); `None` for a preset (errors name keys only: the
+/// preset's text is not a file the user can open).
 fn parse_source(
     text: &str,
     origin: &str,
-    dir: PathBuf,
+    dir: Option<PathBuf>,
 ) -> Result<(toml::Table, Source), ScenarioError> {
     let invalid = |e| ScenarioError::Invalid(format!("{e}"));
-    let doc = Document::parse(text, origin).map_err(invalid)?;
+    let doc = match dir {
+        Some(_) => Document::parse(text, origin),
+        None => Document::parse_generated(text, origin),
+    }
+    .map_err(invalid)?;
     let table = doc.deserialize::<toml::Table>().map_err(invalid)?;
     let src = Source {
         origin: origin.to_string(),
-        dir,
+        dir: dir.unwrap_or_else(|| PathBuf::from(".")),
         doc,
     };
     Ok((table, src))
@@ -239,7 +245,7 @@ pub fn default_table(mode: &str) -> Result<toml::Table, ScenarioError> {
         }
     };
     let text = preset_text(preset).unwrap_or_default();
-    let (table, src) = parse_source(&text, preset, PathBuf::from("."))?;
+    let (table, src) = parse_source(&text, preset, None)?;
     let f = parse_table(&table, &src)?;
     let mut full = toml::Table::try_from(&f).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
     // Write the mode's gains out in full (the file may give only a few keys).
@@ -336,7 +342,7 @@ mod tests {
     /// The error of `text` (a scenario file named `s.toml`) from parsing, validation and
     /// the design check, as printed.
     fn error_of(text: &str) -> String {
-        let (t, src) = parse_source(text, "s.toml", PathBuf::from(".")).unwrap();
+        let (t, src) = parse_source(text, "s.toml", Some(PathBuf::from("."))).unwrap();
         let e = match parse_table(&t, &src) {
             Ok(f) => resolve_design(&f, &src).map(|_| ()).unwrap_err(),
             Err(e) => e,
@@ -412,7 +418,7 @@ mod tests {
     #[test]
     fn syntax_and_missing_sections_are_located() {
         let (text, n) = preset_with("work-setpoint", "duration =", "duration = ");
-        let e = parse_source(&text, "s.toml", PathBuf::from("."))
+        let e = parse_source(&text, "s.toml", Some(PathBuf::from(".")))
             .unwrap_err()
             .to_string();
         assert!(e.starts_with(&format!("s.toml:{n}:")), "{e}");
@@ -428,5 +434,13 @@ mod tests {
         t.insert("physics".into(), toml::Value::Table(physics));
         let e = parse_table(&t, &src).unwrap_err().to_string();
         assert!(e.starts_with("transport-method2: physics.drag: "), "{e}");
+        // A preset's text is not a file the user sees: its errors name keys, not lines.
+        let (mut t, src) = load_table("work-setpoint").unwrap();
+        t["scenario"]["duration"] = toml::Value::Float(-1.0);
+        let e = parse_table(&t, &src).unwrap_err().to_string();
+        assert!(
+            e.starts_with("work-setpoint: scenario.duration: must be"),
+            "{e}"
+        );
     }
 }
