@@ -88,7 +88,7 @@ impl<E: fmt::Display> fmt::Display for Located<E> {
 impl<E: fmt::Debug + fmt::Display> std::error::Error for Located<E> {}
 
 /// A problem at a key path, not yet placed in a file: what checks of a parsed value
-/// (`validate`) return; [`crate::input::Document::place`] turns it into an [`InputError`].
+/// (`validate`) return; [`crate::input::document::Document::place`] turns it into an [`InputError`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("{key}: {message}")]
 pub struct KeyError {

@@ -7,8 +7,8 @@
 //! 1. **Preset**: `preset = "usm-paper"` (a name in [`PRESETS`]), optionally with `name`.
 //! 2. **Explicit lists**: `[[body]]`, `[[joint]]`, `[[thruster]]`, optional `[fluid]`,
 //!    `[base]` and `[end_effector]`. Joint `k` joins body `k` to body `k+1`.
-//! 3. **Generator**: a `[generator]` table mapping onto [`GeneratorSpec`]; every field is
-//!    optional and defaults to [`GeneratorSpec::default`]. An explicit `[[thruster]]` list
+//! 3. **Generator**: a `[generator]` table mapping onto [`GeneratorSpec`](crate::model::generator::GeneratorSpec); every field is
+//!    optional and defaults to [`GeneratorSpec::default`](crate::model::generator::GeneratorSpec::default). An explicit `[[thruster]]` list
 //!    given next to `[generator]` *replaces* the thrusters of the placement rule (set
 //!    `thruster_rule = "none"` to make that obvious). `[fluid]`, `[base]` and
 //!    `[end_effector]` may be given too; the generated bodies stay neutrally buoyant in the
@@ -24,7 +24,7 @@
 //! # Schema (explicit form)
 //! - top: `name` (string, optional; defaults to the file stem).
 //! - `[fluid]`: `rho` [kg/m³], `g` [m/s²], `current` [3] [m/s] in the inertial frame;
-//!   all optional, defaults from [`Fluid::default`].
+//!   all optional, defaults from [`Fluid::default`](crate::model::Fluid::default).
 //! - `[[body]]`: `name`, `mass` [kg], `length` [m], `radius` [m] required; optional `cg` [3]
 //!   and `cb` [3] [m] (default: the centre `(l/2, 0, 0)`), `volume` [m³] (default `πr²l`) or
 //!   `neutral = true` (volume `m/ρ`), `inertia` [3][3] [kg·m²] about the CG (default solid
