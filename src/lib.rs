@@ -15,8 +15,8 @@
 
 pub mod allocation;
 pub mod control;
-pub mod diag;
 pub mod dynamics;
+pub mod input;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;

@@ -5,25 +5,13 @@
 //! (`[v; ω]` in the base frame, m/s and rad/s), `joint_rates` [n] (rad/s),
 //! `generalized_forces` [6+n] (base wrench in F_b then joint torques; N, N·m).
 
+use crate::input::located::{InputError, KeyError, Located, Location};
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
 use crate::spatial::{orthonormality_error, Mat3, Vec3, Vec6};
 use nalgebra::{Rotation3, UnitQuaternion};
 use serde::Deserialize;
 use std::path::Path;
-use thiserror::Error;
-
-/// A problem with a state file: the file, the key and what is wrong.
-#[derive(Debug, Error)]
-#[error("{file}: {key}: {message}")]
-pub struct StateError {
-    /// File name as given.
-    pub file: String,
-    /// Offending key (or `(file)` for read/parse problems).
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -65,38 +53,50 @@ impl VehicleState {
     }
 }
 
-/// Read and check a state file against a design.
-pub fn load_state(path: &Path, v: &Vehicle) -> Result<VehicleState, StateError> {
+/// Read and check a state file against a design; errors name the file, the key and, for
+/// JSON syntax and schema errors, the line and column.
+pub fn load_state(path: &Path, v: &Vehicle) -> Result<VehicleState, InputError> {
     let file = path.display().to_string();
-    let err = |key: &str, message: String| StateError {
-        file: file.clone(),
-        key: key.to_string(),
-        message,
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| err("(file)", e.to_string()))?;
-    parse_state(&text, v).map_err(|(key, message)| err(&key, message))
+    let text = std::fs::read_to_string(path).map_err(|e| Located {
+        at: Location::origin(&file),
+        error: e.to_string(),
+    })?;
+    parse_state(&text, v, &file)
 }
 
-/// Parse a state from JSON text; errors are `(key, message)`.
-pub fn parse_state(text: &str, v: &Vehicle) -> Result<VehicleState, (String, String)> {
-    let raw: RawState = serde_json::from_str(text).map_err(|e| {
-        (
-            "(json)".to_string(),
-            format!("line {} column {}: {e}", e.line(), e.column()),
-        )
+/// Parse a state from JSON text; `origin` names it in errors.
+pub fn parse_state(text: &str, v: &Vehicle, origin: &str) -> Result<VehicleState, InputError> {
+    let raw: RawState = serde_json::from_str(text).map_err(|e| Located {
+        at: Location {
+            line: Some(e.line()),
+            column: Some(e.column()),
+            ..Location::origin(origin)
+        },
+        error: e.to_string(),
     })?;
+    check_state(raw, v).map_err(|e| Located {
+        at: Location {
+            key: e.key,
+            ..Location::origin(origin)
+        },
+        error: e.message,
+    })
+}
+
+/// Check the fields of a state file against the design `v`.
+fn check_state(raw: RawState, v: &Vehicle) -> Result<VehicleState, KeyError> {
     let n = v.n_joints();
     let mut s = VehicleState::rest(v);
-    let finite = |key: &str, xs: &[f64]| -> Result<(), (String, String)> {
+    let finite = |key: &str, xs: &[f64]| -> Result<(), KeyError> {
         match xs.iter().position(|x| !x.is_finite()) {
-            Some(i) => Err((key.to_string(), format!("entry {i} is not finite"))),
+            Some(i) => Err(KeyError::new(key, format!("entry {i} is not finite"))),
             None => Ok(()),
         }
     };
-    let sized = |key: &str, xs: &[f64], len: usize| -> Result<(), (String, String)> {
+    let sized = |key: &str, xs: &[f64], len: usize| -> Result<(), KeyError> {
         if xs.len() != len {
-            return Err((
-                key.to_string(),
+            return Err(KeyError::new(
+                key,
                 format!(
                     "has {} entries but the design '{}' needs {len}",
                     xs.len(),
@@ -116,8 +116,8 @@ pub fn parse_state(text: &str, v: &Vehicle) -> Result<VehicleState, (String, Str
         let m = Mat3::from_fn(|i, j| r[i][j]);
         let e = orthonormality_error(&m);
         if e > 1e-6 {
-            return Err((
-                "base_rotation".into(),
+            return Err(KeyError::new(
+                "base_rotation",
                 format!("is not a rotation matrix (|RᵀR − I|, |det R − 1| up to {e:.3e})"),
             ));
         }
@@ -159,16 +159,26 @@ mod tests {
             ),
             (r#"{"joint_rates": [0,0,0,0,0,0,0,0,0]}"#, "joint_rates"),
             (r#"{"generalized_forces": [0]}"#, "generalized_forces"),
-            (r#"{"bogus": 1}"#, "(json)"),
-            (r#"{"base_position": [0,0]}"#, "(json)"),
         ];
         for (text, key) in bad {
-            let e = parse_state(text, &v).unwrap_err();
-            assert_eq!(e.0, key, "{text}: {}", e.1);
+            let e = parse_state(text, &v, "s.json").unwrap_err();
+            assert_eq!(e.at.key, key, "{text}: {e}");
+        }
+        // JSON syntax and schema errors carry the line instead of a key.
+        for text in [r#"{"bogus": 1}"#, "{\n\"base_position\": [0,0]}"] {
+            let e = parse_state(text, &v, "s.json").unwrap_err();
+            let line = text.lines().count();
+            assert_eq!(
+                (e.at.key.as_str(), e.at.line),
+                ("", Some(line)),
+                "{text}: {e}"
+            );
+            assert!(e.to_string().starts_with(&format!("s.json:{line}:")), "{e}");
         }
         let ok = parse_state(
             r#"{"base_position":[1,2,3],"base_rotation":[[0,-1,0],[1,0,0],[0,0,1]],"joint_angles":[0,0.1,0,0,0,0,0,0]}"#,
             &v,
+            "s.json",
         )
         .unwrap();
         assert!((ok.base.orientation.angle() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);

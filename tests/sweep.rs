@@ -365,13 +365,13 @@ fn tcm_on_the_paper_design() {
 proptest! {
     #[test]
     fn axis_path_parser_never_panics(s in "\\PC{0,40}") {
-        let _ = usm_study::study::path::KeyPath::parse(&s);
+        let _ = usm_study::input::keypath::KeyPath::parse(&s);
     }
 
     #[test]
     fn axis_path_roundtrip(s in "[a-z_]{1,6}(\\[[0-9]{1,3}\\])?(\\.[a-z_]{1,6}(\\[[0-9]{1,2}\\]){0,2}){0,3}") {
-        let p = usm_study::study::path::KeyPath::parse(&s).unwrap();
-        let again = usm_study::study::path::KeyPath::parse(&p.to_string()).unwrap();
+        let p = usm_study::input::keypath::KeyPath::parse(&s).unwrap();
+        let again = usm_study::input::keypath::KeyPath::parse(&p.to_string()).unwrap();
         prop_assert_eq!(p, again);
     }
 }

@@ -26,7 +26,7 @@ fn run(preset: &str, overrides: &[(&str, &str, toml::Value)]) -> RunResult {
             .unwrap()
             .insert(key.to_string(), val.clone());
     }
-    let f = parse_table(&t, preset).unwrap();
+    let f = parse_table(&t, &src).unwrap();
     let v = resolve_design(&f, &src).unwrap();
     let r = run_scenario(&v, &f).unwrap();
     assert!(r.failure.is_none(), "{preset}: {:?}", r.failure);

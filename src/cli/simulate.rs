@@ -1,15 +1,14 @@
 //! `usm-study simulate SCENARIO [--out DIR] [--allocation METHOD] [--set key=value ...]`.
 
-use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::allocation::Method;
+use usm_study::input::keypath::{parse_override, set};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use usm_study::report::fmt_num;
 use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
-use usm_study::study::path::{set, KeyPath};
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
@@ -31,20 +30,6 @@ pub struct SimulateArgs {
     pub no_plots: bool,
 }
 
-/// Parse `key=value` with a TOML value (bare words become strings).
-fn parse_override(s: &str) -> anyhow::Result<(KeyPath, toml::Value)> {
-    let (k, v) = s
-        .split_once('=')
-        .with_context(|| format!("--set {s}: expected KEY=VALUE"))?;
-    let path = KeyPath::parse(k.trim()).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
-    let text = v.trim();
-    let value = toml::from_str::<toml::Table>(&format!("v = {text}"))
-        .ok()
-        .and_then(|mut t| t.remove("v"))
-        .unwrap_or_else(|| toml::Value::String(text.to_string()));
-    Ok((path, value))
-}
-
 /// Run `simulate`.
 pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     let (mut table, src) = load_table(&a.scenario)?;
@@ -55,7 +40,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         let (path, value) = parse_override(s)?;
         set(&mut table, &path.0, value, s).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
     }
-    let file = parse_table(&table, &src.origin)?;
+    let file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
     let out = a
         .out

@@ -111,7 +111,7 @@ pub fn run_paper(
         if let Some(m) = method {
             set_allocation_method(&mut table, *m);
         }
-        let file = parse_table(&table, &src.origin)?;
+        let file = parse_table(&table, &src)?;
         let v = resolve_design(&file, &src)?;
         let r = run_scenario(&v, &file)?;
         let run_dir: PathBuf = out.join(dir);

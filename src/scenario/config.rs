@@ -39,8 +39,12 @@ use crate::control::dynamic::DynamicGains;
 use crate::control::guidance::PathSpec;
 use crate::control::transport::TransportGains;
 use crate::control::work::WorkGains;
+use crate::control::ControlError;
 use crate::dynamics::{DynOptions, ServoModel, SimConfig, ThrusterModel};
+use crate::input::document::deserialize_table;
+use crate::input::located::KeyError;
 use crate::metrics::trajectory::PowerModel;
+use crate::model::Vehicle;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -392,16 +396,24 @@ pub enum ModeGains {
 
 impl ScenarioFile {
     /// Parse the `[control]` table for the mode; errors name the key.
-    pub fn mode_gains(&self) -> Result<ModeGains, String> {
-        let v = toml::Value::Table(self.control.clone());
+    pub fn mode_gains(&self) -> Result<ModeGains, KeyError> {
         match self.scenario.mode {
-            Mode::Transport => TransportGains::deserialize(v)
-                .map(ModeGains::Transport)
-                .map_err(|e| format!("control: {}", e.message().trim())),
-            Mode::Work => WorkGains::deserialize(v)
-                .map(ModeGains::Work)
-                .map_err(|e| format!("control: {}", e.message().trim())),
+            Mode::Transport => {
+                deserialize_table(&self.control, "control").map(ModeGains::Transport)
+            }
+            Mode::Work => deserialize_table(&self.control, "control").map(ModeGains::Work),
         }
+    }
+
+    /// Check the gains against the design `v` they will drive (USM-33/34 and the mode's
+    /// gains; work-mode weights need 6 + n entries); errors name the file key
+    /// (`control.weights`, `base_control.kp[2]`).
+    pub fn check_design(&self, v: &Vehicle) -> Result<(), KeyError> {
+        match self.mode_gains()? {
+            ModeGains::Transport(g) => g.validate(),
+            ModeGains::Work(g) => g.validate(v.n_joints()),
+        }
+        .map_err(file_key_error)
     }
 
     /// Base control gains: the file's, or the mode's default
@@ -417,7 +429,7 @@ impl ScenarioFile {
     }
 
     /// The simulator configuration.
-    pub fn sim_config(&self) -> Result<SimConfig, String> {
+    pub fn sim_config(&self) -> Result<SimConfig, KeyError> {
         let servo = match self.servo.kind.as_str() {
             "second_order" => ServoModel::SecondOrder {
                 omega_n: self.servo.omega_n,
@@ -429,8 +441,9 @@ impl ScenarioFile {
                 torque_limit: self.servo.torque_limit,
             },
             other => {
-                return Err(format!(
-                    "servo.kind: unknown servo '{other}'; valid: second_order, torque_pd"
+                return Err(KeyError::new(
+                    "servo.kind",
+                    format!("unknown servo '{other}'; valid: second_order, torque_pd"),
                 ))
             }
         };
@@ -445,8 +458,9 @@ impl ScenarioFile {
             },
             "model" => ThrusterModel::FromModel,
             other => {
-                return Err(format!(
-                    "thrusters.model: unknown model '{other}'; valid: ideal, lag, rate, model"
+                return Err(KeyError::new(
+                    "thrusters.model",
+                    format!("unknown model '{other}'; valid: ideal, lag, rate, model"),
                 ))
             }
         };
@@ -473,54 +487,25 @@ impl ScenarioFile {
     }
 
     /// Check rates, durations and mode-specific sections; errors name the key.
-    pub fn validate(&self) -> Result<(), String> {
-        let s = &self.scenario;
-        for (k, v) in [
-            ("scenario.duration", s.duration),
-            ("scenario.dt", s.dt),
-            ("scenario.control_dt", s.control_dt),
-            ("scenario.log_dt", s.log_dt),
-        ] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(format!("{k} must be a finite number > 0, got {v}"));
-            }
-        }
-        let ratio = |a: f64, b: f64| {
-            let r = (a / b).round();
-            r >= 1.0 && (a - r * b).abs() <= 1e-9 * a.max(1.0)
-        };
-        if !ratio(s.control_dt, s.dt) {
-            return Err(format!(
-                "scenario.control_dt ({}) must be a whole multiple of scenario.dt ({})",
-                s.control_dt, s.dt
-            ));
-        }
-        if !ratio(s.log_dt, s.control_dt) {
-            return Err(format!(
-                "scenario.log_dt ({}) must be a whole multiple of scenario.control_dt ({})",
-                s.log_dt, s.control_dt
-            ));
-        }
-        if s.duration / s.dt > 5.0e7 {
-            return Err(format!(
-                "scenario.duration / scenario.dt = {:.0} steps is more than 5e7",
-                s.duration / s.dt
-            ));
-        }
+    pub fn validate(&self) -> Result<(), KeyError> {
+        self.validate_rates()?;
         let finite = |k: &str, xs: &[f64]| match xs.iter().find(|x| !x.is_finite()) {
-            Some(x) => Err(format!("{k} must be finite, got {x}")),
+            Some(x) => Err(KeyError::new(k, format!("must be finite, got {x}"))),
             None => Ok(()),
         };
         finite("initial.position", &self.initial.position)?;
         finite("initial.yaw_deg", &[self.initial.yaw_deg])?;
         finite("initial.joint_angles_deg", &self.initial.joint_angles_deg)?;
         finite("physics.current", &self.physics.current)?;
-        match s.mode {
+        match self.scenario.mode {
             Mode::Transport if self.path.is_none() => {
-                return Err("path: transport mode needs a [path] table".into())
+                return Err(KeyError::new("path", "transport mode needs a [path] table"))
             }
             Mode::Work if self.setpoint.is_none() => {
-                return Err("setpoint: work mode needs a [setpoint] table".into())
+                return Err(KeyError::new(
+                    "setpoint",
+                    "work mode needs a [setpoint] table",
+                ))
             }
             _ => {}
         }
@@ -528,6 +513,60 @@ impl ScenarioFile {
             finite("setpoint.position", &sp.position)?;
             finite("setpoint.rpy_deg", &sp.rpy_deg)?;
         }
+        self.validate_metrics()?;
+        self.mode_gains()?;
+        self.base_gains().validate().map_err(file_key_error)?;
+        self.sim_config()?;
+        Ok(())
+    }
+
+    /// `[scenario]`: positive durations, control and logging periods whole multiples.
+    fn validate_rates(&self) -> Result<(), KeyError> {
+        let s = &self.scenario;
+        for (k, v) in [
+            ("scenario.duration", s.duration),
+            ("scenario.dt", s.dt),
+            ("scenario.control_dt", s.control_dt),
+            ("scenario.log_dt", s.log_dt),
+        ] {
+            positive(k, v)?;
+        }
+        let ratio = |a: f64, b: f64| {
+            let r = (a / b).round();
+            r >= 1.0 && (a - r * b).abs() <= 1e-9 * a.max(1.0)
+        };
+        if !ratio(s.control_dt, s.dt) {
+            return Err(KeyError::new(
+                "scenario.control_dt",
+                format!(
+                    "{} must be a whole multiple of scenario.dt ({})",
+                    s.control_dt, s.dt
+                ),
+            ));
+        }
+        if !ratio(s.log_dt, s.control_dt) {
+            return Err(KeyError::new(
+                "scenario.log_dt",
+                format!(
+                    "{} must be a whole multiple of scenario.control_dt ({})",
+                    s.log_dt, s.control_dt
+                ),
+            ));
+        }
+        if s.duration / s.dt > 5.0e7 {
+            return Err(KeyError::new(
+                "scenario.duration",
+                format!(
+                    "gives {:.0} steps of scenario.dt, more than 5e7",
+                    s.duration / s.dt
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// `[metrics]`: positive thresholds and tolerances.
+    fn validate_metrics(&self) -> Result<(), KeyError> {
         let m = &self.metrics;
         for (k, v) in [
             ("metrics.threshold", m.threshold),
@@ -541,21 +580,37 @@ impl ScenarioFile {
             ("metrics.efficiency", m.efficiency),
             ("metrics.divergence_distance", m.divergence_distance),
         ] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(format!("{k} must be a finite number > 0, got {v}"));
-            }
+            positive(k, v)?;
         }
         if !m.char_length.is_finite() || m.char_length < 0.0 {
-            return Err(format!(
-                "metrics.char_length must be finite and >= 0, got {}",
-                m.char_length
+            return Err(KeyError::new(
+                "metrics.char_length",
+                format!("must be finite and >= 0, got {}", m.char_length),
             ));
         }
-        self.mode_gains()?;
-        self.base_gains()
-            .validate()
-            .map_err(|e| format!("base_control.{e}"))?;
-        self.sim_config()?;
         Ok(())
     }
+}
+
+/// `key` must be a finite number > 0.
+fn positive(key: &str, v: f64) -> Result<(), KeyError> {
+    if !v.is_finite() || v <= 0.0 {
+        return Err(KeyError::new(
+            key,
+            format!("must be a finite number > 0, got {v}"),
+        ));
+    }
+    Ok(())
+}
+
+/// A control-layer error keyed by the controller (`transport.k_psi`, `work.weights`,
+/// `dynamic.kp[2]`) as an error keyed by the scenario file (`control.k_psi`,
+/// `control.weights`, `base_control.kp[2]`).
+fn file_key_error(e: ControlError) -> KeyError {
+    let key = match e.key.split_once('.') {
+        Some(("transport" | "work", rest)) => format!("control.{rest}"),
+        Some(("dynamic", rest)) => format!("base_control.{rest}"),
+        _ => e.key,
+    };
+    KeyError::new(key, e.message)
 }

@@ -35,10 +35,10 @@ pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
 pub use run::{run_scenario, RunResult};
 
-use crate::diag::line_col;
+use crate::input::document::{deserialize_table, Document};
+use crate::input::located::KeyError;
 use crate::model::design::{load_design, parse_design_table};
 use crate::model::Vehicle;
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// Names of the built-in scenarios.
@@ -138,83 +138,105 @@ pub fn preset_names() -> Vec<&'static str> {
     PRESETS.to_vec()
 }
 
-/// Where a scenario came from: a preset or a file (whose directory anchors relative paths).
+/// Where a scenario came from: a preset or a file (whose directory anchors relative paths),
+/// with its located document so that errors name the line of their key.
 #[derive(Clone, Debug)]
 pub struct Source {
     /// Name used in messages (file path or preset name).
     pub origin: String,
     /// Directory for relative design paths.
     pub dir: PathBuf,
+    /// The text as read, with the span of every key (see [`Document`]).
+    pub doc: Document,
+}
+
+impl Source {
+    /// A scenario table built in memory (a sweep case): errors name keys but no lines.
+    pub fn unplaced(origin: &str) -> Source {
+        Source {
+            origin: origin.to_string(),
+            dir: PathBuf::from("."),
+            doc: Document::unplaced(origin),
+        }
+    }
+
+    /// `e` placed in this scenario's document (file, line, column, key) as a
+    /// [`ScenarioError::Invalid`].
+    pub fn invalid(&self, e: KeyError) -> ScenarioError {
+        ScenarioError::Invalid(self.doc.place(e).to_string())
+    }
 }
 
 /// Read a scenario (preset name or file) as a TOML table; errors give file:line:col.
 pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     let path = Path::new(arg);
-    let (text, src) = if path.is_file() {
+    let (text, dir) = if path.is_file() {
         let text = std::fs::read_to_string(path)
             .map_err(|e| ScenarioError::Invalid(format!("{arg}: {e}")))?;
-        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         (
             text,
-            Source {
-                origin: arg.to_string(),
-                dir,
-            },
+            Some(path.parent().map(Path::to_path_buf).unwrap_or_default()),
         )
     } else if let Some(t) = preset_text(arg) {
-        (
-            t,
-            Source {
-                origin: arg.to_string(),
-                dir: PathBuf::from("."),
-            },
-        )
+        (t, None)
     } else {
         return Err(ScenarioError::Invalid(format!(
             "{arg}: no such scenario file, and not a preset (presets: {})",
             preset_names().join(", ")
         )));
     };
-    let table: toml::Table = toml::from_str(&text).map_err(|e| {
-        ScenarioError::Invalid(format!(
-            "{}{}: {}",
-            src.origin,
-            e.span()
-                .map(|s| {
-                    let (l, c) = line_col(&text, s.start);
-                    format!(":{l}:{c}")
-                })
-                .unwrap_or_default(),
-            e.message().trim()
-        ))
-    })?;
+    parse_source(&text, arg, dir)
+}
+
+/// A scenario's text as a table and its [`Source`]. `dir` is the directory of a file the
+/// user wrote (its errors name lines); `None` for a preset (errors name keys only: the
+/// preset's text is not a file the user can open).
+fn parse_source(
+    text: &str,
+    origin: &str,
+    dir: Option<PathBuf>,
+) -> Result<(toml::Table, Source), ScenarioError> {
+    let invalid = |e| ScenarioError::Invalid(format!("{e}"));
+    let doc = match dir {
+        Some(_) => Document::parse(text, origin),
+        None => Document::parse_generated(text, origin),
+    }
+    .map_err(invalid)?;
+    let table = doc.deserialize::<toml::Table>().map_err(invalid)?;
+    let src = Source {
+        origin: origin.to_string(),
+        dir: dir.unwrap_or_else(|| PathBuf::from(".")),
+        doc,
+    };
     Ok((table, src))
 }
 
-/// Parse a scenario table (after any overrides); `origin` names it in errors.
-pub fn parse_table(table: &toml::Table, origin: &str) -> Result<ScenarioFile, ScenarioError> {
-    let f = ScenarioFile::deserialize(toml::Value::Table(table.clone()))
-        .map_err(|e| ScenarioError::Invalid(format!("{origin}: {}", e.message().trim())))?;
-    f.validate()
-        .map_err(|e| ScenarioError::Invalid(format!("{origin}: {e}")))?;
+/// Parse a scenario table (after any overrides) read from `src`; errors name the file, the
+/// key and, for keys of the file, the line.
+pub fn parse_table(table: &toml::Table, src: &Source) -> Result<ScenarioFile, ScenarioError> {
+    let f: ScenarioFile = deserialize_table(table, "").map_err(|e| src.invalid(e))?;
+    f.validate().map_err(|e| src.invalid(e))?;
     Ok(f)
 }
 
 /// The design a scenario runs: its inline `[design]` table, or `scenario.design` (a preset,
-/// or a file relative to the scenario's directory).
+/// or a file relative to the scenario's directory), checked against the scenario's gains.
 pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, ScenarioError> {
-    if let Some(t) = &file.design {
-        return parse_design_table(t, &format!("{} [design]", src.origin))
-            .map_err(|e| ScenarioError::Invalid(e.to_string()));
-    }
-    let d = &file.scenario.design;
-    let rel = src.dir.join(d);
-    let arg = if rel.is_file() {
-        rel.display().to_string()
+    let v = if let Some(t) = &file.design {
+        parse_design_table(t, &format!("{} [design]", src.origin))
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?
     } else {
-        d.clone()
+        let d = &file.scenario.design;
+        let rel = src.dir.join(d);
+        let arg = if rel.is_file() {
+            rel.display().to_string()
+        } else {
+            d.clone()
+        };
+        load_design(&arg).map_err(|e| ScenarioError::Invalid(e.to_string()))?
     };
-    load_design(&arg).map_err(|e| ScenarioError::Invalid(e.to_string()))
+    file.check_design(&v).map_err(|e| src.invalid(e))?;
+    Ok(v)
 }
 
 /// Every scenario-side key with its default for `mode` (`transport` or `work`): the
@@ -231,12 +253,11 @@ pub fn default_table(mode: &str) -> Result<toml::Table, ScenarioError> {
         }
     };
     let text = preset_text(preset).unwrap_or_default();
-    let table: toml::Table =
-        toml::from_str(&text).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
-    let f = parse_table(&table, preset)?;
+    let (table, src) = parse_source(&text, preset, None)?;
+    let f = parse_table(&table, &src)?;
     let mut full = toml::Table::try_from(&f).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
     // Write the mode's gains out in full (the file may give only a few keys).
-    let gains = match f.mode_gains().map_err(ScenarioError::Invalid)? {
+    let gains = match f.mode_gains().map_err(|e| src.invalid(e))? {
         config::ModeGains::Transport(g) => toml::Table::try_from(&g),
         config::ModeGains::Work(g) => toml::Table::try_from(&g),
     }
@@ -270,7 +291,7 @@ pub fn run_case(
     log: bool,
 ) -> Result<CaseRun, ScenarioError> {
     let _ = seed;
-    let f = parse_table(scenario, "scenario")?;
+    let f = parse_table(scenario, &Source::unplaced("scenario"))?;
     let r = run_scenario(vehicle, &f)?;
     Ok(CaseRun {
         metrics: r.metrics,
@@ -289,7 +310,7 @@ mod tests {
     fn presets_parse_and_default_tables_are_complete() {
         for name in preset_names() {
             let (t, src) = load_table(name).unwrap();
-            let f = parse_table(&t, name).unwrap();
+            let f = parse_table(&t, &src).unwrap();
             resolve_design(&f, &src).unwrap();
         }
         for mode in ["transport", "work"] {
@@ -298,7 +319,7 @@ mod tests {
                 assert!(t.contains_key(k), "{mode}: {k}");
             }
             // The full table parses back.
-            parse_table(&t, mode).unwrap();
+            parse_table(&t, &Source::unplaced(mode)).unwrap();
         }
         assert!(default_table("static").is_err());
     }
@@ -310,15 +331,124 @@ mod tests {
             .as_table_mut()
             .unwrap()
             .insert("control_dt".into(), toml::Value::Float(0.033));
-        let e = parse_table(&t, "x").unwrap_err().to_string();
+        let e = parse_table(&t, &Source::unplaced("x"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("control_dt"), "{e}");
         let (mut t, _) = load_table("transport-method2").unwrap();
         t["control"]
             .as_table_mut()
             .unwrap()
             .insert("k_spi".into(), toml::Value::Float(0.3));
-        let e = parse_table(&t, "x").unwrap_err().to_string();
+        let e = parse_table(&t, &Source::unplaced("x"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("k_spi"), "{e}");
         assert!(load_table("nope").is_err());
+    }
+
+    /// The error of `text` (a scenario file named `s.toml`) from parsing, validation and
+    /// the design check, as printed.
+    fn error_of(text: &str) -> String {
+        let (t, src) = parse_source(text, "s.toml", Some(PathBuf::from("."))).unwrap();
+        let e = match parse_table(&t, &src) {
+            Ok(f) => resolve_design(&f, &src).map(|_| ()).unwrap_err(),
+            Err(e) => e,
+        };
+        e.to_string()
+    }
+
+    /// `preset` with its first line starting with `old` replaced by `line`, and that line's
+    /// 1-based number.
+    fn preset_with(preset: &str, old: &str, line: &str) -> (String, usize) {
+        let text = preset_text(preset).unwrap();
+        let mut lines: Vec<&str> = text.lines().collect();
+        let n = lines.iter().position(|l| l.starts_with(old)).unwrap();
+        lines[n] = line;
+        (lines.join("\n"), n + 1)
+    }
+
+    #[test]
+    fn semantic_errors_name_the_line_and_key() {
+        let cases = [
+            (
+                "work-setpoint",
+                "duration =",
+                "duration = -5.0",
+                "scenario.duration",
+                "must be a finite number > 0",
+            ),
+            (
+                "work-setpoint",
+                "control_dt =",
+                "control_dt = 0.033",
+                "scenario.control_dt",
+                "whole multiple",
+            ),
+            (
+                "transport-method2",
+                "method = \"qp\"",
+                "method = \"simplex\"",
+                "allocation.method",
+                "unknown variant",
+            ),
+            (
+                "work-setpoint",
+                "k_b =",
+                "k_b = [0.15, 0.15]",
+                "control.k_b",
+                "invalid length 2",
+            ),
+            (
+                "work-setpoint",
+                "weights =",
+                "weights = [1.0, 1.0]",
+                "control.weights",
+                "the design needs 6 + 8",
+            ),
+            (
+                "work-setpoint",
+                "kp =",
+                "kp = [1.0, -1.0, 1.0, 0.0, 1.0, 1.0]",
+                "base_control.kp[1]",
+                "must be >= 0",
+            ),
+        ];
+        for (preset, old, line, path, message) in cases {
+            let (text, n) = preset_with(preset, old, line);
+            let e = error_of(&text);
+            assert!(e.starts_with(&format!("s.toml:{n}:")), "{line}: {e}");
+            assert!(e.contains(&format!(": {path}: ")), "{line}: {e}");
+            assert!(e.contains(message), "{line}: {e}");
+        }
+    }
+
+    #[test]
+    fn syntax_and_missing_sections_are_located() {
+        let (text, n) = preset_with("work-setpoint", "duration =", "duration = ");
+        let e = parse_source(&text, "s.toml", Some(PathBuf::from(".")))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&format!("s.toml:{n}:")), "{e}");
+        assert!(e.contains("TOML syntax error"), "{e}");
+        let text = preset_text("transport-method2")
+            .unwrap()
+            .replace("[path]", "[pathx]");
+        let e = error_of(&text);
+        assert!(e.contains(": pathx: unknown field `pathx`"), "{e}");
+        // An override of a key the file does not have is named, without a line.
+        let (mut t, src) = load_table("transport-method2").unwrap();
+        let physics = toml::Table::from_iter([("drag".to_string(), 1.0.into())]);
+        t.insert("physics".into(), toml::Value::Table(physics));
+        let e = parse_table(&t, &src).unwrap_err().to_string();
+        assert!(e.starts_with("transport-method2: physics.drag: "), "{e}");
+        // A preset's text is not a file the user sees: its errors name keys, not lines.
+        let (mut t, src) = load_table("work-setpoint").unwrap();
+        t["scenario"]["duration"] = toml::Value::Float(-1.0);
+        let e = parse_table(&t, &src).unwrap_err().to_string();
+        assert!(
+            e.starts_with("work-setpoint: scenario.duration: must be"),
+            "{e}"
+        );
     }
 }

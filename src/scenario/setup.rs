@@ -89,7 +89,8 @@ fn allocator(v: &Vehicle, file: &ScenarioFile) -> Result<Allocator, ScenarioErro
 impl<'f> ClosedLoop<'f> {
     /// Set up a run of `file` on `v`. Settings problems are [`ScenarioError::Invalid`].
     pub fn new(v: &Vehicle, file: &'f ScenarioFile) -> Result<Self, ScenarioError> {
-        file.validate().map_err(ScenarioError::Invalid)?;
+        file.validate()
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let s = &file.scenario;
         let mut vehicle = v.clone();
         vehicle.fluid.current = Vec3::from(file.physics.current);
@@ -100,11 +101,17 @@ impl<'f> ClosedLoop<'f> {
                 "design: a closed-loop scenario needs at least one thruster".into(),
             ));
         }
-        let mut sim = Simulator::new(v, file.sim_config().map_err(ScenarioError::Invalid)?)
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+        let mut sim = Simulator::new(
+            v,
+            file.sim_config()
+                .map_err(|e| ScenarioError::Invalid(e.to_string()))?,
+        )
+        .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         sim.set_state(initial_state(v, file)?)
             .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
-        let gains = file.mode_gains().map_err(ScenarioError::Invalid)?;
+        let gains = file
+            .mode_gains()
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let base_ctl = DynamicController::new(file.base_gains())
             .map_err(|e| ScenarioError::Invalid(format!("base_control.{e}")))?;
         let q0 = sim.state().joint_angles.clone();

@@ -7,11 +7,11 @@ use std::collections::BTreeSet;
 use serde::Deserialize;
 
 use super::error::InputError;
-use super::path::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
 use super::schema::{
     is_scenario_table, Axis, AxisSpec, Dist, Doe, Target, GENERATOR_KEYS, MAX_CASES,
 };
-use super::spans::Spans;
+use crate::input::document::Document;
+use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
 use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
 
 #[derive(Deserialize)]
@@ -124,19 +124,19 @@ pub(crate) fn parse_axes(
     names: &Names,
     design: &toml::Table,
     doe: Doe,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<Vec<Axis>, InputError> {
     let mut axes = Vec::new();
     for (i, a) in files.iter().enumerate() {
-        let axis = validate_axis(a, i, names, design, doe, spans)?;
+        let axis = validate_axis(a, i, names, design, doe, doc)?;
         if axes.iter().any(|b: &Axis| b.name == axis.name) {
-            return Err(spans.err(&format!("axis[{i}].name"), "duplicate axis name"));
+            return Err(doc.err(&format!("axis[{i}].name"), "duplicate axis name"));
         }
         axes.push(axis);
     }
     if let Doe::Sampled { kind, .. } = doe {
         if kind == Sampling::Sobol && axes.len() > MAX_SOBOL_DIMS {
-            return Err(spans.err(
+            return Err(doc.err(
                 "doe.kind",
                 format!("sobol supports at most {MAX_SOBOL_DIMS} axes"),
             ));
@@ -148,7 +148,7 @@ pub(crate) fn parse_axes(
             n = n.saturating_mul(a.spec.grid_len());
         }
         if n > MAX_CASES {
-            return Err(spans.err(
+            return Err(doc.err(
                 "axis",
                 format!("the grid has {n} cases, more than {MAX_CASES}"),
             ));
@@ -163,10 +163,10 @@ fn validate_axis(
     names: &Names,
     design: &toml::Table,
     doe: Doe,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<Axis, InputError> {
     let unknown = || {
-        spans.err(
+        doc.err(
             &format!("axis[{i}].name"),
             format!(
                 "unknown parameter `{}`; valid names: {}",
@@ -175,14 +175,14 @@ fn validate_axis(
             ),
         )
     };
-    let (target, reference) = axis_target(a, i, names, design, spans)?.ok_or_else(unknown)?;
+    let (target, reference) = axis_target(a, i, names, design, doc)?.ok_or_else(unknown)?;
     let integer = matches!(reference, Some(toml::Value::Integer(_)));
     let spec = match (&a.values, &a.range, &a.distribution) {
-        (Some(v), None, None) => values_spec(v, i, spans)?,
-        (None, Some(r), None) => range_spec(r, i, doe, spans)?,
-        (None, None, Some(d)) => distribution_spec(d, i, doe, spans)?,
+        (Some(v), None, None) => values_spec(v, i, doc)?,
+        (None, Some(r), None) => range_spec(r, i, doe, doc)?,
+        (None, None, Some(d)) => distribution_spec(d, i, doe, doc)?,
         _ => {
-            return Err(spans.err(
+            return Err(doc.err(
                 &format!("axis[{i}]"),
                 "needs exactly one of `values = [...]`, `range = { start, stop, steps }` or `distribution = { kind, ... }`",
             ))
@@ -210,9 +210,9 @@ fn axis_target(
     i: usize,
     names: &Names,
     design: &toml::Table,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<Option<(Target, Option<toml::Value>)>, InputError> {
-    let path = KeyPath::parse(&a.name).map_err(|m| spans.err(&format!("axis[{i}].name"), m))?;
+    let path = KeyPath::parse(&a.name).map_err(|m| doc.err(&format!("axis[{i}].name"), m))?;
     if path.head() == "design" {
         let mut rest = path.tail();
         if names.generator {
@@ -227,7 +227,7 @@ fn axis_target(
         {
             return Ok(None);
         }
-        let reference = super::path::get(design, &rest.0)
+        let reference = crate::input::keypath::get(design, &rest.0)
             .cloned()
             .or_else(|| (rest.pattern() == "generator.links").then_some(toml::Value::Integer(5)));
         Ok(Some((Target::Design(rest), reference)))
@@ -235,7 +235,7 @@ fn axis_target(
         if !pattern_allowed(&path.pattern(), &names.scenario, &names.scenario_arrays) {
             return Ok(None);
         }
-        let reference = super::path::get(&names.scenario_ref, &path.0).cloned();
+        let reference = crate::input::keypath::get(&names.scenario_ref, &path.0).cloned();
         Ok(Some((Target::Scenario(path), reference)))
     } else {
         Ok(None)
@@ -243,34 +243,32 @@ fn axis_target(
 }
 
 /// `values = [...]`: non-empty, finite.
-fn values_spec(v: &[toml::Value], i: usize, spans: &Spans) -> Result<AxisSpec, InputError> {
+fn values_spec(v: &[toml::Value], i: usize, doc: &Document) -> Result<AxisSpec, InputError> {
     if v.is_empty() {
-        return Err(spans.err(&format!("axis[{i}].values"), "needs at least one value"));
+        return Err(doc.err(&format!("axis[{i}].values"), "needs at least one value"));
     }
     if let Some(j) = v
         .iter()
         .position(|x| matches!(x, toml::Value::Float(f) if !f.is_finite()))
     {
-        return Err(spans.err(&format!("axis[{i}].values[{j}]"), "must be finite"));
+        return Err(doc.err(&format!("axis[{i}].values[{j}]"), "must be finite"));
     }
     Ok(AxisSpec::Values(v.to_vec()))
 }
 
 /// `range = { start, stop, steps, log }`: finite ends, positive for `log`, `steps` for grids.
-fn range_spec(r: &RangeFile, i: usize, doe: Doe, spans: &Spans) -> Result<AxisSpec, InputError> {
+fn range_spec(r: &RangeFile, i: usize, doe: Doe, doc: &Document) -> Result<AxisSpec, InputError> {
     let key = |f: &str| format!("axis[{i}].{f}");
     if !(r.start.is_finite() && r.stop.is_finite()) {
-        return Err(spans.err(&key("range"), "start and stop must be finite"));
+        return Err(doc.err(&key("range"), "start and stop must be finite"));
     }
     let log = r.log.unwrap_or(false);
     if log && !(r.start > 0.0 && r.stop > 0.0) {
-        return Err(spans.err(&key("range.log"), "a log range needs start, stop > 0"));
+        return Err(doc.err(&key("range.log"), "a log range needs start, stop > 0"));
     }
     match (doe, r.steps) {
-        (Doe::Grid, None) => {
-            return Err(spans.err(&key("range"), "grid designs need `steps` (>= 1)"))
-        }
-        (_, Some(0)) => return Err(spans.err(&key("range.steps"), "must be >= 1")),
+        (Doe::Grid, None) => return Err(doc.err(&key("range"), "grid designs need `steps` (>= 1)")),
+        (_, Some(0)) => return Err(doc.err(&key("range.steps"), "must be >= 1")),
         _ => {}
     }
     Ok(AxisSpec::Range {
@@ -287,10 +285,10 @@ fn distribution_spec(
     d: &DistFile,
     i: usize,
     doe: Doe,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<AxisSpec, InputError> {
     if doe == Doe::Grid {
-        return Err(spans.err(
+        return Err(doc.err(
             &format!("axis[{i}].distribution"),
             "distributions need a sampled design ([doe] kind = \"random\" | \"lhs\" | \"sobol\")",
         ));
@@ -298,10 +296,10 @@ fn distribution_spec(
     let dk = |f: &str| format!("axis[{i}].distribution.{f}");
     let need = |v: Option<f64>, f: &str| {
         v.filter(|x| x.is_finite())
-            .ok_or_else(|| spans.err(&dk(f), format!("`{f}` is required and must be finite")))
+            .ok_or_else(|| doc.err(&dk(f), format!("`{f}` is required and must be finite")))
     };
     let forbid = |v: Option<f64>, f: &str| match v {
-        Some(_) => Err(spans.err(&dk(f), format!("not a parameter of kind \"{}\"", d.kind))),
+        Some(_) => Err(doc.err(&dk(f), format!("not a parameter of kind \"{}\"", d.kind))),
         None => Ok(()),
     };
     let dist = match d.kind.as_str() {
@@ -310,13 +308,13 @@ fn distribution_spec(
             forbid(d.std, "std")?;
             let (lo, hi) = (need(d.low, "low")?, need(d.high, "high")?);
             if lo >= hi {
-                return Err(spans.err(&dk("high"), "needs low < high"));
+                return Err(doc.err(&dk("high"), "needs low < high"));
             }
             if d.kind == "uniform" {
                 Dist::Uniform(lo, hi)
             } else {
                 if lo <= 0.0 {
-                    return Err(spans.err(&dk("low"), "loguniform needs low > 0"));
+                    return Err(doc.err(&dk("low"), "loguniform needs low > 0"));
                 }
                 Dist::LogUniform(lo, hi)
             }
@@ -326,12 +324,12 @@ fn distribution_spec(
             forbid(d.high, "high")?;
             let (m, s) = (need(d.mean, "mean")?, need(d.std, "std")?);
             if s <= 0.0 {
-                return Err(spans.err(&dk("std"), "must be > 0"));
+                return Err(doc.err(&dk("std"), "must be > 0"));
             }
             Dist::Normal(m, s)
         }
         other => {
-            return Err(spans.err(
+            return Err(doc.err(
                 &dk("kind"),
                 format!("unknown distribution '{other}'; valid: uniform, loguniform, normal"),
             ))

@@ -3,8 +3,8 @@
 
 use super::doe::Case;
 use super::hash::{case_hashes, unresolved_case_hash};
-use super::path::{set, Seg};
 use super::schema::{Study, Target};
+use crate::input::keypath::{set, Seg};
 use crate::model::design::{design_to_toml, parse_design_table};
 use crate::sampling::derive_seed;
 

@@ -1,51 +1,11 @@
 //! Errors of the study room: [`InputError`] (a located problem with the study file) and
 //! [`StudyError`] (everything a sweep, merge or report can fail with).
 
-use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::diag::write_located;
-use crate::model::design::DesignError;
-
-/// A problem with the study file or the command line (exit code 2).
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub struct InputError {
-    /// File (or other origin) of the problem.
-    pub origin: String,
-    /// 1-based line, when known.
-    pub line: Option<usize>,
-    /// 1-based column, when known.
-    pub column: Option<usize>,
-    /// Key path, e.g. `axis[2].name`; empty when none.
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for InputError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_located(
-            f,
-            &self.origin,
-            self.line,
-            self.column,
-            &self.key,
-            &self.message,
-        )
-    }
-}
-
-impl From<DesignError> for InputError {
-    fn from(e: DesignError) -> Self {
-        InputError {
-            origin: e.origin,
-            line: e.line,
-            column: e.column,
-            key: e.key,
-            message: e.message,
-        }
-    }
-}
+/// A problem with the study file or the command line (exit code 2), located by the input
+/// layer (`file:line:col: key: message`).
+pub use crate::input::located::InputError;
 
 /// Errors of the batch engine. [`StudyError::is_input`] tells bad input (exit code 2) from
 /// other failures.

@@ -6,8 +6,6 @@
 //!
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
-//! - [`spans`]: key positions in a study file, for located errors.
-//! - [`path`]: parameter paths of sweep axes and table edits.
 //! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
 //! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
 //! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
@@ -33,14 +31,12 @@ pub mod finish;
 pub mod hash;
 pub mod manifest;
 pub mod parse;
-pub mod path;
 pub mod plots;
 pub mod records;
 pub mod runner;
 pub mod schema;
 pub mod selection;
 pub mod shards;
-pub mod spans;
 pub mod static_table;
 pub mod static_tcm;
 pub mod summary;

@@ -13,11 +13,12 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 use super::error::InputError;
 use super::hash::study_hash;
-use super::path::{flatten, pattern_allowed};
 use super::runner::{self, Mode};
 use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
-use super::spans::Spans;
 use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
+use crate::input::document::Document;
+use crate::input::keypath::{flatten, pattern_allowed};
+use crate::input::located::Location;
 use crate::model::design::{load_design_table, parse_design_table};
 
 #[derive(Deserialize)]
@@ -76,11 +77,8 @@ fn merge_into(base: &mut toml::Table, over: &toml::Table) {
 pub fn load_study(path: &Path) -> Result<Study, InputError> {
     let origin = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| InputError {
-        origin: origin.clone(),
-        line: None,
-        column: None,
-        key: String::new(),
-        message: format!("cannot read the study file: {e}"),
+        at: Location::origin(&origin),
+        error: format!("cannot read the study file: {e}"),
     })?;
     parse_study(&text, path)
 }
@@ -88,17 +86,17 @@ pub fn load_study(path: &Path) -> Result<Study, InputError> {
 fn base_design(
     d: &toml::Table,
     dir: &Path,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<(toml::Table, String), InputError> {
     if let Some(f) = d.get("file") {
         if let Some(k) = d.keys().find(|k| *k != "file") {
-            return Err(spans.err(
+            return Err(doc.err(
                 &format!("design.{k}"),
                 "cannot be combined with `design.file`",
             ));
         }
         let f = f.as_str().ok_or_else(|| {
-            spans.err(
+            doc.err(
                 "design.file",
                 "must be a string (a path relative to the study file)",
             )
@@ -106,14 +104,14 @@ fn base_design(
         let p = dir.join(f);
         let arg = p.display().to_string();
         if !p.is_file() {
-            return Err(spans.err("design.file", format!("no design file {arg}")));
+            return Err(doc.err("design.file", format!("no design file {arg}")));
         }
         let t = load_design_table(&arg).map_err(InputError::from)?;
         return Ok((t, arg));
     }
     if let Some(p) = d.get("preset") {
         if let Some(k) = d.keys().find(|k| *k != "preset" && *k != "name") {
-            return Err(spans.err(
+            return Err(doc.err(
                 &format!("design.{k}"),
                 "not allowed with `design.preset` (only `name`); sweep axes may still edit the \
                  preset's keys, e.g. design.thruster[2].position",
@@ -121,8 +119,8 @@ fn base_design(
         }
         let p = p
             .as_str()
-            .ok_or_else(|| spans.err("design.preset", "must be a string"))?;
-        let mut t = load_design_table(p).map_err(|e| spans.err("design.preset", e.message))?;
+            .ok_or_else(|| doc.err("design.preset", "must be a string"))?;
+        let mut t = load_design_table(p).map_err(|e| doc.err("design.preset", e.error.message))?;
         if let Some(n) = d.get("name") {
             t.insert("name".into(), n.clone());
         }
@@ -132,27 +130,27 @@ fn base_design(
     if !t.contains_key("name") {
         t.insert("name".into(), toml::Value::String("design".into()));
     }
-    Ok((t, format!("{} [design]", spans.origin)))
+    Ok((t, format!("{} [design]", doc.origin())))
 }
 
 /// Parse and validate study text; `path` locates relative design files and names the origin.
 pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
     let origin = path.display().to_string();
-    let spans = Spans::parse(text, &origin)?;
-    let file: StudyFile = toml::from_str(text).map_err(|e| spans.serde(&e))?;
+    let doc = Document::parse(text, &origin)?;
+    let file: StudyFile = toml::from_str(text).map_err(|e| doc.serde_error(&e))?;
     let meta = &file.study;
-    check_name(&meta.name, &spans)?;
+    check_name(&meta.name, &doc)?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let (design, generator) = check_design(&file, dir, &spans)?;
-    let side = scenario_side(&file, &spans)?;
+    let (design, generator) = check_design(&file, dir, &doc)?;
+    let side = scenario_side(&file, &doc)?;
     let names = valid_names(&design, generator, side.names, side.arrays, side.reference);
-    let doe = parse_doe(file.doe.as_ref(), &spans)?;
+    let doe = parse_doe(file.doe.as_ref(), &doc)?;
     let axes = parse_axes(
         file.axis.as_deref().unwrap_or_default(),
         &names,
         &design,
         doe,
-        &spans,
+        &doc,
     )?;
     let output = meta
         .output
@@ -185,14 +183,14 @@ pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
 }
 
 /// `study.name` names the output directory: non-empty, letters, digits, `_`, `-` and `.`.
-fn check_name(name: &str, spans: &Spans) -> Result<(), InputError> {
+fn check_name(name: &str, doc: &Document) -> Result<(), InputError> {
     if name.is_empty()
         || !name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
         || name.starts_with('.')
     {
-        return Err(spans.err(
+        return Err(doc.err(
             "study.name",
             "must be non-empty and use only letters, digits, `_`, `-` and `.` (it names the output directory)",
         ));
@@ -204,9 +202,9 @@ fn check_name(name: &str, spans: &Spans) -> Result<(), InputError> {
 fn check_design(
     file: &StudyFile,
     dir: &Path,
-    spans: &Spans,
+    doc: &Document,
 ) -> Result<(toml::Table, bool), InputError> {
-    let (design, design_origin) = base_design(&file.design, dir, spans)?;
+    let (design, design_origin) = base_design(&file.design, dir, doc)?;
     let generator = design.contains_key("generator");
     if let Err(e) = parse_design_table(&design, &design_origin) {
         return Err(if file.design.contains_key("file") {
@@ -221,12 +219,12 @@ fn check_design(
                 Ok(_) => e.into(),
             }
         } else {
-            let key = if e.key.is_empty() {
+            let key = if e.at.key.is_empty() {
                 "design".to_string()
             } else {
-                format!("design.{}", e.key)
+                format!("design.{}", e.at.key)
             };
-            spans.err(&key, e.message)
+            doc.err(&key, e.error.message)
         });
     }
     Ok((design, generator))
@@ -247,7 +245,7 @@ struct ScenarioSide {
     arrays: BTreeSet<String>,
 }
 
-fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputError> {
+fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, InputError> {
     let mut own = toml::Table::new();
     for (k, t) in [
         ("scenario", &file.scenario),
@@ -267,9 +265,9 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
             own.insert(k.into(), toml::Value::Table(t.clone()));
         }
     }
-    let mode = parse_mode(file, spans)?;
+    let mode = parse_mode(file, doc)?;
     let static_enabled = mode == Mode::Static || file.static_.is_some();
-    let mut defaults = runner::default_table(mode).map_err(|m| spans.err("scenario.mode", m))?;
+    let mut defaults = runner::default_table(mode).map_err(|m| doc.err("scenario.mode", m))?;
     if static_enabled {
         defaults.insert(
             STATIC_TABLE.into(),
@@ -285,14 +283,14 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
         .iter()
         .find(|p| !pattern_allowed(p, &sc_names, &sc_arrays))
     {
-        return Err(unknown_scenario_key(p, mode, &sc_names, spans));
+        return Err(unknown_scenario_key(p, mode, &sc_names, doc));
     }
     let mut reference = defaults;
     merge_into(&mut reference, &own);
     // Static settings of the base must parse.
     if static_enabled {
         if let Err(m) = static_spec(&reference, 0) {
-            return Err(spans.err(STATIC_TABLE, m));
+            return Err(doc.err(STATIC_TABLE, m));
         }
     }
     Ok(ScenarioSide {
@@ -306,14 +304,14 @@ fn scenario_side(file: &StudyFile, spans: &Spans) -> Result<ScenarioSide, InputE
 }
 
 /// `scenario.mode` (default `static`).
-fn parse_mode(file: &StudyFile, spans: &Spans) -> Result<Mode, InputError> {
+fn parse_mode(file: &StudyFile, doc: &Document) -> Result<Mode, InputError> {
     let Some(v) = file.scenario.as_ref().and_then(|s| s.get("mode")) else {
         return Ok(Mode::Static);
     };
     if let Some(m) = v.as_str().and_then(|m| m.parse::<Mode>().ok()) {
         return Ok(m);
     }
-    Err(spans.err(
+    Err(doc.err(
         "scenario.mode",
         format!(
             "must be one of {}, got {v}",
@@ -331,7 +329,7 @@ fn unknown_scenario_key(
     p: &str,
     mode: Mode,
     valid: &BTreeSet<String>,
-    spans: &Spans,
+    doc: &Document,
 ) -> InputError {
     let parent = p.rfind('.').map_or("", |i| &p[..i]);
     let siblings: Vec<String> = valid
@@ -339,7 +337,7 @@ fn unknown_scenario_key(
         .filter(|n| n.rfind('.').map_or("", |i| &n[..i]) == parent && !n.contains("[]"))
         .map(|n| n.rsplit('.').next().unwrap_or(n).to_string())
         .collect();
-    spans.err(
+    doc.err(
         p,
         format!(
             "unknown key for scenario mode \"{mode}\"; valid keys here: {}",
@@ -353,24 +351,24 @@ fn unknown_scenario_key(
 }
 
 /// `[doe]` (default: grid).
-fn parse_doe(d: Option<&DoeFile>, spans: &Spans) -> Result<Doe, InputError> {
+fn parse_doe(d: Option<&DoeFile>, doc: &Document) -> Result<Doe, InputError> {
     let Some(d) = d else {
         return Ok(Doe::Grid);
     };
-    let kind: DoeKind = d.kind.parse().map_err(|m| spans.err("doe.kind", m))?;
+    let kind: DoeKind = d.kind.parse().map_err(|m| doc.err("doe.kind", m))?;
     match kind.sampling() {
         None => {
             if d.cases.is_some() {
-                return Err(spans.err("doe.cases", "only for sampled designs (random, lhs, sobol)"));
+                return Err(doc.err("doe.cases", "only for sampled designs (random, lhs, sobol)"));
             }
             Ok(Doe::Grid)
         }
         Some(kind) => {
             let cases = d
                 .cases
-                .ok_or_else(|| spans.err("doe", "sampled designs need `cases = N`"))?;
+                .ok_or_else(|| doc.err("doe", "sampled designs need `cases = N`"))?;
             if cases == 0 || cases > MAX_CASES {
-                return Err(spans.err("doe.cases", format!("must be in 1..={MAX_CASES}")));
+                return Err(doc.err("doe.cases", format!("must be in 1..={MAX_CASES}")));
             }
             Ok(Doe::Sampled { kind, cases })
         }

@@ -5,9 +5,9 @@ use std::fmt;
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use super::path::KeyPath;
 use super::runner::{Mode, SCENARIO_TABLES};
 use super::static_table::STATIC_TABLE;
+use crate::input::keypath::KeyPath;
 use crate::sampling::Sampling;
 
 /// Largest number of cases of a study.

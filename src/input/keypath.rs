@@ -1,6 +1,7 @@
-//! Parameter paths of sweep axes (`design.thruster[2].position[0]`, `control.W[3]`) and the
-//! `toml::Table` operations behind them: look-up, assignment with type coercion, and the
-//! flattened list of valid paths of a table.
+//! Key paths into TOML tables (`design.thruster[2].position[0]`, `control.W[3]`): the one
+//! grammar behind sweep axes, `--set KEY=VALUE` overrides, error locations and the optimiser's
+//! parameters, with the `toml::Table` operations on them: look-up, assignment with type
+//! coercion, and the flattened list of valid paths of a table.
 //!
 //! Grammar: `segment ('.' segment)*`, `segment = key ('[' index ']')*`, `key` made of ASCII
 //! letters, digits, `_` and `-`, `index` a decimal integer. A *pattern* is a path with every
@@ -237,6 +238,57 @@ fn set_in(
     }
 }
 
+/// `parent.key`, or `key` at the top.
+pub fn join_key(parent: &str, key: &str) -> String {
+    if parent.is_empty() {
+        key.to_string()
+    } else {
+        format!("{parent}.{key}")
+    }
+}
+
+/// The parent of a key path: `a.b[2].c` → `a.b[2]` → `a.b` → `a` → none.
+pub fn parent_path(p: &str) -> Option<&str> {
+    if p.ends_with(']') {
+        return p.rfind('[').map(|i| &p[..i]);
+    }
+    p.rfind('.').map(|i| &p[..i])
+}
+
+/// A `--set KEY=VALUE` argument that cannot be read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum OverrideError {
+    /// No `=` in the argument.
+    #[error("--set {0}: expected KEY=VALUE")]
+    NoEquals(String),
+    /// The key is not a valid path.
+    #[error("--set {arg}: {reason}")]
+    BadPath {
+        /// The argument as given.
+        arg: String,
+        /// Why the path does not parse.
+        reason: String,
+    },
+}
+
+/// Parse a `KEY=VALUE` override: a path and a TOML value (numbers, strings, arrays; bare
+/// words become strings).
+pub fn parse_override(s: &str) -> Result<(KeyPath, toml::Value), OverrideError> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| OverrideError::NoEquals(s.to_string()))?;
+    let path = KeyPath::parse(k.trim()).map_err(|reason| OverrideError::BadPath {
+        arg: s.to_string(),
+        reason,
+    })?;
+    let text = v.trim();
+    let value = toml::from_str::<toml::Table>(&format!("v = {text}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(text.to_string()));
+    Ok((path, value))
+}
+
 /// Every pattern of `table` (tables recursed, arrays as `name` and `name[]…`), prefixed with
 /// `prefix`. Array patterns (those whose value is an array) are also put in `arrays`.
 pub fn flatten(
@@ -246,12 +298,7 @@ pub fn flatten(
     arrays: &mut BTreeSet<String>,
 ) {
     for (k, v) in table {
-        let p = if prefix.is_empty() {
-            k.clone()
-        } else {
-            format!("{prefix}.{k}")
-        };
-        flatten_value(v, p, out, arrays);
+        flatten_value(v, join_key(prefix, k), out, arrays);
     }
 }
 
@@ -364,5 +411,26 @@ mod tests {
         assert!(names.contains("b[]") && names.contains("c.d") && arrays.contains("b"));
         assert!(pattern_allowed("b[][]", &names, &arrays));
         assert!(!pattern_allowed("c.e", &names, &arrays));
+    }
+
+    #[test]
+    fn overrides_and_parents() {
+        let (p, v) = parse_override("control.k_psi = 0.3").unwrap();
+        assert_eq!(
+            (p.to_string(), v),
+            ("control.k_psi".into(), toml::Value::Float(0.3))
+        );
+        let (_, v) = parse_override("allocation.method=qp").unwrap();
+        assert_eq!(v, toml::Value::String("qp".into()));
+        assert!(matches!(
+            parse_override("x"),
+            Err(OverrideError::NoEquals(_))
+        ));
+        let e = parse_override("a..b=1").unwrap_err();
+        assert!(e.to_string().starts_with("--set a..b=1: "), "{e}");
+        assert_eq!(parent_path("a.b[2].c"), Some("a.b[2]"));
+        assert_eq!(parent_path("a.b[2]"), Some("a.b"));
+        assert_eq!(parent_path("a"), None);
+        assert_eq!(join_key("", "a"), "a");
     }
 }
