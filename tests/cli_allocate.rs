@@ -1,32 +1,26 @@
 //! End-to-end tests of `usm-study allocate` (SPEC §5): JSON and text output, method selection,
 //! and exit code 2 with a message naming the file and the key on bad input.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+
+use common::{run, write};
+use std::process::Output;
 
 /// A straight-USM-like T (7 thrusters, roll row zero) as JSON rows.
 const T7: &str = r#"[[1,1,0,0,0,0,0.6],[0,0,1,1,0,0,0],[0,0,0,0,1,1,0.8],
     [0,0,0,0,0,0,0],[0,0,0,0,-0.6,-1.4,-0.8],[0,0,0.4,1.6,0,0,0]]"#;
 
-fn write(dir: &tempfile::TempDir, name: &str, body: &str) -> PathBuf {
-    let p = dir.path().join(name);
-    std::fs::write(&p, body).expect("write case");
-    p
-}
-
 fn allocate(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_usm-study"))
-        .arg("allocate")
-        .args(args)
-        .output()
-        .expect("run usm-study")
+    let mut a = vec!["allocate"];
+    a.extend_from_slice(args);
+    run(&a)
 }
 
 #[test]
 fn json_output_has_every_method() {
     let dir = tempfile::tempdir().unwrap();
     let p = write(
-        &dir,
+        dir.path(),
         "case.json",
         &format!(r#"{{"T": {T7}, "tau": [10, 2, -3, 0, 1, 0.5]}}"#),
     );
@@ -53,7 +47,7 @@ fn json_output_has_every_method() {
 fn single_method_and_unattainable_roll() {
     let dir = tempfile::tempdir().unwrap();
     let p = write(
-        &dir,
+        dir.path(),
         "roll.json",
         &format!(
             r#"{{"T": {T7}, "tau": [10, 2, -3, 5, 1, 0.5], "u_min": [-40,-40,-40,-40,-40,-40,-40]}}"#
@@ -80,7 +74,7 @@ fn single_method_and_unattainable_roll() {
 fn text_output_is_a_table() {
     let dir = tempfile::tempdir().unwrap();
     let p = write(
-        &dir,
+        dir.path(),
         "case.json",
         &format!(r#"{{"T": {T7}, "tau": [10, 2, -3, 0, 1, 0.5], "rate_limit": [5,5,5,5,5,5,5]}}"#),
     );
@@ -120,7 +114,7 @@ fn bad_input_exits_2_naming_file_and_key() {
         ),
     ];
     for (name, body, key) in cases {
-        let p = write(&dir, name, &body);
+        let p = write(dir.path(), name, &body);
         let out = allocate(&["--input", p.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(2), "{name}");
         let err = String::from_utf8_lossy(&out.stderr);

@@ -2,32 +2,14 @@
 //! of the foundation issue and every bad-input case (exit code 2, a message naming the file,
 //! the key and, for TOML, the line).
 
+mod common;
+
+use common::{json, run};
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_usm-study"))
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("run usm-study")
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = run(args);
-    assert!(
-        out.status.success(),
-        "{:?} failed: {}",
-        args,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
-
+/// [`common::write`], as the `&str` argument the commands take.
 fn write(dir: &Path, name: &str, text: &str) -> String {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p.display().to_string()
+    common::write(dir, name, text).display().to_string()
 }
 
 fn f(v: &serde_json::Value) -> f64 {

@@ -2,26 +2,10 @@
 //! allocators differ the way their objectives predict, a diverging run stops with the time
 //! and the cause and still writes what it has, and bad overrides are clear errors.
 
+mod common;
+
+use common::{metric, run, summary};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_usm-study"))
-        .args(args)
-        .output()
-        .expect("run usm-study")
-}
-
-fn summary(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("valid JSON")
-}
-
-fn metric(s: &serde_json::Value, k: &str) -> f64 {
-    s["metrics"][k]
-        .as_f64()
-        .unwrap_or_else(|| panic!("metric {k} in {s}"))
-}
 
 fn simulate(dir: &Path, extra: &[&str]) -> serde_json::Value {
     let out = dir.display().to_string();

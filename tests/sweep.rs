@@ -1,10 +1,11 @@
 //! End-to-end tests of `usm-study sweep`, `merge`, `report` and `tcm` on small static studies.
 
-use proptest::prelude::*;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_usm-study");
+use common::{read, run, stderr, write};
+use proptest::prelude::*;
+use std::path::Path;
+use std::process::Output;
 
 /// 12 cases: 3 link counts × 2 rules × 2 offsets, all valid.
 const STUDY12: &str = r#"
@@ -32,19 +33,6 @@ name = "design.generator.longitudinal_offset"
 range = { start = 0.1, stop = 0.2, steps = 2 }
 "#;
 
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run usm-study")
-}
-
 fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut a = vec![
         "sweep",
@@ -54,14 +42,6 @@ fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
     ];
     a.extend_from_slice(extra);
     run(&a)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn read(p: &Path) -> Vec<u8> {
-    std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
 #[test]

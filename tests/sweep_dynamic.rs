@@ -2,7 +2,9 @@
 //! failed row with its reason (time and cause), the other cases complete, and the exit code
 //! says that some failed.
 
-use std::process::Command;
+mod common;
+
+use common::usm_study;
 
 #[test]
 fn diverging_case_is_recorded_and_the_rest_complete() {
@@ -30,7 +32,7 @@ values = [3.0, 5.0, 2000.0]
     )
     .unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_usm-study"))
+    let o = usm_study()
         .args([
             "sweep",
             study.to_str().unwrap(),

@@ -1,0 +1,59 @@
+//! Helpers shared by the integration tests (ripgrep's `tests/util.rs` idea): running the
+//! binary, writing input files, reading outputs. Each test file takes what it needs, so some
+//! helpers are unused in some files.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `usm-study` binary built for these tests.
+pub fn usm_study() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_usm-study"))
+}
+
+/// Run `usm-study ARGS…` to completion.
+pub fn run(args: &[&str]) -> Output {
+    usm_study().args(args).output().expect("run usm-study")
+}
+
+/// Run `usm-study ARGS…`, require success and parse its standard output as JSON.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let out = run(args);
+    assert!(out.status.success(), "{args:?} failed: {}", stderr(&out));
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+/// Write `text` to `dir/name` and return the path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    p
+}
+
+/// A path as the `&str` argument the command line takes.
+pub fn arg(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}
+
+/// Standard error of a finished run, as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The bytes of a file that must exist.
+pub fn read(p: &Path) -> Vec<u8> {
+    std::fs::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// The `summary.json` of a `simulate` output directory.
+pub fn summary(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    serde_json::from_str(&text).expect("valid JSON")
+}
+
+/// A metric of a `summary.json`.
+pub fn metric(s: &serde_json::Value, k: &str) -> f64 {
+    s["metrics"][k]
+        .as_f64()
+        .unwrap_or_else(|| panic!("metric {k} in {s}"))
+}
