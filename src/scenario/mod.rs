@@ -242,15 +242,10 @@ pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, Scen
 /// Every scenario-side key with its default for `mode` (`transport` or `work`): the
 /// preset of that mode with every section written out in full. The sweep engine lists these
 /// as the valid parameter names.
-pub fn default_table(mode: &str) -> Result<toml::Table, ScenarioError> {
+pub fn default_table(mode: Mode) -> Result<toml::Table, ScenarioError> {
     let preset = match mode {
-        "transport" => "transport-method2",
-        "work" => "work-setpoint",
-        other => {
-            return Err(ScenarioError::Invalid(format!(
-                "unknown scenario mode '{other}'; valid: transport, work"
-            )))
-        }
+        Mode::Transport => "transport-method2",
+        Mode::Work => "work-setpoint",
     };
     let text = preset_text(preset).unwrap_or_default();
     let (table, src) = parse_source(&text, preset, None)?;
@@ -313,15 +308,15 @@ mod tests {
             let f = parse_table(&t, &src).unwrap();
             resolve_design(&f, &src).unwrap();
         }
-        for mode in ["transport", "work"] {
+        for mode in [Mode::Transport, Mode::Work] {
             let t = default_table(mode).unwrap();
             for k in ["scenario", "control", "allocation", "metrics", "physics"] {
                 assert!(t.contains_key(k), "{mode}: {k}");
             }
-            // The full table parses back.
-            parse_table(&t, &Source::unplaced(mode)).unwrap();
+            // The full table parses back, in the mode asked for.
+            let f = parse_table(&t, &Source::unplaced(&mode.to_string())).unwrap();
+            assert_eq!(f.scenario.mode, mode);
         }
-        assert!(default_table("static").is_err());
     }
 
     #[test]

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::StudyError;
 use super::records::StatusCounts;
-use super::runner::Mode;
+use super::runner::StudyMode;
 use super::schema::{DoeKind, ReportSettings};
 use crate::report::ColumnKind;
 
@@ -85,7 +85,7 @@ pub struct Manifest {
     /// Study seed.
     pub seed: u64,
     /// Scenario mode.
-    pub mode: Mode,
+    pub mode: StudyMode,
     /// Whether the static analysis ran.
     pub static_analysis: bool,
     /// Design of experiments (`grid`, `sobol`, …).

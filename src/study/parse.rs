@@ -13,7 +13,7 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 use super::error::InputError;
 use super::hash::study_hash;
-use super::runner::{self, Mode};
+use super::runner::{self, StudyMode};
 use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
 use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::Document;
@@ -235,7 +235,7 @@ struct ScenarioSide {
     /// The study's own scenario-side tables, as written.
     own: toml::Table,
     /// Scenario mode.
-    mode: Mode,
+    mode: StudyMode,
     /// Whether the static analysis runs.
     static_enabled: bool,
     /// The mode's defaults (with `[static]` when enabled) merged under `own`.
@@ -266,7 +266,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         }
     }
     let mode = parse_mode(file, doc)?;
-    let static_enabled = mode == Mode::Static || file.static_.is_some();
+    let static_enabled = mode == StudyMode::Static || file.static_.is_some();
     let mut defaults = runner::default_table(mode).map_err(|m| doc.err("scenario.mode", m))?;
     if static_enabled {
         defaults.insert(
@@ -304,18 +304,18 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
 }
 
 /// `scenario.mode` (default `static`).
-fn parse_mode(file: &StudyFile, doc: &Document) -> Result<Mode, InputError> {
+fn parse_mode(file: &StudyFile, doc: &Document) -> Result<StudyMode, InputError> {
     let Some(v) = file.scenario.as_ref().and_then(|s| s.get("mode")) else {
-        return Ok(Mode::Static);
+        return Ok(StudyMode::Static);
     };
-    if let Some(m) = v.as_str().and_then(|m| m.parse::<Mode>().ok()) {
+    if let Some(m) = v.as_str().and_then(|m| m.parse::<StudyMode>().ok()) {
         return Ok(m);
     }
     Err(doc.err(
         "scenario.mode",
         format!(
             "must be one of {}, got {v}",
-            Mode::ALL
+            StudyMode::ALL
                 .iter()
                 .map(|m| format!("\"{m}\""))
                 .collect::<Vec<_>>()
@@ -327,7 +327,7 @@ fn parse_mode(file: &StudyFile, doc: &Document) -> Result<Mode, InputError> {
 /// The error for an unknown scenario-side key `p`, listing its valid siblings.
 fn unknown_scenario_key(
     p: &str,
-    mode: Mode,
+    mode: StudyMode,
     valid: &BTreeSet<String>,
     doc: &Document,
 ) -> InputError {

@@ -2,7 +2,7 @@
 //!
 //! Everything the sweep needs from the closed-loop scenarios goes through this file:
 //!
-//! - [`Mode`]: the scenario modes a study may name.
+//! - [`StudyMode`]: the scenario modes a study may name.
 //! - [`default_table`]: every scenario-side key with its default for a mode, shaped like the
 //!   scenario side of a study file — a table with the sub-tables `scenario`, `control`,
 //!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
@@ -19,6 +19,7 @@ use std::str::FromStr;
 
 use crate::model::Vehicle;
 use crate::report::Table;
+use crate::scenario::Mode as ScenarioMode;
 
 /// The result of one dynamic case.
 #[derive(Clone, Debug, Default)]
@@ -49,11 +50,12 @@ pub const SCENARIO_TABLES: [&str; 11] = [
     "thrusters",
 ];
 
-/// The scenario mode of a study (`scenario.mode`; written as lower-case text in study files
-/// and manifests).
+/// The mode of a study (`scenario.mode`; written as lower-case text in study files and
+/// manifests): the static analysis alone, or one of the closed-loop scenario modes
+/// ([`ScenarioMode`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum Mode {
+pub enum StudyMode {
     /// Only the static TCM analysis (the default).
     #[default]
     Static,
@@ -63,39 +65,39 @@ pub enum Mode {
     Work,
 }
 
-impl Mode {
+impl StudyMode {
     /// Every mode, in the order listed in messages.
-    pub const ALL: [Mode; 3] = [Mode::Static, Mode::Transport, Mode::Work];
+    pub const ALL: [StudyMode; 3] = [StudyMode::Static, StudyMode::Transport, StudyMode::Work];
 
     /// The name as written in study files.
     pub fn as_str(self) -> &'static str {
         match self {
-            Mode::Static => "static",
-            Mode::Transport => "transport",
-            Mode::Work => "work",
+            StudyMode::Static => "static",
+            StudyMode::Transport => "transport",
+            StudyMode::Work => "work",
         }
     }
 
     /// Whether the mode runs a closed-loop scenario (as opposed to the static analysis).
     pub fn is_dynamic(self) -> bool {
-        self != Mode::Static
+        self != StudyMode::Static
     }
 }
 
-impl fmt::Display for Mode {
+impl fmt::Display for StudyMode {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.as_str())
     }
 }
 
-impl FromStr for Mode {
+impl FromStr for StudyMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Mode::ALL
+        StudyMode::ALL
             .into_iter()
             .find(|m| m.as_str() == s)
             .ok_or_else(|| {
-                let names: Vec<&str> = Mode::ALL.iter().map(|m| m.as_str()).collect();
+                let names: Vec<&str> = StudyMode::ALL.iter().map(|m| m.as_str()).collect();
                 format!("unknown scenario mode '{s}'; valid: {}", names.join(", "))
             })
     }
@@ -103,13 +105,16 @@ impl FromStr for Mode {
 
 /// Every scenario-side key with its default for `mode` (see the module docs for the shape):
 /// `crate::scenario::default_table` for the dynamic modes.
-pub fn default_table(mode: Mode) -> Result<toml::Table, String> {
+pub fn default_table(mode: StudyMode) -> Result<toml::Table, String> {
     match mode {
-        Mode::Static => {
+        StudyMode::Static => {
             toml::from_str("[scenario]\nmode = \"static\"\n").map_err(|e| e.to_string())
         }
-        Mode::Transport | Mode::Work => {
-            crate::scenario::default_table(mode.as_str()).map_err(|e| e.to_string())
+        StudyMode::Transport => {
+            crate::scenario::default_table(ScenarioMode::Transport).map_err(|e| e.to_string())
+        }
+        StudyMode::Work => {
+            crate::scenario::default_table(ScenarioMode::Work).map_err(|e| e.to_string())
         }
     }
 }

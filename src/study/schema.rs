@@ -5,7 +5,7 @@ use std::fmt;
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use super::runner::{Mode, SCENARIO_TABLES};
+use super::runner::{StudyMode, SCENARIO_TABLES};
 use super::static_table::STATIC_TABLE;
 use crate::input::keypath::KeyPath;
 use crate::sampling::Sampling;
@@ -201,7 +201,7 @@ pub struct Study {
     /// The scenario-side table with every default filled in (what cases start from).
     pub scenario_full: toml::Table,
     /// Scenario mode.
-    pub mode: Mode,
+    pub mode: StudyMode,
     /// Whether the static TCM analysis runs for every case.
     pub static_enabled: bool,
     /// Axes in file order.
