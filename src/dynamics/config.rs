@@ -30,6 +30,14 @@ pub enum ServoModel {
     Passive,
 }
 
+impl ServoModel {
+    /// Default natural frequency ω_n [rad/s] of the ideal servos' reference filter (inferred:
+    /// well inside the joint modules' bandwidth).
+    pub const DEFAULT_OMEGA_N: f64 = 5.0;
+    /// Default damping ratio ζ_n [-] of the reference filter (critically damped).
+    pub const DEFAULT_ZETA: f64 = 1.0;
+}
+
 /// Thruster dynamics model (SPEC §2: optional lag and rate limit per thruster).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ThrusterModel {
@@ -69,8 +77,8 @@ impl Default for SimConfig {
         Self {
             options: DynOptions::full(),
             servo: ServoModel::SecondOrder {
-                omega_n: 5.0,
-                zeta: 1.0,
+                omega_n: ServoModel::DEFAULT_OMEGA_N,
+                zeta: ServoModel::DEFAULT_ZETA,
             },
             thruster: ThrusterModel::Ideal,
         }

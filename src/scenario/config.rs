@@ -247,8 +247,8 @@ impl Default for ServoSpec {
     fn default() -> Self {
         Self {
             kind: "second_order".into(),
-            omega_n: 5.0,
-            zeta: 1.0,
+            omega_n: ServoModel::DEFAULT_OMEGA_N,
+            zeta: ServoModel::DEFAULT_ZETA,
             kp: 200.0,
             kd: 40.0,
             torque_limit: 100.0,

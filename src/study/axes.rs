@@ -229,7 +229,10 @@ fn axis_target(
         }
         let reference = crate::input::keypath::get(design, &rest.0)
             .cloned()
-            .or_else(|| (rest.pattern() == "generator.links").then_some(toml::Value::Integer(5)));
+            .or_else(|| {
+                let links = crate::model::generator::GeneratorSpec::default().links as i64;
+                (rest.pattern() == "generator.links").then_some(toml::Value::Integer(links))
+            });
         Ok(Some((Target::Design(rest), reference)))
     } else if is_scenario_table(path.head()) {
         if !pattern_allowed(&path.pattern(), &names.scenario, &names.scenario_arrays) {

@@ -239,7 +239,7 @@ fn axis_number(v: &toml::Value) -> f64 {
 }
 
 /// A message on one line (newlines become spaces), as the `reason` column holds it.
-pub fn one_line(s: &str) -> String {
+pub fn reason_cell(s: &str) -> String {
     s.replace(['\n', '\r'], " ")
 }
 
@@ -304,7 +304,7 @@ impl Row {
     /// Mark the row as ended with `status` for `reason` (made one line).
     pub fn end(&mut self, status: CaseStatus, reason: &str) {
         self.status = status;
-        self.reason = one_line(reason);
+        self.reason = reason_cell(reason);
     }
 
     /// The cells in raw-schema order; `texts` are the axis values as text.
