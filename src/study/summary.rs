@@ -92,7 +92,7 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
     }
     let _ = writeln!(
         md,
-        "StudyMode `{}`{}, design of experiments `{}`, seed {}, {} of {} cases in this output: \
+        "Mode `{}`{}, design of experiments `{}`, seed {}, {} of {} cases in this output: \
          **{} ok, {} failed, {} skipped**. Study hash `{}`, usm-study {}.\n",
         m.mode,
         if m.static_analysis {
