@@ -355,3 +355,28 @@ proptest! {
         prop_assert_eq!(p, again);
     }
 }
+
+/// `usm-study … | head -1`: once the reader has gone, the program ends quietly (SIGPIPE's
+/// default action), never with a panic and exit code 101. The dry run of the 100 000-case
+/// study prints far more than a pipe holds, so it must write after the reader is gone.
+#[test]
+fn closed_output_pipe_ends_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let mut child = common::usm_study()
+        .args(["sweep", "studies/static_large.toml", "--dry-run"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn usm-study");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with("study"), "{first}");
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}
