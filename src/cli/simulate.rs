@@ -14,7 +14,8 @@ use usm_study::study::path::{set, KeyPath};
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint.
+    /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint,
+    /// transport-method1-torque-limited.
     pub scenario: String,
     /// Output directory (default: out/<scenario name>).
     #[arg(long)]
