@@ -134,7 +134,11 @@ fn cruise_energy_counts_inflow_and_the_path_covered() {
 #[test]
 fn torque_limited_servos_bound_the_joint_torque_at_the_turn() {
     let d = tempfile::tempdir().unwrap();
-    let s = simulate_preset("transport-method1-torque-limited", d.path(), &["--no-plots"]);
+    let s = simulate_preset(
+        "transport-method1-torque-limited",
+        d.path(),
+        &["--no-plots"],
+    );
     assert_eq!(s["status"], "ok");
     let peak = metric(&s, "joint_torque_peak");
     assert!(peak <= 50.0 + 1e-9 && peak > 40.0, "{peak}");

@@ -395,7 +395,10 @@ mod tests {
             let p0 = m.static_power(u);
             for v_a in [0.0, -0.2, -5.0] {
                 let p = m.shaft_power(u, v_a);
-                assert!((p - p0).abs() <= 1e-14 * p0, "u {u}, v_a {v_a}: {p} vs {p0}");
+                assert!(
+                    (p - p0).abs() <= 1e-14 * p0,
+                    "u {u}, v_a {v_a}: {p} vs {p0}"
+                );
             }
         }
         assert_eq!(m.shaft_power(0.0, 0.0), 0.0);
@@ -484,10 +487,22 @@ mod tests {
     fn path_progress_counts_advance_within_each_segment() {
         let mut e = EnergyIntegrator::default();
         // 2 m along segment 0, then a switch to segment 1 entered 150 m along it, 3 m more.
-        for (seg, along) in [(0.0, 1.0), (0.0, 2.0), (0.0, 3.0), (1.0, 150.0), (1.0, 153.0)] {
+        for (seg, along) in [
+            (0.0, 1.0),
+            (0.0, 2.0),
+            (0.0, 3.0),
+            (1.0, 150.0),
+            (1.0, 153.0),
+        ] {
             e.track_path(seg, along);
         }
-        e.add(&PowerSample { thruster_power: 10.0, ..PowerSample::default() }, 2.5);
+        e.add(
+            &PowerSample {
+                thruster_power: 10.0,
+                ..PowerSample::default()
+            },
+            2.5,
+        );
         let m = e.metrics();
         assert!((m.path_progress - 5.0).abs() < 1e-12);
         assert!((m.energy_per_metre() - 5.0).abs() < 1e-12);

@@ -10,9 +10,9 @@ use super::channels::{channel_layout, Channel, Pose, Trajectory, Twist};
 use super::controller::ModeController;
 use super::setup::ClosedLoop;
 use crate::allocation::AllocStatus;
-use crate::metrics::singularity::sigma_min_scaled_gram;
 use crate::dynamics::SimState;
 use crate::kinematics::KinWorkspace;
+use crate::metrics::singularity::sigma_min_scaled_gram;
 use crate::metrics::trajectory::{
     EnergyIntegrator, EnergyMetrics, PowerModel, PowerSample, ThrusterSample,
 };
@@ -100,7 +100,13 @@ fn body_twist_in_base(ws: &KinWorkspace, base_twist: &Vec6, qd: &[f64], body: us
 /// thruster pushing the vehicle forward while the vehicle moves forward sees a positive
 /// inflow equal to that speed. `ws` must hold the forward kinematics of the current joint
 /// angles. Writes `out` (one per thruster).
-fn thruster_inflow(v: &Vehicle, ws: &KinWorkspace, state: &SimState, thrust: &[f64], out: &mut [f64]) {
+fn thruster_inflow(
+    v: &Vehicle,
+    ws: &KinWorkspace,
+    state: &SimState,
+    thrust: &[f64],
+    out: &mut [f64],
+) {
     let water_b = state
         .pose
         .orientation
@@ -309,7 +315,10 @@ impl Recorder {
                 .enumerate()
                 .map(|(j, (u, v_a))| (Channel::Power(j), power.shaft_power(*u, *v_a))),
         );
-        w.put_all(held.enumerate().map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)));
+        w.put_all(
+            held.enumerate()
+                .map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)),
+        );
         w.put(
             Channel::SigmaMin,
             sigma_min_scaled_gram(&lp.t_mat, self.char_length),
