@@ -1,5 +1,6 @@
 //! The summary metrics of one closed-loop run (SPEC §6): pure functions of its trajectory,
-//! looked up by [`Channel`], in a fixed order for the mode — the common effort, energy,
+//! looked up by [`Channel`], and of the effort and energy integrals the loop accumulated
+//! (at the control and physics rates, not from the log), in a fixed order for the mode — the common effort, energy,
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics.
 
@@ -41,16 +42,17 @@ pub fn run_summary(
     out
 }
 
-/// Completion, energy and effort (SPEC §6, integrated at the control rate: see
+/// Completion, energy and effort (SPEC §6, integrated along the run, not from the log: see
 /// [`EnergyMetrics`]), σ_min of T(q) and allocation outcomes:
 /// - `thruster_energy` [J]: thruster shaft energy by actuator-disk momentum theory with each
 ///   thruster's axial inflow; `thruster_energy_static` [J] the same thrusts at zero inflow
 ///   (the figure before inflow was modelled);
 /// - `effort_sq` [N²·s] `∫‖u‖²dt`, `effort_abs` [N·s] `∫Σ|u_j|dt`, of the thrust held over
-///   each control interval;
-/// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint torques and the joint
-///   rates at each control tick; `joint_torque_peak` [N·m] the largest |τ_q,i| at a tick;
-/// - `peak_thrust` [N], `saturation_fraction` of the control intervals.
+///   each control interval (rectangle rule on the zero-order hold, at the control rate);
+/// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint motor torques and the
+///   joint rates at the start of every physics step; `joint_torque_peak` [N·m] the largest
+///   |τ_q,i| among them;
+/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals.
 fn common_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,

@@ -3,11 +3,10 @@
 //!
 //! Rates: the physics advances with RK4 steps of `dt`; the controllers and the allocator run
 //! every `control_dt` with the actuator commands held in between (zero-order hold); the
-//! recorder samples the actuators at every control tick for the energy integrals and logs
-//! every `log_dt`. Each control period is a fixed sequence of named phases
-//! (`measure`, `control`, `allocate`, the recorder's `sample` and `observe`, `advance`),
-//! timed by phase;
-//! nothing allocates inside the loop.
+//! recorder samples the thrusters at every control tick and the joints at every physics step
+//! for the energy integrals, and logs every `log_dt`. Each control period is a fixed sequence
+//! of named phases (`measure`, `control`, `allocate`, the recorder's `sample` and `observe`,
+//! `advance`), timed by phase; nothing allocates inside the loop.
 
 use super::channels::Trajectory;
 use super::config::{Mode, ScenarioFile};
@@ -130,8 +129,8 @@ impl ClosedLoop<'_> {
     /// Control period `k`: measure, control, allocate, sample the thrusters and record, then
     /// advance the physics (except after the last period) and integrate the thruster sample
     /// over the period just simulated (SPEC §6 energy: rectangle rule on the zero-order hold,
-    /// at the control rate; the joints are integrated per physics step inside `advance`; a
-    /// period that fails is not counted).
+    /// at the control rate; the joints are integrated per physics step inside `advance`; the
+    /// thrusters of a period that fails are not counted).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
         let t = k as f64 * self.file.scenario.control_dt;
         let measured = timed!(rec.timing.control_s, self.measure(t))?;
