@@ -37,7 +37,7 @@ enum Command {
     /// Run one closed-loop scenario (transport or work mode) and write its time series,
     /// summary and figure.
     Simulate(simulate::SimulateArgs),
-    /// Regenerate the USM paper's simulations (three presets, allocator comparison) with
+    /// Regenerate the USM paper's simulations (the scenario presets, allocator comparison) with
     /// figures and comparison tables.
     Paper(paper::PaperArgs),
     /// Static configuration-space analysis of the thruster matrix: how often is T(q) singular.

@@ -13,7 +13,8 @@ use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario,
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint.
+    /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint,
+    /// transport-method1-torque-limited.
     pub scenario: String,
     /// Output directory (default: out/<scenario name>).
     #[arg(long)]

@@ -1,11 +1,11 @@
 //! The summary metrics of one closed-loop run (SPEC §6): pure functions of its trajectory,
-//! looked up by [`Channel`], in a fixed order for the mode — the common effort, energy,
+//! looked up by [`Channel`], and of the effort and energy integrals the loop accumulated
+//! (at the control and physics rates, not from the log), in a fixed order for the mode — the common effort, energy,
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics.
 
-use super::trajectory::{energy_metrics, segment_tracking, settling_time, singularity_exposure};
+use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
 use crate::control::wrap_angle;
-use crate::model::Vehicle;
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
@@ -22,50 +22,54 @@ fn channel(traj: &Trajectory, c: Channel) -> &[f64] {
     traj.get(c).unwrap_or(&[])
 }
 
-/// The metrics of a run of `file` on `v` from its trajectory: the common ones, then the
-/// mode's. `failed` says whether the run stopped early; `counts` are its allocation outcomes.
+/// The metrics of a run of `file` from its trajectory: the common ones, then the
+/// mode's. `failed` says whether the run stopped early; `counts` are its allocation outcomes;
+/// `energy` its effort and energy integrals, accumulated at every control step (not from
+/// the log).
 pub fn run_summary(
-    v: &Vehicle,
     file: &ScenarioFile,
     traj: &Trajectory,
     failed: bool,
     counts: &AllocationCounts,
+    energy: &EnergyMetrics,
 ) -> Vec<(String, f64)> {
     let mut out = Metrics::new();
-    common_metrics(&mut out, v, file, traj, failed, counts);
+    common_metrics(&mut out, file, traj, failed, counts, energy);
     match file.scenario.mode {
-        Mode::Transport => transport_metrics(&mut out, &file.metrics, traj),
+        Mode::Transport => transport_metrics(&mut out, &file.metrics, traj, energy),
         Mode::Work => work_metrics(&mut out, &file.metrics, traj),
     }
     out
 }
 
-/// Completion, energy and effort, σ_min of T(q) and allocation outcomes.
+/// Completion, energy and effort (SPEC §6, integrated along the run, not from the log: see
+/// [`EnergyMetrics`]), σ_min of T(q) and allocation outcomes:
+/// - `thruster_energy` [J]: thruster shaft energy by actuator-disk momentum theory with each
+///   thruster's axial inflow; `thruster_energy_static` [J] the same thrusts at zero inflow
+///   (the figure before inflow was modelled);
+/// - `effort_sq` [N²·s] `∫‖u‖²dt`, `effort_abs` [N·s] `∫Σ|u_j|dt`, of the thrust held over
+///   each control interval (rectangle rule on the zero-order hold, at the control rate);
+/// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint motor torques and the
+///   joint rates at the start of every physics step; `joint_torque_peak` [N·m] the largest
+///   |τ_q,i| among them;
+/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals.
 fn common_metrics(
     out: &mut Metrics,
-    v: &Vehicle,
     file: &ScenarioFile,
     traj: &Trajectory,
     failed: bool,
     counts: &AllocationCounts,
+    e: &EnergyMetrics,
 ) {
     let t = channel(traj, Channel::T);
-    let limits: Vec<(f64, f64)> = v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect();
-    let e = energy_metrics(
-        t,
-        &traj.indexed(Channel::U),
-        &limits,
-        &traj.indexed(Channel::Tau),
-        &traj.indexed(Channel::Qd),
-        &file.power_model(v.fluid.rho),
-        file.metrics.saturation_tolerance,
-    );
     add(out, "completed", if failed { 0.0 } else { 1.0 });
     add(out, "simulated_time", t.last().copied().unwrap_or(0.0));
     add(out, "thruster_energy", e.thruster_energy);
+    add(out, "thruster_energy_static", e.thruster_energy_static);
     add(out, "effort_sq", e.effort_sq);
     add(out, "effort_abs", e.effort_abs);
     add(out, "joint_energy", e.joint_energy);
+    add(out, "joint_torque_peak", e.joint_torque_peak);
     add(out, "peak_thrust", e.peak_thrust);
     add(out, "saturation_fraction", e.saturation_fraction);
     let sig = channel(traj, Channel::SigmaMin);
@@ -108,8 +112,15 @@ fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
 }
 
 /// Transport: convergence, overshoot and cross-track RMS per segment (after convergence)
-/// and over the run, the base's cross-track RMS, the final cross-track error.
-fn transport_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
+/// and over the run, the base's cross-track RMS, the final cross-track error; the distance
+/// the end-effector covered along the path (`path_progress` [m], at the control rate) and
+/// the thruster shaft energy per metre of it (`energy_per_metre` [J/m]).
+fn transport_metrics(
+    out: &mut Metrics,
+    spec: &MetricsSpec,
+    traj: &Trajectory,
+    energy: &EnergyMetrics,
+) {
     let t = channel(traj, Channel::T);
     let ey = channel(traj, Channel::CrossTrack);
     let base_ct = channel(traj, Channel::BaseCrossTrack);
@@ -172,6 +183,8 @@ fn transport_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         "final_cross_track",
         ey.last().copied().unwrap_or(f64::NAN),
     );
+    add(out, "path_progress", energy.path_progress);
+    add(out, "energy_per_metre", energy.energy_per_metre());
 }
 
 /// Work: final errors and settling times of the end-effector, the base's drift, and the

@@ -1,22 +1,27 @@
-//! Metrics as pure functions of a sampled trajectory (SPEC §6): thruster energy by momentum
-//! theory, effort integrals, joint mechanical energy, peak thrust, saturation and singularity
-//! exposure, and tracking quality (cross-track error, convergence, overshoot, settling).
+//! Metrics of a run (SPEC §6): thruster power by actuator-disk momentum theory with axial
+//! inflow and the effort and energy integrals of the actuators, accumulated at every control
+//! step by an [`EnergyIntegrator`] (not from the log); and, as pure functions of a sampled
+//! trajectory, singularity exposure and tracking quality (cross-track error, convergence,
+//! overshoot, settling).
 //!
 //! Time series are slices sampled at times `t` [s] (strictly increasing, not necessarily
-//! uniform); integrals use the trapezoidal rule, and fractions of time weight each interval
-//! by its length.
+//! uniform); their integrals use the trapezoidal rule, and fractions of time weight each
+//! interval by its length.
 
 use serde::{Deserialize, Serialize};
 
-/// Parameters of the momentum-theory thruster power model (SPEC §6; inferred defaults).
+/// Parameters of the actuator-disk (momentum-theory) thruster power model (SPEC §6). Both
+/// defaults are inferred (the paper gives no propeller data): a 70 mm propeller, the size of
+/// the small ROV thrusters such a vehicle carries, and an overall shaft efficiency η = 0.5.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PowerModel {
-    /// Propeller diameter [m] (default 0.07 m).
+    /// Propeller diameter D [m], disk area `A = πD²/4`. Default 0.07 m (inferred).
     pub propeller_diameter: f64,
-    /// Overall efficiency η (default 0.5).
+    /// Overall efficiency η from shaft to ideal (induced + useful) power. Default 0.5
+    /// (inferred).
     pub efficiency: f64,
-    /// Water density ρ [kg/m³].
+    /// Water density ρ [kg/m³]. Default [`crate::model::RHO_SEAWATER`].
     pub rho: f64,
 }
 
@@ -45,12 +50,64 @@ impl PowerModel {
         Ok(())
     }
 
-    /// Electrical power [W] of one thruster delivering thrust `u` [N]:
-    /// `P = |u|^{3/2} / (η √(2ρA))`, `A = πD²/4` (SPEC §6).
+    /// Disk area `A = πD²/4` [m²].
     #[inline]
-    pub fn power(&self, u: f64) -> f64 {
-        let a = std::f64::consts::PI * self.propeller_diameter.powi(2) / 4.0;
-        u.abs().powf(1.5) / (self.efficiency * (2.0 * self.rho * a).sqrt())
+    pub fn disk_area(&self) -> f64 {
+        std::f64::consts::PI * self.propeller_diameter.powi(2) / 4.0
+    }
+
+    /// `(w, V_a + w)` [m/s] of a disk delivering thrust `u` [N] with axial inflow `v_a`
+    /// [m/s]: the induced velocity, the non-negative root of `|u| = 2ρA w (V_a + w)`
+    /// (SPEC §6), `w = (−V_a + √(V_a² + 4c)) / 2` with `c = |u| / (2ρA)`, and the flow
+    /// speed through the disk. Both without cancellation for either sign of `v_a`: where a
+    /// printed form subtracts nearly equal numbers it is replaced by the conjugate
+    /// `2c / (|V_a| + √(V_a² + 4c))` (for `w` when `V_a > 0`, for `V_a + w` when `V_a < 0`).
+    #[inline]
+    pub fn disk_velocities(&self, u: f64, v_a: f64) -> (f64, f64) {
+        let c = u.abs() / (2.0 * self.rho * self.disk_area());
+        let root = (v_a * v_a + 4.0 * c).sqrt();
+        // 0/0 at zero thrust and zero inflow, where both velocities are 0.
+        let small = if c > 0.0 {
+            2.0 * c / (v_a.abs() + root)
+        } else {
+            0.0
+        };
+        let large = 0.5 * (root + v_a.abs());
+        if v_a > 0.0 {
+            (small, v_a + small)
+        } else {
+            (large, small)
+        }
+    }
+
+    /// Induced velocity w ≥ 0 [m/s] of [`PowerModel::disk_velocities`].
+    #[inline]
+    pub fn induced_velocity(&self, u: f64, v_a: f64) -> f64 {
+        self.disk_velocities(u, v_a).0
+    }
+
+    /// Shaft power [W] of one thruster delivering thrust `u` [N] with axial inflow `v_a`
+    /// [m/s]: the ideal power `P = |u| (V_a + w)` of the actuator disk (useful power `|u| V_a`
+    /// plus the induced loss `|u| w`) divided by η (SPEC §6).
+    ///
+    /// Sign convention: `v_a` is the speed of the water through the disk in the direction of
+    /// the jet, i.e. the thruster's velocity relative to the water projected on the direction
+    /// it pushes the vehicle (a thruster pushing the vehicle forward sees an inflow equal to
+    /// the forward speed). Where the flow opposes the thrust (`v_a < 0`: braking, or the
+    /// vehicle moving against the thrust) momentum theory has no valid slipstream (windmill
+    /// brake and vortex-ring states), and the inflow is taken as `max(V_a, 0)`: the static
+    /// figure, an upper bound on the slipstream power at that thrust. At `v_a ≤ 0` this is
+    /// therefore [`PowerModel::static_power`] (to rounding).
+    #[inline]
+    pub fn shaft_power(&self, u: f64, v_a: f64) -> f64 {
+        u.abs() * self.disk_velocities(u, v_a.max(0.0)).1 / self.efficiency
+    }
+
+    /// Shaft power [W] at zero inflow (hover, the bollard figure):
+    /// `P = |u|^{3/2} / (η √(2ρA))` (SPEC §6).
+    #[inline]
+    pub fn static_power(&self, u: f64) -> f64 {
+        u.abs().powf(1.5) / (self.efficiency * (2.0 * self.rho * self.disk_area()).sqrt())
     }
 }
 
@@ -83,66 +140,154 @@ pub fn time_fraction(t: &[f64], flag: impl Fn(usize) -> bool) -> f64 {
         / span
 }
 
-/// Effort and energy of a run.
+/// The thrusters at one control tick, as the closed loop reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct ThrusterSample<'a> {
+    /// Thrust of each thruster over the coming control interval [N].
+    pub thrust: &'a [f64],
+    /// Axial inflow of each thruster along its thrust [m/s] (sign convention of
+    /// [`PowerModel::shaft_power`]).
+    pub inflow: &'a [f64],
+    /// `(u_min, u_max)` of each thruster [N].
+    pub limits: &'a [(f64, f64)],
+}
+
+/// Thruster effort and power at one control tick: the integrands of [`EnergyMetrics`]'
+/// thruster figures, held over the control interval that starts at the tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PowerSample {
+    /// `Σ_j P_j / η` with axial inflow [W] ([`PowerModel::shaft_power`]).
+    pub thruster_power: f64,
+    /// `Σ_j P_j / η` at zero inflow [W] ([`PowerModel::static_power`]).
+    pub thruster_power_static: f64,
+    /// `‖u‖²` [N²].
+    pub thrust_sq: f64,
+    /// `Σ_j |u_j|` [N].
+    pub thrust_abs: f64,
+    /// Largest `|u_j|` [N].
+    pub peak_thrust: f64,
+    /// Whether at least one thruster is within `sat_tol` of a limit.
+    pub saturated: bool,
+}
+
+impl PowerSample {
+    /// The sample of thrusters `a` under the power model `model`; a thruster counts as
+    /// saturated within `sat_tol` [N] of a limit.
+    pub fn new(model: &PowerModel, a: &ThrusterSample, sat_tol: f64) -> Self {
+        let mut s = Self::default();
+        for ((u, v_a), (lo, hi)) in a.thrust.iter().zip(a.inflow).zip(a.limits) {
+            s.thruster_power += model.shaft_power(*u, *v_a);
+            s.thruster_power_static += model.static_power(*u);
+            s.thrust_sq += u * u;
+            s.thrust_abs += u.abs();
+            s.peak_thrust = s.peak_thrust.max(u.abs());
+            s.saturated |= *u <= lo + sat_tol || *u >= hi - sat_tol;
+        }
+        s
+    }
+}
+
+/// Effort and energy of a run (SPEC §6), integrated over the control intervals.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct EnergyMetrics {
-    /// Thruster energy by momentum theory, `∫ Σ_j P_j dt` [J].
+    /// Thruster shaft energy with axial inflow, `∫ Σ_j P_j(u_j, V_a,j) / η dt` [J].
     pub thruster_energy: f64,
+    /// Thruster shaft energy at zero inflow, `∫ Σ_j |u_j|^{3/2} / (η √(2ρA)) dt` [J] (the
+    /// figure reported before inflow was modelled; a lower bound on `thruster_energy`, which
+    /// adds the useful power against the through-flow).
+    pub thruster_energy_static: f64,
     /// `∫ ‖u‖² dt` [N²·s].
     pub effort_sq: f64,
     /// `∫ Σ_j |u_j| dt` [N·s].
     pub effort_abs: f64,
-    /// Joint mechanical energy `∫ Σ_i |τ_i q̇_i| dt` [J].
+    /// Joint mechanical energy `∫ Σ_i |τ_q,i q̇_i| dt` [J].
     pub joint_energy: f64,
-    /// Largest |u_j| over the run [N].
+    /// Largest |u_j| at a control tick [N].
     pub peak_thrust: f64,
-    /// Fraction of time at least one thruster is at a limit (within `sat_tol` N).
+    /// Largest |τ_q,i| at the start of a physics step [N·m].
+    pub joint_torque_peak: f64,
+    /// Fraction of the integrated time during which at least one thruster is at a limit.
     pub saturation_fraction: f64,
+    /// Distance covered along the path [m] (transport; 0 otherwise): the sum over the
+    /// control ticks of the along-track advance of the guided point while its segment stays
+    /// active (a segment switch starts counting afresh on the new segment).
+    pub path_progress: f64,
 }
 
-/// Energy and effort (SPEC §6). `thrust[j]` is thruster j's actual thrust series [N],
-/// `limits[j] = (u_min, u_max)`, `torque[i]`/`rate[i]` joint i's torque [N·m] and rate
-/// [rad/s]. A thruster counts as saturated within `sat_tol` [N] of a limit.
-pub fn energy_metrics(
-    t: &[f64],
-    thrust: &[&[f64]],
-    limits: &[(f64, f64)],
-    torque: &[&[f64]],
-    rate: &[&[f64]],
-    model: &PowerModel,
-    sat_tol: f64,
-) -> EnergyMetrics {
-    let thruster_energy = thrust
-        .iter()
-        .map(|u| integrate_fn(t, |k| model.power(u[k])))
-        .sum();
-    let effort_sq = thrust
-        .iter()
-        .map(|u| integrate_fn(t, |k| u[k] * u[k]))
-        .sum();
-    let effort_abs = thrust.iter().map(|u| integrate_fn(t, |k| u[k].abs())).sum();
-    let joint_energy = torque
-        .iter()
-        .zip(rate)
-        .map(|(tau, qd)| integrate_fn(t, |k| (tau[k] * qd[k]).abs()))
-        .sum();
-    let peak_thrust = thrust
-        .iter()
-        .flat_map(|u| u.iter())
-        .fold(0.0f64, |peak, x| peak.max(x.abs()));
-    let saturation_fraction = time_fraction(t, |k| {
-        thrust
-            .iter()
-            .zip(limits)
-            .any(|(u, (lo, hi))| u[k] <= lo + sat_tol || u[k] >= hi - sat_tol)
-    });
-    EnergyMetrics {
-        thruster_energy,
-        effort_sq,
-        effort_abs,
-        joint_energy,
-        peak_thrust,
-        saturation_fraction,
+impl EnergyMetrics {
+    /// Thruster shaft energy per metre of path covered [J/m]; NaN if no progress was made.
+    pub fn energy_per_metre(&self) -> f64 {
+        if self.path_progress > 0.0 {
+            self.thruster_energy / self.path_progress
+        } else {
+            f64::NAN
+        }
+    }
+}
+
+/// Integrates the effort and energy of a run: the thrusters' [`PowerSample`]s over the
+/// control intervals by the rectangle rule on the zero-order hold (each sample is held over
+/// the interval that starts at its tick), the joints' power over the physics steps (torque
+/// and rate at the start of each step, held over it).
+#[derive(Clone, Debug, Default)]
+pub struct EnergyIntegrator {
+    sums: EnergyMetrics,
+    span: f64,
+    saturated: f64,
+    /// The active segment and along-track position at the last tracked tick.
+    last_on_path: Option<(f64, f64)>,
+}
+
+impl EnergyIntegrator {
+    /// Add thruster sample `s` held for `dt` [s] (`dt = 0` for a tick that starts no
+    /// interval, e.g. the last one: only its peak counts).
+    pub fn add(&mut self, s: &PowerSample, dt: f64) {
+        let e = &mut self.sums;
+        e.thruster_energy += s.thruster_power * dt;
+        e.thruster_energy_static += s.thruster_power_static * dt;
+        e.effort_sq += s.thrust_sq * dt;
+        e.effort_abs += s.thrust_abs * dt;
+        e.peak_thrust = e.peak_thrust.max(s.peak_thrust);
+        self.span += dt;
+        if s.saturated {
+            self.saturated += dt;
+        }
+    }
+
+    /// Add one physics step of `dt` [s] of the joints: motor torques τ_q [N·m] and rates q̇
+    /// [rad/s] at its start, held over it: `joint_energy += Σ_i |τ_q,i q̇_i| dt`, and the peak
+    /// torque.
+    pub fn add_joint_step(&mut self, joint_torque: &[f64], joint_rate: &[f64], dt: f64) {
+        let e = &mut self.sums;
+        for (tau, qd) in joint_torque.iter().zip(joint_rate) {
+            e.joint_energy += (tau * qd).abs() * dt;
+            e.joint_torque_peak = e.joint_torque_peak.max(tau.abs());
+        }
+    }
+
+    /// Track the guided point at a control tick: `segment` is the active segment's index,
+    /// `along_track` [m] the position along it; the advance since the previous tick counts
+    /// towards [`EnergyMetrics::path_progress`] if the segment is the same (negative when
+    /// moving backwards along it).
+    pub fn track_path(&mut self, segment: f64, along_track: f64) {
+        if let Some((seg, along)) = self.last_on_path {
+            if seg == segment {
+                self.sums.path_progress += along_track - along;
+            }
+        }
+        self.last_on_path = Some((segment, along_track));
+    }
+
+    /// The integrals so far, with the saturated fraction of the integrated time.
+    pub fn metrics(&self) -> EnergyMetrics {
+        EnergyMetrics {
+            saturation_fraction: if self.span > 0.0 {
+                self.saturated / self.span
+            } else {
+                0.0
+            },
+            ..self.sums.clone()
+        }
     }
 }
 
@@ -233,31 +378,134 @@ mod tests {
     use super::*;
 
     #[test]
-    fn power_model_reference_value() {
+    fn static_power_reference_value() {
         // 70 mm propeller, η = 0.5, ρ = 1026: A = 3.848e-3 m², √(2ρA) = 2.8102, so
         // 10 N costs 10^1.5 / (0.5·2.8102) = 22.5060 W.
         let m = PowerModel::default();
-        assert!((m.power(10.0) - 22.5060).abs() < 1e-4);
-        assert_eq!(m.power(-10.0), m.power(10.0));
+        assert!((m.static_power(10.0) - 22.5060).abs() < 1e-4);
+        assert_eq!(m.static_power(-10.0), m.static_power(10.0));
     }
 
     #[test]
-    fn energy_of_constant_thrust() {
-        let t: Vec<f64> = (0..=100).map(|k| k as f64 * 0.1).collect();
-        let (u0, u1) = (vec![10.0; 101], vec![-5.0; 101]);
-        let u = [u0.as_slice(), u1.as_slice()];
-        let lim = [(-40.0, 40.0), (-5.0, 5.0)];
-        let tau = vec![2.0; 101];
-        let qd = vec![-0.5; 101];
+    fn zero_inflow_is_the_static_formula() {
+        // At V_a = 0, w = √(|u|/2ρA) and P/η = |u|^{3/2}/(η√(2ρA)) exactly; a flow opposing
+        // the thrust is clamped to V_a = 0.
         let m = PowerModel::default();
-        let e = energy_metrics(&t, &u, &lim, &[&tau], &[&qd], &m, 1e-9);
-        // Exact for constant signals over 10 s.
-        assert!((e.thruster_energy - 10.0 * (m.power(10.0) + m.power(5.0))).abs() < 1e-9);
+        for u in [1e-6, 0.3, 1.0, 10.0, -17.5, 40.0, 1e4] {
+            let p0 = m.static_power(u);
+            for v_a in [0.0, -0.2, -5.0] {
+                let p = m.shaft_power(u, v_a);
+                assert!(
+                    (p - p0).abs() <= 1e-14 * p0,
+                    "u {u}, v_a {v_a}: {p} vs {p0}"
+                );
+            }
+        }
+        assert_eq!(m.shaft_power(0.0, 0.0), 0.0);
+        assert_eq!(m.shaft_power(0.0, 1.0), 0.0);
+    }
+
+    #[test]
+    fn inflow_power_hand_computed() {
+        // u = 10 N, V_a = 0.5 m/s, defaults: 2ρA = 7.897021 kg/m, c = u/2ρA = 1.266300 m²/s²,
+        // w = (−0.5 + √(0.25 + 4c))/2 = 0.902736 m/s, P/η = 10·(0.5 + w)/0.5 = 28.054719 W
+        // (against 22.506001 W static).
+        let m = PowerModel::default();
+        assert!((m.induced_velocity(10.0, 0.5) - 0.902_735_971).abs() < 1e-8);
+        assert!((m.shaft_power(10.0, 0.5) - 28.054_719_43).abs() < 1e-7);
+        // The sign of u is the thrust direction; V_a is already measured along it.
+        assert_eq!(m.shaft_power(-10.0, 0.5), m.shaft_power(10.0, 0.5));
+    }
+
+    #[test]
+    fn induced_velocity_solves_the_momentum_balance_for_both_signs() {
+        // |u| = 2ρA w (V_a + w) to rounding, including inflows far above the induced velocity
+        // (where the printed root would cancel) and strongly negative inflows (where V_a + w
+        // would).
+        let m = PowerModel::default();
+        let k = 2.0 * m.rho * m.disk_area();
+        for u in [1e-6, 0.5, 10.0, 40.0] {
+            for v_a in [-50.0, -1.0, -1e-3, 0.0, 1e-3, 0.5, 3.0, 1e3] {
+                let (w, through) = m.disk_velocities(u, v_a);
+                assert!(w >= 0.0 && through >= 0.0);
+                assert_eq!(w, m.induced_velocity(u, v_a));
+                let back = k * w * through;
+                assert!((back - u).abs() <= 1e-11 * u, "u {u}, v_a {v_a}: {back}");
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn power_is_non_negative_and_increases_with_thrust(
+            u in -100.0f64..100.0,
+            du in 1e-6f64..50.0,
+            v_a in -5.0f64..5.0,
+        ) {
+            let m = PowerModel::default();
+            let p = m.shaft_power(u, v_a);
+            proptest::prop_assert!(p >= 0.0);
+            proptest::prop_assert!(m.shaft_power(u.abs() + du, v_a) > p);
+            proptest::prop_assert!(m.shaft_power(-(u.abs() + du), v_a) > p);
+        }
+    }
+
+    #[test]
+    fn energy_of_constant_samples() {
+        let m = PowerModel::default();
+        let limits = [(-40.0, 40.0), (-5.0, 5.0)];
+        let a = ThrusterSample {
+            thrust: &[10.0, -5.0],
+            inflow: &[0.5, -0.5],
+            limits: &limits,
+        };
+        let s = PowerSample::new(&m, &a, 1e-9);
+        let mut e = EnergyIntegrator::default();
+        for _ in 0..200 {
+            e.add(&s, 0.05);
+            for _ in 0..5 {
+                e.add_joint_step(&[2.0, -3.0], &[-0.5, 0.0], 0.01);
+            }
+        }
+        e.add(&s, 0.0);
+        let e = e.metrics();
+        // Exact for constant samples over 10 s (rounding of 200 additions aside).
+        let p = m.shaft_power(10.0, 0.5) + m.static_power(5.0);
+        assert!((e.thruster_energy - 10.0 * p).abs() < 1e-9);
+        let p0 = m.static_power(10.0) + m.static_power(5.0);
+        assert!((e.thruster_energy_static - 10.0 * p0).abs() < 1e-9);
         assert!((e.effort_sq - 10.0 * 125.0).abs() < 1e-9);
         assert!((e.effort_abs - 150.0).abs() < 1e-9);
         assert!((e.joint_energy - 10.0).abs() < 1e-9);
         assert_eq!(e.peak_thrust, 10.0);
+        assert_eq!(e.joint_torque_peak, 3.0);
         assert!((e.saturation_fraction - 1.0).abs() < 1e-12);
+        assert!(e.energy_per_metre().is_nan());
+    }
+
+    #[test]
+    fn path_progress_counts_advance_within_each_segment() {
+        let mut e = EnergyIntegrator::default();
+        // 2 m along segment 0, then a switch to segment 1 entered 150 m along it, 3 m more.
+        for (seg, along) in [
+            (0.0, 1.0),
+            (0.0, 2.0),
+            (0.0, 3.0),
+            (1.0, 150.0),
+            (1.0, 153.0),
+        ] {
+            e.track_path(seg, along);
+        }
+        e.add(
+            &PowerSample {
+                thruster_power: 10.0,
+                ..PowerSample::default()
+            },
+            2.5,
+        );
+        let m = e.metrics();
+        assert!((m.path_progress - 5.0).abs() < 1e-12);
+        assert!((m.energy_per_metre() - 5.0).abs() < 1e-12);
     }
 
     #[test]

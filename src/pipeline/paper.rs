@@ -1,5 +1,6 @@
-//! The `paper` pipeline: regenerate the USM paper's simulations — the three scenario presets
-//! (Fig. 8 a–h and Fig. 9 of the paper) and the allocator comparison — with their figures,
+//! The `paper` pipeline: regenerate the USM paper's simulations — the scenario presets
+//! (Fig. 8 a–h and Fig. 9 of the paper, and the torque-limited transport variant) and the
+//! allocator comparison — with their figures,
 //! summaries and the comparison tables of `README.md`.
 
 use std::fmt::Write as _;
@@ -12,7 +13,7 @@ use crate::report::{atomic_write, fmt_num, MarkdownTable};
 use crate::scenario::{load_table, parse_table, preset_names, resolve_design, run_scenario};
 
 /// Metrics shown in the transport comparison table.
-const TRANSPORT_KEYS: [&str; 10] = [
+const TRANSPORT_KEYS: [&str; 14] = [
     "seg0_convergence_time",
     "seg0_overshoot",
     "seg1_convergence_time",
@@ -20,6 +21,10 @@ const TRANSPORT_KEYS: [&str; 10] = [
     "cross_track_rms",
     "base_cross_track_rms",
     "thruster_energy",
+    "thruster_energy_static",
+    "energy_per_metre",
+    "joint_energy",
+    "joint_torque_peak",
     "effort_abs",
     "peak_thrust",
     "saturation_fraction",
@@ -71,7 +76,7 @@ pub struct PaperOutcome {
     pub failed: Vec<String>,
 }
 
-/// The runs: output subdirectory, scenario preset, allocation override. The three presets,
+/// The runs: output subdirectory, scenario preset, allocation override. The presets,
 /// then every allocator on transport Method 2 and on work mode.
 fn planned_runs() -> Vec<(String, String, Option<Method>)> {
     let mut runs: Vec<(String, String, Option<Method>)> = preset_names()
@@ -144,9 +149,14 @@ fn write_tables(md: &mut String, rows: &[(String, Vec<(String, f64)>)]) {
     table(
         md,
         rows,
-        "Transport mode: Method 1 vs Method 2 (USM Table III gains, qp allocation)",
+        "Transport mode: Method 1 vs Method 2 (USM Table III gains, qp allocation), and \
+         Method 1 with torque-limited joint servos",
         &TRANSPORT_KEYS,
-        &["transport-method1".into(), "transport-method2".into()],
+        &[
+            "transport-method1".into(),
+            "transport-method2".into(),
+            "transport-method1-torque-limited".into(),
+        ],
     );
     table(
         md,

@@ -135,8 +135,13 @@ pub enum Channel {
     UCmd(usize),
     /// Actual thrust of thruster j, clamped to its limits [N].
     U(usize),
-    /// Shaft power of thruster j by momentum theory [W].
+    /// Shaft power of thruster j by momentum theory with axial inflow [W] (SPEC §6): of the
+    /// thrust held over the control interval starting at this sample (the allocation
+    /// saturated to the limits), the integrand of `thruster_energy`.
     Power(usize),
+    /// Axial inflow V_a of thruster j [m/s]: its velocity relative to the water along the
+    /// direction it pushes the vehicle (positive when moving the way it pushes).
+    Inflow(usize),
     /// Scaled σ_min of the thruster configuration matrix T(q) (SPEC §6).
     SigmaMin,
     /// Allocation slack norm ‖s‖ [N or N·m].
@@ -190,6 +195,7 @@ impl Channel {
             Channel::UCmd(j) => return format!("ucmd_{j}"),
             Channel::U(j) => return format!("u_{j}"),
             Channel::Power(j) => return format!("power_{j}"),
+            Channel::Inflow(j) => return format!("inflow_{j}"),
         };
         fixed.to_string()
     }
@@ -197,7 +203,7 @@ impl Channel {
 
 /// The channels of a run in column order: time, base and end-effector pose and twist, the
 /// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the per-thruster blocks
-/// (commanded, actual, power), then σ_min and the allocation outcome.
+/// (commanded, actual, power, inflow), then σ_min and the allocation outcome.
 pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Channel> {
     let mut c = vec![Channel::T];
     c.extend(Pose::ALL.map(Channel::BasePose));
@@ -215,7 +221,7 @@ pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Ch
     for family in [Channel::Q, Channel::QRef, Channel::Qd, Channel::Tau] {
         c.extend((0..n_joints).map(family));
     }
-    for family in [Channel::UCmd, Channel::U, Channel::Power] {
+    for family in [Channel::UCmd, Channel::U, Channel::Power, Channel::Inflow] {
         c.extend((0..n_thrusters).map(family));
     }
     c.extend([Channel::SigmaMin, Channel::SlackNorm, Channel::AllocStatus]);
@@ -302,15 +308,15 @@ mod tests {
             base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
             ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
             base_cross_track path_y q_0 qref_0 qd_0 tau_0 ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
-            sigma_min slack_norm alloc_status";
+            inflow_0 inflow_1 sigma_min slack_norm alloc_status";
         assert_eq!(names.join(" "), expected);
         let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
             .into_iter()
             .map(Channel::name)
             .collect();
         let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
-            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r ucmd_0 u_0 power_0";
-        assert_eq!(work[25..42].join(" "), expected);
+            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r ucmd_0 u_0 power_0 inflow_0";
+        assert_eq!(work[25..43].join(" "), expected);
     }
 
     #[test]

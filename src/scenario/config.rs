@@ -317,9 +317,11 @@ pub struct MetricsSpec {
     pub position_tolerance: f64,
     /// Orientation tolerance for settling (roll excluded) [deg] (work).
     pub orientation_tolerance_deg: f64,
-    /// Propeller diameter [m] of the power model.
+    /// Propeller diameter D [m] of the actuator-disk power model (SPEC §6). Default 0.07 m
+    /// (inferred: the paper gives no propeller data).
     pub propeller_diameter: f64,
-    /// Efficiency η of the power model.
+    /// Overall efficiency η of the power model, shaft power = ideal power / η. Default 0.5
+    /// (inferred).
     pub efficiency: f64,
     /// A thruster counts as saturated within this distance of a limit [N].
     pub saturation_tolerance: f64,

@@ -1,15 +1,23 @@
 //! The recorder of a closed-loop run, an observer outside the step: it owns the trajectory
-//! (one column per [`Channel`] of [`channel_layout`]), the allocation outcome counts and the
-//! wall-clock timers. It samples the loop every `log_dt` (the state at t with the commands
-//! decided at t) into a row sized once, so recording never allocates.
+//! (one column per [`Channel`] of [`channel_layout`]), the allocation outcome counts, the
+//! energy integrals and the wall-clock timers. At every control tick it samples the
+//! thrusters (thrust held over the coming interval, each thruster's axial inflow) and at every
+//! physics step the joints (motor torque and rate) for the [`EnergyIntegrator`]; every
+//! `log_dt` it logs the state at t with the commands decided at t into a row sized once.
+//! Nothing here allocates after setup.
 
 use super::channels::{channel_layout, Channel, Pose, Trajectory, Twist};
 use super::controller::ModeController;
 use super::setup::ClosedLoop;
 use crate::allocation::AllocStatus;
+use crate::dynamics::SimState;
+use crate::kinematics::KinWorkspace;
 use crate::metrics::singularity::sigma_min_scaled_gram;
-use crate::metrics::trajectory::PowerModel;
-use crate::spatial::{ang, euler_zyx, lin};
+use crate::metrics::trajectory::{
+    EnergyIntegrator, EnergyMetrics, PowerModel, PowerSample, ThrusterSample,
+};
+use crate::model::Vehicle;
+use crate::spatial::{ang, euler_zyx, lin, Vec6};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -74,6 +82,45 @@ fn status_code(s: &AllocStatus) -> f64 {
     }
 }
 
+/// Twist of body `body` relative to the inertial frame, expressed in the base frame `F_b`
+/// (linear part: the velocity of the body point at the base origin):
+/// `V_b + Σ_{k < body} ξ_k q̇_k` with `ξ_k` the joint unit twists in `F_b` (USM-17: joint k
+/// moves body k+1 and everything after it). `base_twist` is the base's body twist.
+fn body_twist_in_base(ws: &KinWorkspace, base_twist: &Vec6, qd: &[f64], body: usize) -> Vec6 {
+    let mut v = *base_twist;
+    for (x, r) in ws.joint_twist_b.iter().zip(qd).take(body) {
+        v += x * *r;
+    }
+    v
+}
+
+/// Axial inflow `V_a` of every thruster [m/s] (SPEC §6) for the thrusts `thrust` [N]: the
+/// velocity of the thruster point relative to the water (the current `ν_c` rotated into
+/// `F_b`) projected on the direction the thruster pushes the vehicle, `sign(u_j) d_j`. A
+/// thruster pushing the vehicle forward while the vehicle moves forward sees a positive
+/// inflow equal to that speed. `ws` must hold the forward kinematics of the current joint
+/// angles. Writes `out` (one per thruster).
+fn thruster_inflow(
+    v: &Vehicle,
+    ws: &KinWorkspace,
+    state: &SimState,
+    thrust: &[f64],
+    out: &mut [f64],
+) {
+    let water_b = state
+        .pose
+        .orientation
+        .inverse_transform_vector(&v.fluid.current);
+    for ((th, u), o) in v.thrusters.iter().zip(thrust).zip(out.iter_mut()) {
+        let g = &ws.g_b[th.body];
+        let tw = body_twist_in_base(ws, &state.base_twist, &state.joint_rates, th.body);
+        let p = g.act_point(&th.position);
+        let d = g.act_vector(&th.direction);
+        let v_rel = lin(&tw) + ang(&tw).cross(&p) - water_b;
+        *o = u.signum() * d.dot(&v_rel);
+    }
+}
+
 /// `(family(k), xs[k])` for every k: the samples of an indexed channel family.
 fn indexed(family: fn(usize) -> Channel, xs: &[f64]) -> impl Iterator<Item = (Channel, f64)> + '_ {
     xs.iter().enumerate().map(move |(k, x)| (family(k), *x))
@@ -112,8 +159,21 @@ pub(crate) struct Recorder {
     /// Characteristic length for the scaled σ_min of T(q) [m].
     char_length: f64,
     power: PowerModel,
+    /// Thruster limits `(u_min, u_max)` [N].
+    limits: Vec<(f64, f64)>,
+    /// Saturation tolerance [N].
+    sat_tol: f64,
+    /// Thrust held over the current control interval: the allocation saturated to the limits,
+    /// as the simulator applies it [N].
+    thrust: Vec<f64>,
+    /// Axial inflow of each thruster at the current tick [m/s].
+    inflow: Vec<f64>,
+    /// Joint rates at the start of the current physics step [rad/s].
+    qd_step: Vec<f64>,
     /// Allocation outcomes so far.
     pub counts: AllocationCounts,
+    /// Energy and effort integrals over the control intervals so far.
+    pub energy: EnergyIntegrator,
     /// Wall-clock timers.
     pub timing: Timing,
 }
@@ -136,12 +196,54 @@ impl Recorder {
                 v.characteristic_length()
             },
             power: file.power_model(v.fluid.rho),
+            limits: v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect(),
+            sat_tol: file.metrics.saturation_tolerance,
+            thrust: vec![0.0; v.n_thrusters()],
+            inflow: vec![0.0; v.n_thrusters()],
+            qd_step: vec![0.0; v.n_joints()],
             counts: AllocationCounts::default(),
+            energy: EnergyIntegrator::default(),
             timing: Timing::default(),
         }
     }
 
-    /// Observe control period `k` at time `t` [s]: log a row every `log_dt`.
+    /// Sample the thrusters at a control tick, after allocation (`lp.ws` holds the forward
+    /// kinematics of the tick): the thrust the simulator will hold over the coming interval
+    /// (the allocation saturated to the limits; a thruster lag or rate limit, if configured,
+    /// is not followed) and each thruster's axial inflow. Also tracks the guided point along
+    /// the path (transport). The sample is for [`EnergyIntegrator::add`] once the interval
+    /// has been simulated.
+    pub fn sample(&mut self, lp: &ClosedLoop) -> PowerSample {
+        let (v, state) = (&lp.vehicle, lp.sim.state());
+        for ((u, a), th) in self.thrust.iter_mut().zip(&lp.alloc.u).zip(&v.thrusters) {
+            *u = a.clamp(th.u_min, th.u_max);
+        }
+        thruster_inflow(v, &lp.ws, state, &self.thrust, &mut self.inflow);
+        if let ModeController::Transport { signals: s, .. } = &lp.mode {
+            self.energy.track_path(s.segment, s.along_track);
+        }
+        let thrusters = ThrusterSample {
+            thrust: &self.thrust,
+            inflow: &self.inflow,
+            limits: &self.limits,
+        };
+        PowerSample::new(&self.power, &thrusters, self.sat_tol)
+    }
+
+    /// Before a physics step: note the joint rates at its start.
+    pub fn before_step(&mut self, state: &SimState) {
+        self.qd_step.copy_from_slice(&state.joint_rates);
+    }
+
+    /// After a physics step of `dt` [s]: its joint power, from the simulator's joint torques
+    /// at the step's start (`Simulator::last_joint_torque`: recovered for ideal servos, the
+    /// saturated PD torque for PD servos) and the rates noted by [`Recorder::before_step`].
+    pub fn after_step(&mut self, joint_torque: &[f64], dt: f64) {
+        self.energy.add_joint_step(joint_torque, &self.qd_step, dt);
+    }
+
+    /// Observe control period `k` at time `t` [s] after [`Recorder::sample`]: log a row every
+    /// `log_dt`.
     pub fn observe(&mut self, k: usize, t: f64, lp: &ClosedLoop) {
         if k % self.log_every != 0 {
             return;
@@ -149,10 +251,8 @@ impl Recorder {
         let (v, ws, state) = (&lp.vehicle, &lp.ws, lp.sim.state());
         let g_ib = state.pose.to_se3();
         let g_ie = g_ib.compose(&ws.g_be);
-        let mut v_in_b = state.base_twist;
-        for (x, r) in ws.joint_twist_b.iter().zip(&state.joint_rates) {
-            v_in_b += x * *r;
-        }
+        let last = ws.g_b.len() - 1;
+        let v_in_b = body_twist_in_base(ws, &state.base_twist, &state.joint_rates, last);
         let v_e = ws.g_be.twist_to_child(&v_in_b);
         let eb = euler_zyx(&g_ib.r);
         let ee = euler_zyx(&g_ie.r);
@@ -207,12 +307,17 @@ impl Recorder {
             .iter()
             .zip(&v.thrusters)
             .map(|(x, th)| x.clamp(th.u_min, th.u_max));
-        w.put_all(actual.clone().enumerate().map(|(j, u)| (Channel::U(j), u)));
+        w.put_all(actual.enumerate().map(|(j, u)| (Channel::U(j), u)));
         let power = &self.power;
+        let held = self.thrust.iter().zip(&self.inflow);
         w.put_all(
-            actual
+            held.clone()
                 .enumerate()
-                .map(|(j, u)| (Channel::Power(j), power.power(u))),
+                .map(|(j, (u, v_a))| (Channel::Power(j), power.shaft_power(*u, *v_a))),
+        );
+        w.put_all(
+            held.enumerate()
+                .map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)),
         );
         w.put(
             Channel::SigmaMin,
@@ -223,9 +328,12 @@ impl Recorder {
         self.traj.push_row(&self.row);
     }
 
-    /// The trajectory, the allocation counts and the timers, with the total wall time since
-    /// `started` and the real-time factor filled in.
-    pub fn finish(mut self, started: Instant) -> (Trajectory, AllocationCounts, Timing) {
+    /// The trajectory, the allocation counts, the energy integrals and the timers, with the
+    /// total wall time since `started` and the real-time factor filled in.
+    pub fn finish(
+        mut self,
+        started: Instant,
+    ) -> (Trajectory, AllocationCounts, EnergyMetrics, Timing) {
         let timing = &mut self.timing;
         timing.total_s = started.elapsed().as_secs_f64();
         let simulated = self
@@ -238,6 +346,71 @@ impl Recorder {
         } else {
             f64::INFINITY
         };
-        (self.traj, self.counts, self.timing)
+        (self.traj, self.counts, self.energy.metrics(), self.timing)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::thruster_inflow;
+    use crate::dynamics::SimState;
+    use crate::kinematics::KinWorkspace;
+    use crate::model::presets::usm_paper;
+    use crate::spatial::{Vec3, Vec6};
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    /// The straight paper design (T2, T6 sway; T3, T4 surge; T1, T5, T7 heave) with the
+    /// given base twist, yaw and current.
+    fn inflow(twist: [f64; 6], yaw: f64, current: Vec3, thrust: [f64; 7]) -> [f64; 7] {
+        let mut v = usm_paper();
+        v.fluid.current = current;
+        let ws = KinWorkspace::new(&v);
+        let mut s = SimState::rest(&v);
+        s.base_twist = Vec6::from_row_slice(&twist);
+        s.pose.orientation = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), yaw);
+        let mut out = [0.0; 7];
+        thruster_inflow(&v, &ws, &s, &thrust, &mut out);
+        out
+    }
+
+    #[test]
+    fn inflow_is_the_speed_through_water_along_the_thrust() {
+        let push = [10.0; 7];
+        // Surging at 0.5 m/s in still water: the surge thrusters pushing forward see 0.5 m/s,
+        // pushing backward −0.5 m/s (clamped to 0 by the power model); the others nothing.
+        let a = inflow([0.5, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0, Vec3::zeros(), push);
+        let expect = [0.0, 0.0, 0.5, 0.5, 0.0, 0.0, 0.0];
+        for (x, e) in a.iter().zip(expect) {
+            assert!((x - e).abs() < 1e-12, "{a:?}");
+        }
+        let back = [-10.0; 7];
+        let b = inflow([0.5, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0, Vec3::zeros(), back);
+        assert!((b[2] + 0.5).abs() < 1e-12 && (b[3] + 0.5).abs() < 1e-12);
+        // Heading along inertial +y at 0.5 m/s, carried by a 0.5 m/s current along +y: at
+        // rest relative to the water.
+        let c = inflow(
+            [0.5, 0.0, 0.0, 0.0, 0.0, 0.0],
+            std::f64::consts::FRAC_PI_2,
+            Vec3::new(0.0, 0.5, 0.0),
+            push,
+        );
+        assert!(c.iter().all(|x| x.abs() < 1e-12), "{c:?}");
+    }
+
+    #[test]
+    fn inflow_of_a_yawing_body_grows_with_the_lever_arm() {
+        // Yaw rate r about the base origin (the tail face): a thruster at (x_b, y_b) moves at
+        // (−r·y_b, r·x_b, 0), so a sway thruster sees r·x_b, a surge thruster −r·y_b (the
+        // off-axis pair T3/T4 at y_b = ∓0.1 m: ±0.02 m/s), a heave thruster nothing.
+        let r = 0.2;
+        let a = inflow([0.0, 0.0, 0.0, 0.0, 0.0, r], 0.0, Vec3::zeros(), [10.0; 7]);
+        let v = usm_paper();
+        let ws = KinWorkspace::new(&v);
+        for (j, th) in v.thrusters.iter().enumerate() {
+            let p = ws.g_b[th.body].act_point(&th.position);
+            let expect = th.direction.x * (-r * p.y) + th.direction.y * (r * p.x);
+            assert!((a[j] - expect).abs() < 1e-12, "{j}: {a:?}");
+        }
+        assert!(a[5] > a[1] && a[1] > 0.0);
     }
 }

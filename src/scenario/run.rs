@@ -3,9 +3,10 @@
 //!
 //! Rates: the physics advances with RK4 steps of `dt`; the controllers and the allocator run
 //! every `control_dt` with the actuator commands held in between (zero-order hold); the
-//! recorder samples every `log_dt`. Each control period is a fixed sequence of named phases
-//! (`measure`, `control`, `allocate`, the recorder's `observe`, `advance`), timed by phase;
-//! nothing allocates inside the loop.
+//! recorder samples the thrusters at every control tick and the joints at every physics step
+//! for the energy integrals, and logs every `log_dt`. Each control period is a fixed sequence
+//! of named phases (`measure`, `control`, `allocate`, the recorder's `sample` and `observe`,
+//! `advance`), timed by phase; nothing allocates inside the loop.
 
 use super::channels::Trajectory;
 use super::config::{Mode, ScenarioFile};
@@ -106,8 +107,9 @@ impl ClosedLoop<'_> {
             .map_err(|e| (t, format!("allocation: {e}")))
     }
 
-    /// Advance the physics over one control period with the commands held.
-    fn advance(&mut self) -> Result<(), Failure> {
+    /// Advance the physics over one control period with the commands held; the recorder sees
+    /// each physics step (joint power).
+    fn advance(&mut self, rec: &mut Recorder) -> Result<(), Failure> {
         let cmd = ActuatorCommand {
             thrust: &self.alloc.u,
             joint_ref: &self.cmd.q_ref,
@@ -115,15 +117,20 @@ impl ClosedLoop<'_> {
         };
         let dt = self.file.scenario.dt;
         for _ in 0..self.substeps {
+            rec.before_step(self.sim.state());
             self.sim
                 .step(dt, &cmd)
                 .map_err(|e| (e.time, e.to_string()))?;
+            rec.after_step(self.sim.last_joint_torque(), dt);
         }
         Ok(())
     }
 
-    /// Control period `k`: measure, control, allocate, record, then advance the physics
-    /// (except after the last period).
+    /// Control period `k`: measure, control, allocate, sample the thrusters and record, then
+    /// advance the physics (except after the last period) and integrate the thruster sample
+    /// over the period just simulated (SPEC §6 energy: rectangle rule on the zero-order hold,
+    /// at the control rate; the joints are integrated per physics step inside `advance`; the
+    /// thrusters of a period that fails are not counted).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
         let t = k as f64 * self.file.scenario.control_dt;
         let measured = timed!(rec.timing.control_s, self.measure(t))?;
@@ -132,11 +139,15 @@ impl ClosedLoop<'_> {
         timed!(rec.timing.control_s, self.control(t, &measured, &terms));
         timed!(rec.timing.allocation_s, self.allocate(t))?;
         rec.counts.count(&self.alloc.status);
+        let sample = timed!(rec.timing.logging_s, rec.sample(self));
         timed!(rec.timing.logging_s, rec.observe(k, t, self));
         if k == self.n_control {
+            rec.energy.add(&sample, 0.0);
             return Ok(());
         }
-        timed!(rec.timing.dynamics_s, self.advance())
+        timed!(rec.timing.dynamics_s, self.advance(rec))?;
+        rec.energy.add(&sample, self.file.scenario.control_dt);
+        Ok(())
     }
 }
 
@@ -148,8 +159,8 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
     let failure = (0..=lp.n_control).find_map(|k| lp.period(k, &mut rec).err());
-    let (trajectory, counts, timing) = rec.finish(started);
-    let metrics = run_summary(&lp.vehicle, file, &trajectory, failure.is_some(), &counts);
+    let (trajectory, counts, energy, timing) = rec.finish(started);
+    let metrics = run_summary(file, &trajectory, failure.is_some(), &counts, &energy);
     Ok(RunResult {
         name: file.scenario.name.clone(),
         mode: file.scenario.mode,

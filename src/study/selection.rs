@@ -52,7 +52,11 @@ impl Selection {
                 || m.starts_with("sigma_min")
                 || matches!(
                     m.as_str(),
-                    "completed" | "converged" | "segments_reached" | "simulated_time"
+                    "completed"
+                        | "converged"
+                        | "segments_reached"
+                        | "simulated_time"
+                        | "path_progress"
                 )
             {
                 maximise.insert(m.clone());
