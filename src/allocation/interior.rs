@@ -112,6 +112,8 @@ pub(crate) fn inside(u: &[f64], lo: &[f64], hi: &[f64]) -> bool {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::needless_range_loop)]
+
     use super::super::tests::bent_t;
     use super::super::{AllocPath, AllocSettings, Allocation, Allocator, Method, RateSettings};
     use nalgebra::{DMatrix, DVector, Matrix6xX, Vector6};
