@@ -1,15 +1,52 @@
-//! Thrust-allocation benchmarks (SPEC §5): one allocation step per method on a 6×7 T typical of a
-//! bent USM (seeded random unit thrust directions, positions within ±1.5 m), with the
+//! Thrust-allocation benchmarks (SPEC §5): one allocation step per path on a 6×7 T typical of
+//! a bent USM (seeded random unit thrust directions, positions within ±1.5 m), with the
 //! [`Allocator`] reused across steps as in a closed loop. Each iteration takes the next of 8
-//! precomputed (T, τ) pairs, so every solve sees new data. Also compares the Clarabel
-//! formulations (slack kept / eliminated) and solver reuse against a rebuild per step.
+//! precomputed (T, τ) pairs, so every solve sees new data.
 //!
-//! Targets: `qp` median ≤ 30 µs, `pinv` ≤ 2 µs.
+//! Groups:
+//! - `path`: `qp_interior` (the certified interior shortcut: every case's unconstrained optimum
+//!   lies inside ±40 N), `qp_interior_clarabel` (the same cases with the shortcut off, Clarabel
+//!   every step), `qp_active` (Clarabel: τ up to 40 N, bounds ±5 N active in every case), `pinv`,
+//!   `minimax`, `power` (Clarabel, same cases as `qp_active`);
+//! - `formulation_<method>`: the Clarabel formulations (slack kept / eliminated) and solver
+//!   reuse against a rebuild per step (shortcut off).
+//!
+//! Before measuring, every case is checked to take the path its group names, and a counting
+//! allocator checks that the `qp_interior` and `pinv` steps allocate nothing (Clarabel's solve
+//! may allocate internally; its count is printed).
+//!
+//! Run with `cargo bench --bench allocation -- --warm-up-time 1 --measurement-time 3`.
+//! Target (issue 11): the qp step ≤ 5 µs median in closed loop, where nearly every step takes
+//! the interior shortcut.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{Matrix6xX, Vector3, Vector6};
 use rand::{Rng, SeedableRng};
-use usm_study::allocation::{AllocSettings, Allocation, Allocator, Formulation, Method};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use usm_study::allocation::{AllocPath, AllocSettings, Allocation, Allocator, Formulation, Method};
+
+/// Counts heap allocations (all threads) to check the hot paths allocate nothing.
+struct Counting;
+
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
 
 /// A bent-USM-like T: 7 thrusters with random unit directions and positions in ±1.5 m.
 fn bent_t(rng: &mut rand_chacha::ChaCha8Rng) -> Matrix6xX<f64> {
@@ -36,13 +73,14 @@ fn bent_t(rng: &mut rand_chacha::ChaCha8Rng) -> Matrix6xX<f64> {
     t
 }
 
-fn cases() -> Vec<(Matrix6xX<f64>, Vector6<f64>)> {
+/// 8 seeded (T, τ) pairs with forces in ±`force` N and moments in ±`force`/3 N·m.
+fn cases(force: f64) -> Vec<(Matrix6xX<f64>, Vector6<f64>)> {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2024);
     (0..8)
         .map(|_| {
             let t = bent_t(&mut rng);
             let tau = Vector6::from_fn(|i, _| {
-                let s = if i < 3 { 30.0 } else { 10.0 };
+                let s = if i < 3 { force } else { force / 3.0 };
                 rng.random_range(-s..s)
             });
             (t, tau)
@@ -50,16 +88,61 @@ fn cases() -> Vec<(Matrix6xX<f64>, Vector6<f64>)> {
         .collect()
 }
 
-fn bench_step(c: &mut Criterion, group: &str, id: &str, method: Method, settings: AllocSettings) {
-    let cases = cases();
-    let mut alloc = Allocator::new(method, 7, &[-40.0; 7], &[40.0; 7], &[1.0; 7], settings)
-        .expect("valid bench case");
+/// One benchmarked configuration: method, bounds (±`bound` N), settings, the cases and the
+/// path every case must take (`None`: not checked).
+struct Case {
+    method: Method,
+    bound: f64,
+    settings: AllocSettings,
+    cases: Vec<(Matrix6xX<f64>, Vector6<f64>)>,
+    path: Option<AllocPath>,
+}
+
+impl Case {
+    fn allocator(&self) -> Allocator {
+        let b = self.bound;
+        Allocator::new(
+            self.method,
+            7,
+            &[-b; 7],
+            &[b; 7],
+            &[1.0; 7],
+            self.settings.clone(),
+        )
+        .expect("valid bench case")
+    }
+
+    /// Check the path of every case, then count the heap allocations of one more pass
+    /// (after a warm-up pass); returns that count.
+    fn check(&self, id: &str) -> usize {
+        let mut alloc = self.allocator();
+        let mut out = Allocation::new(7);
+        for (t, tau) in &self.cases {
+            alloc
+                .allocate_into(t, tau, &mut out)
+                .expect("valid bench case");
+            if let Some(path) = self.path {
+                assert_eq!(out.path, path, "{id}: a case takes another path");
+            }
+        }
+        let before = ALLOCS.load(Ordering::Relaxed);
+        for (t, tau) in &self.cases {
+            alloc
+                .allocate_into(t, tau, &mut out)
+                .expect("valid bench case");
+        }
+        ALLOCS.load(Ordering::Relaxed) - before
+    }
+}
+
+fn bench_step(c: &mut Criterion, group: &str, id: &str, case: &Case) {
+    let mut alloc = case.allocator();
     let mut out = Allocation::new(7);
     let mut k = 0usize;
     let mut g = c.benchmark_group(group);
     g.bench_function(BenchmarkId::from_parameter(id), |b| {
         b.iter(|| {
-            let (t, tau) = &cases[k % cases.len()];
+            let (t, tau) = &case.cases[k % case.cases.len()];
             k += 1;
             alloc
                 .allocate_into(t, tau, &mut out)
@@ -70,15 +153,51 @@ fn bench_step(c: &mut Criterion, group: &str, id: &str, method: Method, settings
     g.finish();
 }
 
-fn methods(c: &mut Criterion) {
-    for method in Method::ALL {
-        bench_step(
-            c,
-            "allocate",
-            method.name(),
-            method,
-            AllocSettings::default(),
-        );
+fn paths(c: &mut Criterion) {
+    let d = AllocSettings::default;
+    let forced = || AllocSettings {
+        interior_shortcut: false,
+        ..d()
+    };
+    let interior = |settings, path| Case {
+        method: Method::Qp,
+        bound: 40.0,
+        settings,
+        cases: cases(3.0),
+        path: Some(path),
+    };
+    let active = |method, path| Case {
+        method,
+        bound: 5.0,
+        settings: d(),
+        cases: cases(40.0),
+        path,
+    };
+    let list = [
+        ("qp_interior", interior(d(), AllocPath::Interior)),
+        (
+            "qp_interior_clarabel",
+            interior(forced(), AllocPath::Clarabel),
+        ),
+        ("qp_active", active(Method::Qp, Some(AllocPath::Clarabel))),
+        ("pinv", active(Method::Pinv, Some(AllocPath::Pinv))),
+        (
+            "minimax",
+            active(Method::Minimax, Some(AllocPath::Clarabel)),
+        ),
+        ("power", active(Method::Power, Some(AllocPath::Clarabel))),
+    ];
+    for (id, case) in &list {
+        let n = case.check(id);
+        if matches!(case.path, Some(AllocPath::Interior | AllocPath::Pinv)) {
+            assert_eq!(n, 0, "{id}: a step allocated on the heap");
+        } else {
+            println!(
+                "{id}: {n} heap allocations over {} Clarabel steps",
+                case.cases.len()
+            );
+        }
+        bench_step(c, "path", id, case);
     }
 }
 
@@ -90,15 +209,22 @@ fn formulations(c: &mut Criterion) {
             ("kept_reuse", Formulation::SlackKept, true),
             ("kept_rebuild", Formulation::SlackKept, false),
         ] {
-            let settings = AllocSettings {
-                formulation,
-                reuse_solver: reuse,
-                ..AllocSettings::default()
+            let case = Case {
+                method,
+                bound: 40.0,
+                settings: AllocSettings {
+                    formulation,
+                    reuse_solver: reuse,
+                    interior_shortcut: false,
+                    ..AllocSettings::default()
+                },
+                cases: cases(30.0),
+                path: None,
             };
-            bench_step(c, &format!("formulation_{method}"), name, method, settings);
+            bench_step(c, &format!("formulation_{method}"), name, &case);
         }
     }
 }
 
-criterion_group!(benches, methods, formulations);
+criterion_group!(benches, paths, formulations);
 criterion_main!(benches);

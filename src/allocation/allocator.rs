@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use super::conic::{self, ConicProblem};
 use super::error::{check_bounds, check_t, check_tau, check_vec, AllocError};
+use super::interior::{inside, InteriorQp};
 use super::pinv::{pinv_into, wrench};
 use super::settings::{AllocSettings, Method};
 
@@ -80,6 +81,35 @@ impl fmt::Display for AllocStatus {
     }
 }
 
+/// Which computation produced an allocation (counted per run by the scenario recorder).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AllocPath {
+    /// `pinv`: the closed-form damped pseudoinverse (USM-37).
+    Pinv,
+    /// `qp` with no bound or rate limit active: the unconstrained optimum, one SPD solve,
+    /// certified as the QP solution (KKT with zero bound multipliers; see `interior.rs`).
+    Interior,
+    /// Clarabel's interior-point solve (a bound or rate limit would be active, or the method
+    /// is `minimax`/`power`, or the shortcut is off).
+    Clarabel,
+    /// Clarabel failed: `u` is the clipped pseudoinverse (or zero), see
+    /// [`AllocStatus::SolverFailed`].
+    Fallback,
+}
+
+impl AllocPath {
+    /// Short machine-readable label: `pinv`, `interior`, `clarabel`, `fallback`.
+    pub fn label(self) -> &'static str {
+        match self {
+            AllocPath::Pinv => "pinv",
+            AllocPath::Interior => "interior",
+            AllocPath::Clarabel => "clarabel",
+            AllocPath::Fallback => "fallback",
+        }
+    }
+}
+
 /// Result of one allocation (SPEC §5).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Allocation {
@@ -94,10 +124,13 @@ pub struct Allocation {
     pub objective: f64,
     /// Outcome.
     pub status: AllocStatus,
-    /// Clarabel's own status text (`"Solved"`, `"AlmostSolved"`, …); `"-"` for `pinv`.
+    /// Clarabel's own status text (`"Solved"`, `"AlmostSolved"`, …); `"-"` when Clarabel was
+    /// not called (paths [`AllocPath::Pinv`], [`AllocPath::Interior`]).
     pub solver_status: &'static str,
-    /// Interior-point iterations (0 for `pinv`).
+    /// Interior-point iterations (0 when Clarabel was not called).
     pub iterations: u32,
+    /// Which computation produced `u`.
+    pub path: AllocPath,
 }
 
 impl Allocation {
@@ -110,6 +143,7 @@ impl Allocation {
             status: AllocStatus::Solved,
             solver_status: "-",
             iterations: 0,
+            path: AllocPath::Pinv,
         }
     }
 
@@ -140,6 +174,8 @@ pub struct Allocator {
     lo: Vec<f64>,
     hi: Vec<f64>,
     conic: Option<ConicProblem>,
+    /// Scratch of the `qp` interior shortcut (`qp` with the shortcut on only).
+    interior: Option<InteriorQp>,
     failures: u64,
     steps: u64,
 }
@@ -203,6 +239,8 @@ impl Allocator {
                 settings.tol,
             )),
         };
+        let interior = (method == Method::Qp && settings.interior_shortcut)
+            .then(|| InteriorQp::new(n_thrusters));
         Ok(Self {
             method,
             n_thrusters,
@@ -216,6 +254,7 @@ impl Allocator {
             lo: u_min.to_vec(),
             hi: u_max.to_vec(),
             conic,
+            interior,
             failures: 0,
             steps: 0,
             settings,
@@ -289,66 +328,92 @@ impl Allocator {
             self.hi[j] = (self.u_prev[j] + self.rate_step[j]).clamp(self.u_min[j], self.u_max[j]);
         }
         match self.method {
-            Method::Pinv => {
-                pinv_into(t, tau, &self.w_inv, self.settings.lambda, &mut out.u);
-                out.s = wrench(t, &out.u) - tau;
-                out.solver_status = "-";
-                out.iterations = 0;
-                let max_violation = out
-                    .u
-                    .iter()
-                    .zip(self.u_min.iter().zip(&self.u_max))
-                    .fold(0.0_f64, |a, (&u, (&lo, &hi))| a.max(u - hi).max(lo - u));
-                out.objective = self.objective(&out.u, &out.s);
-                out.status = if max_violation > 0.0 {
-                    AllocStatus::BoundsViolated { max_violation }
-                } else {
-                    self.slack_status(&out.s, tau)
-                };
-            }
-            _ => {
-                let Some(conic) = self.conic.as_mut() else {
-                    unreachable!("Allocator::new gives every constrained method a conic problem")
-                };
-                let params = conic::Params {
-                    t,
-                    tau,
-                    lo: &self.lo,
-                    hi: &self.hi,
-                    w: &self.w,
-                    rate_w: &self.rate_w,
-                    u_prev: &self.u_prev,
-                    q: self.settings.q,
-                    eps: self.settings.eps,
-                };
-                let outcome = conic.solve(&params, &mut out.u);
-                out.solver_status = outcome.status_text;
-                out.iterations = outcome.iterations;
-                if outcome.ok {
-                    out.s = wrench(t, &out.u) - tau;
-                    out.objective = self.objective(&out.u, &out.s);
-                    out.status = self.slack_status(&out.s, tau);
-                } else {
-                    self.failures += 1;
-                    if self.settings.fallback {
-                        pinv_into(t, tau, &self.w_inv, self.settings.lambda, &mut out.u);
-                    } else {
-                        out.u.iter_mut().for_each(|u| *u = 0.0);
-                    }
-                    for (u, (&lo, &hi)) in out.u.iter_mut().zip(self.lo.iter().zip(&self.hi)) {
-                        *u = u.clamp(lo, hi);
-                    }
-                    out.s = wrench(t, &out.u) - tau;
-                    out.objective = self.objective(&out.u, &out.s);
-                    out.status = AllocStatus::SolverFailed {
-                        solver_status: outcome.status_text,
-                        fallback: self.settings.fallback,
-                    };
-                }
-            }
+            Method::Pinv => self.allocate_pinv(t, tau, out),
+            _ => self.allocate_constrained(t, tau, out),
         }
         self.u_prev.copy_from_slice(&out.u);
         Ok(())
+    }
+
+    /// `pinv` (USM-37): the damped pseudoinverse, unclipped, with its bound violation.
+    fn allocate_pinv(&mut self, t: &Matrix6xX<f64>, tau: &Vector6<f64>, out: &mut Allocation) {
+        pinv_into(t, tau, &self.w_inv, self.settings.lambda, &mut out.u);
+        out.s = wrench(t, &out.u) - tau;
+        out.solver_status = "-";
+        out.iterations = 0;
+        out.path = AllocPath::Pinv;
+        let max_violation = out
+            .u
+            .iter()
+            .zip(self.u_min.iter().zip(&self.u_max))
+            .fold(0.0_f64, |a, (&u, (&lo, &hi))| a.max(u - hi).max(lo - u));
+        out.objective = self.objective(&out.u, &out.s);
+        out.status = if max_violation > 0.0 {
+            AllocStatus::BoundsViolated { max_violation }
+        } else {
+            self.slack_status(&out.s, tau)
+        };
+    }
+
+    /// The constrained forms: the certified interior shortcut (`qp`), else Clarabel, else the
+    /// fallback.
+    fn allocate_constrained(
+        &mut self,
+        t: &Matrix6xX<f64>,
+        tau: &Vector6<f64>,
+        out: &mut Allocation,
+    ) {
+        let params = conic::Params {
+            t,
+            tau,
+            lo: &self.lo,
+            hi: &self.hi,
+            w: &self.w,
+            rate_w: &self.rate_w,
+            u_prev: &self.u_prev,
+            q: self.settings.q,
+            eps: self.settings.eps,
+        };
+        if let Some(interior) = self.interior.as_mut() {
+            if interior.solve(&params, &mut out.u) && inside(&out.u, &self.lo, &self.hi) {
+                out.solver_status = "-";
+                out.iterations = 0;
+                out.path = AllocPath::Interior;
+                out.s = wrench(t, &out.u) - tau;
+                out.objective = self.objective(&out.u, &out.s);
+                out.status = self.slack_status(&out.s, tau);
+                return;
+            }
+        }
+        let Some(conic) = self.conic.as_mut() else {
+            unreachable!("Allocator::new gives every constrained method a conic problem")
+        };
+        let outcome = conic.solve(&params, &mut out.u);
+        out.solver_status = outcome.status_text;
+        out.iterations = outcome.iterations;
+        if outcome.ok {
+            out.path = AllocPath::Clarabel;
+            out.s = wrench(t, &out.u) - tau;
+            out.objective = self.objective(&out.u, &out.s);
+            out.status = self.slack_status(&out.s, tau);
+            return;
+        }
+        self.failures += 1;
+        if self.settings.fallback {
+            pinv_into(t, tau, &self.w_inv, self.settings.lambda, &mut out.u);
+        } else {
+            out.u.iter_mut().for_each(|u| *u = 0.0);
+        }
+        for (u, (&lo, &hi)) in out.u.iter_mut().zip(self.lo.iter().zip(&self.hi)) {
+            *u = u.clamp(lo, hi);
+        }
+        out.path = AllocPath::Fallback;
+        out.s = wrench(t, &out.u) - tau;
+        out.objective = self.objective(&out.u, &out.s);
+        out.status = AllocStatus::SolverFailed {
+            solver_status: outcome.status_text,
+            fallback: self.settings.fallback,
+        };
     }
 
     fn slack_status(&self, s: &Vector6<f64>, tau: &Vector6<f64>) -> AllocStatus {

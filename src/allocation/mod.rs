@@ -24,15 +24,21 @@
 //! [`AllocStatus`]. Bad input (dimensions, ordering of bounds, non-finite values, non-positive
 //! weights) is an [`AllocError`].
 //!
+//! `qp` steps whose unconstrained optimum lies within the bounds skip Clarabel: that optimum (one
+//! n_thrusters×n_thrusters Cholesky solve) is the QP solution, certified by the KKT conditions
+//! with zero bound multipliers (`interior`); [`Allocation::path`] says which way a step went.
+//!
 //! Files: `settings` (method, formulation, [`AllocSettings`] with defaults and `validate()`),
 //! `error` ([`AllocError`] and the input checks), `allocator` ([`Allocator`], [`Allocation`],
-//! [`AllocStatus`]), `conic` (the Clarabel formulations), `attainable` (attainable wrench);
+//! [`AllocStatus`], [`AllocPath`]), `interior` (the certified interior shortcut of `qp`),
+//! `conic` (the Clarabel formulations), `attainable` (attainable wrench);
 //! `pinv` (the damped pseudoinverse kernel and `T u`); here: the one-shot conveniences.
 
 mod allocator;
 mod attainable;
 mod conic;
 mod error;
+mod interior;
 mod pinv;
 mod settings;
 #[cfg(test)]
@@ -40,7 +46,7 @@ pub(crate) mod tests;
 
 use nalgebra::{Matrix6xX, Vector6};
 
-pub use allocator::{AllocStatus, Allocation, Allocator};
+pub use allocator::{AllocPath, AllocStatus, Allocation, Allocator};
 pub use attainable::{attainable_wrench, AttainableWrench};
 pub(crate) use error::check_t;
 pub use error::AllocError;

@@ -173,6 +173,11 @@ pub struct AllocSettings {
     /// Clarabel's gap and feasibility tolerances (`tol_gap_abs`, `tol_gap_rel`, `tol_feas`),
     /// in (0, 1). Default [`DEFAULT_TOL`] = 1e-8 (Clarabel's own default).
     pub tol: f64,
+    /// `qp` only: return the unconstrained optimum (one SPD solve) when it lies within the
+    /// effective bounds — it is then the QP solution, certified by the KKT conditions with
+    /// zero bound multipliers — and call Clarabel only when a bound or rate limit would be
+    /// active. Off sends every step to Clarabel. Default `true`.
+    pub interior_shortcut: bool,
 }
 
 impl Default for AllocSettings {
@@ -187,6 +192,7 @@ impl Default for AllocSettings {
             formulation: Formulation::default(),
             reuse_solver: true,
             tol: DEFAULT_TOL,
+            interior_shortcut: true,
         }
     }
 }

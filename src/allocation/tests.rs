@@ -90,7 +90,11 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 
 /// Check the KKT conditions of the original (slack-kept, ½-free) problem at the returned `u`,
 /// with the multipliers taken from Clarabel's dual `z` (valid for both formulations).
+/// A `qp` result of the interior shortcut is checked with zero bound multipliers instead.
 fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) {
+    if r.path == AllocPath::Interior {
+        return check_kkt_interior(a, r, t, u_prev);
+    }
     let conic = a.conic().expect("constrained method");
     let l = conic.layout();
     let sol = conic.solution().expect("solved");
@@ -197,6 +201,35 @@ fn check_kkt(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) 
     }
 }
 
+/// KKT of the `qp` problem at an interior-shortcut result: bounds hold, and stationarity
+/// `2Wu + 2R(u − u_prev) + 2q Tᵀs = 0` holds with zero bound multipliers (relative to the
+/// largest term).
+fn check_kkt_interior(a: &Allocator, r: &Allocation, t: &Matrix6xX<f64>, u_prev: &[f64]) {
+    assert_eq!(a.method(), Method::Qp);
+    let st = a.settings();
+    let (lo, hi) = a.effective_bounds();
+    let rate_w = st.rate.as_ref().map(|r| r.weights.clone());
+    let ts = t.transpose() * r.s;
+    for j in 0..r.u.len() {
+        assert!(
+            lo[j] <= r.u[j] && r.u[j] <= hi[j],
+            "interior path outside the bounds"
+        );
+        let rw = rate_w.as_ref().map_or(0.0, |w| w[j]);
+        let terms = [
+            2.0 * a.w[j] * r.u[j],
+            2.0 * rw * (r.u[j] - u_prev[j]),
+            2.0 * st.q * ts[j],
+        ];
+        let scale = terms.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+        let res: f64 = terms.iter().sum();
+        assert!(
+            res.abs() <= 1e-9 * scale,
+            "interior stationarity {j}: {res}"
+        );
+    }
+}
+
 /// Default settings with a tight Clarabel tolerance, for the KKT checks.
 fn tight() -> AllocSettings {
     AllocSettings {
@@ -205,15 +238,22 @@ fn tight() -> AllocSettings {
     }
 }
 
-fn all_formulations() -> [AllocSettings; 3] {
+/// The default (interior shortcut on), then Clarabel forced in every formulation.
+fn all_formulations() -> [AllocSettings; 4] {
     [
         tight(),
         AllocSettings {
+            interior_shortcut: false,
+            ..tight()
+        },
+        AllocSettings {
             formulation: Formulation::SlackEliminated,
+            interior_shortcut: false,
             ..tight()
         },
         AllocSettings {
             reuse_solver: false,
+            interior_shortcut: false,
             ..tight()
         },
     ]

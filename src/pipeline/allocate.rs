@@ -21,7 +21,8 @@
 //!
 //! JSON output is an object keyed by method name, each with `u`, `s`, `objective`, `status`
 //! (`solved`, `slack_active`, `bounds_violated`, `solver_failed`), `status_detail`,
-//! `solver_status`, `iterations` and `solve_time_us`.
+//! `solver_status`, `iterations`, `path` (`pinv`, `interior`: the certified interior shortcut of
+//! `qp`, `clarabel`, `fallback`) and `solve_time_us`.
 //!
 //! Bad input is a [`CaseFileError`] naming the file and the key.
 
@@ -229,6 +230,8 @@ pub struct MethodResult {
     pub solver_status: &'static str,
     /// Solver iterations.
     pub iterations: u32,
+    /// Which computation produced `u` ([`AllocPath::label`](crate::allocation::AllocPath::label)).
+    pub path: &'static str,
     /// Wall-clock time of the solve (µs).
     pub solve_time_us: f64,
 }
@@ -245,6 +248,7 @@ impl MethodResult {
             status_detail: a.status.to_string(),
             solver_status: a.solver_status,
             iterations: a.iterations,
+            path: a.path.label(),
             solve_time_us,
         }
     }

@@ -9,7 +9,7 @@
 use super::channels::{channel_layout, Channel, Pose, Trajectory, Twist};
 use super::controller::ModeController;
 use super::setup::ClosedLoop;
-use crate::allocation::AllocStatus;
+use crate::allocation::{AllocPath, AllocStatus, Allocation};
 use crate::dynamics::SimState;
 use crate::kinematics::KinWorkspace;
 use crate::metrics::singularity::sigma_min_scaled_gram;
@@ -49,25 +49,40 @@ pub struct Timing {
     pub realtime_factor: f64,
 }
 
-/// How the allocations of a run went, counted over control periods.
+/// How the allocations of a run went, counted over control periods: outcomes, and which path
+/// computed each step (`steps = pinv + fast_path + clarabel + solver_failures`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct AllocationCounts {
     /// Allocations made (one per control period reached).
     pub steps: u64,
     /// Allocations whose wrench slack was active (the demand was not met exactly).
     pub slack_active: u64,
-    /// Allocations the solver did not solve (neither solved, slack-active nor bounds-violated).
+    /// Allocations the solver did not solve (neither solved, slack-active nor bounds-violated);
+    /// their `u` is the fallback ([`AllocPath::Fallback`]).
     pub solver_failures: u64,
+    /// `qp` steps solved by the certified interior shortcut, without Clarabel
+    /// ([`AllocPath::Interior`]).
+    pub fast_path: u64,
+    /// Steps solved by Clarabel ([`AllocPath::Clarabel`]).
+    pub clarabel: u64,
+    /// `pinv` steps ([`AllocPath::Pinv`]).
+    pub pinv: u64,
 }
 
 impl AllocationCounts {
-    /// Count one allocation outcome.
-    pub fn count(&mut self, status: &AllocStatus) {
+    /// Count one allocation: its outcome and its path.
+    pub fn count(&mut self, a: &Allocation) {
         self.steps += 1;
-        match status {
+        match a.status {
             AllocStatus::SlackActive { .. } => self.slack_active += 1,
             AllocStatus::Solved | AllocStatus::BoundsViolated { .. } => {}
             _ => self.solver_failures += 1,
+        }
+        match a.path {
+            AllocPath::Interior => self.fast_path += 1,
+            AllocPath::Clarabel => self.clarabel += 1,
+            AllocPath::Pinv => self.pinv += 1,
+            AllocPath::Fallback => {}
         }
     }
 }

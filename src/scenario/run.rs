@@ -138,7 +138,7 @@ impl ClosedLoop<'_> {
             .map_err(|e| (t, e.to_string()))?;
         timed!(rec.timing.control_s, self.control(t, &measured, &terms));
         timed!(rec.timing.allocation_s, self.allocate(t))?;
-        rec.counts.count(&self.alloc.status);
+        rec.counts.count(&self.alloc);
         let sample = timed!(rec.timing.logging_s, rec.sample(self));
         timed!(rec.timing.logging_s, rec.observe(k, t, self));
         if k == self.n_control {
