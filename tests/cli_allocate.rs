@@ -124,3 +124,19 @@ fn bad_input_exits_2_naming_file_and_key() {
     let out = allocate(&["--input", dir.path().join("missing.json").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// A damping whose square overflows used to send the pseudoinverse's SVD fallback into an
+/// endless loop on infinite data: it is now refused up front, naming the key (exit 2).
+#[test]
+fn overflowing_damping_is_refused_not_a_hang() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "huge_lambda.json",
+        &format!(r#"{{"T": {T7}, "tau": [1, 0, 0, 0, 0, 0], "lambda": 1e300}}"#),
+    );
+    let out = allocate(&["--input", p.to_str().unwrap(), "--method", "pinv"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("lambda") && err.contains("1e300"), "{err}");
+}

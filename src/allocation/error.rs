@@ -65,7 +65,7 @@ pub enum AllocError {
         requirement: &'static str,
     },
     /// A scalar setting is out of range.
-    #[error("setting `{name}` = {value} must be {requirement}")]
+    #[error("setting `{name}` = {value:?} must be {requirement}")]
     BadSetting {
         /// Setting name.
         name: &'static str,
@@ -158,4 +158,18 @@ pub(super) fn check_setting(
             requirement,
         })
     }
+}
+
+/// Largest damping λ accepted (USM-37 uses λ²; beyond 1e150 it overflows to infinity and the
+/// damped pseudoinverse has no meaningful value).
+pub const MAX_LAMBDA: f64 = 1e150;
+
+/// Check the damping λ of the pseudoinverse: finite, ≥ 0 and ≤ [`MAX_LAMBDA`].
+pub(super) fn check_lambda(lambda: f64) -> Result<(), AllocError> {
+    check_setting(
+        "lambda",
+        lambda,
+        (0.0..=MAX_LAMBDA).contains(&lambda),
+        ">= 0 and <= 1e150 (λ² must be finite)",
+    )
 }

@@ -49,8 +49,8 @@ use nalgebra::{Matrix6xX, Vector6};
 pub use allocator::{AllocPath, AllocStatus, Allocation, Allocator};
 pub use attainable::{attainable_wrench, AttainableWrench};
 pub(crate) use error::check_t;
-pub use error::AllocError;
-use error::{check_setting, check_tau, check_vec};
+use error::{check_lambda, check_tau, check_vec};
+pub use error::{AllocError, MAX_LAMBDA};
 use pinv::pinv_into;
 pub use pinv::wrench;
 pub use settings::{
@@ -79,7 +79,7 @@ pub fn damped_pinv(
             requirement: "> 0",
         });
     }
-    check_setting("lambda", lambda, lambda >= 0.0, ">= 0")?;
+    check_lambda(lambda)?;
     let w_inv: Vec<f64> = w.iter().map(|x| 1.0 / x).collect();
     let mut u = vec![0.0; n_thrusters];
     pinv_into(t, tau, &w_inv, lambda, &mut u);

@@ -3,6 +3,9 @@
 
 use nalgebra::{Matrix6, Matrix6xX, Vector6};
 
+/// Iteration cap of the 6×6 SVD fallback (it converges in a few dozen on finite data).
+const SVD_MAX_ITERATIONS: usize = 1000;
+
 /// `T u` (base frame; N, N·m).
 pub fn wrench(t: &Matrix6xX<f64>, u: &[f64]) -> Vector6<f64> {
     let mut f = Vector6::zeros();
@@ -30,10 +33,11 @@ pub(super) fn pinv_into(
     }
     let y = match a.cholesky() {
         Some(ch) => ch.solve(tau),
+        // A capped SVD: on non-finite data an uncapped one iterates forever.
         None => a
-            .svd(true, true)
-            .solve(tau, 1e-12 * a.norm().max(f64::MIN_POSITIVE))
-            .unwrap_or_else(|_| Vector6::zeros()),
+            .try_svd(true, true, f64::EPSILON, SVD_MAX_ITERATIONS)
+            .and_then(|svd| svd.solve(tau, 1e-12 * a.norm().max(f64::MIN_POSITIVE)).ok())
+            .unwrap_or_else(Vector6::zeros),
     };
     for (j, (uj, &wi)) in u.iter_mut().zip(w_inv).enumerate() {
         *uj = wi * t.fixed_view::<6, 1>(0, j).dot(&y);

@@ -7,7 +7,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{check_setting, check_vec, AllocError};
+use super::error::{check_lambda, check_setting, check_vec, AllocError};
 
 /// Default damping factor λ of the pseudoinverse (USM-37; the paper uses λ = 0.1).
 pub const DEFAULT_LAMBDA: f64 = 0.1;
@@ -198,11 +198,11 @@ impl Default for AllocSettings {
 }
 
 impl AllocSettings {
-    /// Check the scalar settings (`lambda ≥ 0`, `q > 0`, `eps ≥ 0`, `slack_tol ≥ 0`,
+    /// Check the scalar settings (`0 ≤ lambda ≤` [`crate::allocation::MAX_LAMBDA`], `q > 0`, `eps ≥ 0`, `slack_tol ≥ 0`,
     /// `tol ∈ (0, 1)`, all finite), in that order; the rate terms are checked against the
     /// thruster count by [`RateSettings::validate`].
     pub fn validate(&self) -> Result<(), AllocError> {
-        check_setting("lambda", self.lambda, self.lambda >= 0.0, ">= 0")?;
+        check_lambda(self.lambda)?;
         check_setting("q", self.q, self.q > 0.0, "> 0")?;
         check_setting("eps", self.eps, self.eps >= 0.0, ">= 0")?;
         check_setting("slack_tol", self.slack_tol, self.slack_tol >= 0.0, ">= 0")?;

@@ -676,3 +676,16 @@ proptest! {
         }
     }
 }
+
+/// Finite thruster-matrix entries whose Gram matrix overflows (1e200² = inf) send the damped
+/// pseudoinverse to its SVD fallback on infinite data; the capped SVD gives up instead of
+/// iterating forever, and the result is finite (zero thrust), not NaN.
+#[test]
+fn pinv_on_an_overflowing_gram_matrix_terminates() {
+    let mut t = Matrix6xX::<f64>::zeros(3);
+    t[(0, 0)] = 1e200;
+    t[(1, 1)] = 1.0;
+    t[(2, 2)] = 1.0;
+    let u = damped_pinv(&t, &tau([1.0, 2.0, 3.0, 0.0, 0.0, 0.0]), &[1.0; 3], 0.0).unwrap();
+    assert!(u.iter().all(|x| x.is_finite()), "{u:?}");
+}
