@@ -229,3 +229,52 @@ pub fn write_drawing(
     atomic_write(out, svg.as_bytes())?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets::{usm_paper, uvms_planar};
+
+    #[test]
+    fn modules_scale_and_caption_of_the_straight_usm() {
+        let v = usm_paper();
+        let modules: Vec<&str> = (0..v.bodies.len())
+            .filter(|&i| is_joint_module(&v, i))
+            .map(|i| v.bodies[i].name.as_str())
+            .collect();
+        assert_eq!(modules, ["J1", "J2", "J3", "J4"]);
+        assert!(!(0..4).any(|i| is_joint_module(&uvms_planar(), i)));
+        // 0.15 · 3.3 m / 40 N = 0.0124 m/N, rounded down to 0.01.
+        assert_eq!(arrow_scale(&v), 0.01);
+        let s = VehicleState::rest(&v);
+        let m = state_metrics(&v, &s).unwrap().unwrap();
+        let text = caption(&v, "straight", Some(&m)).join("\n");
+        assert!(
+            text.contains("rank 5 of 6; lost (σ ≤ 1e-6 σ_max): roll"),
+            "{text}"
+        );
+        assert_eq!(weakest_axis(&m).map(|w| w.0), Some("roll"));
+    }
+
+    #[test]
+    fn a_bent_scene_follows_forward_kinematics() {
+        let v = usm_paper();
+        let mut s = VehicleState::rest(&v);
+        s.q = vec![0.4, -0.2, 0.3, 0.1, -0.5, 0.2, 0.3, -0.1];
+        let scene = vehicle_scene(&v, &s);
+        let mut ws = KinWorkspace::new(&v);
+        forward_kinematics(&v, &s.q, &mut ws);
+        let t = thruster_matrix_owned(&v, &ws);
+        for (j, a) in scene.arrows.iter().enumerate() {
+            // The arrow's force and moment about the base origin are T(q)'s column (USM-25).
+            let f = a.direction;
+            let m = a.start.cross(&f);
+            for r in 0..3 {
+                assert!((t[(r, j)] - f[r]).abs() < 1e-12 && (t[(r + 3, j)] - m[r]).abs() < 1e-12);
+            }
+            assert!((a.length - 0.4).abs() < 1e-12);
+        }
+        let ee = scene.triads[1].pose.p;
+        assert!((ee - ws.g_be.p).norm() < 1e-12);
+    }
+}

@@ -9,10 +9,11 @@ const FONT: f64 = 12.0;
 /// Estimated advance of one character [px] (DejaVu Sans averages about 0.6 em).
 const CHAR_W: f64 = 0.62 * FONT;
 
-/// The labels placed so far (their boxes, SVG px `[x, y, w, h]`).
-#[derive(Debug, Default)]
+/// The labels placed so far (their boxes, SVG px `[x, y, w, h]`) on a page `width` px wide.
+#[derive(Debug)]
 pub struct Labeller {
     placed: Vec<[f64; 4]>,
+    width: f64,
 }
 
 fn overlaps(a: &[f64; 4], b: &[f64; 4]) -> bool {
@@ -20,6 +21,14 @@ fn overlaps(a: &[f64; 4], b: &[f64; 4]) -> bool {
 }
 
 impl Labeller {
+    /// No labels yet, on a page `width` px wide (labels stay inside it).
+    pub fn new(width: f64) -> Self {
+        Labeller {
+            placed: Vec::new(),
+            width,
+        }
+    }
+
     /// Reserves a box (e.g. a marker) that later labels must avoid.
     pub fn reserve(&mut self, b: [f64; 4]) {
         self.placed.push(b);
@@ -45,6 +54,10 @@ impl Labeller {
                 let reach = r + d[0].abs() * w / 2.0 + d[1].abs() * h / 2.0;
                 let c = [anchor[0] + d[0] * reach, anchor[1] + d[1] * reach];
                 let b = [c[0] - w / 2.0, c[1] - h / 2.0, w, h];
+                let inside = b[0] >= 0.0 && b[1] >= 0.0 && b[0] + w <= self.width;
+                if !inside {
+                    continue;
+                }
                 first.get_or_insert((c, b, r));
                 if !self.placed.iter().any(|p| overlaps(p, &b)) {
                     chosen = Some((c, b, r));
@@ -91,7 +104,7 @@ mod tests {
 
     #[test]
     fn labels_at_one_anchor_do_not_overlap() {
-        let mut l = Labeller::default();
+        let mut l = Labeller::new(100.0);
         let mut s = Svg::new(100.0, 100.0, "");
         for k in 0..6 {
             l.place(&mut s, "T10", [50.0, 50.0], [1.0, 0.0], &format!("l{k}"));

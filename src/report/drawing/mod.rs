@@ -236,7 +236,7 @@ pub fn render_svg(scene: &Scene) -> String {
     let caption_lines = scene.caption.len().max(legend_lines as usize) as f64;
     let height = lay.caption_top + caption_lines * LINE + MARGIN + LINE;
     let mut s = Svg::new(PAGE_WIDTH, height.ceil(), STYLE);
-    let mut labels = Labeller::default();
+    let mut labels = Labeller::new(PAGE_WIDTH);
     for (k, view) in View::ALL.into_iter().enumerate() {
         render::view(
             &mut s,

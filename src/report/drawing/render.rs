@@ -157,11 +157,45 @@ pub(super) fn view(
     joints(s, scene, view, t);
     let pending = arrows(s, labels, scene, view, t);
     triads(s, labels, scene, view, t);
-    for (name, anchor, pref) in pending {
-        let id = format!("{}-label-{}", view.id(), file_stem_safe(&name));
-        labels.place(s, &name, anchor, pref, &id);
+    for (names, anchor, pref) in group_labels(pending) {
+        let id = format!("{}-label-{}", view.id(), file_stem_safe(&names[0]));
+        labels.place(s, &label_text(&names), anchor, pref, &id);
     }
     s.close("g");
+}
+
+/// Labels whose anchors coincide (within [`SAME_ANCHOR_PX`]) merged into one, in order of
+/// first appearance: arrows seen end-on or sharing a tip get one label.
+fn group_labels(
+    pending: Vec<(String, [f64; 2], [f64; 2])>,
+) -> Vec<(Vec<String>, [f64; 2], [f64; 2])> {
+    let mut groups: Vec<(Vec<String>, [f64; 2], [f64; 2])> = Vec::new();
+    for (name, anchor, pref) in pending {
+        let near = |g: &&mut (Vec<String>, [f64; 2], [f64; 2])| {
+            let d = sub(g.1, anchor);
+            d[0].hypot(d[1]) < SAME_ANCHOR_PX
+        };
+        match groups.iter_mut().find(near) {
+            Some(g) => g.0.push(name),
+            None => groups.push((vec![name], anchor, pref)),
+        }
+    }
+    groups
+}
+
+/// Anchors closer than this [px] share a label.
+const SAME_ANCHOR_PX: f64 = 3.0;
+/// At most this many names in a shared label; the rest are counted.
+const MAX_NAMES: usize = 3;
+
+/// `T1, T5, T7`, or `T2, T4, T6 +15` when more than [`MAX_NAMES`] share a label.
+fn label_text(names: &[String]) -> String {
+    let shown = names[..names.len().min(MAX_NAMES)].join(", ");
+    if names.len() > MAX_NAMES {
+        format!("{shown} +{}", names.len() - MAX_NAMES)
+    } else {
+        shown
+    }
 }
 
 /// Body outlines, far to near along the view's normal (a stable sort keeps ties in order).
