@@ -188,9 +188,8 @@ pub fn caption(v: &Vehicle, state_label: &str, m: Option<&TcmMetrics>) -> Vec<St
     ));
     let lost: Vec<&str> = m.lost_directions.iter().map(|d| d.dominant_axis).collect();
     lines.push(format!(
-        "rank {} of 6; lost (σ ≤ {} σ_max): {}",
+        "rank {} of 6; lost (σ ≤ {DEFAULT_RANK_REL_TOL:e} σ_max): {}",
         m.rank,
-        format!("{DEFAULT_RANK_REL_TOL:e}"),
         if lost.is_empty() {
             "none".to_string()
         } else {
