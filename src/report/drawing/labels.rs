@@ -100,7 +100,7 @@ impl Labeller {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::report::drawing::labels::*;
 
     #[test]
     fn labels_at_one_anchor_do_not_overlap() {

@@ -2,9 +2,9 @@
 //! triads, then the labels; and the legend's symbols, drawn by the same functions.
 
 use super::labels::Labeller;
+use super::scene::Scene;
 use super::svg::{Attr, Svg};
 use super::views::{cylinder_outline, View, ViewTransform};
-use super::Scene;
 use crate::report::file_stem_safe;
 use crate::spatial::Vec3;
 

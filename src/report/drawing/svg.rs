@@ -152,7 +152,7 @@ impl Svg {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::report::drawing::svg::*;
 
     #[test]
     fn numbers_and_text_are_stable() {

@@ -182,7 +182,7 @@ fn convex_hull(mut pts: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::report::drawing::views::*;
 
     #[test]
     fn a_straight_cylinder_is_a_rectangle_from_the_side_and_a_disc_from_the_front() {
