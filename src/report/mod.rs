@@ -22,6 +22,7 @@
 pub mod atomic;
 pub mod column_kind;
 pub mod csv_append;
+pub mod drawing;
 pub mod error;
 /// SVG figures.
 pub mod figures;
