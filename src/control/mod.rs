@@ -4,7 +4,8 @@
 //! | module | law | equations |
 //! |---|---|---|
 //! | [`guidance`] | line-of-sight guidance along straight segments | USM-39 |
-//! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors | USM-28…32 |
+//! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors, inertial-frame task variables | USM-28…32, AC-7…13 |
+//! | [`quintic`] | quintic point-to-point references (zero end rates and accelerations) | AC §5 |
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
 //! | [`work`] | work mode: end-effector pose + base position by SRMTP | USM-42 |
 //! | [`dynamic`] | feedback-linearising base control | USM-33/34 |
@@ -22,6 +23,7 @@
 pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
+pub mod quintic;
 pub mod transport;
 pub mod work;
 
@@ -33,9 +35,10 @@ use thiserror::Error;
 pub use dynamic::{DynamicController, DynamicGains, DynamicOutput};
 pub use guidance::{LosGuidance, LosOutput, PathSpec, SegmentSpec};
 pub use kinematic::{
-    base_position_jacobian, damped_weighted_pinv, ee_pose, ee_pose_error, JointLimitSettings,
-    JointLimitTask, PinvWorkspace, Srmtp, TaskInverse,
+    base_position_jacobian, damped_weighted_pinv, ee_pose, ee_pose_error, InertialTask,
+    JointLimitSettings, JointLimitTask, PinvWorkspace, Srmtp, TaskInverse, TaskVariable,
 };
+pub use quintic::Quintic;
 pub use transport::{
     measure_transport, yaw_joint_mask, SurgeLaw, SurgeSource, TransportController, TransportGains,
     TransportMeasurement, TransportMethod, TransportOutput, YawRateSource,
@@ -110,21 +113,31 @@ pub fn heading(r: &Mat3) -> f64 {
     r[(1, 0)].atan2(r[(0, 0)])
 }
 
-/// Time derivative ψ̇ [rad/s] of [`heading`] for a frame with orientation `r` (in `I`) and
-/// body-fixed angular velocity `omega` (rad/s, in the same frame): with `Ṙ = R ω̂`,
-/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`.
-/// Equal to ω_z for a frame level in the horizontal plane; 0 when the x axis is vertical.
+/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
+/// `g(R)` with `ψ̇ = g(R)·ω` (rad/s per rad/s). With `Ṙ = R ω̂`,
+/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`, so
+/// `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z` for a frame level in
+/// the horizontal plane; zero when the x axis is vertical (heading undefined).
 #[inline]
-pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
+pub fn heading_gradient(r: &Mat3) -> Vec3 {
     let (r00, r10) = (r[(0, 0)], r[(1, 0)]);
-    let d00 = r[(0, 1)] * omega.z - r[(0, 2)] * omega.y;
-    let d10 = r[(1, 1)] * omega.z - r[(1, 2)] * omega.y;
     let den = r00 * r00 + r10 * r10;
     if den < 1e-12 {
-        0.0
-    } else {
-        (r00 * d10 - r10 * d00) / den
+        return Vec3::zeros();
     }
+    Vec3::new(
+        0.0,
+        (r10 * r[(0, 2)] - r00 * r[(1, 2)]) / den,
+        (r00 * r[(1, 1)] - r10 * r[(0, 1)]) / den,
+    )
+}
+
+/// Time derivative ψ̇ [rad/s] of [`heading`] for a frame with orientation `r` (in `I`) and
+/// body-fixed angular velocity `omega` (rad/s, in the same frame): `ψ̇ = g(R)·ω` with `g` the
+/// [`heading_gradient`].
+#[inline]
+pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
+    heading_gradient(r).dot(omega)
 }
 
 /// Orientation error `ε̃` of the end-effector task (SPEC §5, USM-42): the vector part of the

@@ -21,6 +21,7 @@
 //!   kp = [0, 0, 0, 0, 0, 0]` is the literal reading). A partial `[base_control]` table takes
 //!   its missing keys from the work-mode defaults.
 
+pub mod antonelli;
 pub mod channels;
 pub mod config;
 mod controller;
