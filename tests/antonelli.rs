@@ -264,7 +264,7 @@ fn case1b_tracks_the_line_and_moves_the_vehicle() {
 }
 
 #[test]
-fn case2_reaches_q2_with_the_end_effector_tracked_through_an_algorithmic_singularity() {
+fn case2_reaches_q2_with_the_end_effector_tracked_into_an_algorithmic_singularity() {
     // Seed, section 5: q2,d → −0.78 rad by a quintic over 10 s along the same line;
     // "the end-effector location and manipulator joint 2 achieve their target".
     let h = run(AntonelliCase::Case2);
@@ -274,9 +274,11 @@ fn case2_reaches_q2_with_the_end_effector_tracked_through_an_algorithmic_singula
         assert!(tr.max_abs_error() < 1e-8, "{name}");
         assert!((tr.final_value() - end).abs() < 1e-8, "{name}");
     }
-    // The run passes (to sampling resolution) through J_s N_p losing rank; rates stay bounded.
+    // The secondary task (vehicle back to the origin) conflicts with the primary one; its
+    // constrained minimum is where J_s N_p loses rank, so the run ends on an algorithmic
+    // singularity (σ ≈ 4e-8 at t = 10 s, q1 + q2/2 ≈ 0). Rates stay bounded all along.
     let sigma_min = h.sigma_s.iter().fold(f64::INFINITY, |a, b| a.min(*b));
-    assert!(sigma_min < 1e-2, "σ_min = {sigma_min}");
+    assert!(sigma_min < 1e-5, "σ_min = {sigma_min}");
     assert!(max_joint_rate(&h) < 1.0);
     let base_rate = (0..h.t.len())
         .map(|i| h.base_rate[0][i].hypot(h.base_rate[1][i]))

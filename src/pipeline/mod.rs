@@ -5,6 +5,7 @@
 //! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
+//! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
 //! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
 //!
@@ -12,6 +13,7 @@
 //! per-run outcomes reach the caller through callbacks.
 
 pub mod allocate;
+pub mod antonelli;
 pub mod error;
 pub mod inspect;
 pub mod paper;

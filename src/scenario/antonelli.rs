@@ -18,7 +18,7 @@
 //! `K_p = diag(10, 10, 10, 1)`, `K_s = diag(2, 2)`, the vehicle position held at its initial
 //! value by the secondary task. Choices the paper does not state (inferred, overridable in
 //! [`KinematicCase`]): the run lasts the 10 s of the quintic; RK4 at 1 ms (the closed loop has
-//! time constants ≥ 0.1 s); samples every 10 ms. The Jacobians' pseudoinverses are the
+//! time constants ≥ 0.1 s); samples every 50 ms (20 Hz: the motions are smooth over 10 s). The Jacobians' pseudoinverses are the
 //! Moore–Penrose ones of the planar system (λ = 0, usage weights selecting u, v, r and the
 //! joints: [`planar_weights`]); heave, roll and pitch stay zero, so the state is
 //! `(x, y, ψ, q)` with `ẋ = u cos ψ − v sin ψ`, `ẏ = u sin ψ + v cos ψ`, `ψ̇ = r`.
@@ -91,7 +91,7 @@ pub struct KinematicCase {
     pub duration: f64,
     /// RK4 step [s] (inferred: 0.001).
     pub dt: f64,
-    /// Record every this many steps (default 10: 100 Hz).
+    /// Record every this many steps (default 50: 20 Hz).
     pub record_every: usize,
 }
 
@@ -131,7 +131,7 @@ pub fn antonelli_case(which: AntonelliCase) -> KinematicCase {
         ramp: 10.0,
         duration: 10.0,
         dt: 1e-3,
-        record_every: 10,
+        record_every: 50,
     }
 }
 
