@@ -293,3 +293,17 @@ fn history_columns_have_one_value_per_sample() {
     assert_eq!(cols[0].0, "t");
     assert!(cols.iter().all(|(_, c)| c.len() == h.t.len()));
 }
+
+#[test]
+fn invalid_settings_are_rejected_before_running() {
+    let v = planar();
+    let mut c = antonelli_case(AntonelliCase::Case2);
+    c.q0.pop();
+    assert!(run_kinematic_case(&v, &c).is_err());
+    let mut c = antonelli_case(AntonelliCase::Case2);
+    c.dt = 0.0;
+    assert!(run_kinematic_case(&v, &c).is_err());
+    let mut c = antonelli_case(AntonelliCase::Case1);
+    c.secondary[0].variable = TaskVariable::Joint(7);
+    assert!(run_kinematic_case(&v, &c).is_err());
+}

@@ -338,30 +338,33 @@ fn invalid(e: impl std::fmt::Display) -> ScenarioError {
     ScenarioError::Invalid(e.to_string())
 }
 
-fn check(v: &Vehicle, case: &KinematicCase) -> Result<(), ScenarioError> {
-    let n = v.n_joints();
-    let bad = |m: String| Err(ScenarioError::Invalid(format!("{}: {m}", case.name)));
-    if case.q0.len() != n {
-        return bad(format!(
-            "q0 has {} angles, the design {n} joints",
-            case.q0.len()
-        ));
+impl KinematicCase {
+    /// Check the settings against a chain of `n` joints: one initial angle per joint,
+    /// positive times and sampling, finite non-negative gains, finite targets.
+    pub fn validate(&self, n: usize) -> Result<(), ScenarioError> {
+        let bad = |m: String| Err(ScenarioError::Invalid(format!("{}: {m}", self.name)));
+        if self.q0.len() != n {
+            return bad(format!(
+                "q0 has {} angles, the design {n} joints",
+                self.q0.len()
+            ));
+        }
+        let positive = [self.ramp, self.duration, self.dt];
+        if positive.iter().any(|x| !x.is_finite() || *x <= 0.0) || self.record_every == 0 {
+            return bad("ramp, duration, dt and record_every must be > 0".into());
+        }
+        let rows = self.primary.iter().chain(&self.secondary);
+        if rows.clone().any(|r| !r.gain.is_finite() || r.gain < 0.0) {
+            return bad("task gains must be finite and >= 0".into());
+        }
+        if rows
+            .clone()
+            .any(|r| r.target.is_some_and(|x| !x.is_finite()))
+        {
+            return bad("task targets must be finite".into());
+        }
+        Ok(())
     }
-    let positive = [case.ramp, case.duration, case.dt];
-    if positive.iter().any(|x| !x.is_finite() || *x <= 0.0) || case.record_every == 0 {
-        return bad("ramp, duration, dt and record_every must be > 0".into());
-    }
-    let rows = case.primary.iter().chain(&case.secondary);
-    if rows.clone().any(|r| !r.gain.is_finite() || r.gain < 0.0) {
-        return bad("task gains must be finite and >= 0".into());
-    }
-    if rows
-        .clone()
-        .any(|r| r.target.is_some_and(|x| !x.is_finite()))
-    {
-        return bad("task targets must be finite".into());
-    }
-    Ok(())
 }
 
 fn trace(task: &InertialTask) -> Vec<TaskTrace> {
@@ -419,7 +422,7 @@ pub fn run_kinematic_case(
     v: &Vehicle,
     case: &KinematicCase,
 ) -> Result<KinematicHistory, ScenarioError> {
-    check(v, case)?;
+    case.validate(v.n_joints())?;
     let n = v.n_joints();
     let mut r = build(v, case)?;
     let dim = 3 + n;
