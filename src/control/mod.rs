@@ -113,31 +113,34 @@ pub fn heading(r: &Mat3) -> f64 {
     r[(1, 0)].atan2(r[(0, 0)])
 }
 
-/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
-/// `g(R)` with `ψ̇ = g(R)·ω` (rad/s per rad/s). With `Ṙ = R ω̂`,
-/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`, so
-/// `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z` for a frame level in
-/// the horizontal plane; zero when the x axis is vertical (heading undefined).
-#[inline]
-pub fn heading_gradient(r: &Mat3) -> Vec3 {
-    let (r00, r10) = (r[(0, 0)], r[(1, 0)]);
-    let den = r00 * r00 + r10 * r10;
-    if den < 1e-12 {
-        return Vec3::zeros();
-    }
-    Vec3::new(
-        0.0,
-        (r10 * r[(0, 2)] - r00 * r[(1, 2)]) / den,
-        (r00 * r[(1, 1)] - r10 * r[(0, 1)]) / den,
-    )
-}
-
 /// Time derivative ψ̇ [rad/s] of [`heading`] for a frame with orientation `r` (in `I`) and
-/// body-fixed angular velocity `omega` (rad/s, in the same frame): `ψ̇ = g(R)·ω` with `g` the
-/// [`heading_gradient`].
+/// body-fixed angular velocity `omega` (rad/s, in the same frame): with `Ṙ = R ω̂`,
+/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`.
+/// Equal to ω_z for a frame level in the horizontal plane; 0 when the x axis is vertical.
 #[inline]
 pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
-    heading_gradient(r).dot(omega)
+    let (r00, r10) = (r[(0, 0)], r[(1, 0)]);
+    let d00 = r[(0, 1)] * omega.z - r[(0, 2)] * omega.y;
+    let d10 = r[(1, 1)] * omega.z - r[(1, 2)] * omega.y;
+    let den = r00 * r00 + r10 * r10;
+    if den < 1e-12 {
+        0.0
+    } else {
+        (r00 * d10 - r10 * d00) / den
+    }
+}
+
+/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
+/// `g(R)` with `ψ̇ = g(R)·ω` — [`heading_rate`] is linear in `ω`, so `g` is its value on the
+/// unit vectors: `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z`
+/// for a frame level in the horizontal plane; zero when the x axis is vertical.
+#[inline]
+pub fn heading_gradient(r: &Mat3) -> Vec3 {
+    Vec3::new(
+        heading_rate(r, &Vec3::x()),
+        heading_rate(r, &Vec3::y()),
+        heading_rate(r, &Vec3::z()),
+    )
 }
 
 /// Orientation error `ε̃` of the end-effector task (SPEC §5, USM-42): the vector part of the
