@@ -11,8 +11,18 @@
 //!   the projector uses the solver's own usage weights and damping (those given to
 //!   [`Srmtp::new`]): the usage weight is a property of the vehicle's coordinates, not of a task.
 //!   Each task's own pseudoinverse can be weighted or plain ([`TaskInverse`]).
+//! - This is the singularity-robust task priority of Chiaverini (1997) that Antonelli &
+//!   Chiaverini use (AC-7): each lower task enters as `N_{1…k−1} J_k^# w_k`, not through the
+//!   pseudoinverse of the projected Jacobian `(J_k N_{1…k−1})^#` of the classical form, so an
+//!   *algorithmic* singularity (`J_k N_{1…k−1}` losing rank, measured by
+//!   [`Srmtp::projected_singular_value`]) degrades the lower task without large rates. With
+//!   damping λ = 0, [`TaskInverse::weighted`]`(0)` and 0/1 usage weights it is AC-7 exactly
+//!   with the Moore–Penrose pseudoinverse of the Jacobians restricted to the coordinates whose
+//!   weight is 1 (the paper's planar system: `U` selects u, v, r and the joints).
 //! - Tasks: end-effector pose ([`ee_pose_error`], Jacobian [`crate::kinematics::ee_jacobian`]),
-//!   base position ([`base_position_jacobian`]), joint limits (set-based, [`JointLimitTask`]).
+//!   base position ([`base_position_jacobian`]), joint limits (set-based, [`JointLimitTask`]),
+//!   and inertial-frame task variables ([`InertialTask`] of [`TaskVariable`]s: end-effector and
+//!   base position and heading, joint angles; AC-10…13) with the closed-loop rate of AC-8/9.
 //!   The paper's other secondary objectives — manipulability and TCM conditioning — are **not
 //!   implemented yet** (TODO): they need configuration gradients (analytic derivatives of the
 //!   Jacobian / of `T(q)`); [`Srmtp::push_velocity`] is the hook that will project such a
@@ -33,6 +43,9 @@ use crate::spatial::{stack, Mat3, Se3, Vec3, Vec6};
 use faer::{Mat, MatRef};
 use nalgebra::{Rotation3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
+
+mod inertial;
+pub use inertial::{InertialTask, TaskVariable};
 
 /// Usage weight `u_c` of column `c` (1 when no weights are given).
 #[inline]
@@ -479,6 +492,26 @@ impl Srmtp {
     /// The resolved reference `ζ_r = [V_r; q̇_r]` (length N).
     pub fn zeta(&self) -> &[f64] {
         &self.zeta
+    }
+
+    /// The algorithmic-singularity measure of a candidate next task `j` (`m`×N): the smallest
+    /// weighted singular value of `J N_{1…k}`, `√λ_min(J N U Nᵀ Jᵀ)`, with `N_{1…k}` the
+    /// projector of the tasks pushed so far and `U` the usage weights. Zero when `j` loses rank
+    /// inside the null space of the higher-priority tasks (an algorithmic singularity of
+    /// Chiaverini 1997). Allocates: a diagnostic, not for the inner loop of a time step.
+    pub fn projected_singular_value(&mut self, j: MatRef<'_, f64>) -> f64 {
+        self.refresh_null();
+        let (m, n) = (j.nrows(), self.n);
+        let jn = nalgebra::DMatrix::from_fn(m, n, |r, c| {
+            let s: f64 = (0..n).map(|k| j[(r, k)] * self.null[(k, c)]).sum();
+            s * self.weights[c].sqrt()
+        });
+        let gram = &jn * jn.transpose();
+        gram.symmetric_eigenvalues()
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b))
+            .max(0.0)
+            .sqrt()
     }
 }
 

@@ -4,7 +4,8 @@
 //! | module | law | equations |
 //! |---|---|---|
 //! | [`guidance`] | line-of-sight guidance along straight segments | USM-39 |
-//! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors | USM-28…32 |
+//! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors, inertial-frame task variables | USM-28…32, AC-7…13 |
+//! | [`quintic`] | quintic point-to-point references (zero end rates and accelerations) | AC §5 |
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
 //! | [`work`] | work mode: end-effector pose + base position by SRMTP | USM-42 |
 //! | [`dynamic`] | feedback-linearising base control | USM-33/34 |
@@ -22,6 +23,7 @@
 pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
+pub mod quintic;
 pub mod transport;
 pub mod work;
 
@@ -33,9 +35,10 @@ use thiserror::Error;
 pub use dynamic::{DynamicController, DynamicGains, DynamicOutput};
 pub use guidance::{LosGuidance, LosOutput, PathSpec, SegmentSpec};
 pub use kinematic::{
-    base_position_jacobian, damped_weighted_pinv, ee_pose, ee_pose_error, JointLimitSettings,
-    JointLimitTask, PinvWorkspace, Srmtp, TaskInverse,
+    base_position_jacobian, damped_weighted_pinv, ee_pose, ee_pose_error, InertialTask,
+    JointLimitSettings, JointLimitTask, PinvWorkspace, Srmtp, TaskInverse, TaskVariable,
 };
+pub use quintic::Quintic;
 pub use transport::{
     measure_transport, yaw_joint_mask, SurgeLaw, SurgeSource, TransportController, TransportGains,
     TransportMeasurement, TransportMethod, TransportOutput, YawRateSource,
@@ -125,6 +128,19 @@ pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
     } else {
         (r00 * d10 - r10 * d00) / den
     }
+}
+
+/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
+/// `g(R)` with `ψ̇ = g(R)·ω` — [`heading_rate`] is linear in `ω`, so `g` is its value on the
+/// unit vectors: `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z`
+/// for a frame level in the horizontal plane; zero when the x axis is vertical.
+#[inline]
+pub fn heading_gradient(r: &Mat3) -> Vec3 {
+    Vec3::new(
+        heading_rate(r, &Vec3::x()),
+        heading_rate(r, &Vec3::y()),
+        heading_rate(r, &Vec3::z()),
+    )
 }
 
 /// Orientation error `ε̃` of the end-effector task (SPEC §5, USM-42): the vector part of the

@@ -2,6 +2,9 @@
 //! following) and work mode (end-effector setpoint with task priority), described by a TOML
 //! file ([`config`]) and run by [`run::run_scenario`].
 //!
+//! [`antonelli`] holds the kinematic case studies of Antonelli & Chiaverini (SPEC §8): task
+//! priority on inertial-frame tasks, integrated without dynamics.
+//!
 //! Presets reproduce the paper's simulations: `transport-method1`, `transport-method2`
 //! (USM Table III, u_c = 0.5 m/s, straight segments parallel to X, a 180° turn commanded at
 //! t = 95 s, 140 s) and `work-setpoint` (USM-42 with the paper's k_e, k_b, W, K_p, λ = 0.1);
@@ -23,6 +26,7 @@
 //!   kp = [0, 0, 0, 0, 0, 0]` is the literal reading). A partial `[base_control]` table takes
 //!   its missing keys from the work-mode defaults.
 
+pub mod antonelli;
 pub mod channels;
 pub mod config;
 mod controller;
