@@ -65,7 +65,14 @@ fn common_metrics(
     add(out, "thruster_energy", e.thruster_energy);
     add(out, "effort_sq", e.effort_sq);
     add(out, "effort_abs", e.effort_abs);
-    add(out, "joint_energy", e.joint_energy);
+    // The simulator integrates the joint work with the motion; the sampled quadrature of
+    // |τ q̇| at the logging rate is the fallback for trajectories without that channel.
+    let work = channel(traj, Channel::JointWork);
+    let joint_energy = match (work.first(), work.last()) {
+        (Some(a), Some(b)) => b - a,
+        _ => e.joint_energy,
+    };
+    add(out, "joint_energy", joint_energy);
     add(out, "peak_thrust", e.peak_thrust);
     add(out, "saturation_fraction", e.saturation_fraction);
     let sig = channel(traj, Channel::SigmaMin);

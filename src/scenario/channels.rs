@@ -131,6 +131,9 @@ pub enum Channel {
     Qd(usize),
     /// Joint torque τ_k [N·m].
     Tau(usize),
+    /// Joint work `∫ Σ_k |τ_k q̇_k| dt` since t = 0 [J], integrated by the simulator with the
+    /// motion (the joint-energy metric, SPEC §6).
+    JointWork,
     /// Commanded (allocated) thrust of thruster j [N].
     UCmd(usize),
     /// Actual thrust of thruster j, clamped to its limits [N].
@@ -177,6 +180,7 @@ impl Channel {
             Channel::SigmaMin => "sigma_min",
             Channel::SlackNorm => "slack_norm",
             Channel::AllocStatus => "alloc_status",
+            Channel::JointWork => "joint_work",
             Channel::BasePose(a) => return format!("base_{}", a.suffix()),
             Channel::BaseTwist(a) => return format!("base_{}", a.suffix()),
             Channel::EePose(a) => return format!("ee_{}", a.suffix()),
@@ -196,7 +200,7 @@ impl Channel {
 }
 
 /// The channels of a run in column order: time, base and end-effector pose and twist, the
-/// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the per-thruster blocks
+/// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the joint work, the per-thruster blocks
 /// (commanded, actual, power), then σ_min and the allocation outcome.
 pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Channel> {
     let mut c = vec![Channel::T];
@@ -215,6 +219,7 @@ pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Ch
     for family in [Channel::Q, Channel::QRef, Channel::Qd, Channel::Tau] {
         c.extend((0..n_joints).map(family));
     }
+    c.push(Channel::JointWork);
     for family in [Channel::UCmd, Channel::U, Channel::Power] {
         c.extend((0..n_thrusters).map(family));
     }

@@ -29,8 +29,14 @@ pub(crate) use timed;
 pub struct Timing {
     /// Total wall time [s].
     pub total_s: f64,
-    /// Time in the physics (RK4 steps and the base-control dynamics terms) [s].
+    /// Time in the physics (integrator steps and the base-control dynamics terms) [s].
     pub dynamics_s: f64,
+    /// Physics steps accepted by the integrator (deterministic).
+    pub physics_steps: u64,
+    /// Physics steps rejected by the error control (Dormand–Prince; deterministic).
+    pub physics_rejected: u64,
+    /// Dynamics evaluations (one `M ζ̇ = τ − h` solve each; deterministic).
+    pub physics_evaluations: u64,
     /// Time in thrust allocation [s].
     pub allocation_s: f64,
     /// Time in kinematics, guidance and control laws [s].
@@ -200,6 +206,7 @@ impl Recorder {
         w.put_all(indexed(Channel::QRef, &lp.cmd.q_ref));
         w.put_all(indexed(Channel::Qd, &state.joint_rates));
         w.put_all(indexed(Channel::Tau, lp.sim.last_joint_torque()));
+        w.put(Channel::JointWork, lp.sim.joint_work());
         w.put_all(indexed(Channel::UCmd, &lp.alloc.u));
         // Actual thrust: the thruster states clamped to their limits.
         let actual = state

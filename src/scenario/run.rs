@@ -1,7 +1,8 @@
 //! The closed loop of the USM paper's Fig. 5: guidance → kinematic control → dynamic control
 //! (USM-33) → thrust allocation (USM-36/37) → vehicle (SPEC §4), observed by a recorder.
 //!
-//! Rates: the physics advances with RK4 steps of `dt`; the controllers and the allocator run
+//! Rates: the physics advances with the `[physics] integrator` (RK4 steps of `dt`, or
+//! adaptive Dormand–Prince steps) over each control period; the controllers and the allocator run
 //! every `control_dt` with the actuator commands held in between (zero-order hold); the
 //! recorder samples every `log_dt`. Each control period is a fixed sequence of named phases
 //! (`measure`, `control`, `allocate`, the recorder's `observe`, `advance`), timed by phase;
@@ -113,13 +114,9 @@ impl ClosedLoop<'_> {
             joint_ref: &self.cmd.q_ref,
             joint_rate_ref: &self.cmd.qd_ref,
         };
-        let dt = self.file.scenario.dt;
-        for _ in 0..self.substeps {
-            self.sim
-                .step(dt, &cmd)
-                .map_err(|e| (e.time, e.to_string()))?;
-        }
-        Ok(())
+        self.sim
+            .advance(self.file.scenario.control_dt, &cmd)
+            .map_err(|e| (e.time, e.to_string()))
     }
 
     /// Control period `k`: measure, control, allocate, record, then advance the physics
@@ -148,6 +145,10 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
     let failure = (0..=lp.n_control).find_map(|k| lp.period(k, &mut rec).err());
+    let stats = lp.sim.step_stats();
+    rec.timing.physics_steps = stats.steps;
+    rec.timing.physics_rejected = stats.rejected;
+    rec.timing.physics_evaluations = stats.evaluations;
     let (trajectory, counts, timing) = rec.finish(started);
     let metrics = run_summary(&lp.vehicle, file, &trajectory, failure.is_some(), &counts);
     Ok(RunResult {
