@@ -48,8 +48,8 @@ pub use algorithms::{
     spatial_momentum,
 };
 pub use config::{Integrator, ServoModel, SimConfig, ThrusterModel};
-pub use integrator::StepStats;
 pub use inspect::{inspect_dynamics, DynamicsReport};
+pub use integrator::StepStats;
 pub use sim::{ActuatorCommand, SimState, Simulator};
 pub use workspace::DynWorkspace;
 

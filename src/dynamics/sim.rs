@@ -513,7 +513,9 @@ impl Simulator {
             Integrator::Dopri5 { rtol, atol, .. } => {
                 let mut counts = StepStats::default();
                 let tol = Tolerance { rtol, atol };
-                dopri.span(x0, span, tol, QUAT, &mut counts, &mut f).map_err(fail)?;
+                dopri
+                    .span(x0, span, tol, QUAT, &mut counts, &mut f)
+                    .map_err(fail)?;
                 stats.steps += counts.steps;
                 stats.rejected += counts.rejected;
                 // The last evaluation was at the end state: M and h stay valid for it.

@@ -67,7 +67,10 @@ fn dopri5_meets_its_tolerance_on_the_servo_closed_form() {
             err <= 10.0 * (atol + 0.35 * rtol),
             "rtol {rtol:e}: error {err:e}"
         );
-        assert!(err < last.0 && steps > last.1, "rtol {rtol:e}: {err:e}, {steps} steps");
+        assert!(
+            err < last.0 && steps > last.1,
+            "rtol {rtol:e}: {err:e}, {steps} steps"
+        );
         last = (err, steps);
     }
 }
@@ -167,5 +170,9 @@ fn rk4_span_equals_single_steps_and_integrates_the_joint_work() {
     assert_eq!(a.step_stats().steps, 1000);
     let w = c.joint_work();
     assert!(w > 1e-3, "the servos work: {w}");
-    assert!((a.joint_work() - w).abs() < 1e-7 * w, "{} vs {w}", a.joint_work());
+    assert!(
+        (a.joint_work() - w).abs() < 1e-7 * w,
+        "{} vs {w}",
+        a.joint_work()
+    );
 }
