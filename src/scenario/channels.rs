@@ -306,7 +306,7 @@ mod tests {
         let expected = "t base_x base_y base_z base_roll base_pitch base_yaw base_u base_v \
             base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
             ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
-            base_cross_track path_y q_0 qref_0 qd_0 tau_0 ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
+            base_cross_track path_y q_0 qref_0 qd_0 tau_0 joint_work ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
             sigma_min slack_norm alloc_status";
         assert_eq!(names.join(" "), expected);
         let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
@@ -314,8 +314,8 @@ mod tests {
             .map(Channel::name)
             .collect();
         let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
-            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r ucmd_0 u_0 power_0";
-        assert_eq!(work[25..42].join(" "), expected);
+            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_0 u_0 power_0";
+        assert_eq!(work[25..43].join(" "), expected);
     }
 
     #[test]
