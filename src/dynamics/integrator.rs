@@ -187,12 +187,12 @@ impl Dopri5 {
     {
         for stage in 1..7 {
             let a = &A[stage];
-            for i in 0..x.len() {
+            for (i, (xs, x0)) in self.xs.iter_mut().zip(x).enumerate() {
                 let mut acc = 0.0;
                 for (j, aj) in a.iter().enumerate().take(stage) {
                     acc += aj * self.k[j][i];
                 }
-                self.xs[i] = x[i] + h * acc;
+                *xs = x0 + h * acc;
             }
             let t = s + C[stage] * h;
             let (_, rest) = self.k.split_at_mut(stage);
@@ -201,12 +201,12 @@ impl Dopri5 {
         // Stage 7 is evaluated at the fifth-order solution (a_7 = b): x_new = xs.
         self.x_new.copy_from_slice(&self.xs);
         let mut sum = 0.0;
-        for i in 0..x.len() {
+        for (i, (x0, x1)) in x.iter().zip(&self.x_new).enumerate() {
             let mut e = 0.0;
             for (j, ej) in E.iter().enumerate() {
                 e += ej * self.k[j][i];
             }
-            let scale = tol.atol + tol.rtol * x[i].abs().max(self.x_new[i].abs());
+            let scale = tol.atol + tol.rtol * x0.abs().max(x1.abs());
             let r = h * e / scale;
             sum += r * r;
         }
