@@ -1,15 +1,17 @@
 //! Benchmarks of the dynamics core on `usm-paper` (SPEC §4): mass matrix (CRBA), bias
-//! forces (RNEA), forward and hybrid dynamics, and one RK4 step with full hydrodynamics.
+//! forces (RNEA), forward and hybrid dynamics, one RK4 step with full hydrodynamics, and one
+//! 50 ms control period advanced by the adaptive Dormand–Prince integrator.
 //!
 //! Run with `cargo bench --bench dynamics -- --warm-up-time 1 --measurement-time 3`.
-//! Before measuring, a counting allocator checks that a simulator step allocates nothing.
+//! Before measuring, a counting allocator checks that neither a simulator RK4 step nor an
+//! adaptive span allocates.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use usm_study::dynamics::{
     bias, dynamics_terms, forward_dynamics, hybrid_dynamics, mass_matrix, solve_forward,
-    ActuatorCommand, DynOptions, DynWorkspace, SimConfig, SimState, Simulator,
+    ActuatorCommand, DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
 };
 use usm_study::kinematics::BasePose;
 use usm_study::model::presets::usm_paper;
@@ -58,12 +60,18 @@ fn bench_dynamics(c: &mut Criterion) {
     let qdd: Vec<f64> = (0..8).map(|k| 0.1 * k as f64).collect();
 
     // One-off allocation check of a full RK4 step (after a warm-up step).
-    let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
+    let rk4 = SimConfig {
+        integrator: Integrator::Rk4 { dt: 1e-3 },
+        ..SimConfig::default()
+    };
+    let mut sim = Simulator::new(&v, rk4).unwrap();
+    let mut adaptive = Simulator::new(&v, SimConfig::default()).unwrap();
     let mut st = SimState::rest(&v);
     st.pose = pose;
     st.joint_angles = q.clone();
     st.set_zeta(&zeta);
-    sim.set_state(st).unwrap();
+    sim.set_state(st.clone()).unwrap();
+    adaptive.set_state(st).unwrap();
     let thrust = [5.0, -3.0, 10.0, 10.0, 2.0, -1.0, 4.0];
     let qr: Vec<f64> = q.iter().map(|x| 0.9 * x).collect();
     let qdr = vec![0.0; 8];
@@ -80,6 +88,18 @@ fn bench_dynamics(c: &mut Criterion) {
     let allocs = ALLOCS.load(Ordering::Relaxed) - before;
     println!("heap allocations in 100 RK4 steps: {allocs}");
     assert_eq!(allocs, 0, "Simulator::step must not allocate");
+    adaptive.advance(0.05, &cmd).unwrap();
+    let before = ALLOCS.load(Ordering::Relaxed);
+    for _ in 0..20 {
+        adaptive.advance(0.05, &cmd).unwrap();
+    }
+    let allocs = ALLOCS.load(Ordering::Relaxed) - before;
+    let stats = adaptive.step_stats();
+    println!(
+        "heap allocations in 20 Dormand-Prince spans of 50 ms: {allocs} ({} steps, {} rejected, {} evaluations in all)",
+        stats.steps, stats.rejected, stats.evaluations
+    );
+    assert_eq!(allocs, 0, "Simulator::advance must not allocate");
 
     c.bench_function("mass_matrix", |b| {
         b.iter(|| mass_matrix(&v, &mut ws, black_box(&q), &opts))
@@ -115,6 +135,9 @@ fn bench_dynamics(c: &mut Criterion) {
     });
     c.bench_function("rk4_step_full_hydro", |b| {
         b.iter(|| sim.step(1e-3, black_box(&cmd)).unwrap())
+    });
+    c.bench_function("dopri5_control_period_50ms", |b| {
+        b.iter(|| adaptive.advance(0.05, black_box(&cmd)).unwrap())
     });
 }
 

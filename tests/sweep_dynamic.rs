@@ -24,6 +24,10 @@ preset = "usm-paper"
 mode = "transport"
 duration = 5.0
 
+[physics]
+# Fixed RK4 steps: the adaptive default would resolve the fast servo instead of blowing up.
+integrator = "rk4"
+
 [[axis]]
 # 2000 rad/s is far too fast a joint servo for the 10 ms RK4 step: that case blows up.
 name = "servo.omega_n"

@@ -21,8 +21,10 @@
 //! - `cholesky`: the one dense Cholesky factorisation of the crate (forward dynamics and the
 //!   kinematic-control pseudoinverse);
 //! - [`config`]: the servo and thruster models and the [`SimConfig`] (defaults, `validate()`);
-//! - [`sim`]: the actuator dynamics (thruster lag and rate limit, servo laws), the Lie-group
-//!   RK4 integrator and the [`Simulator`];
+//! - [`sim`]: the actuator dynamics (thruster lag and rate limit, servo laws), the flat
+//!   Lie-group state and the [`Simulator`];
+//! - `integrator`: the fixed-step RK4 step and the adaptive Dormand–Prince 5(4) span
+//!   integrator with error control ([`Integrator`] chooses);
 //! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`.
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
@@ -32,6 +34,7 @@ pub(crate) mod cholesky;
 pub mod config;
 pub mod hydro;
 pub mod inspect;
+mod integrator;
 mod passes;
 pub mod sim;
 pub mod workspace;
@@ -44,8 +47,9 @@ pub use algorithms::{
     kinetic_energy, mass_matrix, restoring_generalized, solve_forward, solve_hybrid,
     spatial_momentum,
 };
-pub use config::{ServoModel, SimConfig, ThrusterModel};
+pub use config::{Integrator, ServoModel, SimConfig, ThrusterModel};
 pub use inspect::{inspect_dynamics, DynamicsReport};
+pub use integrator::StepStats;
 pub use sim::{ActuatorCommand, SimState, Simulator};
 pub use workspace::DynWorkspace;
 

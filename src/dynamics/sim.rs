@@ -1,4 +1,4 @@
-//! Actuator models and the fixed-step Lie-group RK4 integrator (SPEC §4).
+//! Actuator models, the Lie-group time integrators and the [`Simulator`] (SPEC §4).
 //!
 //! State: base pose (inertial position, unit quaternion `R_Ib`), joint angles, base twist
 //! `V_b` in `F_b`, joint rates, and one thrust state per thruster. Joint servos are either
@@ -7,12 +7,22 @@
 //! joint torques recovered), torque-level PD servos with torque limits (full forward
 //! dynamics), or passive (torque-free) joints.
 //!
-//! # Integrator
-//! Classical RK4 on the quaternion kinematics `Q̇ = ½ Q ⊗ [0; ω]` together with
-//! `ṗ = R_Ib v`, `q̇`, `ζ̇`: every stage uses the normalised stage quaternion, and the
-//! quaternion is renormalised at the end of each step (a projection onto the unit sphere
-//! that changes it by `O(dt⁵)`). Chosen over RKMK for simplicity; it keeps fourth-order
-//! accuracy and the quaternion unit to machine precision.
+//! # Integrators
+//! The flat state `x = [p, Q, q, V_b, q̇, W]` with the quaternion kinematics
+//! `Q̇ = ½ Q ⊗ [0; ω]`, `ṗ = R_Ib v`, `q̇`, `ζ̇` and the joint work
+//! `Ẇ = Σ_k |τ_k q̇_k|` (the integrand of the joint-energy metric, SPEC §6, integrated with
+//! the motion instead of from logged samples). Every stage uses the normalised stage
+//! quaternion, and the quaternion is projected back onto the unit sphere after each step
+//! (a change of the order of the local error). Chosen over RKMK for simplicity; it keeps
+//! the order of the method and the quaternion unit to machine precision.
+//!
+//! [`Simulator::step`] is one classical RK4 step. [`Simulator::advance`] integrates over a
+//! span (a control period, commands held) with the configured [`Integrator`]: fixed RK4
+//! steps, or Dormand–Prince 5(4) with error control (`integrator`), restarted at each span
+//! start because the held command jumps there. After a Dormand–Prince span, `M` and `h` of
+//! the last (FSAL) evaluation are those of the end state, so
+//! [`Simulator::base_control_terms`] and the first stage of the next span reuse them
+//! instead of recomputing the dynamics terms.
 //!
 //! # Thrusters
 //! The commanded thrust is held over a step (zero-order hold) and first saturated to
@@ -26,7 +36,8 @@
 use super::algorithms::{
     dynamics_terms, kinetic_energy, solve_forward, solve_hybrid, spatial_momentum,
 };
-use super::config::{config_err, ServoModel, SimConfig, ThrusterModel};
+use super::config::{config_err, Integrator, ServoModel, SimConfig, ThrusterModel};
+use super::integrator::{rk4_step, Dopri5, StepStats, Tolerance};
 use super::{check_finite, DynError, DynWorkspace, SimError};
 use crate::kinematics::{generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
@@ -138,14 +149,20 @@ impl ThrusterDyn {
     }
 }
 
-/// Offsets in the flat integration vector `[p (3), Q (4: w,i,j,k), q (n), V_b (6), q̇ (n)]`.
+/// Offsets in the flat integration vector
+/// `[p (3), Q (4: w,i,j,k), q (n), V_b (6), q̇ (n), W (1)]`.
 const P: usize = 0;
 const QUAT: usize = 3;
 const JOINTS: usize = 7;
 
-/// A fixed-step simulator of one vehicle (SPEC §4): owns a copy of the vehicle, its
-/// [`DynWorkspace`], the state and the actuator models; [`Simulator::step`] allocates
-/// nothing.
+/// Offset of the joint work `W` (the last entry) for `n` joints.
+const fn work_index(n: usize) -> usize {
+    JOINTS + 2 * n + 6
+}
+
+/// A simulator of one vehicle (SPEC §4): owns a copy of the vehicle, its [`DynWorkspace`],
+/// the state, the actuator models and the integrators' buffers; [`Simulator::step`] and
+/// [`Simulator::advance`] allocate nothing.
 #[derive(Clone, Debug)]
 pub struct Simulator {
     vehicle: Vehicle,
@@ -157,6 +174,13 @@ pub struct Simulator {
     x0: Vec<f64>,
     xs: Vec<f64>,
     k: [Vec<f64>; 4],
+    dopri: Dopri5,
+    stats: StepStats,
+    joint_work: f64,
+    /// Peak |τ_q| [N·m] over the step boundaries evaluated since the simulator was built.
+    joint_torque_peak: f64,
+    /// `ws.mass` and `ws.bias` hold `M` and `h` of the current state.
+    terms_fresh: bool,
     u_cmd: Vec<f64>,
     u_act: Vec<f64>,
     q_gen: Vec<f64>,
@@ -201,7 +225,11 @@ impl Simulator {
             .collect();
         let n = vehicle.n_joints();
         let m = vehicle.n_thrusters();
-        let nx = JOINTS + n + 6 + n;
+        let nx = work_index(n) + 1;
+        let first_step = match cfg.integrator {
+            Integrator::Dopri5 { first_step, .. } => first_step,
+            Integrator::Rk4 { dt } => dt,
+        };
         Ok(Self {
             vehicle: vehicle.clone(),
             cfg,
@@ -212,6 +240,11 @@ impl Simulator {
             x0: vec![0.0; nx],
             xs: vec![0.0; nx],
             k: std::array::from_fn(|_| vec![0.0; nx]),
+            dopri: Dopri5::new(nx, first_step),
+            stats: StepStats::default(),
+            joint_work: 0.0,
+            joint_torque_peak: 0.0,
+            terms_fresh: false,
             u_cmd: vec![0.0; m],
             u_act: vec![0.0; m],
             q_gen: vec![0.0; 6 + n],
@@ -257,6 +290,7 @@ impl Simulator {
             }
         }
         self.state = state;
+        self.terms_fresh = false;
         Ok(())
     }
 
@@ -270,21 +304,42 @@ impl Simulator {
         self.time = t;
     }
 
-    /// Actual thrust per thruster [N] at the start of the last step (RK4 stage 1: the
-    /// saturated thrust state under that step's command).
+    /// Actual thrust per thruster [N] at the last step boundary evaluated (RK4: the start
+    /// of the last step; Dormand–Prince: the end of the last span, under its command): the
+    /// saturated thrust state.
     pub fn last_thrust(&self) -> &[f64] {
         &self.last_thrust
     }
 
-    /// Joint motor torques [N·m] at the start of the last step: recovered by the hybrid
-    /// dynamics for ideal servos, the saturated PD torque for PD servos, zero if passive.
+    /// Joint motor torques [N·m] at the last step boundary evaluated (as
+    /// [`Simulator::last_thrust`]): recovered by the hybrid dynamics for ideal servos, the
+    /// saturated PD torque for PD servos, zero if passive.
     pub fn last_joint_torque(&self) -> &[f64] {
         &self.last_joint_torque
     }
 
-    /// Generalised acceleration `ζ̇ = [V̇_b; q̈]` at the start of the last step.
+    /// Generalised acceleration `ζ̇ = [V̇_b; q̈]` at the last step boundary evaluated (as
+    /// [`Simulator::last_thrust`]).
     pub fn last_acceleration(&self) -> &[f64] {
         &self.last_accel
+    }
+
+    /// Joint work `W = ∫ Σ_k |τ_k q̇_k| dt` [J] since the simulator was built: the joint
+    /// energy of SPEC §6, integrated with the motion (same method and accuracy).
+    pub fn joint_work(&self) -> f64 {
+        self.joint_work
+    }
+
+    /// Peak joint motor torque |τ_q| [N·m] over every step boundary evaluated since the
+    /// simulator was built (the recovered torques of ideal servos, the saturated PD torques).
+    pub fn joint_torque_peak(&self) -> f64 {
+        self.joint_torque_peak
+    }
+
+    /// Work done by the integrators since the simulator was built: accepted and rejected
+    /// steps and derivative evaluations.
+    pub fn step_stats(&self) -> StepStats {
+        self.stats
     }
 
     /// The dynamics workspace (holds `M` and `h` of the last evaluation).
@@ -294,18 +349,22 @@ impl Simulator {
 
     /// `M_11(q)` and `h_1 = n(R_Ib, q, ζ)` (USM-33/34: the base block of the mass matrix and
     /// the base rows of the bias forces, both in `F_b`) at the current state, with the
-    /// simulator's options.
+    /// simulator's options. Reuses `M` and `h` when the workspace already holds them for the
+    /// current state (after a Dormand–Prince span or a previous call).
     pub fn base_control_terms(&mut self) -> Result<(Matrix6<f64>, Vector6<f64>), SimError> {
         self.check_state()?;
-        self.load_zeta();
-        dynamics_terms(
-            &self.vehicle,
-            &mut self.ws,
-            &self.state.pose,
-            &self.state.joint_angles,
-            &self.zeta,
-            &self.cfg.options,
-        );
+        if !self.terms_fresh {
+            self.load_zeta();
+            dynamics_terms(
+                &self.vehicle,
+                &mut self.ws,
+                &self.state.pose,
+                &self.state.joint_angles,
+                &self.zeta,
+                &self.cfg.options,
+            );
+            self.terms_fresh = true;
+        }
         check_finite("bias", &self.ws.bias).map_err(|e| e.at(self.time))?;
         Ok((self.ws.mass_base_block(), self.ws.bias_base()))
     }
@@ -313,6 +372,7 @@ impl Simulator {
     /// Kinetic energy `½ζᵀMζ` [J] of the current state (USM-22 `M`, with added mass when the
     /// options have it).
     pub fn kinetic_energy(&mut self) -> f64 {
+        self.terms_fresh = false;
         self.load_zeta();
         kinetic_energy(
             &self.vehicle,
@@ -326,6 +386,7 @@ impl Simulator {
     /// Inertial-frame spatial momentum about the inertial origin of the current state (see
     /// [`spatial_momentum`]).
     pub fn spatial_momentum(&mut self) -> Vec6 {
+        self.terms_fresh = false;
         self.load_zeta();
         spatial_momentum(
             &self.vehicle,
@@ -355,18 +416,11 @@ impl Simulator {
         check_finite("thrust", &s.thrust).map_err(|e| e.at(t))
     }
 
-    /// Advance the state by one RK4 step of `dt` [s] under `cmd` (held over the step).
-    ///
-    /// On error (bad `dt` or command, a non-finite state or acceleration, a singular mass
-    /// matrix) the state and time are left unchanged and the error names the quantity and
-    /// the simulation time at which it was detected.
-    pub fn step(&mut self, dt: f64, cmd: &ActuatorCommand) -> Result<(), SimError> {
+    /// Check the command's lengths and finiteness and the state's finiteness at `t0`.
+    fn check_command(&self, cmd: &ActuatorCommand) -> Result<(), SimError> {
         let t0 = self.time;
         let n = self.vehicle.n_joints();
         let m = self.vehicle.n_thrusters();
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(DynError::new("dt", format!("must be finite and > 0, got {dt}")).at(t0));
-        }
         for (name, x, want) in [
             ("command.thrust", cmd.thrust, m),
             ("command.joint_ref", cmd.joint_ref, n),
@@ -381,12 +435,111 @@ impl Simulator {
             }
             check_finite(name, x).map_err(|e| e.at(t0))?;
         }
-        self.check_state()?;
+        self.check_state()
+    }
 
+    /// Advance the state by one RK4 step of `dt` [s] under `cmd` (held over the step),
+    /// whatever the configured [`Integrator`].
+    ///
+    /// On error (bad `dt` or command, a non-finite state or acceleration, a singular mass
+    /// matrix) the state and time are left unchanged and the error names the quantity and
+    /// the simulation time at which it was detected.
+    pub fn step(&mut self, dt: f64, cmd: &ActuatorCommand) -> Result<(), SimError> {
+        self.integrate(dt, Integrator::Rk4 { dt }, cmd)
+    }
+
+    /// Advance the state over `span` [s] under `cmd` (held: zero-order hold over a control
+    /// period) with the configured [`Integrator`]: RK4 steps of `dt`, or Dormand–Prince
+    /// steps sized by the error control. Errors as in [`Simulator::step`].
+    pub fn advance(&mut self, span: f64, cmd: &ActuatorCommand) -> Result<(), SimError> {
+        self.integrate(span, self.cfg.integrator, cmd)
+    }
+
+    /// Integrate over `span` with `method`, the thruster states exactly (closed form from
+    /// the span start), the rest through the flat state.
+    fn integrate(
+        &mut self,
+        span: f64,
+        method: Integrator,
+        cmd: &ActuatorCommand,
+    ) -> Result<(), SimError> {
+        let t0 = self.time;
+        if !(span.is_finite() && span > 0.0) {
+            return Err(DynError::new("dt", format!("must be finite and > 0, got {span}")).at(t0));
+        }
+        self.check_command(cmd)?;
         for (j, th) in self.thr.iter().enumerate() {
             self.u_cmd[j] = th.saturate(cmd.thrust[j]);
         }
-        // Pack x0.
+        self.pack_state();
+        let Self {
+            vehicle,
+            cfg,
+            ws,
+            state,
+            thr,
+            x0,
+            xs,
+            k,
+            dopri,
+            u_cmd,
+            u_act,
+            q_gen,
+            qdd,
+            last_thrust,
+            last_joint_torque,
+            last_accel,
+            terms_fresh,
+            stats,
+            joint_torque_peak,
+            ..
+        } = self;
+        let mut reuse = *terms_fresh;
+        let mut f = |s: f64, x: &[f64], dx: &mut [f64], boundary: bool| {
+            for (j, th) in thr.iter().enumerate() {
+                u_act[j] = th.saturate(th.evolve(state.thrust[j], u_cmd[j], s));
+            }
+            eval_stage(vehicle, cfg, ws, x, u_act, cmd, q_gen, qdd, dx, reuse)?;
+            reuse = false;
+            stats.evaluations += 1;
+            if boundary {
+                last_thrust.copy_from_slice(u_act);
+                last_joint_torque.copy_from_slice(&ws.joint_torque);
+                last_accel.copy_from_slice(&ws.zeta_dot);
+                let peak = ws.joint_torque.iter().fold(0.0_f64, |m, t| m.max(t.abs()));
+                *joint_torque_peak = joint_torque_peak.max(peak);
+            }
+            Ok(())
+        };
+        let fail = |(s, e): (f64, DynError)| e.at(t0 + s);
+        match method {
+            Integrator::Rk4 { dt } => {
+                let steps = ((span / dt).round() as usize).max(1);
+                let h = span / steps as f64;
+                for i in 0..steps {
+                    rk4_step(x0, i as f64 * h, h, k, xs, QUAT, &mut f).map_err(fail)?;
+                }
+                stats.steps += steps as u64;
+                *terms_fresh = false;
+            }
+            Integrator::Dopri5 { rtol, atol, .. } => {
+                let mut counts = StepStats::default();
+                let tol = Tolerance { rtol, atol };
+                dopri
+                    .span(x0, span, tol, QUAT, &mut counts, &mut f)
+                    .map_err(fail)?;
+                stats.steps += counts.steps;
+                stats.rejected += counts.rejected;
+                // The last evaluation was at the end state: M and h stay valid for it.
+                *terms_fresh = true;
+            }
+        }
+        self.unpack_state(t0 + span)
+    }
+
+    /// Pack the state into the flat vector `x0`.
+    fn pack_state(&mut self) {
+        let n = self.vehicle.n_joints();
         let s = &self.state;
         let x0 = &mut self.x0;
         x0[P..P + 3].copy_from_slice(s.pose.position.as_slice());
@@ -394,80 +547,50 @@ impl Simulator {
         x0[QUAT..QUAT + 4].copy_from_slice(&[qc.w, qc.i, qc.j, qc.k]);
         x0[JOINTS..JOINTS + n].copy_from_slice(&s.joint_angles);
         x0[JOINTS + n..JOINTS + n + 6].copy_from_slice(s.base_twist.as_slice());
-        x0[JOINTS + n + 6..].copy_from_slice(&s.joint_rates);
+        x0[JOINTS + n + 6..work_index(n)].copy_from_slice(&s.joint_rates);
+        x0[work_index(n)] = self.joint_work;
+    }
 
-        const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
-        for (stage, c) in C.iter().enumerate() {
-            let h = c * dt;
-            if stage == 0 {
-                self.xs.copy_from_slice(&self.x0);
-            } else {
-                let kp = &self.k[stage - 1];
-                for ((xs, x0), k) in self.xs.iter_mut().zip(&self.x0).zip(kp) {
-                    *xs = x0 + h * k;
-                }
-            }
-            for (j, th) in self.thr.iter().enumerate() {
-                let u = th.evolve(self.state.thrust[j], self.u_cmd[j], h);
-                self.u_act[j] = th.saturate(u);
-            }
-            eval_stage(
-                &self.vehicle,
-                &self.cfg,
-                &mut self.ws,
-                &self.xs,
-                &self.u_act,
-                cmd,
-                &mut self.q_gen,
-                &mut self.qdd,
-                &mut self.k[stage],
-            )
-            .map_err(|e| e.at(t0 + h))?;
-            if stage == 0 {
-                self.last_thrust.copy_from_slice(&self.u_act);
-                self.last_joint_torque
-                    .copy_from_slice(&self.ws.joint_torque);
-                self.last_accel.copy_from_slice(&self.ws.zeta_dot);
-            }
-        }
-        // Combine.
-        let [k1, k2, k3, k4] = &self.k;
-        for i in 0..self.xs.len() {
-            self.xs[i] = self.x0[i] + dt / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
-        let t1 = t0 + dt;
-        let x = &self.xs;
-        let names: [(&str, std::ops::Range<usize>); 5] = [
+    /// Check the flat vector `x0` at time `t1` and make it the state (thrust states evolved
+    /// in closed form from the span start); on error nothing changes.
+    fn unpack_state(&mut self, t1: f64) -> Result<(), SimError> {
+        let n = self.vehicle.n_joints();
+        let x = &self.x0;
+        let names: [(&str, std::ops::Range<usize>); 6] = [
             ("base_position", P..P + 3),
             ("base_orientation", QUAT..QUAT + 4),
             ("joint_angles", JOINTS..JOINTS + n),
             ("base_twist", JOINTS + n..JOINTS + n + 6),
-            ("joint_rates", JOINTS + n + 6..x.len()),
+            ("joint_rates", JOINTS + n + 6..work_index(n)),
+            ("joint_work", work_index(n)..x.len()),
         ];
         for (name, r) in names {
             check_finite(name, &x[r]).map_err(|e| e.at(t1))?;
         }
         let quat = Quaternion::new(x[QUAT], x[QUAT + 1], x[QUAT + 2], x[QUAT + 3]);
-        let norm = quat.norm();
-        if norm == 0.0 {
+        if quat.norm() == 0.0 {
             return Err(DynError::new("base_orientation", "quaternion has zero norm").at(t1));
         }
+        let span = t1 - self.time;
         let s = &mut self.state;
         s.pose.position = Vec3::new(x[P], x[P + 1], x[P + 2]);
-        s.pose.orientation = UnitQuaternion::new_unchecked(quat / norm);
+        s.pose.orientation = UnitQuaternion::new_normalize(quat);
         s.joint_angles.copy_from_slice(&x[JOINTS..JOINTS + n]);
         s.base_twist = Vec6::from_column_slice(&x[JOINTS + n..JOINTS + n + 6]);
-        s.joint_rates.copy_from_slice(&x[JOINTS + n + 6..]);
+        s.joint_rates
+            .copy_from_slice(&x[JOINTS + n + 6..work_index(n)]);
         for (j, th) in self.thr.iter().enumerate() {
-            s.thrust[j] = th.evolve(s.thrust[j], self.u_cmd[j], dt);
+            s.thrust[j] = th.evolve(s.thrust[j], self.u_cmd[j], span);
         }
+        self.joint_work = x[work_index(n)];
         self.time = t1;
         Ok(())
     }
 }
 
-/// One RK4 stage: the time derivative `dx` of the flat state `x` with actual thrust
-/// `u_act` (SPEC §4 dynamics + the servo model).
+/// One stage: the time derivative `dx` of the flat state `x` with actual thrust `u_act`
+/// (SPEC §4 dynamics + the servo model, and the joint power `Σ|τ_k q̇_k|`). With
+/// `terms_ready` the workspace already holds `M`, `h` and the kinematics of `x`.
 #[allow(clippy::too_many_arguments)]
 fn eval_stage(
     v: &Vehicle,
@@ -479,6 +602,7 @@ fn eval_stage(
     q_gen: &mut [f64],
     qdd: &mut [f64],
     dx: &mut [f64],
+    terms_ready: bool,
 ) -> Result<(), DynError> {
     let n = v.n_joints();
     let quat = Quaternion::new(x[QUAT], x[QUAT + 1], x[QUAT + 2], x[QUAT + 3]);
@@ -495,10 +619,12 @@ fn eval_stage(
         position: Vec3::new(x[P], x[P + 1], x[P + 2]),
     };
     let q = &x[JOINTS..JOINTS + n];
-    let zeta = &x[JOINTS + n..];
+    let zeta = &x[JOINTS + n..work_index(n)];
     check_finite("joint_angles", q)?;
     check_finite("generalized_velocity", zeta)?;
-    dynamics_terms(v, ws, &pose, q, zeta, &cfg.options);
+    if !terms_ready {
+        dynamics_terms(v, ws, &pose, q, zeta, &cfg.options);
+    }
 
     // Generalised thrust force Q = Σ_j (J_g,iᵀ F_j) u_j.
     q_gen.fill(0.0);
@@ -551,6 +677,12 @@ fn eval_stage(
     dx[QUAT + 2] = dv.y;
     dx[QUAT + 3] = dv.z;
     dx[JOINTS..JOINTS + n].copy_from_slice(qd);
-    dx[JOINTS + n..].copy_from_slice(&ws.zeta_dot);
+    dx[JOINTS + n..work_index(n)].copy_from_slice(&ws.zeta_dot);
+    dx[work_index(n)] = ws
+        .joint_torque
+        .iter()
+        .zip(qd)
+        .map(|(t, w)| (t * w).abs())
+        .sum();
     Ok(())
 }

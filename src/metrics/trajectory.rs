@@ -227,8 +227,8 @@ impl EnergyMetrics {
 
 /// Integrates the effort and energy of a run: the thrusters' [`PowerSample`]s over the
 /// control intervals by the rectangle rule on the zero-order hold (each sample is held over
-/// the interval that starts at its tick), the joints' power over the physics steps (torque
-/// and rate at the start of each step, held over it).
+/// the interval that starts at its tick); the joints' energy and peak torque come from the
+/// simulator ([`EnergyIntegrator::set_joints`]).
 #[derive(Clone, Debug, Default)]
 pub struct EnergyIntegrator {
     sums: EnergyMetrics,
@@ -254,15 +254,12 @@ impl EnergyIntegrator {
         }
     }
 
-    /// Add one physics step of `dt` [s] of the joints: motor torques τ_q [N·m] and rates q̇
-    /// [rad/s] at its start, held over it: `joint_energy += Σ_i |τ_q,i q̇_i| dt`, and the peak
-    /// torque.
-    pub fn add_joint_step(&mut self, joint_torque: &[f64], joint_rate: &[f64], dt: f64) {
-        let e = &mut self.sums;
-        for (tau, qd) in joint_torque.iter().zip(joint_rate) {
-            e.joint_energy += (tau * qd).abs() * dt;
-            e.joint_torque_peak = e.joint_torque_peak.max(tau.abs());
-        }
+    /// Set the joints' figures of the run: the joint mechanical energy `∫Σ|τ_q,i q̇_i| dt`
+    /// [J], integrated by the simulator with the motion, and the peak |τ_q| [N·m] over its
+    /// step boundaries.
+    pub fn set_joints(&mut self, joint_energy: f64, joint_torque_peak: f64) {
+        self.sums.joint_energy = joint_energy;
+        self.sums.joint_torque_peak = joint_torque_peak;
     }
 
     /// Track the guided point at a control tick: `segment` is the active segment's index,
@@ -463,11 +460,9 @@ mod tests {
         let mut e = EnergyIntegrator::default();
         for _ in 0..200 {
             e.add(&s, 0.05);
-            for _ in 0..5 {
-                e.add_joint_step(&[2.0, -3.0], &[-0.5, 0.0], 0.01);
-            }
         }
         e.add(&s, 0.0);
+        e.set_joints(10.0, 3.0);
         let e = e.metrics();
         // Exact for constant samples over 10 s (rounding of 200 additions aside).
         let p = m.shaft_power(10.0, 0.5) + m.static_power(5.0);

@@ -131,6 +131,9 @@ pub enum Channel {
     Qd(usize),
     /// Joint torque τ_k [N·m].
     Tau(usize),
+    /// Joint work `∫ Σ_k |τ_k q̇_k| dt` since t = 0 [J], integrated by the simulator with the
+    /// motion (the joint-energy metric, SPEC §6).
+    JointWork,
     /// Commanded (allocated) thrust of thruster j [N].
     UCmd(usize),
     /// Actual thrust of thruster j, clamped to its limits [N].
@@ -182,6 +185,7 @@ impl Channel {
             Channel::SigmaMin => "sigma_min",
             Channel::SlackNorm => "slack_norm",
             Channel::AllocStatus => "alloc_status",
+            Channel::JointWork => "joint_work",
             Channel::BasePose(a) => return format!("base_{}", a.suffix()),
             Channel::BaseTwist(a) => return format!("base_{}", a.suffix()),
             Channel::EePose(a) => return format!("ee_{}", a.suffix()),
@@ -202,7 +206,7 @@ impl Channel {
 }
 
 /// The channels of a run in column order: time, base and end-effector pose and twist, the
-/// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the per-thruster blocks
+/// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the joint work, the per-thruster blocks
 /// (commanded, actual, power, inflow), then σ_min and the allocation outcome.
 pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Channel> {
     let mut c = vec![Channel::T];
@@ -221,6 +225,7 @@ pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Ch
     for family in [Channel::Q, Channel::QRef, Channel::Qd, Channel::Tau] {
         c.extend((0..n_joints).map(family));
     }
+    c.push(Channel::JointWork);
     for family in [Channel::UCmd, Channel::U, Channel::Power, Channel::Inflow] {
         c.extend((0..n_thrusters).map(family));
     }
@@ -307,7 +312,7 @@ mod tests {
         let expected = "t base_x base_y base_z base_roll base_pitch base_yaw base_u base_v \
             base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
             ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
-            base_cross_track path_y q_0 qref_0 qd_0 tau_0 ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
+            base_cross_track path_y q_0 qref_0 qd_0 tau_0 joint_work ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
             inflow_0 inflow_1 sigma_min slack_norm alloc_status";
         assert_eq!(names.join(" "), expected);
         let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
@@ -315,8 +320,8 @@ mod tests {
             .map(Channel::name)
             .collect();
         let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
-            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r ucmd_0 u_0 power_0 inflow_0";
-        assert_eq!(work[25..43].join(" "), expected);
+            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_0 u_0 power_0 inflow_0";
+        assert_eq!(work[25..44].join(" "), expected);
     }
 
     #[test]

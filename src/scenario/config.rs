@@ -7,7 +7,7 @@
 //! mode = "transport"          # transport | work
 //! design = "usm-paper"        # preset name or design file (relative to this file)
 //! duration = 140.0            # s
-//! dt = 0.01                   # physics step (RK4) [s]
+//! dt = 0.01                   # physics step (RK4; first trial step of dopri5) [s]
 //! control_dt = 0.05           # control period [s]
 //! log_dt = 0.1                # logging period [s]
 //!
@@ -27,7 +27,7 @@
 //! [allocation]                # method, lambda, q, eps, weights, rate limits
 //! [servo]                     # joint servos
 //! [thrusters]                 # thruster dynamics
-//! [physics]                   # which effects, current
+//! [physics]                   # which effects, current, integrator (rk4 | dopri5), rtol, atol
 //! [metrics]                   # thresholds, power model
 //! ```
 //!
@@ -40,7 +40,7 @@ use crate::control::guidance::PathSpec;
 use crate::control::transport::TransportGains;
 use crate::control::work::WorkGains;
 use crate::control::ControlError;
-use crate::dynamics::{DynOptions, ServoModel, SimConfig, ThrusterModel};
+use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
 use crate::metrics::trajectory::PowerModel;
@@ -278,7 +278,13 @@ impl Default for ThrusterSpec {
     }
 }
 
-/// `[physics]`: which effects act, and the current.
+/// `(rtol, atol)` of [`Integrator::dopri5_default`].
+const DOPRI5_DEFAULT: (f64, f64) = match Integrator::dopri5_default() {
+    Integrator::Dopri5 { rtol, atol, .. } => (rtol, atol),
+    Integrator::Rk4 { .. } => (0.0, 0.0),
+};
+
+/// `[physics]`: which effects act, the current, and the time integrator.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhysicsSpec {
@@ -290,6 +296,13 @@ pub struct PhysicsSpec {
     pub restoring: bool,
     /// Constant irrotational current, inertial frame [m/s].
     pub current: [f64; 3],
+    /// Time integrator: `"dopri5"` (adaptive Dormand–Prince 5(4), the default) or `"rk4"`
+    /// (fixed steps of `scenario.dt`); see [`Integrator`].
+    pub integrator: String,
+    /// Relative tolerance of `dopri5` (> 0). Default from [`Integrator::dopri5_default`].
+    pub rtol: f64,
+    /// Absolute tolerance of `dopri5` (> 0). Default from [`Integrator::dopri5_default`].
+    pub atol: f64,
 }
 
 impl Default for PhysicsSpec {
@@ -299,6 +312,9 @@ impl Default for PhysicsSpec {
             drag: true,
             restoring: true,
             current: [0.0; 3],
+            integrator: "dopri5".into(),
+            rtol: DOPRI5_DEFAULT.0,
+            atol: DOPRI5_DEFAULT.1,
         }
     }
 }
@@ -467,6 +483,22 @@ impl ScenarioFile {
             }
         };
         let p = &self.physics;
+        let integrator = match p.integrator.as_str() {
+            "rk4" => Integrator::Rk4 {
+                dt: self.scenario.dt,
+            },
+            "dopri5" => Integrator::Dopri5 {
+                rtol: p.rtol,
+                atol: p.atol,
+                first_step: self.scenario.dt,
+            },
+            other => {
+                return Err(KeyError::new(
+                    "physics.integrator",
+                    format!("unknown integrator '{other}'; valid: rk4, dopri5"),
+                ))
+            }
+        };
         Ok(SimConfig {
             options: DynOptions {
                 added_mass: p.added_mass,
@@ -476,6 +508,7 @@ impl ScenarioFile {
             },
             servo,
             thruster,
+            integrator,
         })
     }
 

@@ -15,7 +15,9 @@
 //! - the start is 3 m to the right of the first segment, heading along it, so convergence is
 //!   visible; the second segment runs back along X at y = 6 m (a lane change plus the 180°
 //!   turn) and becomes active at t = 95 s;
-//! - physics at dt = 10 ms (RK4), control and allocation at 20 Hz, logging at 10 Hz;
+//! - physics by the adaptive Dormand–Prince 5(4) integrator over each control period
+//!   (`[physics] integrator = "rk4"` for fixed RK4 steps of `dt` = 10 ms), control and
+//!   allocation at 20 Hz, logging at 10 Hz;
 //! - ideal second-order joint servos (ω_n = 5 rad/s, ζ = 1) and ideal thrusters, as in the
 //!   paper's Vortex model where joint angles are set directly;
 //! - transport runs the paper's 140 s, which leaves only 45 s after the segment commanded at

@@ -37,8 +37,14 @@ pub(crate) use timed;
 pub struct Timing {
     /// Total wall time [s].
     pub total_s: f64,
-    /// Time in the physics (RK4 steps and the base-control dynamics terms) [s].
+    /// Time in the physics (integrator steps and the base-control dynamics terms) [s].
     pub dynamics_s: f64,
+    /// Physics steps accepted by the integrator (deterministic).
+    pub physics_steps: u64,
+    /// Physics steps rejected by the error control (Dormand–Prince; deterministic).
+    pub physics_rejected: u64,
+    /// Dynamics evaluations (one `M ζ̇ = τ − h` solve each; deterministic).
+    pub physics_evaluations: u64,
     /// Time in thrust allocation [s].
     pub allocation_s: f64,
     /// Time in kinematics, guidance and control laws [s].
@@ -184,7 +190,6 @@ pub(crate) struct Recorder {
     /// Axial inflow of each thruster at the current tick [m/s].
     inflow: Vec<f64>,
     /// Joint rates at the start of the current physics step [rad/s].
-    qd_step: Vec<f64>,
     /// Allocation outcomes so far.
     pub counts: AllocationCounts,
     /// Energy and effort integrals over the control intervals so far.
@@ -215,7 +220,6 @@ impl Recorder {
             sat_tol: file.metrics.saturation_tolerance,
             thrust: vec![0.0; v.n_thrusters()],
             inflow: vec![0.0; v.n_thrusters()],
-            qd_step: vec![0.0; v.n_joints()],
             counts: AllocationCounts::default(),
             energy: EnergyIntegrator::default(),
             timing: Timing::default(),
@@ -243,18 +247,6 @@ impl Recorder {
             limits: &self.limits,
         };
         PowerSample::new(&self.power, &thrusters, self.sat_tol)
-    }
-
-    /// Before a physics step: note the joint rates at its start.
-    pub fn before_step(&mut self, state: &SimState) {
-        self.qd_step.copy_from_slice(&state.joint_rates);
-    }
-
-    /// After a physics step of `dt` [s]: its joint power, from the simulator's joint torques
-    /// at the step's start (`Simulator::last_joint_torque`: recovered for ideal servos, the
-    /// saturated PD torque for PD servos) and the rates noted by [`Recorder::before_step`].
-    pub fn after_step(&mut self, joint_torque: &[f64], dt: f64) {
-        self.energy.add_joint_step(joint_torque, &self.qd_step, dt);
     }
 
     /// Observe control period `k` at time `t` [s] after [`Recorder::sample`]: log a row every
@@ -315,6 +307,7 @@ impl Recorder {
         w.put_all(indexed(Channel::QRef, &lp.cmd.q_ref));
         w.put_all(indexed(Channel::Qd, &state.joint_rates));
         w.put_all(indexed(Channel::Tau, lp.sim.last_joint_torque()));
+        w.put(Channel::JointWork, lp.sim.joint_work());
         w.put_all(indexed(Channel::UCmd, &lp.alloc.u));
         // Actual thrust: the thruster states clamped to their limits.
         let actual = state

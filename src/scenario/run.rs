@@ -1,10 +1,11 @@
 //! The closed loop of the USM paper's Fig. 5: guidance → kinematic control → dynamic control
 //! (USM-33) → thrust allocation (USM-36/37) → vehicle (SPEC §4), observed by a recorder.
 //!
-//! Rates: the physics advances with RK4 steps of `dt`; the controllers and the allocator run
+//! Rates: the physics advances with the `[physics] integrator` (RK4 steps of `dt`, or
+//! adaptive Dormand–Prince steps) over each control period; the controllers and the allocator run
 //! every `control_dt` with the actuator commands held in between (zero-order hold); the
-//! recorder samples the thrusters at every control tick and the joints at every physics step
-//! for the energy integrals, and logs every `log_dt`. Each control period is a fixed sequence
+//! recorder samples the thrusters at every control tick for the energy integrals (the
+//! simulator integrates the joint work), and logs every `log_dt`. Each control period is a fixed sequence
 //! of named phases (`measure`, `control`, `allocate`, the recorder's `sample` and `observe`,
 //! `advance`), timed by phase; nothing allocates inside the loop.
 
@@ -109,27 +110,21 @@ impl ClosedLoop<'_> {
 
     /// Advance the physics over one control period with the commands held; the recorder sees
     /// each physics step (joint power).
-    fn advance(&mut self, rec: &mut Recorder) -> Result<(), Failure> {
+    fn advance(&mut self) -> Result<(), Failure> {
         let cmd = ActuatorCommand {
             thrust: &self.alloc.u,
             joint_ref: &self.cmd.q_ref,
             joint_rate_ref: &self.cmd.qd_ref,
         };
-        let dt = self.file.scenario.dt;
-        for _ in 0..self.substeps {
-            rec.before_step(self.sim.state());
-            self.sim
-                .step(dt, &cmd)
-                .map_err(|e| (e.time, e.to_string()))?;
-            rec.after_step(self.sim.last_joint_torque(), dt);
-        }
-        Ok(())
+        self.sim
+            .advance(self.file.scenario.control_dt, &cmd)
+            .map_err(|e| (e.time, e.to_string()))
     }
 
     /// Control period `k`: measure, control, allocate, sample the thrusters and record, then
     /// advance the physics (except after the last period) and integrate the thruster sample
     /// over the period just simulated (SPEC §6 energy: rectangle rule on the zero-order hold,
-    /// at the control rate; the joints are integrated per physics step inside `advance`; the
+    /// at the control rate; the joint work is integrated by the simulator with the motion; the
     /// thrusters of a period that fails are not counted).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
         let t = k as f64 * self.file.scenario.control_dt;
@@ -145,7 +140,7 @@ impl ClosedLoop<'_> {
             rec.energy.add(&sample, 0.0);
             return Ok(());
         }
-        timed!(rec.timing.dynamics_s, self.advance(rec))?;
+        timed!(rec.timing.dynamics_s, self.advance())?;
         rec.energy.add(&sample, self.file.scenario.control_dt);
         Ok(())
     }
@@ -159,6 +154,12 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
     let failure = (0..=lp.n_control).find_map(|k| lp.period(k, &mut rec).err());
+    let stats = lp.sim.step_stats();
+    rec.timing.physics_steps = stats.steps;
+    rec.timing.physics_rejected = stats.rejected;
+    rec.timing.physics_evaluations = stats.evaluations;
+    rec.energy
+        .set_joints(lp.sim.joint_work(), lp.sim.joint_torque_peak());
     let (trajectory, counts, energy, timing) = rec.finish(started);
     let metrics = run_summary(file, &trajectory, failure.is_some(), &counts, &energy);
     Ok(RunResult {

@@ -38,8 +38,6 @@ pub(crate) struct ClosedLoop<'f> {
     pub cmd: Command,
     /// Measured joint rates [rad/s].
     pub qd_meas: Vec<f64>,
-    /// Physics steps per control period.
-    pub substeps: usize,
     /// Control periods in the run (the loop visits 0..=n_control).
     pub n_control: usize,
 }
@@ -127,7 +125,6 @@ impl<'f> ClosedLoop<'f> {
             t_mat: Matrix6xX::<f64>::zeros(n_thrusters),
             alloc: Allocation::new(n_thrusters),
             qd_meas: vec![0.0; v.n_joints()],
-            substeps: (s.control_dt / s.dt).round() as usize,
             n_control: (s.duration / s.control_dt).round() as usize,
             file,
             sim,

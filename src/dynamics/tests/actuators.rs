@@ -61,6 +61,7 @@ fn pd_servo_torques_are_saturated() {
                 ..DynOptions::full()
             },
             thruster: ThrusterModel::Ideal,
+            ..SimConfig::default()
         },
     )
     .unwrap();
@@ -116,6 +117,7 @@ fn thruster_models_saturate_lag_and_rate_limit() {
                 options: DynOptions::rigid(),
                 servo: ServoModel::Passive,
                 thruster: model,
+                ..SimConfig::default()
             },
         )
         .unwrap();
@@ -149,6 +151,7 @@ fn lag_and_rate_limit_combined_is_a_flow() {
             options: DynOptions::rigid(),
             servo: ServoModel::Passive,
             thruster: ThrusterModel::FromModel, // T = 0.1 s, 100 N/s from the model
+            ..SimConfig::default()
         },
     )
     .unwrap();
@@ -185,6 +188,7 @@ fn thrust_moves_the_vehicle_in_its_direction() {
             options: DynOptions::rigid(),
             servo: ServoModel::Passive,
             thruster: ThrusterModel::Ideal,
+            ..SimConfig::default()
         },
     )
     .unwrap();

@@ -171,6 +171,7 @@ fn passive_sim(v: &Vehicle, options: DynOptions) -> Simulator {
             options,
             servo: ServoModel::Passive,
             thruster: ThrusterModel::Ideal,
+            ..SimConfig::default()
         },
     )
     .unwrap()
@@ -198,4 +199,5 @@ mod conservation;
 mod equations;
 mod errors;
 mod inspect;
+mod integrator;
 mod kinematics_mass;

@@ -1,0 +1,260 @@
+//! The adaptive time integrator of the [`Simulator`](super::Simulator): Dormand–Prince
+//! 5(4) (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.5, Table 5.2) with FSAL and the
+//! standard step-size controller, over one span with the commands held.
+//!
+//! The state is the simulator's flat vector (see `sim`); the derivative is a closure
+//! `f(s, x, dx, boundary)` of the time `s` since the span start, so that the
+//! exactly-integrated thruster states can be evaluated at any stage time; `boundary` says
+//! the stage lies on a step boundary (RK4: the step's start; Dormand–Prince: the start of
+//! the span and the end of every step). The fixed-step [`rk4_step`] lives here too. After every accepted step the
+//! quaternion block is projected back onto the unit sphere (as the RK4 step does); the
+//! derivative normalises the stage quaternion itself, so the projection changes the next
+//! FSAL derivative only by rounding.
+//!
+//! Every buffer lives in [`Dopri5`], sized once: stepping allocates nothing.
+
+use super::DynError;
+
+/// Nodes `c_i` of the Dormand–Prince tableau.
+const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+
+/// Coefficients `a_ij` (row `i`, the first `i` entries used).
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+
+/// Error weights `b_i − b̂_i` (fifth- minus fourth-order solution).
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+/// Step-size controller: safety factor and the bounds on the step ratio.
+const SAFETY: f64 = 0.9;
+const FAC_MIN: f64 = 0.2;
+const FAC_MAX: f64 = 5.0;
+
+/// Tolerances of the error norm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Tolerance {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+}
+
+/// Counts of the work an integrator did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepStats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected (repeated) steps.
+    pub rejected: u64,
+    /// Derivative evaluations (each one dynamics solve; counted by the simulator).
+    pub evaluations: u64,
+}
+
+/// Buffers and the carried step size of the Dormand–Prince integrator.
+#[derive(Clone, Debug)]
+pub(super) struct Dopri5 {
+    /// Stage derivatives `k_1 … k_7`.
+    k: [Vec<f64>; 7],
+    /// Stage state.
+    xs: Vec<f64>,
+    /// Fifth-order solution of the step being tried.
+    x_new: Vec<f64>,
+    /// Step size to try next [s].
+    h: f64,
+}
+
+impl Dopri5 {
+    /// Buffers for a state of `nx` components; `first_step` [s] is the first trial step.
+    pub fn new(nx: usize, first_step: f64) -> Self {
+        Self {
+            k: std::array::from_fn(|_| vec![0.0; nx]),
+            xs: vec![0.0; nx],
+            x_new: vec![0.0; nx],
+            h: first_step,
+        }
+    }
+
+    /// Integrate `x` over `[0, span]` with `ẋ = f(s, x)`, adapting the step to `tol`.
+    /// `quat` is the offset of the unit quaternion in `x`, projected after every step.
+    /// The last evaluation is `f(span, x)` at the end (FSAL), flagged as a boundary.
+    ///
+    /// Errors carry the span time of the failing evaluation; `x` is then unspecified.
+    pub fn span<F>(
+        &mut self,
+        x: &mut [f64],
+        span: f64,
+        tol: Tolerance,
+        quat: usize,
+        stats: &mut StepStats,
+        mut f: F,
+    ) -> Result<(), (f64, DynError)>
+    where
+        F: FnMut(f64, &[f64], &mut [f64], bool) -> Result<(), DynError>,
+    {
+        let mut s = 0.0;
+        let [k0, ..] = &mut self.k;
+        f(0.0, x, k0, true).map_err(|e| (0.0, e))?;
+        let h_min = 1e-12 * span.max(1e-300);
+        while s < span {
+            // Take the remainder when it is within 1 % of the step (no sliver step).
+            let mut h = self.h.min(span - s);
+            if span - s - h < 0.01 * h {
+                h = span - s;
+            }
+            let err = self.try_step(x, s, h, tol, &mut f)?;
+            if err <= 1.0 {
+                s = if h == span - s { span } else { s + h };
+                x.copy_from_slice(&self.x_new);
+                project_quaternion(&mut x[quat..quat + 4]);
+                self.k.swap(0, 6);
+                stats.steps += 1;
+                let fac = if err == 0.0 {
+                    FAC_MAX
+                } else {
+                    (SAFETY * err.powf(-0.2)).clamp(FAC_MIN, FAC_MAX)
+                };
+                // A step shortened to end the span does not shrink the next span's step.
+                self.h = if h < self.h {
+                    (h * fac).max(self.h)
+                } else {
+                    h * fac
+                };
+            } else {
+                stats.rejected += 1;
+                self.h = h * (SAFETY * err.powf(-0.2)).clamp(FAC_MIN, 1.0);
+                if self.h < h_min {
+                    return Err((
+                        s,
+                        DynError::new(
+                            "integrator.step",
+                            format!("fell below {h_min:e} s: the tolerance cannot be met"),
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One trial step of size `h` from `(s, x)` with `k_1 = f(s, x)` given: stages
+    /// 2 … 7 into `k`, the fifth-order solution into `x_new`, and the error norm.
+    fn try_step<F>(
+        &mut self,
+        x: &[f64],
+        s: f64,
+        h: f64,
+        tol: Tolerance,
+        f: &mut F,
+    ) -> Result<f64, (f64, DynError)>
+    where
+        F: FnMut(f64, &[f64], &mut [f64], bool) -> Result<(), DynError>,
+    {
+        for stage in 1..7 {
+            let a = &A[stage];
+            for (i, (xs, x0)) in self.xs.iter_mut().zip(x).enumerate() {
+                let mut acc = 0.0;
+                for (j, aj) in a.iter().enumerate().take(stage) {
+                    acc += aj * self.k[j][i];
+                }
+                *xs = x0 + h * acc;
+            }
+            let t = s + C[stage] * h;
+            let (_, rest) = self.k.split_at_mut(stage);
+            f(t, &self.xs, &mut rest[0], stage == 6).map_err(|e| (t, e))?;
+        }
+        // Stage 7 is evaluated at the fifth-order solution (a_7 = b): x_new = xs.
+        self.x_new.copy_from_slice(&self.xs);
+        let mut sum = 0.0;
+        for (i, (x0, x1)) in x.iter().zip(&self.x_new).enumerate() {
+            let mut e = 0.0;
+            for (j, ej) in E.iter().enumerate() {
+                e += ej * self.k[j][i];
+            }
+            let scale = tol.atol + tol.rtol * x0.abs().max(x1.abs());
+            let r = h * e / scale;
+            sum += r * r;
+        }
+        let err = (sum / x.len() as f64).sqrt();
+        Ok(if err.is_finite() { err } else { f64::INFINITY })
+    }
+}
+
+/// Project a quaternion `[w, i, j, k]` onto the unit sphere (no-op on a zero vector; the
+/// simulator checks for that).
+fn project_quaternion(q: &mut [f64]) {
+    let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if norm > 0.0 {
+        q.iter_mut().for_each(|c| *c /= norm);
+    }
+}
+
+/// One classical RK4 step of size `h` from `(s, x)` into `x` (stage derivatives in `k`,
+/// stage state in `xs`), then the quaternion block at `quat` projected onto the unit sphere
+/// (a change of `O(h⁵)`). `f(s, x, dx, boundary)` is told which stage starts the step.
+pub(super) fn rk4_step<F>(
+    x: &mut [f64],
+    s: f64,
+    h: f64,
+    k: &mut [Vec<f64>; 4],
+    xs: &mut [f64],
+    quat: usize,
+    f: &mut F,
+) -> Result<(), (f64, DynError)>
+where
+    F: FnMut(f64, &[f64], &mut [f64], bool) -> Result<(), DynError>,
+{
+    const NODES: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
+    for (stage, c) in NODES.iter().enumerate() {
+        let hc = c * h;
+        if stage == 0 {
+            xs.copy_from_slice(x);
+        } else {
+            for ((xs, x0), kp) in xs.iter_mut().zip(x.iter()).zip(&k[stage - 1]) {
+                *xs = x0 + hc * kp;
+            }
+        }
+        f(s + hc, xs, &mut k[stage], stage == 0).map_err(|e| (s + hc, e))?;
+    }
+    let [k1, k2, k3, k4] = &*k;
+    for i in 0..x.len() {
+        x[i] += h / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+    }
+    project_quaternion(&mut x[quat..quat + 4]);
+    Ok(())
+}
