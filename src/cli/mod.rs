@@ -37,7 +37,7 @@ enum Command {
     /// Run one closed-loop scenario (transport or work mode) and write its time series,
     /// summary and figure.
     Simulate(simulate::SimulateArgs),
-    /// Regenerate a seed paper's simulations: the USM paper (three presets, allocator
+    /// Regenerate a seed paper's simulations: the USM paper (its scenario presets, allocator
     /// comparison, figures and tables) or Antonelli & Chiaverini's case studies.
     Paper(paper::PaperArgs),
     /// Static configuration-space analysis of the thruster matrix: how often is T(q) singular.

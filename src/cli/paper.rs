@@ -11,7 +11,7 @@ use usm_study::pipeline::paper::run_paper;
 /// Which paper to regenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PaperName {
-    /// The USM paper (three scenario presets, allocator comparison).
+    /// The USM paper (its scenario presets, allocator comparison).
     Usm,
     /// Antonelli & Chiaverini (1998): kinematic case studies 1, 1b and 2 on `uvms-planar`.
     Antonelli,
