@@ -295,9 +295,15 @@ fn bad_inputs_exit_2_naming_the_file() {
     assert_eq!(out.status.code(), Some(2));
     let e = stderr(&out);
     assert!(e.contains("d.toml:3") && e.contains("links"), "{e}");
-    let target = dir.path().join("missing").join("u.svg");
+    // A directory that cannot exist (its parent is a file): exit 2 naming the path.
+    let target = state.join("u.svg");
     let out = run(&["design", "draw", "usm-paper", "--out", arg(&target)]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains(arg(&target)), "{}", stderr(&out));
+    assert!(stderr(&out).contains(arg(&state)), "{}", stderr(&out));
     assert!(!target.exists());
+    // A directory that does not exist yet is created, as other verbs' `--out` are.
+    let target = dir.path().join("missing").join("u.svg");
+    let out = run(&["design", "draw", "usm-paper", "--out", arg(&target)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(target.is_file());
 }

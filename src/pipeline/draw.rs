@@ -217,7 +217,7 @@ pub fn draw_design(
     Ok(render_svg(&scene))
 }
 
-/// Writes the drawing of `v` at `s` to `out` atomically.
+/// Writes the drawing of `v` at `s` to `out` atomically, creating its directory if needed.
 pub fn write_drawing(
     v: &Vehicle,
     s: &VehicleState,
@@ -225,6 +225,9 @@ pub fn write_drawing(
     out: &Path,
 ) -> Result<(), PipelineError> {
     let svg = draw_design(v, s, state_label)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        super::create_dir(dir)?;
+    }
     atomic_write(out, svg.as_bytes())?;
     Ok(())
 }
