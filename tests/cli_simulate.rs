@@ -48,6 +48,30 @@ fn work_mode_reaches_the_setpoint() {
     }
     let svg = std::fs::read_to_string(d.path().join("figure.svg")).unwrap();
     assert!(svg.contains("End-effector position") && svg.contains("time [s]"));
+    // Issue 10: the roll extreme covers the whole logged run (roll is uncontrolled and swings
+    // early), and the after-settling figure is the smaller one.
+    let csv = std::fs::read_to_string(d.path().join("timeseries.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let (er, sr) = (col("ee_roll"), col("sp_roll"));
+    let wrap = |a: f64| {
+        (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+    };
+    let peak = lines
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.parse::<f64>().unwrap())
+                .collect::<Vec<f64>>()
+        })
+        .map(|r| wrap(r[er] - r[sr]).abs().to_degrees())
+        .fold(0.0f64, f64::max);
+    let reported = metric(&s, "ee_roll_max_deg");
+    assert!(
+        (reported - peak).abs() < 1e-6 * peak.max(1.0),
+        "{reported} vs {peak}"
+    );
+    assert!(metric(&s, "ee_roll_max_settled_deg") <= reported);
 }
 
 #[test]

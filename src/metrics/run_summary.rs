@@ -188,7 +188,8 @@ fn transport_metrics(
 }
 
 /// Work: final errors and settling times of the end-effector, the base's drift, and the
-/// end-effector roll about its setpoint over the second half of the run.
+/// end-effector roll about its setpoint over the whole run and after settling
+/// ([`roll_metrics`]).
 fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
     let t = channel(traj, Channel::T);
     let ep = channel(traj, Channel::EePositionError);
@@ -196,16 +197,10 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
     let last = |x: &[f64]| x.last().copied().unwrap_or(f64::NAN);
     add(out, "final_position_error", last(ep));
     add(out, "final_orientation_error_deg", last(ea).to_degrees());
-    add(
-        out,
-        "settling_time_position",
-        settling_time(t, ep, spec.position_tolerance),
-    );
-    add(
-        out,
-        "settling_time_orientation",
-        settling_time(t, ea, spec.orientation_tolerance_deg.to_radians()),
-    );
+    let settle_p = settling_time(t, ep, spec.position_tolerance);
+    let settle_a = settling_time(t, ea, spec.orientation_tolerance_deg.to_radians());
+    add(out, "settling_time_position", settle_p);
+    add(out, "settling_time_orientation", settle_a);
     let bx = channel(traj, Channel::BasePose(Pose::X));
     let by = channel(traj, Channel::BasePose(Pose::Y));
     let bz = channel(traj, Channel::BasePose(Pose::Z));
@@ -216,25 +211,37 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
     };
     add(out, "base_drift", drift);
-    // Roll of the end-effector about its setpoint over the second half of the run.
+    roll_metrics(out, traj, settle_p.max(settle_a));
+}
+
+/// Roll of the end effector about its setpoint (uncontrolled in the paper's work mode):
+/// `ee_roll_max_deg`, the largest |deviation| over the whole logged run;
+/// `ee_roll_max_settled_deg` and `ee_roll_std_deg`, its largest |deviation| and its standard
+/// deviation after the pose has settled (`settled` [s] from the start: the later of the
+/// position and orientation settling times; NaN when the pose never settles).
+fn roll_metrics(out: &mut Metrics, traj: &Trajectory, settled: f64) {
+    let t = channel(traj, Channel::T);
     let er = channel(traj, Channel::EePose(Pose::Roll));
     let sr = channel(traj, Channel::Setpoint(Pose::Roll));
-    let half = er.len() / 2;
-    let dev: Vec<f64> = er[half..]
+    let dev: Vec<f64> = er.iter().zip(sr).map(|(a, b)| wrap_angle(a - b)).collect();
+    let peak = |d: &[f64]| d.iter().fold(0.0f64, |m, x| m.max(x.abs())).to_degrees();
+    add(out, "ee_roll_max_deg", peak(&dev));
+    let t0 = t.first().copied().unwrap_or(0.0);
+    let after: Vec<f64> = t
         .iter()
-        .zip(&sr[half..])
-        .map(|(a, b)| wrap_angle(a - b))
+        .zip(&dev)
+        .filter(|(ti, _)| settled.is_finite() && **ti - t0 >= settled)
+        .map(|(_, d)| *d)
         .collect();
-    let mean = dev.iter().sum::<f64>() / dev.len().max(1) as f64;
-    let var = dev.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / dev.len().max(1) as f64;
+    if after.is_empty() {
+        add(out, "ee_roll_max_settled_deg", f64::NAN);
+        add(out, "ee_roll_std_deg", f64::NAN);
+        return;
+    }
+    let mean = after.iter().sum::<f64>() / after.len() as f64;
+    let var = after.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / after.len() as f64;
+    add(out, "ee_roll_max_settled_deg", peak(&after));
     add(out, "ee_roll_std_deg", var.sqrt().to_degrees());
-    add(
-        out,
-        "ee_roll_max_deg",
-        dev.iter()
-            .fold(0.0f64, |peak, d| peak.max(d.abs()))
-            .to_degrees(),
-    );
 }
 
 #[cfg(test)]

@@ -30,13 +30,14 @@ const TRANSPORT_KEYS: [&str; 14] = [
     "saturation_fraction",
 ];
 /// Metrics shown in the work-mode table.
-const WORK_KEYS: [&str; 8] = [
+const WORK_KEYS: [&str; 9] = [
     "final_position_error",
     "final_orientation_error_deg",
     "settling_time_position",
     "settling_time_orientation",
     "base_drift",
     "ee_roll_max_deg",
+    "ee_roll_max_settled_deg",
     "thruster_energy",
     "peak_thrust",
 ];
