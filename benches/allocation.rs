@@ -19,34 +19,14 @@
 //! Target (issue 11): the qp step ≤ 5 µs median in closed loop, where nearly every step takes
 //! the interior shortcut.
 
+mod common;
+
+use common::ALLOCS;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use nalgebra::{Matrix6xX, Vector3, Vector6};
 use rand::{Rng, SeedableRng};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::Ordering;
 use usm_study::allocation::{AllocPath, AllocSettings, Allocation, Allocator, Formulation, Method};
-
-/// Counts heap allocations (all threads) to check the hot paths allocate nothing.
-struct Counting;
-
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 /// A bent-USM-like T: 7 thrusters with random unit directions and positions in ±1.5 m.
 fn bent_t(rng: &mut rand_chacha::ChaCha8Rng) -> Matrix6xX<f64> {

@@ -6,9 +6,11 @@
 //! Before measuring, a counting allocator checks that neither a simulator RK4 step nor an
 //! adaptive span allocates.
 
+mod common;
+
+use common::ALLOCS;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::Ordering;
 use usm_study::dynamics::{
     bias, dynamics_terms, forward_dynamics, hybrid_dynamics, mass_matrix, solve_forward,
     ActuatorCommand, DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
@@ -16,28 +18,6 @@ use usm_study::dynamics::{
 use usm_study::kinematics::BasePose;
 use usm_study::model::presets::usm_paper;
 use usm_study::spatial::Vec3;
-
-/// Counts heap allocations (all threads) to check the hot path allocates nothing.
-struct Counting;
-
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 /// A bent, moving state of the paper's USM in a current.
 fn state() -> (BasePose, Vec<f64>, Vec<f64>) {
