@@ -94,6 +94,7 @@ fn write_design(o: &mut String, v: &Vehicle, k: &KinematicsReport) {
         let hydro = match b.hydro {
             Hydro::Cylinder { .. } => "cyl",
             Hydro::Coefficients { .. } => "coeff",
+            Hydro::Manoeuvring(_) => "manoeuv",
         };
         let _ = writeln!(
             o,

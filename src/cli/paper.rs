@@ -1,6 +1,6 @@
 //! `usm-study paper [usm|antonelli] [--out DIR]`: regenerate a seed paper's simulations — the
 //! USM paper (see [`usm_study::pipeline::paper`], the default) or Antonelli & Chiaverini's
-//! kinematic case studies (see [`usm_study::pipeline::antonelli`]).
+//! case studies and Table I (see [`usm_study::pipeline::antonelli`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -13,7 +13,8 @@ use usm_study::pipeline::paper::run_paper;
 pub enum PaperName {
     /// The USM paper (its scenario presets, allocator comparison).
     Usm,
-    /// Antonelli & Chiaverini (1998): kinematic case studies 1, 1b and 2 on `uvms-planar`.
+    /// Antonelli & Chiaverini (1998): kinematic case studies 1, 1b and 2 on `uvms-planar`,
+    /// case 3 (NPS AUV II under current, Table I) and the paper-like figures.
     Antonelli,
 }
 
@@ -36,7 +37,7 @@ pub struct PaperArgs {
 pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
     if a.paper == PaperName::Antonelli {
         let out = a.out.clone().unwrap_or_else(|| "results/antonelli".into());
-        run_antonelli(&out, &mut |s| {
+        let outcome = run_antonelli(&out, &mut |s| {
             eprintln!(
                 "[paper antonelli] {}: {} → {:.4} (target {:.4}), max end-effector error {:.2e} m",
                 s.name,
@@ -46,6 +47,19 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
                 s.max_ee_position_error
             );
         })?;
+        let t = &outcome.table1;
+        eprintln!(
+            "[paper antonelli] Table I (ours / paper): ∫‖f‖ a {:.0} / {:.0}, b {:.0} / {:.0}; \
+             ∫‖m‖ a {:.0} / {:.0}, b {:.0} / {:.0}",
+            t.ours.force_integral_a,
+            t.paper.force_integral_a,
+            t.ours.force_integral_b,
+            t.paper.force_integral_b,
+            t.ours.moment_integral_a,
+            t.paper.moment_integral_a,
+            t.ours.moment_integral_b,
+            t.paper.moment_integral_b
+        );
         eprintln!("[paper antonelli] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }

@@ -9,6 +9,7 @@
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
 //! | [`work`] | work mode: end-effector pose + base position by SRMTP | USM-42 |
 //! | [`dynamic`] | feedback-linearising base control | USM-33/34 |
+//! | [`sliding`] | sliding-mode base control (Antonelli & Chiaverini case 3) | AC ref. [1] |
 //!
 //! Every controller is split like the rest of the crate: settings (serde-deserialisable,
 //! `deny_unknown_fields`, defaults = the paper's values), a controller struct that owns all
@@ -24,6 +25,7 @@ pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
+pub mod sliding;
 pub mod transport;
 pub mod work;
 

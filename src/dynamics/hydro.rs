@@ -4,6 +4,7 @@
 //! towards the head), and every returned wrench `[f; m]` (N, N·m) acts on the body, in the
 //! body frame, with the moment about the body frame's origin.
 
+use super::manoeuvring::ManoeuvringKernel;
 use crate::model::{Body, Hydro};
 use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 
@@ -115,6 +116,8 @@ pub enum DampingKernel {
         /// `D_q`.
         quadratic: Mat6,
     },
+    /// Manoeuvring derivatives of a streamlined hull (NPS AUV II, SPEC §8 case 3).
+    Manoeuvring(Box<ManoeuvringKernel>),
 }
 
 impl DampingKernel {
@@ -144,6 +147,22 @@ impl DampingKernel {
                 linear: *linear,
                 quadratic: *quadratic,
             },
+            Hydro::Manoeuvring(m) => {
+                DampingKernel::Manoeuvring(Box::new(ManoeuvringKernel::new(m)))
+            }
+        }
+    }
+
+    /// Whether the dynamics add the Kirchhoff term `V_r ×* (M_A V_r)` of the added mass for
+    /// this body: yes, except for manoeuvring derivatives whose velocity-product table is
+    /// the whole measured hull force (MSS `npsauv.m` has no `C_A`), unless their
+    /// [`Manoeuvring::kirchhoff`](crate::model::manoeuvring::Manoeuvring::kirchhoff) asks for
+    /// it.
+    #[inline]
+    pub fn kirchhoff(&self) -> bool {
+        match self {
+            DampingKernel::Manoeuvring(k) => k.model.kirchhoff,
+            _ => true,
         }
     }
 
@@ -155,6 +174,7 @@ impl DampingKernel {
             DampingKernel::Coefficients { linear, quadratic } => {
                 coefficient_damping(linear, quadratic, v_r)
             }
+            DampingKernel::Manoeuvring(k) => k.wrench(v_r),
         }
     }
 }

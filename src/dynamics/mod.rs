@@ -11,7 +11,8 @@
 //! [`DynWorkspace`], free functions `algo(&model, &mut ws, …)`; MuJoCo style fluid forces as
 //! pure kernels on local 6-vectors under a thin driver):
 //! - [`hydro`]: pure kernels — cylinder strip-theory drag, coefficient damping, restoring
-//!   wrench — on one body's relative twist, in that body's frame;
+//!   wrench — on one body's relative twist, in that body's frame; [`manoeuvring`]: the
+//!   manoeuvring-derivative kernel of a streamlined hull (NPS AUV II);
 //! - [`workspace`]: the [`DynWorkspace`] (per-body inertias, kernels and every buffer);
 //! - `passes`: the staged passes (CRBA, Newton–Euler forward pass, body wrenches, backward
 //!   pass) after the one position pass, [`crate::kinematics::forward_kinematics`];
@@ -35,6 +36,7 @@ pub mod config;
 pub mod hydro;
 pub mod inspect;
 mod integrator;
+pub mod manoeuvring;
 mod passes;
 pub mod sim;
 pub mod workspace;

@@ -176,7 +176,8 @@ pub(super) fn uses_current(v: &Vehicle, opts: &DynOptions) -> bool {
 /// derivative of the body-frame current, `d/dt(R_Iiᵀ ν_c) = −ω × v_c`, so that
 /// `M_A V̇_r = M_A (V̇ + [ω × v_c; 0])` (Fossen's `M_A ν̇_r`); with it the dynamics in a
 /// uniform current are the current-free dynamics seen from a frame drifting with the current
-/// (tested). `V_r ×* (M_A V_r)` is Fossen's `C_A(ν_r) ν_r` (the Kirchhoff term).
+/// (tested). `V_r ×* (M_A V_r)` is Fossen's `C_A(ν_r) ν_r` (the Kirchhoff term), left out
+/// for bodies whose manoeuvring derivatives hold it ([`super::hydro::DampingKernel::kirchhoff`]).
 pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions) {
     let current = uses_current(v, opts);
     for i in 0..ws.twist.len() {
@@ -191,7 +192,14 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions)
         let mut f;
         if opts.added_mass {
             f = ws.i_tot[i] * ai;
-            if current {
+            if !ws.damping[i].kirchhoff() {
+                // Manoeuvring derivatives carry the added mass's velocity forces themselves.
+                f += cross_force(&vi, &(ws.i_rb[i] * vi));
+                if current {
+                    let wv = ang(&vi).cross(&vc);
+                    f += ws.m_a[i].fixed_view::<6, 3>(0, 0) * wv;
+                }
+            } else if current {
                 let ma = &ws.m_a[i];
                 f += cross_force(&vi, &(ws.i_rb[i] * vi));
                 f += cross_force(&vr, &(ma * vr));

@@ -8,6 +8,8 @@
 
 pub mod design;
 pub mod generator;
+pub mod manoeuvring;
+pub mod nps_auv2;
 pub mod presets;
 
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};
@@ -80,6 +82,11 @@ pub enum Hydro {
         /// Quadratic damping matrix, multiplying the element-wise `|ν_r| ∘ ν_r`.
         quadratic: Mat6,
     },
+    /// Manoeuvring derivatives of a streamlined hull (added mass, velocity products,
+    /// resistance, cross-flow drag) about a reference point in axes of their own: the NPS
+    /// AUV II of Antonelli & Chiaverini's case 3 ([`nps_auv2`]). The velocity-product table
+    /// replaces the Kirchhoff term of the added mass (SPEC §4).
+    Manoeuvring(Box<manoeuvring::Manoeuvring>),
 }
 
 impl Hydro {
@@ -166,6 +173,7 @@ impl Body {
                 Se3::from_translation(self.centre()).inertia_to_parent(&Mat6::from_diagonal(&d))
             }
             Hydro::Coefficients { added_mass, .. } => *added_mass,
+            Hydro::Manoeuvring(m) => m.added_mass_in_body(),
         }
     }
 }
@@ -371,6 +379,14 @@ impl Vehicle {
                         return Err(ModelError::new(
                             k("hydro.axial_added_mass_ratio"),
                             "must be finite and >= 0",
+                        ));
+                    }
+                }
+                Hydro::Manoeuvring(m) => {
+                    if let Some(key) = m.first_non_finite() {
+                        return Err(ModelError::new(
+                            k(&format!("hydro.{key}")),
+                            "must be finite",
                         ));
                     }
                 }

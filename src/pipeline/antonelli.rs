@@ -1,21 +1,27 @@
-//! The `paper antonelli` pipeline: Antonelli & Chiaverini's kinematic case studies 1, 1b and 2
-//! (SPEC §8, [`crate::scenario::antonelli`]) on `uvms-planar`, written as one CSV of time
-//! histories per case (`<case>.csv`, the columns of
-//! [`KinematicHistory::columns`]) and a `summary.json` of what the paper's text claims
-//! (targets reached, end-effector held or tracked, vehicle motion, bounded rates).
-//! Case 3 (the dynamic NPS AUV II runs and Table I) and the paper-like figures are not part
-//! of it yet.
+//! The `paper antonelli` pipeline: Antonelli & Chiaverini's case studies (SPEC §8) —
+//! the kinematic cases 1, 1b and 2 ([`crate::scenario::antonelli`]) on `uvms-planar` and the
+//! dynamic case 3 ([`crate::scenario::antonelli::dynamic`]: the NPS AUV II under current,
+//! 3a holding its pose, 3b following case 1's re-orientation). Writes one CSV of time
+//! histories per case (`<case>.csv`), the paper-like figures (`fig*.svg`, see
+//! [`super::antonelli_figures`]) and a `summary.json` of what the paper's text claims, with
+//! `table1` beside the paper's Table I and the steady-state breakdown of the current forces.
 
 use std::path::Path;
 
 use serde::Serialize;
 
 use super::error::{create_dir, PipelineError};
+use crate::dynamics::hydro::DampingKernel;
+use crate::model::nps_auv2::nps_auv2;
 use crate::model::presets::uvms_planar;
 use crate::report::{atomic_write, write_csv, Table};
+use crate::scenario::antonelli::dynamic::{
+    run_dynamic_case, BaseTrajectory, DynamicCase, DynamicHistory,
+};
 use crate::scenario::antonelli::{
     antonelli_case, run_kinematic_case, AntonelliCase, KinematicHistory, TaskTrace,
 };
+use crate::spatial::Vec6;
 
 /// What a kinematic case run shows, in the terms of the paper's text (SI units, rad).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -92,42 +98,359 @@ pub fn summarize(h: &KinematicHistory) -> CaseSummary {
     }
 }
 
-/// `summary.json`: the case summaries and the choices the paper leaves open.
+/// The paper's Table I (Antonelli & Chiaverini 1998, section 5): `∫‖f‖dt` [N·s] and
+/// `∫‖m‖dt` [N·m·s] over 100 s, a: without re-orientation, b: with.
+pub const PAPER_TABLE1: Table1Values = Table1Values {
+    force_integral_a: 2300.0,
+    force_integral_b: 800.0,
+    moment_integral_a: 9500.0,
+    moment_integral_b: 5800.0,
+};
+
+/// The four entries of Table I.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Table1Values {
+    /// `∫‖f‖dt` of case 3a [N·s].
+    pub force_integral_a: f64,
+    /// `∫‖f‖dt` of case 3b [N·s].
+    pub force_integral_b: f64,
+    /// `∫‖m‖dt` of case 3a [N·m·s].
+    pub moment_integral_a: f64,
+    /// `∫‖m‖dt` of case 3b [N·m·s].
+    pub moment_integral_b: f64,
+}
+
+impl Table1Values {
+    fn as_array(&self) -> [f64; 4] {
+        [
+            self.force_integral_a,
+            self.force_integral_b,
+            self.moment_integral_a,
+            self.moment_integral_b,
+        ]
+    }
+}
+
+/// Table I of ours beside the paper's: the four integrals (`force_integral_a` … flattened into
+/// this object), the paper's values, ours/paper for each, and the a/b ratios.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Table1 {
+    /// Ours.
+    #[serde(flatten)]
+    pub ours: Table1Values,
+    /// The paper's.
+    pub paper: Table1Values,
+    /// Ours divided by the paper's, entry by entry.
+    pub ours_over_paper: Table1Values,
+    /// `[force a/b, moment a/b]`, ours.
+    pub ratio_a_over_b: [f64; 2],
+    /// `[force a/b, moment a/b]`, the paper's (2.875, 1.638).
+    pub paper_ratio_a_over_b: [f64; 2],
+}
+
+impl Table1 {
+    /// Ours (from the two runs) beside [`PAPER_TABLE1`].
+    pub fn new(a: &DynamicHistory, b: &DynamicHistory) -> Self {
+        let ours = Table1Values {
+            force_integral_a: a.force_integral,
+            force_integral_b: b.force_integral,
+            moment_integral_a: a.moment_integral,
+            moment_integral_b: b.moment_integral,
+        };
+        let p = PAPER_TABLE1;
+        let q: Vec<f64> = ours
+            .as_array()
+            .iter()
+            .zip(p.as_array())
+            .map(|(o, p)| o / p)
+            .collect();
+        Self {
+            ours,
+            paper: p,
+            ours_over_paper: Table1Values {
+                force_integral_a: q[0],
+                force_integral_b: q[1],
+                moment_integral_a: q[2],
+                moment_integral_b: q[3],
+            },
+            ratio_a_over_b: [
+                ours.force_integral_a / ours.force_integral_b,
+                ours.moment_integral_a / ours.moment_integral_b,
+            ],
+            paper_ratio_a_over_b: [
+                p.force_integral_a / p.force_integral_b,
+                p.moment_integral_a / p.moment_integral_b,
+            ],
+        }
+    }
+}
+
+/// A case-3 run in numbers (SI units).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DynamicSummary {
+    /// `case3a` or `case3b`.
+    pub name: String,
+    /// `∫‖f‖dt` [N·s].
+    pub force_integral: f64,
+    /// `∫‖m‖dt` [N·m·s].
+    pub moment_integral: f64,
+    /// `∫‖f‖dt` over the first 10 s (the re-orientation of 3b) [N·s].
+    pub force_integral_first_10s: f64,
+    /// `∫‖m‖dt` over the first 10 s [N·m·s].
+    pub moment_integral_first_10s: f64,
+    /// Largest distance from the reference position [m].
+    pub max_position_error: f64,
+    /// Largest yaw error [rad].
+    pub max_yaw_error: f64,
+    /// Final pose `(x, y, ψ)` [m, m, rad].
+    pub final_pose: [f64; 3],
+    /// Final `‖f‖` [N] and `‖m‖` [N·m].
+    pub final_norms: [f64; 2],
+}
+
+/// Trapezoid integral of the logged `y` over `t ≤ t_end` (for the first-10-s split; the
+/// run's totals are exact sums at the control rate).
+fn logged_integral(t: &[f64], y: &[f64], t_end: f64) -> f64 {
+    t.windows(2)
+        .zip(y.windows(2))
+        .filter(|(w, _)| w[1] <= t_end + 1e-9)
+        .map(|(w, v)| 0.5 * (w[1] - w[0]) * (v[0] + v[1]))
+        .sum()
+}
+
+/// The summary of a case-3 run.
+pub fn summarize_dynamic(h: &DynamicHistory) -> DynamicSummary {
+    DynamicSummary {
+        name: h.name.clone(),
+        force_integral: h.force_integral,
+        moment_integral: h.moment_integral,
+        force_integral_first_10s: logged_integral(&h.t, &h.force_norm, 10.0),
+        moment_integral_first_10s: logged_integral(&h.t, &h.moment_norm, 10.0),
+        max_position_error: h.max_position_error(),
+        max_yaw_error: h.max_yaw_error(),
+        final_pose: [
+            last(&h.position[0]),
+            last(&h.position[1]),
+            last(&h.attitude[2]),
+        ],
+        final_norms: [last(&h.force_norm), last(&h.moment_norm)],
+    }
+}
+
+/// The hydrodynamic wrench on the NPS AUV II held still in the current, by part (SNAME-free:
+/// `F_b` axes of the crate, x forward, y port, z up; moments about `CO`) [N, N·m].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SteadyCurrentForces {
+    /// Vehicle heading [rad].
+    pub heading: f64,
+    /// Velocity-product derivatives (`Xvv v²`, `Yv u v`, `Zvv v²`, `Mvv v²`, `Nv u v`, …).
+    pub products: [f64; 6],
+    /// Surge resistance `Cd0 ½ρL² |u|u`.
+    pub resistance: [f64; 6],
+    /// Cross-flow drag.
+    pub crossflow: [f64; 6],
+    /// `‖f‖` and `‖m‖` of the total [N, N·m].
+    pub norms: [f64; 2],
+    /// `100 s × norms`: what a perfect station keeper spends over the paper's 100 s.
+    pub over_100s: [f64; 2],
+}
+
+/// The current's force on the still vehicle at heading `psi` (at rest, so `V_r = −R_Ibᵀ ν_c`).
+pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> SteadyCurrentForces {
+    let v = nps_auv2();
+    let DampingKernel::Manoeuvring(k) = DampingKernel::of(&v.bodies[0], v.fluid.rho) else {
+        unreachable!("nps_auv2 has manoeuvring hydrodynamics")
+    };
+    let (s, c) = psi.sin_cos();
+    let rel = Vec6::new(
+        -(c * current.x + s * current.y),
+        s * current.x - c * current.y,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    );
+    // `parts` takes the twist at the body origin and returns moments about it; the base
+    // frame sits at CO, a pure translation ahead, so move the wrench to CO.
+    let p = k.parts(&rel);
+    let to_co = |w: Vec6| v.base.wrench_to_child(&w);
+    let (pr, re, cf) = (to_co(p.products), to_co(p.resistance), to_co(p.crossflow));
+    let total = pr + re + cf;
+    let norms = [
+        total.fixed_rows::<3>(0).norm(),
+        total.fixed_rows::<3>(3).norm(),
+    ];
+    let arr = |w: Vec6| [w[0], w[1], w[2], w[3], w[4], w[5]];
+    SteadyCurrentForces {
+        heading: psi,
+        products: arr(pr),
+        resistance: arr(re),
+        crossflow: arr(cf),
+        norms,
+        over_100s: norms.map(|n| 100.0 * n),
+    }
+}
+
+/// Table I's four integrals under one modelling choice other than the paper's set-up.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Case3Variant {
+    /// Short name.
+    pub name: &'static str,
+    /// What differs from [`DynamicCase::paper`] and case 3b's reference.
+    pub what: &'static str,
+    /// The integrals (a and b).
+    pub values: Table1Values,
+}
+
+/// The diagnostic variants of case 3 (`hold`: 3a's reference; `case1`: 3b's): the MSS form
+/// without `C_A`; 3b re-orienting in place (case 1's yaw, position held), with and without
+/// current; sliding-mode gains ×4 (`K_D`, and `Λ` = 1 1/s).
+pub fn case3_variants(
+    hold: &BaseTrajectory,
+    case1: &BaseTrajectory,
+) -> Result<Vec<Case3Variant>, PipelineError> {
+    let mut in_place = case1.clone();
+    for k in 0..2 {
+        in_place.pose[k].iter_mut().for_each(|x| *x = 0.0);
+        in_place.rate[k].iter_mut().for_each(|x| *x = 0.0);
+    }
+    let paper = DynamicCase::paper("variant");
+    let mut mss = paper.clone();
+    mss.added_mass_coriolis = false;
+    let mut still = paper.clone();
+    still.current = crate::spatial::Vec3::zeros();
+    let mut stiff = paper.clone();
+    stiff.gains.k_d.iter_mut().for_each(|k| *k *= 4.0);
+    stiff.gains.lambda = [1.0; 6];
+    let runs: [(&'static str, &'static str, &DynamicCase, &BaseTrajectory); 4] = [
+        (
+            "mss_without_c_a",
+            "no added-mass Coriolis C_A (MSS npsauv.m form)",
+            &mss,
+            case1,
+        ),
+        (
+            "reorientation_in_place",
+            "3b: case 1's yaw, position held at the origin",
+            &paper,
+            &in_place,
+        ),
+        (
+            "reorientation_in_place_still_water",
+            "3b re-orienting in place without current (a: holds still in still water)",
+            &still,
+            &in_place,
+        ),
+        ("gains_x4", "K_D ×4 and Λ = 1 1/s", &stiff, case1),
+    ];
+    runs.into_iter()
+        .map(|(name, what, case, b_ref)| {
+            let a = run_dynamic_case(case, hold)?;
+            let b = run_dynamic_case(case, b_ref)?;
+            Ok(Case3Variant {
+                name,
+                what,
+                values: Table1Values {
+                    force_integral_a: a.force_integral,
+                    force_integral_b: b.force_integral,
+                    moment_integral_a: a.moment_integral,
+                    moment_integral_b: b.moment_integral,
+                },
+            })
+        })
+        .collect()
+}
+
+/// `summary.json`: the case summaries, Table I and the choices the paper leaves open.
 #[derive(Serialize)]
 struct Summary<'a> {
     source: &'static str,
     inferred: &'static str,
     cases: &'a [CaseSummary],
+    case3: &'a [DynamicSummary],
+    table1: &'a Table1,
+    table1_variants: &'a [Case3Variant],
+    steady_current_forces: [SteadyCurrentForces; 2],
 }
 
-/// Run cases 1, 1b and 2 and write `<case>.csv` and `summary.json` into `out`; `on_case` is
-/// called after each case. Returns the summaries.
+/// What `run_antonelli` returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AntonelliOutcome {
+    /// Cases 1, 1b, 2.
+    pub kinematic: Vec<CaseSummary>,
+    /// Cases 3a, 3b.
+    pub dynamic: Vec<DynamicSummary>,
+    /// Table I, ours beside the paper's.
+    pub table1: Table1,
+    /// Table I under other modelling choices (the diagnosis of the differences).
+    pub variants: Vec<Case3Variant>,
+}
+
+fn write_table(columns: Vec<(String, &[f64])>, path: &Path) -> Result<(), PipelineError> {
+    let mut table = Table::new();
+    for (name, col) in columns {
+        table.push(name, col.to_vec())?;
+    }
+    Ok(write_csv(&table, path)?)
+}
+
+/// Run cases 1, 1b, 2, 3a and 3b and write `<case>.csv`, the figures and `summary.json` into
+/// `out`; `on_case` is called after each kinematic case. Returns the summaries and Table I.
 pub fn run_antonelli(
     out: &Path,
     on_case: &mut dyn FnMut(&CaseSummary),
-) -> Result<Vec<CaseSummary>, PipelineError> {
+) -> Result<AntonelliOutcome, PipelineError> {
     create_dir(out)?;
     let v = uvms_planar();
     let mut summaries = Vec::new();
+    let mut histories = Vec::new();
     for which in AntonelliCase::ALL {
         let h = run_kinematic_case(&v, &antonelli_case(which))?;
-        let mut table = Table::new();
-        for (name, col) in h.columns() {
-            table.push(name, col.to_vec())?;
-        }
-        write_csv(&table, &out.join(format!("{}.csv", which.name())))?;
+        write_table(h.columns(), &out.join(format!("{}.csv", which.name())))?;
         let s = summarize(&h);
         on_case(&s);
         summaries.push(s);
+        histories.push(h);
     }
+    // Case 3b follows case 1's vehicle motion, sampled at the control rate (10 ms).
+    let mut case1 = antonelli_case(AntonelliCase::Case1);
+    case1.record_every = 10;
+    let reference_b = BaseTrajectory::from_kinematic(&run_kinematic_case(&v, &case1)?);
+    let hold = BaseTrajectory::hold([0.0; 3]);
+    let a = run_dynamic_case(&DynamicCase::paper("case3a"), &hold)?;
+    let b = run_dynamic_case(&DynamicCase::paper("case3b"), &reference_b)?;
+    let variants = case3_variants(&hold, &reference_b)?;
+    for h in [&a, &b] {
+        write_table(h.columns(), &out.join(format!("{}.csv", h.name)))?;
+    }
+    super::antonelli_figures::write_figures(out, &histories, &[&a, &b])?;
+    let table1 = Table1::new(&a, &b);
+    let dynamic = vec![summarize_dynamic(&a), summarize_dynamic(&b)];
+    let current = DynamicCase::paper("").current;
     let summary = Summary {
-        source: "Antonelli & Chiaverini (1998), section 5; SPEC §8",
-        inferred: "arm geometry of uvms-planar (SPEC §8); 10 s runs (the quintic's duration); \
-                   RK4 at 1 ms, samples every 50 ms; Moore–Penrose pseudoinverses of the planar \
-                   Jacobians (λ = 0)",
+        source: "Antonelli & Chiaverini (1998), section 5 and Table I; SPEC §8",
+        inferred: "arm geometry of uvms-planar (SPEC §8); 10 s kinematic runs (the quintic's \
+                   duration); RK4 at 1 ms, samples every 50 ms; Moore–Penrose pseudoinverses \
+                   of the planar Jacobians (λ = 0). Case 3: the NPS AUV II alone (legacy MSS \
+                   constants ρ = 1000, m = 5454.54), starting at rest; the MSS derivative \
+                   table as damping beside Fossen's added-mass Coriolis C_A (AC-3); \
+                   sliding-mode gains and boundary layer of control::sliding; 100 Hz control, \
+                   RK4 at 10 ms; 3b follows case 1's vehicle motion and then holds it",
         cases: &summaries,
+        case3: &dynamic,
+        table1: &table1,
+        table1_variants: &variants,
+        steady_current_forces: [
+            steady_current_forces(&current, 0.0),
+            steady_current_forces(&current, 0.78),
+        ],
     };
     let json = serde_json::to_vec_pretty(&summary)?;
     atomic_write(&out.join("summary.json"), &json)?;
-    Ok(summaries)
+    Ok(AntonelliOutcome {
+        kinematic: summaries,
+        dynamic,
+        table1,
+        variants,
+    })
 }

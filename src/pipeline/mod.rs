@@ -6,7 +6,8 @@
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
-//! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
+//! - [`antonelli`]: Antonelli & Chiaverini's case studies (kinematic 1, 1b, 2; dynamic 3a,
+//!   3b and Table I), their CSVs and summary; [`antonelli_figures`]: their figures;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
 //! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
 //!
@@ -15,6 +16,7 @@
 
 pub mod allocate;
 pub mod antonelli;
+pub mod antonelli_figures;
 pub mod draw;
 pub mod error;
 pub mod inspect;

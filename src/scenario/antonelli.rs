@@ -22,6 +22,10 @@
 //! Moore–Penrose ones of the planar system (λ = 0, usage weights selecting u, v, r and the
 //! joints: [`planar_weights`]); heave, roll and pitch stay zero, so the state is
 //! `(x, y, ψ, q)` with `ẋ = u cos ψ − v sin ψ`, `ẏ = u sin ψ + v cos ψ`, `ψ̇ = r`.
+//!
+//! Case 3 (the dynamic NPS AUV II runs behind Table I) is in [`dynamic`].
+
+pub mod dynamic;
 
 use super::ScenarioError;
 use crate::control::{InertialTask, Quintic, Srmtp, TaskInverse, TaskVariable};
