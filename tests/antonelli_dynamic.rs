@@ -1,6 +1,8 @@
 //! Antonelli & Chiaverini case 3: the NPS AUV II model (`model::nps_auv2`) in still water,
 //! its energy and momentum without dissipation, the sliding-mode runs 3a/3b and Table I in
-//! `paper antonelli`'s summary.json.
+//! `paper antonelli`'s summary.json; the `simulate antonelli-…` presets.
+
+mod common;
 
 use usm_study::dynamics::{
     ActuatorCommand, DynOptions, Integrator, SimConfig, SimState, Simulator,
@@ -234,4 +236,28 @@ fn paper_antonelli_writes_table1_with_finite_entries() {
     // added-mass Coriolis C_A of AC-3 dominates (Munk moment; FINDINGS.md).
     let m_a = outcome.table1.ours.moment_integral_a;
     assert!((m_a / 9500.0 - 1.0).abs() < 0.10, "{m_a}");
+}
+
+#[test]
+fn simulate_runs_the_paper_cases_as_presets_and_refuses_overrides() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c2");
+    let s = common::json(&["simulate", "antonelli-case2", "--out", common::arg(&out)]);
+    assert!((s["fourth_task_final"].as_f64().unwrap() + 0.78).abs() < 1e-6);
+    assert!(out.join("case2.csv").exists() && out.join("summary.json").exists());
+    let out = dir.path().join("c3a");
+    let s = common::json(&["simulate", "antonelli-case3a", "--out", common::arg(&out)]);
+    assert!(s["force_integral"].as_f64().unwrap() > 0.0);
+    let o = common::run(&[
+        "simulate",
+        "antonelli-case3b",
+        "--set",
+        "scenario.duration=5",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        common::stderr(&o).contains("do not apply"),
+        "{}",
+        common::stderr(&o)
+    );
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::allocation::Method;
 use usm_study::input::keypath::{parse_override, set};
+use usm_study::pipeline::antonelli::AntonelliPreset;
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use usm_study::report::fmt_num;
@@ -14,7 +15,8 @@ use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario,
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint,
-    /// transport-method1-torque-limited.
+    /// transport-method1-torque-limited; or one of Antonelli & Chiaverini's cases
+    /// antonelli-case1, -case1b, -case2, -case3a, -case3b (fixed set-ups: no overrides).
     pub scenario: String,
     /// Output directory (default: out/<scenario name>).
     #[arg(long)]
@@ -33,6 +35,9 @@ pub struct SimulateArgs {
 
 /// Run `simulate`.
 pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
+    if let Some(p) = AntonelliPreset::parse(&a.scenario) {
+        return super::paper::run_antonelli_preset(p, a);
+    }
     let (mut table, src) = load_table(&a.scenario)?;
     if let Some(m) = a.allocation {
         set_allocation_method(&mut table, m);

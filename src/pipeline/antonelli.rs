@@ -412,10 +412,7 @@ pub fn run_antonelli(
         summaries.push(s);
         histories.push(h);
     }
-    // Case 3b follows case 1's vehicle motion, sampled at the control rate (10 ms).
-    let mut case1 = antonelli_case(AntonelliCase::Case1);
-    case1.record_every = 10;
-    let reference_b = BaseTrajectory::from_kinematic(&run_kinematic_case(&v, &case1)?);
+    let reference_b = case3b_reference()?;
     let hold = BaseTrajectory::hold([0.0; 3]);
     let a = run_dynamic_case(&DynamicCase::paper("case3a"), &hold)?;
     let b = run_dynamic_case(&DynamicCase::paper("case3b"), &reference_b)?;
@@ -453,4 +450,82 @@ pub fn run_antonelli(
         table1,
         variants,
     })
+}
+
+/// One of the paper's cases as a `simulate` preset (`antonelli-case1`, `-case1b`, `-case2`,
+/// `-case3a`, `-case3b`). Not a TOML scenario: the kinematic cases have no dynamics and case 3
+/// drives generalised forces without allocation, which the transport/work closed loop does
+/// not model; `simulate` dispatches these names here.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AntonelliPreset {
+    /// A kinematic case (1, 1b, 2).
+    Kinematic(AntonelliCase),
+    /// Case 3a: hold the pose against the current.
+    Case3a,
+    /// Case 3b: follow case 1's re-orientation.
+    Case3b,
+}
+
+impl AntonelliPreset {
+    /// The preset names, in the paper's order.
+    pub const NAMES: [&'static str; 5] = [
+        "antonelli-case1",
+        "antonelli-case1b",
+        "antonelli-case2",
+        "antonelli-case3a",
+        "antonelli-case3b",
+    ];
+
+    /// The preset called `name`, if any.
+    pub fn parse(name: &str) -> Option<Self> {
+        match name.strip_prefix("antonelli-")? {
+            "case3a" => Some(AntonelliPreset::Case3a),
+            "case3b" => Some(AntonelliPreset::Case3b),
+            other => AntonelliCase::ALL
+                .into_iter()
+                .find(|c| c.name() == other)
+                .map(AntonelliPreset::Kinematic),
+        }
+    }
+}
+
+/// Case 1's vehicle motion sampled at case 3's control rate (10 ms): the reference of 3b.
+fn case3b_reference() -> Result<BaseTrajectory, PipelineError> {
+    let mut case1 = antonelli_case(AntonelliCase::Case1);
+    case1.record_every = 10;
+    Ok(BaseTrajectory::from_kinematic(&run_kinematic_case(
+        &uvms_planar(),
+        &case1,
+    )?))
+}
+
+/// Run one preset and write `<case>.csv` and `summary.json` (its [`CaseSummary`] or
+/// [`DynamicSummary`]) into `out`; returns the summary as JSON.
+pub fn run_antonelli_preset(
+    preset: AntonelliPreset,
+    out: &Path,
+) -> Result<serde_json::Value, PipelineError> {
+    create_dir(out)?;
+    let summary = match preset {
+        AntonelliPreset::Kinematic(which) => {
+            let h = run_kinematic_case(&uvms_planar(), &antonelli_case(which))?;
+            write_table(h.columns(), &out.join(format!("{}.csv", which.name())))?;
+            serde_json::to_value(summarize(&h))?
+        }
+        AntonelliPreset::Case3a | AntonelliPreset::Case3b => {
+            let (name, reference) = if preset == AntonelliPreset::Case3a {
+                ("case3a", BaseTrajectory::hold([0.0; 3]))
+            } else {
+                ("case3b", case3b_reference()?)
+            };
+            let h = run_dynamic_case(&DynamicCase::paper(name), &reference)?;
+            write_table(h.columns(), &out.join(format!("{name}.csv")))?;
+            serde_json::to_value(summarize_dynamic(&h))?
+        }
+    };
+    atomic_write(
+        &out.join("summary.json"),
+        &serde_json::to_vec_pretty(&summary)?,
+    )?;
+    Ok(summary)
 }
