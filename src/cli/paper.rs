@@ -5,9 +5,7 @@
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use usm_study::pipeline::antonelli::{
-    run_antonelli, run_antonelli_preset as run_preset, AntonelliPreset,
-};
+use usm_study::pipeline::antonelli::run_antonelli;
 use usm_study::pipeline::paper::run_paper;
 
 /// Which paper to regenerate.
@@ -80,26 +78,4 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
-}
-
-/// `simulate antonelli-…`: one of the paper's cases with its fixed set-up, written to `--out`
-/// (default `out/<preset>`); the closed-loop overrides do not apply to it.
-pub fn run_antonelli_preset(
-    p: AntonelliPreset,
-    a: &super::simulate::SimulateArgs,
-) -> anyhow::Result<ExitCode> {
-    if a.allocation.is_some() || !a.set.is_empty() {
-        anyhow::bail!(
-            "{}: a fixed case of Antonelli & Chiaverini; --allocation and --set do not apply",
-            a.scenario
-        );
-    }
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(&a.scenario));
-    let summary = run_preset(p, &out)?;
-    println!("{}", serde_json::to_string_pretty(&summary)?);
-    eprintln!("[simulate] wrote {}", out.display());
-    Ok(ExitCode::SUCCESS)
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::allocation::Method;
 use usm_study::input::keypath::{parse_override, set};
-use usm_study::pipeline::antonelli::AntonelliPreset;
+use usm_study::pipeline::antonelli::{run_antonelli_preset as run_preset, AntonelliPreset};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use usm_study::report::fmt_num;
@@ -36,7 +36,7 @@ pub struct SimulateArgs {
 /// Run `simulate`.
 pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     if let Some(p) = AntonelliPreset::parse(&a.scenario) {
-        return super::paper::run_antonelli_preset(p, a);
+        return run_antonelli_preset(p, a);
     }
     let (mut table, src) = load_table(&a.scenario)?;
     if let Some(m) = a.allocation {
@@ -90,4 +90,23 @@ fn print_summary(r: &RunResult) {
         "  wall time {:.3} s ({:.0}x real time): dynamics {:.3} s, allocation {:.3} s, control {:.3} s, logging {:.3} s",
         t.total_s, t.realtime_factor, t.dynamics_s, t.allocation_s, t.control_s, t.logging_s
     );
+}
+
+/// `simulate antonelli-…`: one of the paper's cases with its fixed set-up, written to `--out`
+/// (default `out/<preset>`); the closed-loop overrides do not apply to it.
+pub fn run_antonelli_preset(p: AntonelliPreset, a: &SimulateArgs) -> anyhow::Result<ExitCode> {
+    if a.allocation.is_some() || !a.set.is_empty() {
+        anyhow::bail!(
+            "{}: a fixed case of Antonelli & Chiaverini; --allocation and --set do not apply",
+            a.scenario
+        );
+    }
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&a.scenario));
+    let summary = run_preset(p, &out)?;
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    eprintln!("[simulate] wrote {}", out.display());
+    Ok(ExitCode::SUCCESS)
 }

@@ -11,8 +11,8 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::error::{create_dir, PipelineError};
-use crate::dynamics::hydro::DampingKernel;
-use crate::model::nps_auv2::nps_auv2;
+use crate::dynamics::manoeuvring::ManoeuvringKernel;
+use crate::model::nps_auv2::{nps_auv2, nps_auv2_hydro};
 use crate::model::presets::uvms_planar;
 use crate::report::{atomic_write, write_csv, Table};
 use crate::scenario::antonelli::dynamic::{
@@ -21,7 +21,7 @@ use crate::scenario::antonelli::dynamic::{
 use crate::scenario::antonelli::{
     antonelli_case, run_kinematic_case, AntonelliCase, KinematicHistory, TaskTrace,
 };
-use crate::spatial::Vec6;
+use crate::spatial::{cross_force, Se3, Vec3, Vec6};
 
 /// What a kinematic case run shows, in the terms of the paper's text (SI units, rad).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -237,7 +237,7 @@ pub fn summarize_dynamic(h: &DynamicHistory) -> DynamicSummary {
     }
 }
 
-/// The hydrodynamic wrench on the NPS AUV II held still in the current, by part (SNAME-free:
+/// The hydrodynamic wrench on the NPS AUV II held still in the current, by part (not SNAME:
 /// `F_b` axes of the crate, x forward, y port, z up; moments about `CO`) [N, N·m].
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SteadyCurrentForces {
@@ -249,7 +249,10 @@ pub struct SteadyCurrentForces {
     pub resistance: [f64; 6],
     /// Cross-flow drag.
     pub crossflow: [f64; 6],
-    /// `‖f‖` and `‖m‖` of the total [N, N·m].
+    /// Added-mass Coriolis `−C_A(ν_r) ν_r` (the Munk moment `(M_A,22 − M_A,11) u v` on yaw),
+    /// part of the paper's AC-3 set-up ([`DynamicCase::added_mass_coriolis`]).
+    pub added_mass_coriolis: [f64; 6],
+    /// `‖f‖` and `‖m‖` of the total (all four parts) [N, N·m].
     pub norms: [f64; 2],
     /// `100 s × norms`: what a perfect station keeper spends over the paper's 100 s.
     pub over_100s: [f64; 2],
@@ -258,9 +261,8 @@ pub struct SteadyCurrentForces {
 /// The current's force on the still vehicle at heading `psi` (at rest, so `V_r = −R_Ibᵀ ν_c`).
 pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> SteadyCurrentForces {
     let v = nps_auv2();
-    let DampingKernel::Manoeuvring(k) = DampingKernel::of(&v.bodies[0], v.fluid.rho) else {
-        unreachable!("nps_auv2 has manoeuvring hydrodynamics")
-    };
+    let hydro = nps_auv2_hydro(v.fluid.rho);
+    let k = ManoeuvringKernel::new(&hydro);
     let (s, c) = psi.sin_cos();
     let rel = Vec6::new(
         -(c * current.x + s * current.y),
@@ -275,7 +277,10 @@ pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> Steady
     let p = k.parts(&rel);
     let to_co = |w: Vec6| v.base.wrench_to_child(&w);
     let (pr, re, cf) = (to_co(p.products), to_co(p.resistance), to_co(p.crossflow));
-    let total = pr + re + cf;
+    // Fossen's C_A(ν_r) ν_r at CO (the Kirchhoff term; the water applies its negative).
+    let m_a = Se3::new(hydro.axes, Vec3::zeros()).inertia_to_parent(&hydro.added_mass);
+    let ca = -cross_force(&rel, &(m_a * rel));
+    let total = pr + re + cf + ca;
     let norms = [
         total.fixed_rows::<3>(0).norm(),
         total.fixed_rows::<3>(3).norm(),
@@ -286,6 +291,7 @@ pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> Steady
         products: arr(pr),
         resistance: arr(re),
         crossflow: arr(cf),
+        added_mass_coriolis: arr(ca),
         norms,
         over_100s: norms.map(|n| 100.0 * n),
     }

@@ -97,7 +97,7 @@ fn norm_figure(runs: &[&DynamicHistory], moment: bool, title: &str) -> Figure {
         ("‖f‖", "[N]")
     };
     let mut p = Panel::new(
-        format!("{what} of the control forces (a: fixed attitude, b: re-oriented)"),
+        format!("{what} of the control wrench (a: fixed attitude, b: re-oriented)"),
         TIME,
         format!("{what} {unit}"),
     );
