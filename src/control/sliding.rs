@@ -1,7 +1,8 @@
 //! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (SPEC §8), after their
 //! reference [1] (Antonelli & Chiaverini, ACC 1998, "Singularity-free regulation of UVMS"),
-//! whose law is not restated in the seed; as written in Antonelli's later book
-//! ("Underwater Robots", the quaternion-based sliding-mode law, itself after Slotine & Li):
+//! whose law is not restated in the seed and whose text we did not have. We use the
+//! quaternion-based sliding-mode law in the form of Antonelli's later book ("Underwater
+//! Robots", after Slotine & Li), from memory of that book — an inference:
 //!
 //! ```text
 //! s = [R_Ibᵀ ṗ_d − v; R_Ibᵀ ω_d − ω] + Λ [R_Ibᵀ (p_d − p); ε̃],   τ = K_D s + K_S sat(s/φ) + ĝ
