@@ -6,6 +6,7 @@
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
+//! - [`review`]: `report.html`, the design-review page of a study output directory;
 //! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
 //! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
@@ -19,6 +20,7 @@ pub mod draw;
 pub mod error;
 pub mod inspect;
 pub mod paper;
+pub mod review;
 pub mod simulate;
 pub mod tcm;
 
