@@ -4,6 +4,7 @@
 //!
 //! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
+//! - [`shapes`]: the body along a run (`shapes.svg`, `animation.svg`);
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`review`]: `report.html`, the design-review page of a study output directory;
@@ -21,6 +22,7 @@ pub mod error;
 pub mod inspect;
 pub mod paper;
 pub mod review;
+pub mod shapes;
 pub mod simulate;
 pub mod tcm;
 
