@@ -403,24 +403,34 @@ impl Page<'_> {
         h.push_str("<p>Top, side and front views of each design, straight and at rest, to scale. Click a drawing (or a case number in a table) to enlarge it.</p>\n<div class=\"r-grid\">\n");
         for d in self.drawings {
             let first = d.cases[0];
-            let info = self.infos.get(&first).cloned().unwrap_or_default();
-            let bad = d.cases.iter().any(|c| self.infos.get(c).is_some_and(|i| i.unsuccessful));
+            let info = |c: &i64| self.infos.get(c).cloned().unwrap_or_default();
+            let bad: Vec<String> = d
+                .cases
+                .iter()
+                .filter(|c| info(c).unsuccessful)
+                .map(|c| {
+                    let why = info(c).why;
+                    format!("#{c} ({})", if why.is_empty() { "see the tables".into() } else { why })
+                })
+                .collect();
             let ids: Vec<String> = d.cases.iter().map(|c| format!("#{c}")).collect();
+            // Framed red when every case of this design was unsuccessful.
+            let all_bad = bad.len() == d.cases.len();
             let _ = writeln!(
                 h,
                 "<figure class=\"r-card{}\" id=\"case-{first}\"><a href=\"#case-{first}\">{}</a>\
                  <figcaption><strong>{}</strong> {}{}</figcaption></figure>",
-                if bad { " bad" } else { "" },
+                if all_bad { " bad" } else { "" },
                 inline_svg(&d.svg, &format!("c{first}-")),
                 escape(&ids.join(", ")),
-                escape(&info.name),
-                if bad {
+                escape(&info(&first).name),
+                if bad.is_empty() {
+                    String::new()
+                } else {
                     format!(
                         " — <span class=\"r-badword\">unsuccessful</span>: {}",
-                        escape(if info.why.is_empty() { "see the tables" } else { &info.why })
+                        escape(&bad.join("; "))
                     )
-                } else {
-                    String::new()
                 }
             );
         }
