@@ -20,13 +20,13 @@ use super::draw::draw_design;
 use super::error::PipelineError;
 use crate::model::design::parse_design_table;
 use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
-use crate::report::{atomic_write, read_csv, read_parquet, ColumnData, Table};
+use crate::report::{atomic_write, read_csv, read_parquet, Table};
 use crate::state::VehicleState;
 use crate::study::cases::resolve_case;
 use crate::study::doe::expand;
 use crate::study::parse::load_study;
-use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STATUS, STUDY_COPY};
-use crate::study::selection::cell_text;
+use crate::study::plots::{case_name, unsuccessful_rows};
+use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
 
 /// The file name of the page.
 pub const REPORT_HTML: &str = "report.html";
@@ -57,26 +57,12 @@ struct CaseInfo {
     name: String,
 }
 
-/// Whether a cell of a `success` column says yes (`true`, `1`, `yes`, `ok`).
-fn truthy(data: &ColumnData, r: usize) -> bool {
-    match data {
-        ColumnData::Bool(v) => v[r],
-        ColumnData::F64(v) => v[r] != 0.0 && v[r].is_finite(),
-        ColumnData::I64(v) => v[r] != 0,
-        ColumnData::Str(v) => matches!(
-            v[r].trim().to_ascii_lowercase().as_str(),
-            "true" | "1" | "yes" | "ok"
-        ),
-    }
-}
-
 /// Every case of `table` by id: outcome, reason and design name (from the `axes`).
-fn case_infos(table: &Table, axes: &[String]) -> BTreeMap<i64, CaseInfo> {
+fn case_infos(table: &Table, axes: &[&str]) -> BTreeMap<i64, CaseInfo> {
     let Ok(ids) = table.i64(CASE_ID) else {
         return BTreeMap::new();
     };
-    let status = table.str(STATUS).ok();
-    let success = table.column("success").map(|c| &c.data);
+    let bad = unsuccessful_rows(table);
     let why_cols: Vec<&[String]> = table
         .columns
         .iter()
@@ -85,21 +71,15 @@ fn case_infos(table: &Table, axes: &[String]) -> BTreeMap<i64, CaseInfo> {
         .collect();
     (0..table.n_rows())
         .map(|r| {
-            let failed = status.is_some_and(|s| s[r] != "ok");
-            let missed = success.is_some_and(|d| !truthy(d, r));
             let why: Vec<&str> = why_cols
                 .iter()
                 .map(|c| c[r].as_str())
                 .filter(|s| !s.is_empty())
                 .collect();
-            let name: Vec<String> = axes
-                .iter()
-                .map(|a| cell_text(table, a, r).replace("\\|", "|"))
-                .collect();
             let info = CaseInfo {
-                unsuccessful: failed || missed,
+                unsuccessful: bad[r],
                 why: why.join("; "),
-                name: name.join(" / "),
+                name: case_name(table, axes, r).replace('/', " / "),
             };
             (ids[r], info)
         })
@@ -239,7 +219,7 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
     let table = read_cases(dir);
     let infos = table
         .as_ref()
-        .map(|t| case_infos(t, &axes))
+        .map(|t| case_infos(t, &axes.iter().map(String::as_str).collect::<Vec<_>>()))
         .unwrap_or_default();
     let summary = std::fs::read_to_string(dir.join("summary.md")).ok();
     let named = summary.as_deref().map(referenced_cases).unwrap_or_default();
@@ -489,6 +469,7 @@ fn plots_section(h: &mut String, figures: &[PathBuf], warnings: &mut Vec<String>
 mod tests {
     use super::*;
     use crate::report::ColumnData;
+    use crate::study::records::STATUS;
 
     #[test]
     fn outcomes_read_status_and_an_optional_success_column() {
@@ -500,7 +481,7 @@ mod tests {
         t.push(REASON, ColumnData::Str(reason)).unwrap();
         t.push("design.links", ColumnData::F64(vec![3.0, 4.0, 5.0]))
             .unwrap();
-        let axes = vec!["design.links".to_string()];
+        let axes = ["design.links"];
         let i = case_infos(&t, &axes);
         assert!(!i[&0].unsuccessful && i[&1].unsuccessful && !i[&2].unsuccessful);
         assert_eq!((i[&1].why.as_str(), i[&1].name.as_str()), ("diverged", "4"));
