@@ -84,19 +84,28 @@ fn the_sweep_report_is_self_contained_and_draws_every_named_design() {
     // Every case named in a table links to its design's drawing (`<a href="#case-K">#N …`).
     for id in &named {
         let linked = format!("\">#{id} <span class=\"r-name\">");
-        assert!(html.contains(&linked), "case #{id} is not linked to a drawing");
+        assert!(
+            html.contains(&linked),
+            "case #{id} is not linked to a drawing"
+        );
     }
     // Each drawing's three views are inlined with ids made unique per drawing.
     assert!(html.matches("-view-top\"").count() >= 2);
     // The two failed cases' rows are shaded, and the success rule is stated.
-    assert!(html.contains("<tr class=\"bad\">"), "failed rows not marked");
+    assert!(
+        html.contains("<tr class=\"bad\">"),
+        "failed rows not marked"
+    );
     assert!(html.contains("What success means") && html.contains("2 unsuccessful"));
     // Every plot of plots/ is inlined.
     let plots = std::fs::read_dir(out.join("plots")).unwrap().count();
     assert!(plots > 0);
     assert_eq!(html.matches("<figure class=\"r-plot\"").count(), plots);
     // Design names (axis values) stand next to case numbers.
-    assert!(html.contains("<span class=\"r-name\">3 / 2000</span>"), "no design names");
+    assert!(
+        html.contains("<span class=\"r-name\">3 / 2000</span>"),
+        "no design names"
+    );
 }
 
 #[test]
@@ -109,14 +118,21 @@ fn report_rebuilds_the_page_and_fails_loudly_when_it_cannot_write_it() {
     let o = run(&["report", arg(&out)]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("report.html"), "{}", stderr(&o));
-    assert_eq!(read(&page), first, "the rebuilt page differs from the sweep's");
+    assert_eq!(
+        read(&page),
+        first,
+        "the rebuilt page differs from the sweep's"
+    );
     // A directory where the page should go: the write fails, and says where.
     std::fs::remove_file(&page).unwrap();
     std::fs::create_dir(&page).unwrap();
     let o = run(&["report", arg(&out)]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     let err = stderr(&o);
-    assert!(err.contains("error:") && err.contains("report.html"), "{err}");
+    assert!(
+        err.contains("error:") && err.contains("report.html"),
+        "{err}"
+    );
     // A missing directory is an error too.
     let o = run(&["report", arg(&dir.path().join("nowhere"))]);
     assert_eq!(o.status.code(), Some(2));
@@ -126,7 +142,9 @@ fn report_rebuilds_the_page_and_fails_loudly_when_it_cannot_write_it() {
 /// The `data-t` values of the snapshot groups of one view of a run drawing.
 fn snapshot_times(svg: &str, view: &str) -> Vec<f64> {
     let start = svg.find(&format!("id=\"view-{view}\"")).expect("view");
-    let end = svg[start..].find("class=\"view\"").map_or(svg.len(), |e| start + e);
+    let end = svg[start..]
+        .find("class=\"view\"")
+        .map_or(svg.len(), |e| start + e);
     svg[start..end]
         .split("class=\"snap\" data-t=\"")
         .skip(1)
@@ -150,7 +168,11 @@ fn simulate_draws_the_body_along_the_run_deterministically() {
         assert!(o.status.success(), "{}", stderr(&o));
     }
     for f in ["shapes.svg", "animation.svg"] {
-        assert_eq!(read(&out("a").join(f)), read(&out("b").join(f)), "{f} differs");
+        assert_eq!(
+            read(&out("a").join(f)),
+            read(&out("b").join(f)),
+            "{f} differs"
+        );
     }
     let shapes = String::from_utf8(read(&out("a").join("shapes.svg"))).unwrap();
     for view in ["top", "side"] {
@@ -256,7 +278,12 @@ fn decode_png(bytes: &[u8]) -> (usize, usize, Vec<[u8; 4]>) {
 fn chromium(page: &Path, args: &[&str]) -> (String, String) {
     let bin = ["chromium", "chromium-browser"]
         .into_iter()
-        .find(|b| std::process::Command::new(b).arg("--version").output().is_ok())
+        .find(|b| {
+            std::process::Command::new(b)
+                .arg("--version")
+                .output()
+                .is_ok()
+        })
         .expect("USM_BROWSER_TEST is set but neither chromium nor chromium-browser runs");
     let url = format!("file://{}", page.canonicalize().unwrap().display());
     let o = std::process::Command::new(bin)
@@ -306,10 +333,16 @@ fn the_report_renders_in_a_headless_browser() {
     }
     let png = dir.path().join("shot.png");
     let shot = format!("--screenshot={}", png.display());
-    chromium(&page, &[&shot, "--window-size=1200,900", "--hide-scrollbars"]);
+    chromium(
+        &page,
+        &[&shot, "--window-size=1200,900", "--hide-scrollbars"],
+    );
     let (w, h, px) = decode_png(&read(&png));
     assert_eq!((w, h), (1200, 900));
-    let ink = px.iter().filter(|p| p[..3].iter().any(|c| *c < 200)).count();
+    let ink = px
+        .iter()
+        .filter(|p| p[..3].iter().any(|c| *c < 200))
+        .count();
     let colours: BTreeSet<[u8; 4]> = px.iter().copied().collect();
     assert!(
         ink > w * h / 100 && colours.len() > 16,

@@ -66,7 +66,9 @@ fn case_infos(table: &Table, axes: &[&str]) -> BTreeMap<i64, CaseInfo> {
     let why_cols: Vec<&[String]> = table
         .columns
         .iter()
-        .filter(|c| c.name == REASON || c.name.starts_with("success_") || c.name.starts_with("missed"))
+        .filter(|c| {
+            c.name == REASON || c.name.starts_with("success_") || c.name.starts_with("missed")
+        })
         .filter_map(|c| table.str(&c.name).ok())
         .collect();
     (0..table.n_rows())
@@ -309,6 +311,7 @@ impl Page<'_> {
         self.designs_section(&mut h);
         self.tables_section(&mut h);
         plots_section(&mut h, figures, warnings);
+        self.manifest_section(&mut h);
         h.push_str("</body>\n</html>\n");
         h
     }
@@ -335,12 +338,41 @@ impl Page<'_> {
                     .join(" / ")
             );
         }
+        let c = &m["cases"];
+        if let (Some(n), Some(ok)) = (c["in_output"].as_u64(), c["ok"].as_u64()) {
+            let _ = writeln!(
+                h,
+                "<p>Mode <code>{}</code>, design of experiments <code>{}</code>, seed {}: \
+                 {n} cases, {ok} ok, {} failed, {} skipped. All parameters are listed at the \
+                 end of the page.</p>",
+                escape(&json_text(&m["mode"])),
+                escape(&json_text(&m["doe"])),
+                escape(&json_text(&m["seed"])),
+                json_text(&c["failed"]),
+                json_text(&c["skipped"])
+            );
+        }
+        h.push_str("</section>\n");
+    }
+
+    /// Every field of the manifest.
+    fn manifest_section(&self, h: &mut String) {
+        let Some(obj) = self.manifest.and_then(|m| m.as_object()) else {
+            return;
+        };
+        h.push_str("<section id=\"manifest\">\n<h2>Run parameters (manifest.json)</h2>\n");
         h.push_str("<table class=\"r-kv\">\n");
-        if let Some(obj) = m.as_object() {
-            for (k, v) in obj.iter().filter(|(k, _)| !matches!(k.as_str(), "columns" | "axes")) {
-                let text = json_text(v);
-                let _ = writeln!(h, "<tr><td>{}</td><td>{}</td></tr>", escape(k), escape(&text));
-            }
+        for (k, v) in obj
+            .iter()
+            .filter(|(k, _)| !matches!(k.as_str(), "columns" | "axes"))
+        {
+            let text = json_text(v);
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td></tr>",
+                escape(k),
+                escape(&text)
+            );
         }
         h.push_str("</table>\n</section>\n");
     }
@@ -390,7 +422,14 @@ impl Page<'_> {
                 .filter(|c| info(c).unsuccessful)
                 .map(|c| {
                     let why = info(c).why;
-                    format!("#{c} ({})", if why.is_empty() { "see the tables".into() } else { why })
+                    format!(
+                        "#{c} ({})",
+                        if why.is_empty() {
+                            "see the tables".into()
+                        } else {
+                            why
+                        }
+                    )
                 })
                 .collect();
             let ids: Vec<String> = d.cases.iter().map(|c| format!("#{c}")).collect();
@@ -422,7 +461,9 @@ impl Page<'_> {
         h.push_str("<section id=\"tables\">\n");
         match self.summary {
             Some(md) => h.push_str(&markdown_to_html(md, 1, &|id| self.link(id))),
-            None => h.push_str("<h2>Tables</h2>\n<p class=\"r-note\">No summary.md in this directory.</p>\n"),
+            None => h.push_str(
+                "<h2>Tables</h2>\n<p class=\"r-note\">No summary.md in this directory.</p>\n",
+            ),
         }
         h.push_str("</section>\n");
     }
@@ -449,7 +490,9 @@ fn plots_section(h: &mut String, figures: &[PathBuf], warnings: &mut Vec<String>
         h.push_str("<p class=\"r-note\">No plots in this directory.</p>\n");
     }
     for (k, p) in figures.iter().enumerate() {
-        let name = p.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let name = p
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
         match std::fs::read_to_string(p) {
             Ok(svg) => {
                 let _ = writeln!(
@@ -494,7 +537,8 @@ mod tests {
 
     #[test]
     fn case_references_come_from_table_rows_only_once_each() {
-        let md = "# Sweep\n\nCase #7 in a sentence.\n\n| a | b |\n|---|---|\n| #3 | #12 |\n| #3 | x |\n";
+        let md =
+            "# Sweep\n\nCase #7 in a sentence.\n\n| a | b |\n|---|---|\n| #3 | #12 |\n| #3 | x |\n";
         assert_eq!(referenced_cases(md), [3, 12]);
     }
 }

@@ -49,7 +49,11 @@ fn state_at(r: &RunResult, v: &Vehicle, k: usize) -> Option<VehicleState> {
 /// A channel triple as points, e.g. the base or end-effector position.
 fn trace(r: &RunResult, ch: fn(Pose) -> Channel) -> Vec<Vec3> {
     let tr = &r.trajectory;
-    match (tr.get(ch(Pose::X)), tr.get(ch(Pose::Y)), tr.get(ch(Pose::Z))) {
+    match (
+        tr.get(ch(Pose::X)),
+        tr.get(ch(Pose::Y)),
+        tr.get(ch(Pose::Z)),
+    ) {
         (Some(x), Some(y), Some(z)) => (0..x.len())
             .map(|k| Vec3::new(x[k], y[k], z[k]))
             .filter(|p| p.iter().all(|c| c.is_finite()))
@@ -68,7 +72,13 @@ pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawin
     }
     let count = count.clamp(1, n);
     let mut picks: Vec<usize> = (0..count)
-        .map(|i| if count == 1 { 0 } else { i * (n - 1) / (count - 1) })
+        .map(|i| {
+            if count == 1 {
+                0
+            } else {
+                i * (n - 1) / (count - 1)
+            }
+        })
         .collect();
     picks.dedup();
     let snapshots = picks

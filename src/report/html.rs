@@ -47,10 +47,7 @@ fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String
             continue;
         }
         if let (Some(link), '#') = (link, c) {
-            let digits: String = rest[1..]
-                .chars()
-                .take_while(char::is_ascii_digit)
-                .collect();
+            let digits: String = rest[1..].chars().take_while(char::is_ascii_digit).collect();
             if let Some(r) = digits.parse::<i64>().ok().and_then(link) {
                 bad |= r.unsuccessful;
                 let label = match &r.name {
@@ -213,7 +210,10 @@ mod tests {
                   | `e` | #2 |\n| `f` | #3 |\n| `g` | #42 |\n\n- one\n- two\n";
         let h = markdown_to_html(md, 1, &link);
         assert!(h.contains("<h2>Sweep <code>t</code></h2>"), "{h}");
-        assert!(h.contains("<p>Mode <strong>ok</strong>, a &lt; b.</p>"), "{h}");
+        assert!(
+            h.contains("<p>Mode <strong>ok</strong>, a &lt; b.</p>"),
+            "{h}"
+        );
         assert!(h.contains("<h3>Best</h3>"));
         assert!(h.contains(
             "<tr><td><code>e</code></td><td><a href=\"#case-2\">#2 <span class=\"r-name\">paper / 5</span></a></td></tr>"
@@ -235,7 +235,10 @@ mod tests {
         let svg = "<?xml version=\"1.0\"?>\n<svg width=\"800\" height=\"600\" xmlns=\"x\">\
                    <g id=\"view-top\"/><use href=\"#view-top\"/></svg>";
         let s = inline_svg(svg, "d1-");
-        assert!(s.starts_with("<svg viewBox=\"0 0 800 600\" width=\"800\""), "{s}");
+        assert!(
+            s.starts_with("<svg viewBox=\"0 0 800 600\" width=\"800\""),
+            "{s}"
+        );
         assert!(s.contains("id=\"d1-view-top\"") && s.contains("href=\"#d1-view-top\""));
         let with_box = "<svg width=\"8\" height=\"6\" viewBox=\"0 0 8 6\"></svg>";
         assert_eq!(inline_svg(with_box, "p-"), with_box);

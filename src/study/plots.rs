@@ -172,14 +172,21 @@ pub(crate) fn pareto_plot(
     let fig = scatter_labelled(
         &points,
         &highlight,
-        &format!("Pareto front: {} vs {}", metric_title(f.x), metric_title(f.y)),
+        &format!(
+            "Pareto front: {} vs {}",
+            metric_title(f.x),
+            metric_title(f.y)
+        ),
         &metric_title(f.x),
         &metric_title(f.y),
     );
     let result = fig.and_then(|mut fig| {
         let p = &mut fig.panels[0];
         p.series[0].name = "successful cases".into();
-        let short: Vec<&str> = axes.iter().map(|a| a.rsplit('.').next().unwrap_or(a)).collect();
+        let short: Vec<&str> = axes
+            .iter()
+            .map(|a| a.rsplit('.').next().unwrap_or(a))
+            .collect();
         p.series[2].name = format!("Pareto-optimal: #case {}", short.join("/"));
         if let Some(s) = unsuccessful_series(&unsuccessful_rows(table), f.xs, f.ys) {
             p.series.push(s);
@@ -351,9 +358,15 @@ mod tests {
     fn axis_titles_say_what_and_in_which_unit() {
         assert_eq!(metric_title("thruster_energy"), "thruster energy [J]");
         assert_eq!(metric_title("energy_per_metre"), "energy per metre [J/m]");
-        assert_eq!(metric_title("design.longitudinal_offset"), "longitudinal offset [m]");
+        assert_eq!(
+            metric_title("design.longitudinal_offset"),
+            "longitudinal offset [m]"
+        );
         assert_eq!(metric_title("design_mass_kg"), "design mass [kg]");
-        assert_eq!(metric_title("seg1_convergence_time"), "seg1 convergence time [s]");
+        assert_eq!(
+            metric_title("seg1_convergence_time"),
+            "seg1 convergence time [s]"
+        );
         assert_eq!(
             metric_title("singularity_exposure"),
             "singularity exposure [fraction of time, 0–1]"
@@ -367,7 +380,8 @@ mod tests {
         let status = ["ok", "failed", "ok"].map(String::from).to_vec();
         t.push(STATUS, ColumnData::Str(status)).unwrap();
         assert_eq!(unsuccessful_rows(&t), [false, true, false]);
-        t.push("success", ColumnData::F64(vec![1.0, 1.0, 0.0])).unwrap();
+        t.push("success", ColumnData::F64(vec![1.0, 1.0, 0.0]))
+            .unwrap();
         assert_eq!(unsuccessful_rows(&t), [false, true, true]);
     }
 }

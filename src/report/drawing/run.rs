@@ -125,8 +125,18 @@ fn layout(d: &RunDrawing) -> ([ViewTransform; 2], [[f64; 4]; 2], f64) {
     ];
     let w = (x.1 - x.0) * scale + 2.0 * PAD;
     let boxes = [
-        [left - PAD, top_y - PAD, w, top.size()[1] * scale + 2.0 * PAD],
-        [left - PAD, side_y - PAD, w, side.size()[1] * scale + 2.0 * PAD],
+        [
+            left - PAD,
+            top_y - PAD,
+            w,
+            top.size()[1] * scale + 2.0 * PAD,
+        ],
+        [
+            left - PAD,
+            side_y - PAD,
+            w,
+            side.size()[1] * scale + 2.0 * PAD,
+        ],
     ];
     (t, boxes, side_y + side.size()[1] * scale + PAD + GAP * 0.75)
 }
@@ -145,13 +155,23 @@ fn points(t: &ViewTransform, ps: impl Iterator<Item = [f64; 2]>) -> String {
 fn trace(s: &mut Svg, class: &str, view: View, t: &ViewTransform, ps: &[Vec3]) {
     if ps.len() > 1 {
         let pts = points(t, ps.iter().map(|p| view.project(p)));
-        s.empty("polyline", &[("class", class.into()), ("points", pts.into())]);
+        s.empty(
+            "polyline",
+            &[("class", class.into()), ("points", pts.into())],
+        );
     }
 }
 
 /// One snapshot in one view: outlines stroked in the snapshot's colour, thrust arrows in the
 /// accent colour. `extra` is written first inside the group (the animation's `<animate>`).
-fn snapshot(s: &mut Svg, view: View, t: &ViewTransform, snap: &Snapshot, colour: &str, extra: &[(&str, Attr)]) {
+fn snapshot(
+    s: &mut Svg,
+    view: View,
+    t: &ViewTransform,
+    snap: &Snapshot,
+    colour: &str,
+    extra: &[(&str, Attr)],
+) {
     s.open(
         "g",
         &[
@@ -164,10 +184,17 @@ fn snapshot(s: &mut Svg, view: View, t: &ViewTransform, snap: &Snapshot, colour:
         s.empty("animate", extra);
     }
     for c in &snap.scene.cylinders {
-        let pts = points(t, cylinder_outline(view, &c.pose, c.length, c.radius).into_iter());
+        let pts = points(
+            t,
+            cylinder_outline(view, &c.pose, c.length, c.radius).into_iter(),
+        );
         s.empty(
             "polygon",
-            &[("class", "body".into()), ("data-body", c.name.as_str().into()), ("points", pts.into())],
+            &[
+                ("class", "body".into()),
+                ("data-body", c.name.as_str().into()),
+                ("points", pts.into()),
+            ],
         );
     }
     for a in &snap.scene.arrows {
@@ -176,12 +203,30 @@ fn snapshot(s: &mut Svg, view: View, t: &ViewTransform, snap: &Snapshot, colour:
         if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
             continue;
         }
-        s.open("g", &[("class", "thruster".into()), ("data-thruster", a.name.as_str().into())]);
+        s.open(
+            "g",
+            &[
+                ("class", "thruster".into()),
+                ("data-thruster", a.name.as_str().into()),
+            ],
+        );
         s.empty(
             "line",
-            &[("x1", p1[0].into()), ("y1", p1[1].into()), ("x2", p2[0].into()), ("y2", p2[1].into())],
+            &[
+                ("x1", p1[0].into()),
+                ("y1", p1[1].into()),
+                ("x2", p2[0].into()),
+                ("y2", p2[1].into()),
+            ],
         );
-        s.empty("circle", &[("cx", p2[0].into()), ("cy", p2[1].into()), ("r", 1.6.into())]);
+        s.empty(
+            "circle",
+            &[
+                ("cx", p2[0].into()),
+                ("cy", p2[1].into()),
+                ("r", 1.6.into()),
+            ],
+        );
         s.close("g");
     }
     s.close("g");
@@ -201,9 +246,22 @@ fn open_view(s: &mut Svg, view: View, t: &ViewTransform, frame: [f64; 4]) {
     );
     s.empty(
         "rect",
-        &[("class", "frame".into()), ("x", frame[0].into()), ("y", frame[1].into()), ("width", frame[2].into()), ("height", frame[3].into())],
+        &[
+            ("class", "frame".into()),
+            ("x", frame[0].into()),
+            ("y", frame[1].into()),
+            ("width", frame[2].into()),
+            ("height", frame[3].into()),
+        ],
     );
-    s.text(&[("class", "title".into()), ("x", frame[0].into()), ("y", (frame[1] - 8.0).into())], view.title());
+    s.text(
+        &[
+            ("class", "title".into()),
+            ("x", frame[0].into()),
+            ("y", (frame[1] - 8.0).into()),
+        ],
+        view.title(),
+    );
 }
 
 /// Caption (left) and legend (right): time colours, traces, thrusters, scale bar.
@@ -211,7 +269,14 @@ fn caption_and_legend(s: &mut Svg, d: &RunDrawing, scale: f64, top: f64) {
     let y = |i: usize| top + LINE * (i as f64 + 0.8);
     for (i, line) in d.caption.iter().enumerate() {
         let class = if i == 0 { "title" } else { "caption" };
-        s.text(&[("class", class.into()), ("x", MARGIN.into()), ("y", y(i).into())], line);
+        s.text(
+            &[
+                ("class", class.into()),
+                ("x", MARGIN.into()),
+                ("y", y(i).into()),
+            ],
+            line,
+        );
     }
     let x = WIDTH * 0.56;
     let (t0, t1) = match (d.snapshots.first(), d.snapshots.last()) {
@@ -222,22 +287,89 @@ fn caption_and_legend(s: &mut Svg, d: &RunDrawing, scale: f64, top: f64) {
         let f = k as f64 / 9.0;
         s.empty(
             "rect",
-            &[("x", (x + 12.0 * k as f64).into()), ("y", (y(0) - 10.0).into()), ("width", 12.0.into()), ("height", 10.0.into()), ("fill", time_colour(f).into())],
+            &[
+                ("x", (x + 12.0 * k as f64).into()),
+                ("y", (y(0) - 10.0).into()),
+                ("width", 12.0.into()),
+                ("height", 10.0.into()),
+                ("fill", time_colour(f).into()),
+            ],
         );
     }
     let text = |s: &mut Svg, i: usize, t: &str| {
-        s.text(&[("class", "caption".into()), ("x", (x + 130.0).into()), ("y", y(i).into())], t);
+        s.text(
+            &[
+                ("class", "caption".into()),
+                ("x", (x + 130.0).into()),
+                ("y", y(i).into()),
+            ],
+            t,
+        );
     };
-    text(s, 0, &format!("body outline at t = {} s … {} s (light → dark)", num(t0), num(t1)));
-    s.empty("line", &[("class", "base".into()), ("x1", x.into()), ("y1", (y(1) - 4.0).into()), ("x2", (x + 120.0).into()), ("y2", (y(1) - 4.0).into())]);
+    text(
+        s,
+        0,
+        &format!(
+            "body outline at t = {} s … {} s (light → dark)",
+            num(t0),
+            num(t1)
+        ),
+    );
+    s.empty(
+        "line",
+        &[
+            ("class", "base".into()),
+            ("x1", x.into()),
+            ("y1", (y(1) - 4.0).into()),
+            ("x2", (x + 120.0).into()),
+            ("y2", (y(1) - 4.0).into()),
+        ],
+    );
     text(s, 1, "base origin trace");
-    s.empty("line", &[("class", "ee".into()), ("x1", x.into()), ("y1", (y(2) - 4.0).into()), ("x2", (x + 120.0).into()), ("y2", (y(2) - 4.0).into())]);
+    s.empty(
+        "line",
+        &[
+            ("class", "ee".into()),
+            ("x1", x.into()),
+            ("y1", (y(2) - 4.0).into()),
+            ("x2", (x + 120.0).into()),
+            ("y2", (y(2) - 4.0).into()),
+        ],
+    );
     text(s, 2, "end-effector trace");
-    s.empty("line", &[("stroke", ACCENT.into()), ("stroke-width", 1.5.into()), ("x1", x.into()), ("y1", (y(3) - 4.0).into()), ("x2", (x + 40.0).into()), ("y2", (y(3) - 4.0).into())]);
+    s.empty(
+        "line",
+        &[
+            ("stroke", ACCENT.into()),
+            ("stroke-width", 1.5.into()),
+            ("x1", x.into()),
+            ("y1", (y(3) - 4.0).into()),
+            ("x2", (x + 40.0).into()),
+            ("y2", (y(3) - 4.0).into()),
+        ],
+    );
     text(s, 3, "thrust direction (length ∝ limit)");
     let len = nice_length(120.0 / scale);
-    s.empty("rect", &[("id", "scale-bar".into()), ("data-length-m", len.into()), ("x", x.into()), ("y", (y(4) - 7.0).into()), ("width", (len * scale).into()), ("height", 6.0.into()), ("fill", "#000".into())]);
-    text(s, 4, &format!("{} m (both views to this scale)", num(len).trim_end_matches('0').trim_end_matches('.')));
+    s.empty(
+        "rect",
+        &[
+            ("id", "scale-bar".into()),
+            ("data-length-m", len.into()),
+            ("x", x.into()),
+            ("y", (y(4) - 7.0).into()),
+            ("width", (len * scale).into()),
+            ("height", 6.0.into()),
+            ("fill", "#000".into()),
+        ],
+    );
+    text(
+        s,
+        4,
+        &format!(
+            "{} m (both views to this scale)",
+            num(len).trim_end_matches('0').trim_end_matches('.')
+        ),
+    );
 }
 
 /// Page height for a caption of `n` lines below `top`.
@@ -257,14 +389,32 @@ pub fn render_shapes_svg(d: &RunDrawing) -> String {
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
         for (i, snap) in d.snapshots.iter().enumerate() {
-            snapshot(&mut s, view, &ts[k], snap, &time_colour(i as f64 / n as f64), &[]);
+            snapshot(
+                &mut s,
+                view,
+                &ts[k],
+                snap,
+                &time_colour(i as f64 / n as f64),
+                &[],
+            );
         }
         if view == View::Top {
             for (i, snap) in d.snapshots.iter().enumerate() {
-                let Some(c) = snap.scene.cylinders.first() else { continue };
+                let Some(c) = snap.scene.cylinders.first() else {
+                    continue;
+                };
                 let at = ts[k].to_svg(view.project(&c.pose.p));
                 let id = format!("time-label-{i}");
-                labels.place(&mut s, &format!("{} s", num(snap.t).trim_end_matches('0').trim_end_matches('.')), at, [0.0, -1.0], &id);
+                labels.place(
+                    &mut s,
+                    &format!(
+                        "{} s",
+                        num(snap.t).trim_end_matches('0').trim_end_matches('.')
+                    ),
+                    at,
+                    [0.0, -1.0],
+                    &id,
+                );
             }
         }
         s.close("g");
@@ -295,12 +445,26 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
                 ("dur", dur.clone().into()),
                 ("repeatCount", "indefinite".into()),
             ];
-            snapshot(&mut s, view, &ts[k], snap, &time_colour(i as f64 / (n.max(2) - 1) as f64), &anim);
+            snapshot(
+                &mut s,
+                view,
+                &ts[k],
+                snap,
+                &time_colour(i as f64 / (n.max(2) - 1) as f64),
+                &anim,
+            );
             if view == View::Top {
                 // The clock: one text per frame, shown with its frame.
                 s.open("g", &[("class", "clock".into())]);
                 s.empty("animate", &anim);
-                s.text(&[("class", "title".into()), ("x", (boxes[0][0] + 8.0).into()), ("y", (boxes[0][1] + 18.0).into())], &format!("t = {} s", num(snap.t)));
+                s.text(
+                    &[
+                        ("class", "title".into()),
+                        ("x", (boxes[0][0] + 8.0).into()),
+                        ("y", (boxes[0][1] + 18.0).into()),
+                    ],
+                    &format!("t = {} s", num(snap.t)),
+                );
                 s.close("g");
             }
         }
@@ -330,7 +494,10 @@ mod tests {
     #[test]
     fn frames_take_turns() {
         assert_eq!(visible_during(0, 4), ("1;0".into(), "0;0.250000".into()));
-        assert_eq!(visible_during(2, 4), ("0;1;0".into(), "0;0.500000;0.750000".into()));
+        assert_eq!(
+            visible_during(2, 4),
+            ("0;1;0".into(), "0;0.500000;0.750000".into())
+        );
         assert_eq!(visible_during(3, 4), ("0;1".into(), "0;0.750000".into()));
         assert_eq!(time_colour(0.0), "#7db9e6");
         assert_eq!(time_colour(1.0), "#081d58");

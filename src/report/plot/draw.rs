@@ -301,15 +301,17 @@ fn draw_labels(
     s: &Series,
     inside: &dyn Fn(&(f64, f64)) -> bool,
 ) -> DrawResult {
-    let labelled: Vec<((f64, f64), &str)> = s
-        .x
+    let labelled: Vec<((f64, f64), &str)> =
+        s.x.iter()
+            .zip(&s.y)
+            .zip(&s.labels)
+            .map(|((&x, &y), l)| ((x, y), l.as_str()))
+            .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
+            .collect();
+    let px: Vec<(i32, i32)> = labelled
         .iter()
-        .zip(&s.y)
-        .zip(&s.labels)
-        .map(|((&x, &y), l)| ((x, y), l.as_str()))
-        .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
+        .map(|(p, _)| chart.backend_coord(p))
         .collect();
-    let px: Vec<(i32, i32)> = labelled.iter().map(|(p, _)| chart.backend_coord(p)).collect();
     let markers: Vec<(i32, i32)> = finite_points(&s.x, &s.y)
         .filter(|p| inside(p))
         .map(|p| chart.backend_coord(&p))
@@ -349,8 +351,16 @@ fn legend_corner(panel: &Panel, (xr, yr): ((f64, f64), (f64, f64))) -> SeriesLab
             .iter()
             .flat_map(|s| finite_points(&s.x, &s.y))
             .filter(|p| {
-                let in_x = if right { p.0 >= xr.1 - wx } else { p.0 <= xr.0 + wx };
-                let in_y = if upper { p.1 >= yr.1 - wy } else { p.1 <= yr.0 + wy };
+                let in_x = if right {
+                    p.0 >= xr.1 - wx
+                } else {
+                    p.0 <= xr.0 + wx
+                };
+                let in_y = if upper {
+                    p.1 >= yr.1 - wy
+                } else {
+                    p.1 <= yr.0 + wy
+                };
                 in_x && in_y
             })
             .count()

@@ -74,8 +74,10 @@ pub(super) fn place_labels(
                     w,
                     h,
                 ];
-                let inside =
-                    b[0] >= area[0] && b[1] >= area[1] && b[0] + w <= area[2] && b[1] + h <= area[3];
+                let inside = b[0] >= area[0]
+                    && b[1] >= area[1]
+                    && b[0] + w <= area[2]
+                    && b[1] + h <= area[3];
                 if !inside {
                     continue;
                 }
@@ -86,9 +88,7 @@ pub(super) fn place_labels(
                 }
             }
         }
-        let b = chosen
-            .or(first)
-            .unwrap_or([p.0 + 5, p.1 - h - 2, w, h]);
+        let b = chosen.or(first).unwrap_or([p.0 + 5, p.1 - h - 2, w, h]);
         taken.push(b);
         // The point of the box nearest the labelled point.
         let near = (
@@ -112,7 +112,14 @@ mod tests {
     fn crowded_labels_do_not_overlap_and_far_ones_get_leaders() {
         // Six points a few pixels apart (the #9-over-#11 case of a Pareto front).
         let pts: Vec<(i32, i32)> = (0..6).map(|k| (200 + 3 * k, 150 + 2 * k)).collect();
-        let texts = ["#9 paper/5/0.06", "#11 paper/5/0.14", "#34 ends/3/0.1", "#35 a", "#1", "#2"];
+        let texts = [
+            "#9 paper/5/0.06",
+            "#11 paper/5/0.14",
+            "#34 ends/3/0.1",
+            "#35 a",
+            "#1",
+            "#2",
+        ];
         let placed = place_labels(&pts, &texts, &pts, [0, 0, 600, 400]);
         let boxes: Vec<PxBox> = placed
             .iter()
@@ -137,6 +144,9 @@ mod tests {
         let placed = place_labels(&[(598, 2)], &["far corner"], &[], [0, 0, 600, 400]);
         let (w, h) = text_box("far corner");
         let b = [598 + placed[0].offset.0, 2 + placed[0].offset.1, w, h];
-        assert!(b[0] >= 0 && b[1] >= 0 && b[0] + w <= 600 && b[1] + h <= 400, "{b:?}");
+        assert!(
+            b[0] >= 0 && b[1] >= 0 && b[0] + w <= 600 && b[1] + h <= 400,
+            "{b:?}"
+        );
     }
 }
