@@ -28,7 +28,7 @@ pub struct SimulateArgs {
     /// (values are TOML: numbers, strings, arrays).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Do not write the SVG figure.
+    /// Do not write the SVG figure, shapes.svg and animation.svg.
     #[arg(long)]
     pub no_plots: bool,
 }
@@ -65,6 +65,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     let files = RunFiles {
         timeseries: true,
         figure: !a.no_plots,
+        shapes: !a.no_plots,
     };
     write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);

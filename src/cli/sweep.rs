@@ -1,18 +1,21 @@
 //! `usm-study sweep STUDY.toml`, `usm-study merge DIR... --out DIR`, `usm-study report DIR`:
 //! the batch engine's commands (SPEC §7; schema in `docs/study-format.md`).
 //!
+//! Each writes the output directory's `report.html` (the design-review page) last.
+//!
 //! Exit codes: 0 all cases ok or skipped, 1 some cases failed (the batch still completes),
-//! 2 bad input (study file, command line) or an I/O error.
+//! 2 bad input (study file, command line) or an I/O error (including an unwritable report).
 
 use super::progress::Progress;
-use anyhow::{anyhow, bail};
+use anyhow::{anyhow, bail, Context};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use usm_study::pipeline::review::write_review;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
-use usm_study::study::records::axis_text;
+use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -161,6 +164,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     for w in &outcome.warnings {
         eprintln!("[sweep] warning: {w}");
     }
+    review("sweep", &outcome.out)?;
     eprintln!(
         "[sweep] {} cases: {} ok, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
         outcome.in_shard,
@@ -199,6 +203,7 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
     for w in &warnings {
         eprintln!("[merge] warning: {w}");
     }
+    review("merge", &a.out)?;
     eprintln!(
         "[merge] {} directories: {} cases ({} ok, {} failed, {} skipped); wrote {}",
         a.dirs.len(),
@@ -218,16 +223,39 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
 /// Arguments of `report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// A sweep output directory.
+    /// A sweep (or other study) output directory.
     pub dir: PathBuf,
 }
 
-/// Run `usm-study report`.
-pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
-    let warnings = report(&a.dir).map_err(study_err)?;
-    for w in &warnings {
-        eprintln!("[report] warning: {w}");
+/// Writes `report.html` into `dir`, printing what it holds; an unwritable page is an error.
+fn review(verb: &str, dir: &Path) -> anyhow::Result<()> {
+    let r = write_review(dir)
+        .with_context(|| format!("writing the design review of {}", dir.display()))?;
+    for w in &r.warnings {
+        eprintln!("[{verb}] report.html: {w}");
     }
-    eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
+    eprintln!(
+        "[{verb}] wrote {} ({} design drawings, {} plots)",
+        r.path.display(),
+        r.drawings,
+        r.plots
+    );
+    Ok(())
+}
+
+/// Run `usm-study report`: regenerate `summary.md` and the plots of a sweep directory (one
+/// with a case table), then `report.html`.
+pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
+    if !a.dir.is_dir() {
+        bail!("{} is not a directory", a.dir.display());
+    }
+    if a.dir.join(CASES_PARQUET).is_file() || a.dir.join(PARTIAL_FILE).is_file() {
+        let warnings = report(&a.dir).map_err(study_err)?;
+        for w in &warnings {
+            eprintln!("[report] warning: {w}");
+        }
+        eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
+    }
+    review("report", &a.dir)?;
     Ok(ExitCode::SUCCESS)
 }

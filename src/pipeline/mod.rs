@@ -4,8 +4,10 @@
 //!
 //! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
+//! - [`shapes`]: the body along a run (`shapes.svg`, `animation.svg`);
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
+//! - [`review`]: `report.html`, the design-review page of a study output directory;
 //! - [`antonelli`]: Antonelli & Chiaverini's case studies (kinematic 1, 1b, 2; dynamic 3a,
 //!   3b and Table I), their CSVs and summary; [`antonelli_figures`]: their figures;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
@@ -21,6 +23,8 @@ pub mod draw;
 pub mod error;
 pub mod inspect;
 pub mod paper;
+pub mod review;
+pub mod shapes;
 pub mod simulate;
 pub mod tcm;
 

@@ -111,6 +111,7 @@ pub fn run_paper(
     let files = RunFiles {
         timeseries,
         figure: true,
+        shapes: false,
     };
     for (dir, preset, method) in &planned_runs() {
         let (mut table, src) = load_table(preset)?;

@@ -1,6 +1,6 @@
 //! The files of one closed-loop scenario run (`simulate`, and each run of `paper`):
 //! `summary.json`, and optionally `timeseries.csv`, `timeseries.parquet` and the paper-style
-//! `figure.svg`.
+//! `figure.svg`, and the drawings of the body along the run (`shapes.svg`, `animation.svg`).
 
 use std::path::Path;
 
@@ -62,6 +62,9 @@ pub struct RunFiles {
     pub timeseries: bool,
     /// The paper-style figure `figure.svg` (only when the run logged samples).
     pub figure: bool,
+    /// The body along the run, `shapes.svg` and `animation.svg` ([`super::shapes`]; only
+    /// when the run logged samples).
+    pub shapes: bool,
 }
 
 /// Writes `summary.json` and the chosen `files` of a run of `vehicle` into `out`, which must
@@ -93,6 +96,9 @@ pub fn write_run_outputs(
             &format!("{} ({} mode)", r.name, r.mode),
         )?;
         fig.write_svg(&out.join("figure.svg"))?;
+    }
+    if files.shapes {
+        super::shapes::write_shapes(r, vehicle, out)?;
     }
     Ok(())
 }

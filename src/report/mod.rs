@@ -12,6 +12,8 @@
 //! - [`plot`]: data-driven figure specifications ([`Figure`], [`Panel`], [`Series`],
 //!   [`Heatmap`]) rendered to SVG with native `<text>` elements (no font files), byte-identical
 //!   between runs.
+//! - [`html`]: pieces of self-contained HTML pages (escaping, the summary's Markdown, inlined
+//!   SVG).
 //! - [`atomic`]: every whole-file write goes through [`atomic_write`] (temporary file in the
 //!   same directory, then rename).
 //! - [`pareto_front`]: the non-dominated subset of a set of 2-D points (minimise both).
@@ -26,6 +28,7 @@ pub mod drawing;
 pub mod error;
 /// SVG figures.
 pub mod figures;
+pub mod html;
 pub mod markdown;
 pub mod number;
 pub mod pareto;

@@ -6,18 +6,121 @@
 //! - `timeseries.svg`: best and worst case trajectories (dynamic modes, when
 //!   `trajectory_best.csv` / `trajectory_worst.csv` exist).
 //!
+//! Every plot titles its axes in words with units ([`metric_title`]), names its series in the
+//! legend, labels points with their design (axis values, [`case_name`]) without overlaps, and
+//! draws unsuccessful cases ([`unsuccessful_rows`]) as a separate red series.
+//!
 //! Every function returns its problems as warnings; none is fatal.
 
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::records::Extreme;
+use super::records::{Extreme, CASE_ID, STATUS};
 use super::selection::{levels, mean, thin, Front};
 use crate::report::file_stem_safe;
 use crate::report::{
-    heatmap, read_csv, scatter_labelled, ColourScale, ColumnData, ColumnKind, Figure,
+    heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind, Figure,
     LabelledPoint, Panel, PanelKind, Series, Table,
 };
+
+/// Units of metric and design columns, by name or by name suffix (SPEC §6 and the design
+/// columns); unknown names get no unit.
+const UNITS: [(&str, &str); 23] = [
+    ("energy_per_metre", "J/m"),
+    ("effort_sq", "N²·s"),
+    ("effort_abs", "N·s"),
+    ("joint_torque_peak", "N·m"),
+    ("peak_thrust", "N"),
+    ("design_length_m", "m"),
+    ("design_mass_kg", "kg"),
+    ("longitudinal_offset", "m"),
+    ("link_length", "m"),
+    ("thrust_limit", "N"),
+    ("_deg", "°"),
+    ("_energy", "J"),
+    ("_energy_static", "J"),
+    ("_time", "s"),
+    ("_cross_track", "m"),
+    ("cross_track_rms", "m"),
+    ("overshoot", "m"),
+    ("path_progress", "m"),
+    ("position_error", "m"),
+    ("duration", "s"),
+    ("omega_n", "rad/s"),
+    ("_fraction", "0–1"),
+    ("singularity_exposure", "fraction of time, 0–1"),
+];
+
+/// A column name as an axis title: words instead of underscores and dots, and its unit in
+/// brackets when known (`thruster_energy` → `thruster energy [J]`,
+/// `design.longitudinal_offset` → `longitudinal offset [m]`).
+pub fn metric_title(name: &str) -> String {
+    // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
+    let short = name.strip_prefix("design.").unwrap_or(name);
+    let words = short
+        .trim_end_matches("_m")
+        .trim_end_matches("_kg")
+        .replace(['_', '.'], " ");
+    let unit = UNITS
+        .iter()
+        .find(|(key, _)| name == *key || name.ends_with(key))
+        .map(|(_, u)| *u)
+        .or_else(|| {
+            // Singular values and condition numbers of the scaled T(q) (SPEC §6).
+            (name.contains("sigma_min") || name.contains("kappa")).then_some("scaled, –")
+        });
+    match unit {
+        Some(u) => format!("{words} [{u}]"),
+        None => words,
+    }
+}
+
+/// A case's design name: its axis values joined by `/` (e.g. `paper/5/0.06`).
+pub fn case_name(table: &Table, axes: &[&str], row: usize) -> String {
+    axes.iter()
+        .map(|a| super::selection::cell_text(table, a, row).replace("\\|", "|"))
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
+/// Whether each row is unsuccessful: its `status` is not `ok`, or its `success` column (when
+/// the table has one: bool, 0/1 or `true`/`yes`) says no.
+pub fn unsuccessful_rows(table: &Table) -> Vec<bool> {
+    let status = table.str(STATUS).ok();
+    let success = table.column("success").map(|c| &c.data);
+    (0..table.n_rows())
+        .map(|r| {
+            let failed = status.is_some_and(|s| s[r] != "ok");
+            let missed = success.is_some_and(|d| match d {
+                ColumnData::Bool(v) => !v[r],
+                ColumnData::F64(v) => !(v[r] != 0.0 && v[r].is_finite()),
+                ColumnData::I64(v) => v[r] == 0,
+                ColumnData::Str(v) => !matches!(
+                    v[r].trim().to_ascii_lowercase().as_str(),
+                    "true" | "1" | "yes" | "ok"
+                ),
+            });
+            failed || missed
+        })
+        .collect()
+}
+
+/// The unsuccessful rows with finite `xs` and `ys`, as a red series (`None` when there are
+/// none).
+fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Option<Series> {
+    let rows: Vec<usize> = (0..bad.len())
+        .filter(|&r| bad[r] && xs[r].is_finite() && ys[r].is_finite())
+        .collect();
+    (!rows.is_empty()).then(|| {
+        Series::new(
+            "unsuccessful cases",
+            rows.iter().map(|&r| xs[r]).collect(),
+            rows.iter().map(|&r| ys[r]).collect(),
+        )
+        .colour(Colour::Alert)
+        .kind(PanelKind::Scatter)
+    })
+}
 
 /// An axis label: the axis name, with the numbering of its levels for a text axis.
 fn axis_label(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> String {
@@ -26,14 +129,22 @@ fn axis_label(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> Strin
         Some(ColumnKind::Str)
     ) {
         let names: Vec<String> = lv.iter().map(|l| format!("{}={}", l.1, l.0)).collect();
-        format!("{a} ({})", names.join(", "))
+        format!("{} ({})", metric_title(a), names.join(", "))
     } else {
-        a.to_string()
+        metric_title(a)
     }
 }
 
-/// `pareto.svg`: a thinned set of rows plus every front row, the front labelled.
-pub(crate) fn pareto_plot(f: &Front, ids: &[i64], plots: &Path, warnings: &mut Vec<String>) {
+/// `pareto.svg`: a thinned set of rows plus every front row, the front labelled with case
+/// number and design name, unsuccessful cases in red.
+pub(crate) fn pareto_plot(
+    table: &Table,
+    axes: &[&str],
+    f: &Front,
+    plots: &Path,
+    warnings: &mut Vec<String>,
+) {
+    let ids = table.i64(CASE_ID).unwrap_or(&[]);
     let mut shown: Vec<usize> = thin(&(0..f.rows.len()).collect::<Vec<_>>());
     shown.extend(f.front.iter().copied());
     shown.sort_unstable();
@@ -50,23 +161,40 @@ pub(crate) fn pareto_plot(f: &Front, ids: &[i64], plots: &Path, warnings: &mut V
             LabelledPoint {
                 x: f.xs[r],
                 y: f.ys[r],
-                label: format!("#{}", ids[r]),
+                label: format!(
+                    "#{} {}",
+                    ids.get(r).copied().unwrap_or(r as i64),
+                    case_name(table, axes, r)
+                ),
             }
         })
         .collect();
-    match scatter_labelled(
+    let fig = scatter_labelled(
         &points,
         &highlight,
-        &format!("Pareto front: {} vs {}", f.x, f.y),
-        f.x,
-        f.y,
-    ) {
-        Ok(fig) => {
-            if let Err(e) = fig.write_svg(&plots.join("pareto.svg")) {
-                warnings.push(e.to_string());
-            }
+        &format!(
+            "Pareto front: {} vs {}",
+            metric_title(f.x),
+            metric_title(f.y)
+        ),
+        &metric_title(f.x),
+        &metric_title(f.y),
+    );
+    let result = fig.and_then(|mut fig| {
+        let p = &mut fig.panels[0];
+        p.series[0].name = "successful cases".into();
+        let short: Vec<&str> = axes
+            .iter()
+            .map(|a| a.rsplit('.').next().unwrap_or(a))
+            .collect();
+        p.series[2].name = format!("Pareto-optimal: #case {}", short.join("/"));
+        if let Some(s) = unsuccessful_series(&unsuccessful_rows(table), f.xs, f.ys) {
+            p.series.push(s);
         }
-        Err(e) => warnings.push(e.to_string()),
+        fig.write_svg(&plots.join("pareto.svg"))
+    });
+    if let Err(e) = result {
+        warnings.push(e.to_string());
     }
 }
 
@@ -90,19 +218,23 @@ pub(crate) fn axis_plots(
             _ => continue,
         };
         let x_label = axis_label(table, a, &lv);
-        let mut fig = Figure::new(format!("metrics against {a}"));
+        let mut fig = Figure::new(format!("key metrics against {}", metric_title(a)));
         let plotted = thin(ok_rows);
+        let bad = unsuccessful_rows(table);
         for k in key {
             let Ok(yv) = table.f64(k) else { continue };
             let s = Series::new(
-                "",
+                "successful cases",
                 plotted.iter().map(|&r| xv[r]).collect(),
                 plotted.iter().map(|&r| yv[r]).collect(),
             );
-            let mut p = Panel::new(k.clone(), x_label.clone(), k.clone())
+            let mut p = Panel::new(metric_title(k), x_label.clone(), metric_title(k))
                 .kind(PanelKind::Scatter)
                 .with_series(s);
-            p.legend = false;
+            match unsuccessful_series(&bad, &xv, yv) {
+                Some(u) => p.series.push(u),
+                None => p.legend = false,
+            }
             fig.panels.push(p);
         }
         let cols = (fig.panels.len() as f64).sqrt().ceil().max(1.0) as u32;
@@ -148,10 +280,10 @@ pub(crate) fn heatmaps(
                 la.iter().map(|l| l.1).collect(),
                 lb.iter().map(|l| l.1).collect(),
                 zz,
-                &format!("mean {objective}"),
+                &format!("mean {} over the successful cases", metric_title(objective)),
                 &axis_label(table, axes[i], &la),
                 &axis_label(table, axes[j], &lb),
-                objective,
+                &metric_title(objective),
                 ColourScale::Viridis,
             );
             let path = plots.join(format!(
@@ -201,11 +333,11 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
         .unwrap_or("t");
     let mut fig = Figure::new("best and worst case");
     for c in f64_cols.iter().filter(|c| **c != time).take(12) {
-        let mut p = Panel::new(c.to_string(), time, c.to_string());
+        let mut p = Panel::new(c.to_string(), format!("{time} [s]"), c.to_string());
         for (k, (label, t)) in trajs.iter().enumerate() {
             if let (Ok(x), Ok(y)) = (t.f64(time), t.f64(c)) {
                 p.series.push(
-                    Series::new(label.to_string(), x.to_vec(), y.to_vec())
+                    Series::new(format!("{label} case"), x.to_vec(), y.to_vec())
                         .colour(crate::report::Colour::Palette(k)),
                 );
             }
@@ -216,4 +348,40 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
     let rows = (fig.panels.len() as u32).div_ceil(cols).max(1);
     fig.size = (420 * cols, 300 * rows + 40);
     fig
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_titles_say_what_and_in_which_unit() {
+        assert_eq!(metric_title("thruster_energy"), "thruster energy [J]");
+        assert_eq!(metric_title("energy_per_metre"), "energy per metre [J/m]");
+        assert_eq!(
+            metric_title("design.longitudinal_offset"),
+            "longitudinal offset [m]"
+        );
+        assert_eq!(metric_title("design_mass_kg"), "design mass [kg]");
+        assert_eq!(
+            metric_title("seg1_convergence_time"),
+            "seg1 convergence time [s]"
+        );
+        assert_eq!(
+            metric_title("singularity_exposure"),
+            "singularity exposure [fraction of time, 0–1]"
+        );
+        assert_eq!(metric_title("design.links"), "links");
+    }
+
+    #[test]
+    fn unsuccessful_rows_read_status_and_success_when_present() {
+        let mut t = Table::default();
+        let status = ["ok", "failed", "ok"].map(String::from).to_vec();
+        t.push(STATUS, ColumnData::Str(status)).unwrap();
+        assert_eq!(unsuccessful_rows(&t), [false, true, false]);
+        t.push("success", ColumnData::F64(vec![1.0, 1.0, 0.0]))
+            .unwrap();
+        assert_eq!(unsuccessful_rows(&t), [false, true, true]);
+    }
 }

@@ -66,7 +66,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     effects_section(&c, &mut md);
     if let Some(f) = c.sel.front(table, &c.ok_rows) {
         pareto_section(&c, &f, &mut md);
-        pareto_plot(&f, &c.ids, &plots, &mut warnings);
+        pareto_plot(table, &c.axes, &f, &plots, &mut warnings);
         let _ = writeln!(md);
     }
     failures_section(&c, &mut md);

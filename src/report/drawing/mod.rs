@@ -6,6 +6,9 @@
 //! frame (metres) — cylinders, joint axes, thrust arrows, frame triads — and the caption lines;
 //! [`render_svg`] lays the views out and writes the document. The bytes depend only on the scene.
 //!
+//! [`run`] draws a whole run the same way: the body at several times in one picture, and an
+//! SMIL animation.
+//!
 //! Machine-readable structure (for tests and the HTML report): each view is a
 //! `<g class="view" id="view-top|side|front">` whose `data-scale` (px per m), `data-x0` and
 //! `data-y0` give its transform `x = x0 + scale·u`, `y = y0 − scale·v` ([`ViewTransform`]),
@@ -17,6 +20,7 @@
 mod labels;
 mod page;
 mod render;
+pub mod run;
 mod scene;
 pub mod svg;
 pub mod views;

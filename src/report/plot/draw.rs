@@ -14,6 +14,7 @@ use plotters::style::Color;
 use super::canvas::{
     auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult, FONT,
 };
+use super::labels::{place_labels, LABEL_FONT};
 use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
 
 /// A chart with `f64` axes on an SVG canvas.
@@ -231,7 +232,7 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
     if panel.legend && named > 0 {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(legend_corner(panel, (xr, yr)))
             .label_font((FONT, 12))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
@@ -288,17 +289,84 @@ fn draw_data(
         }
     }
     if !s.labels.is_empty() {
-        let texts: Vec<_> =
-            s.x.iter()
-                .zip(&s.y)
-                .zip(&s.labels)
-                .map(|((&x, &y), l)| ((x, y), l))
-                .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
-                .map(|(p, l)| {
-                    EmptyElement::at(p) + Text::new(l.clone(), (5, -14), (FONT, 11).into_font())
-                })
-                .collect();
-        chart.draw_series(texts)?;
+        draw_labels(chart, s, &inside)?;
     }
     Ok(())
+}
+
+/// The point labels of `s` (those inside the ranges), placed so that none overlaps another
+/// or a marker of the series ([`place_labels`]), with leader lines to labels moved away.
+fn draw_labels(
+    chart: &mut Chart<'_, '_>,
+    s: &Series,
+    inside: &dyn Fn(&(f64, f64)) -> bool,
+) -> DrawResult {
+    let labelled: Vec<((f64, f64), &str)> =
+        s.x.iter()
+            .zip(&s.y)
+            .zip(&s.labels)
+            .map(|((&x, &y), l)| ((x, y), l.as_str()))
+            .filter(|(p, l)| p.0.is_finite() && p.1.is_finite() && inside(p) && !l.is_empty())
+            .collect();
+    let px: Vec<(i32, i32)> = labelled
+        .iter()
+        .map(|(p, _)| chart.backend_coord(p))
+        .collect();
+    let markers: Vec<(i32, i32)> = finite_points(&s.x, &s.y)
+        .filter(|p| inside(p))
+        .map(|p| chart.backend_coord(&p))
+        .collect();
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let area = [xs.start, ys.start, xs.end, ys.end];
+    let texts: Vec<&str> = labelled.iter().map(|(_, l)| *l).collect();
+    let placed = place_labels(&px, &texts, &markers, area);
+    let grey = RGBColor(120, 120, 120).stroke_width(1);
+    for (((p, l), pl), _) in labelled.iter().zip(&placed).zip(&px) {
+        let text = Text::new(l.to_string(), pl.offset, (FONT, LABEL_FONT).into_font());
+        match pl.leader {
+            Some(end) => chart.draw_series(std::iter::once(
+                EmptyElement::at(*p) + PathElement::new(vec![(0, 0), end], grey) + text,
+            ))?,
+            None => chart.draw_series(std::iter::once(EmptyElement::at(*p) + text))?,
+        };
+    }
+    Ok(())
+}
+
+/// The corner of the panel for its legend: the one of upper right, upper left, lower right,
+/// lower left (in that order of preference) whose 45 % × 30 % of the ranges holds the fewest
+/// data points, so that the legend hides as little as possible.
+fn legend_corner(panel: &Panel, (xr, yr): ((f64, f64), (f64, f64))) -> SeriesLabelPosition {
+    let (fx, fy) = (0.45, 0.30);
+    let (wx, wy) = ((xr.1 - xr.0) * fx, (yr.1 - yr.0) * fy);
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let count = |right: bool, upper: bool| {
+        panel
+            .series
+            .iter()
+            .flat_map(|s| finite_points(&s.x, &s.y))
+            .filter(|p| {
+                let in_x = if right {
+                    p.0 >= xr.1 - wx
+                } else {
+                    p.0 <= xr.0 + wx
+                };
+                let in_y = if upper {
+                    p.1 >= yr.1 - wy
+                } else {
+                    p.1 <= yr.0 + wy
+                };
+                in_x && in_y
+            })
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|&(_, right, upper)| count(right, upper))
+        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }

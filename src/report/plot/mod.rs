@@ -9,6 +9,8 @@
 //! - empty series and empty panels are drawn as empty axes on `[0, 1]`;
 //! - degenerate (constant or single-point) ranges are padded;
 //! - lines are clipped to the panel's range, markers outside it are not drawn;
+//! - point labels never overlap each other or a marker (a leader line joins a label moved
+//!   away from its point);
 //! - text is native SVG `<text>` (no font files), and the output depends only on the
 //!   specification, so rendering twice gives identical bytes.
 //!
@@ -18,6 +20,7 @@ mod canvas;
 mod charts;
 mod draw;
 mod heatmap;
+mod labels;
 mod spec;
 
 pub use charts::{histogram, scatter_labelled, LabelledPoint};

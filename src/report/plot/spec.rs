@@ -37,6 +37,8 @@ pub enum Colour {
     Palette(usize),
     /// Light grey, for background data.
     Grey,
+    /// Red, for cases that failed or missed their success criteria.
+    Alert,
 }
 
 impl Default for Colour {
@@ -50,6 +52,7 @@ impl Colour {
         match self {
             Colour::Palette(i) => PALETTE[i % PALETTE.len()],
             Colour::Grey => GREY_RGB,
+            Colour::Alert => RGBColor(200, 30, 30),
         }
     }
 }

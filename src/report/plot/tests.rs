@@ -266,3 +266,24 @@ fn heatmap_renders() {
     .unwrap();
     assert_well_formed(&h.render_svg().unwrap());
 }
+
+#[test]
+fn crowded_point_labels_get_leader_lines() {
+    // Eight front points crowded into one corner: their labels cannot all sit beside them.
+    let pts: Vec<LabelledPoint> = (0..8)
+        .map(|i| LabelledPoint {
+            x: 1.0 + 0.001 * i as f64,
+            y: 1.0 - 0.001 * i as f64,
+            label: format!("#{i} paper/5/0.06"),
+        })
+        .chain(std::iter::once(LabelledPoint {
+            x: 10.0,
+            y: 0.0,
+            label: "far".into(),
+        }))
+        .collect();
+    let front: Vec<usize> = (0..9).collect();
+    let fig = scatter_labelled(&pts, &front, "t", "x", "y").unwrap();
+    let svg = fig.render_svg().unwrap();
+    assert!(svg.contains("stroke=\"#787878\""), "no leader line");
+}

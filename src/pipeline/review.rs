@@ -1,0 +1,544 @@
+//! `report.html`: the design-review page of a sweep (or any study) output directory — one
+//! self-contained HTML file (inline CSS and SVG; no scripts, fonts, links or requests) that a
+//! reviewer opens in a browser or prints.
+//!
+//! Built only from the files already in the directory, so `usm-study report DIR` can rebuild
+//! it: `manifest.json` (study description and parameters), `summary.md` (its tables, with case
+//! references linked to drawings), the case table `cases.parquet` / `cases.csv` (each case's
+//! outcome and design name), `study.toml` (to rebuild the designs named in the tables, drawn
+//! by [`super::draw`]) and every `plots/*.svg` and `*.svg` of the directory. Whatever is
+//! missing is left out with a note; the page never needs a file that a sweep does not write.
+//!
+//! A case is *unsuccessful* when its `status` is not `ok` or its `success` column (when the
+//! table has one) is false; such cases are drawn with a red frame and their table rows shaded.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::draw::draw_design;
+use super::error::PipelineError;
+use crate::model::design::parse_design_table;
+use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
+use crate::report::{atomic_write, read_csv, read_parquet, Table};
+use crate::state::VehicleState;
+use crate::study::cases::resolve_case;
+use crate::study::doe::expand;
+use crate::study::parse::load_study;
+use crate::study::plots::{case_name, unsuccessful_rows};
+use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
+
+/// The file name of the page.
+pub const REPORT_HTML: &str = "report.html";
+/// At most this many designs are drawn (the first named in the tables).
+const MAX_DRAWINGS: usize = 40;
+
+/// What [`write_review`] wrote.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReviewOutcome {
+    /// The page written.
+    pub path: PathBuf,
+    /// Designs drawn.
+    pub drawings: usize,
+    /// Figures inlined.
+    pub plots: usize,
+    /// Parts left out, and why (missing files, designs that could not be rebuilt).
+    pub warnings: Vec<String>,
+}
+
+/// One case's outcome and name, from the case table.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct CaseInfo {
+    /// `status` is not `ok`, or `success` is false.
+    unsuccessful: bool,
+    /// Why (the `reason` cell, then any `success_*` / `missed*` text cell).
+    why: String,
+    /// Axis values joined by ` / `.
+    name: String,
+}
+
+/// Every case of `table` by id: outcome, reason and design name (from the `axes`).
+fn case_infos(table: &Table, axes: &[&str]) -> BTreeMap<i64, CaseInfo> {
+    let Ok(ids) = table.i64(CASE_ID) else {
+        return BTreeMap::new();
+    };
+    let bad = unsuccessful_rows(table);
+    let why_cols: Vec<&[String]> = table
+        .columns
+        .iter()
+        .filter(|c| {
+            c.name == REASON || c.name.starts_with("success_") || c.name.starts_with("missed")
+        })
+        .filter_map(|c| table.str(&c.name).ok())
+        .collect();
+    (0..table.n_rows())
+        .map(|r| {
+            let why: Vec<&str> = why_cols
+                .iter()
+                .map(|c| c[r].as_str())
+                .filter(|s| !s.is_empty())
+                .collect();
+            let info = CaseInfo {
+                unsuccessful: bad[r],
+                why: why.join("; "),
+                name: case_name(table, axes, r).replace('/', " / "),
+            };
+            (ids[r], info)
+        })
+        .collect()
+}
+
+/// The case ids named (`#N`) in the table rows of a Markdown text, in order of appearance.
+fn referenced_cases(md: &str) -> Vec<i64> {
+    let mut seen = BTreeSet::new();
+    let mut out = Vec::new();
+    for l in md.lines().filter(|l| l.trim_start().starts_with('|')) {
+        for part in l.split('#').skip(1) {
+            let digits: String = part.chars().take_while(char::is_ascii_digit).collect();
+            if let Ok(id) = digits.parse::<i64>() {
+                if seen.insert(id) {
+                    out.push(id);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// One drawn design: the cases that share it and its SVG.
+struct Drawing {
+    cases: Vec<i64>,
+    svg: String,
+}
+
+/// Rebuilds and draws the designs of `ids` (cases sharing a design drawn once), from the
+/// study copy in `dir` or the original study file the manifest names.
+fn drawings(dir: &Path, study_file: Option<&str>, ids: &[i64]) -> Result<Vec<Drawing>, String> {
+    let copy = dir.join(STUDY_COPY);
+    let path = if copy.is_file() {
+        copy
+    } else {
+        PathBuf::from(study_file.ok_or("no study.toml in the directory")?)
+    };
+    let study = load_study(&path).map_err(|e| e.to_string())?;
+    let all = expand(&study, None)?;
+    let mut out: Vec<Drawing> = Vec::new();
+    let mut by_hash: BTreeMap<String, usize> = BTreeMap::new();
+    for &id in ids {
+        let Some(case) = usize::try_from(id).ok().and_then(|i| all.get(i)) else {
+            continue;
+        };
+        let Ok(r) = resolve_case(&study, case) else {
+            continue;
+        };
+        if let Some(&k) = by_hash.get(&r.design_hash) {
+            out[k].cases.push(id);
+            continue;
+        }
+        if out.len() >= MAX_DRAWINGS {
+            continue;
+        }
+        let Ok(v) = parse_design_table(&r.design, &format!("case {id} design")) else {
+            continue;
+        };
+        let svg = draw_design(&v, &VehicleState::rest(&v), "straight, at rest")
+            .map_err(|e| e.to_string())?;
+        by_hash.insert(r.design_hash, out.len());
+        out.push(Drawing {
+            cases: vec![id],
+            svg,
+        });
+    }
+    Ok(out)
+}
+
+/// The case table of `dir`: `cases.parquet`, else `cases.csv`.
+fn read_cases(dir: &Path) -> Option<Table> {
+    let pq = dir.join(CASES_PARQUET);
+    let csv = dir.join(CASES_CSV);
+    if pq.is_file() {
+        read_parquet(&pq).ok()
+    } else if csv.is_file() {
+        read_csv(&csv).ok()
+    } else {
+        None
+    }
+}
+
+/// The SVG figures of `dir`: `plots/*.svg` then `*.svg`, each sorted by name.
+fn figure_files(dir: &Path) -> Vec<PathBuf> {
+    let list = |d: &Path| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(d)
+            .map(|rd| {
+                rd.filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| p.extension().is_some_and(|x| x == "svg") && p.is_file())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    };
+    let mut out = list(&dir.join("plots"));
+    out.extend(list(dir));
+    out
+}
+
+/// Inline style sheet: readable on screen and on paper; unsuccessful cases in red.
+const STYLE: &str = "body{font-family:'DejaVu Sans',Arial,Helvetica,sans-serif;margin:24px auto;\
+max-width:1280px;padding:0 16px;color:#111;line-height:1.4}h1{font-size:26px}h2{font-size:21px;\
+border-bottom:2px solid #333;padding-bottom:3px;margin-top:34px}h3{font-size:17px}\
+table{border-collapse:collapse;margin:8px 0;font-size:13px}th,td{border:1px solid #bbb;\
+padding:3px 7px;text-align:left;vertical-align:top}th{background:#eee}\
+tr.bad td{background:#fde2e2;color:#7f1d1d}code{font-size:12px}.r-scroll{overflow-x:auto}\
+.r-name{color:#555;font-size:11px}.r-note{color:#555;font-style:italic}\
+.r-ok{color:#166534;font-weight:bold}.r-badword{color:#b91c1c;font-weight:bold}\
+.r-grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(380px,1fr));gap:14px}\
+.r-card{border:2px solid #999;padding:6px;margin:0;break-inside:avoid}\
+.r-card.bad{border-color:#b91c1c;background:#fff5f5}.r-card:target{grid-column:1/-1;\
+border-color:#1d4ed8}.r-card svg,.r-plot svg{width:100%;height:auto;display:block}\
+.r-card figcaption{font-size:13px;margin-top:4px}.r-plot{margin:14px 0;break-inside:avoid}\
+.r-plot figcaption{font-size:13px;color:#333}.r-kv td:first-child{font-weight:bold}\
+@media print{body{max-width:none}.r-grid{display:block}.r-card{margin-bottom:12px}}";
+
+/// Writes `report.html` into `dir` (an existing output directory).
+pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
+    let mut warnings = Vec::new();
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    if manifest.is_none() {
+        warnings.push("no readable manifest.json: study parameters left out".into());
+    }
+    let m = manifest.as_ref();
+    let axes: Vec<String> = m
+        .and_then(|m| m["axes"].as_array())
+        .map(|a| {
+            a.iter()
+                .filter_map(|x| x["name"].as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    let table = read_cases(dir);
+    let infos = table
+        .as_ref()
+        .map(|t| case_infos(t, &axes.iter().map(String::as_str).collect::<Vec<_>>()))
+        .unwrap_or_default();
+    let summary = std::fs::read_to_string(dir.join("summary.md")).ok();
+    let named = summary.as_deref().map(referenced_cases).unwrap_or_default();
+    let study_file = m.and_then(|m| m["study_file"].as_str());
+    let drawn = if named.is_empty() {
+        Vec::new()
+    } else {
+        drawings(dir, study_file, &named).unwrap_or_else(|e| {
+            warnings.push(format!("designs not drawn: {e}"));
+            Vec::new()
+        })
+    };
+    let figures = figure_files(dir);
+    let page = Page {
+        dir,
+        manifest: m,
+        axes: &axes,
+        table: table.as_ref(),
+        infos: &infos,
+        summary: summary.as_deref(),
+        drawings: &drawn,
+    };
+    let html = page.render(&figures, &mut warnings);
+    let path = dir.join(REPORT_HTML);
+    atomic_write(&path, html.as_bytes())?;
+    Ok(ReviewOutcome {
+        path,
+        drawings: drawn.len(),
+        plots: figures.len(),
+        warnings,
+    })
+}
+
+/// Everything the page shows.
+struct Page<'a> {
+    dir: &'a Path,
+    manifest: Option<&'a serde_json::Value>,
+    axes: &'a [String],
+    table: Option<&'a Table>,
+    infos: &'a BTreeMap<i64, CaseInfo>,
+    summary: Option<&'a str>,
+    drawings: &'a [Drawing],
+}
+
+impl Page<'_> {
+    /// The anchor of the drawing that shows case `id`, if any.
+    fn anchor(&self, id: i64) -> Option<String> {
+        self.drawings
+            .iter()
+            .find(|d| d.cases.contains(&id))
+            .map(|d| format!("case-{}", d.cases[0]))
+    }
+
+    fn link(&self, id: i64) -> Option<CaseLink> {
+        let info = self.infos.get(&id);
+        if info.is_none() && self.anchor(id).is_none() {
+            return None;
+        }
+        Some(CaseLink {
+            anchor: self.anchor(id),
+            unsuccessful: info.is_some_and(|i| i.unsuccessful),
+            name: info.map(|i| i.name.clone()).filter(|n| !n.is_empty()),
+        })
+    }
+
+    fn render(&self, figures: &[PathBuf], warnings: &mut Vec<String>) -> String {
+        let title = self
+            .manifest
+            .and_then(|m| m["study_name"].as_str())
+            .map(String::from)
+            .unwrap_or_else(|| {
+                self.dir
+                    .file_name()
+                    .map_or("study".into(), |n| n.to_string_lossy().into_owned())
+            });
+        let mut h = String::new();
+        let _ = writeln!(
+            h,
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+             <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+             <title>Design review: {t}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n\
+             <h1>Design review: <code>{t}</code></h1>",
+            t = escape(&title)
+        );
+        self.study_section(&mut h);
+        self.success_section(&mut h);
+        self.designs_section(&mut h);
+        self.tables_section(&mut h);
+        plots_section(&mut h, figures, warnings);
+        self.manifest_section(&mut h);
+        h.push_str("</body>\n</html>\n");
+        h
+    }
+
+    /// Description, parameters and counts from the manifest.
+    fn study_section(&self, h: &mut String) {
+        h.push_str("<section id=\"study\">\n<h2>The study</h2>\n");
+        let Some(m) = self.manifest else {
+            h.push_str("<p class=\"r-note\">No manifest.json in this directory.</p>\n</section>\n");
+            return;
+        };
+        if let Some(d) = m["description"].as_str().filter(|d| !d.is_empty()) {
+            let _ = writeln!(h, "<p>{}</p>", escape(d));
+        }
+        if !self.axes.is_empty() {
+            let _ = writeln!(
+                h,
+                "<p>Axes swept: {}. A design is named by its axis values in this order \
+                 (e.g. in tables: <code>#case</code> followed by the name).</p>",
+                self.axes
+                    .iter()
+                    .map(|a| format!("<code>{}</code>", escape(a)))
+                    .collect::<Vec<_>>()
+                    .join(" / ")
+            );
+        }
+        let c = &m["cases"];
+        if let (Some(n), Some(ok)) = (c["in_output"].as_u64(), c["ok"].as_u64()) {
+            let _ = writeln!(
+                h,
+                "<p>Mode <code>{}</code>, design of experiments <code>{}</code>, seed {}: \
+                 {n} cases, {ok} ok, {} failed, {} skipped. All parameters are listed at the \
+                 end of the page.</p>",
+                escape(&json_text(&m["mode"])),
+                escape(&json_text(&m["doe"])),
+                escape(&json_text(&m["seed"])),
+                json_text(&c["failed"]),
+                json_text(&c["skipped"])
+            );
+        }
+        h.push_str("</section>\n");
+    }
+
+    /// Every field of the manifest.
+    fn manifest_section(&self, h: &mut String) {
+        let Some(obj) = self.manifest.and_then(|m| m.as_object()) else {
+            return;
+        };
+        h.push_str("<section id=\"manifest\">\n<h2>Run parameters (manifest.json)</h2>\n");
+        h.push_str("<table class=\"r-kv\">\n");
+        for (k, v) in obj
+            .iter()
+            .filter(|(k, _)| !matches!(k.as_str(), "columns" | "axes"))
+        {
+            let text = json_text(v);
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td></tr>",
+                escape(k),
+                escape(&text)
+            );
+        }
+        h.push_str("</table>\n</section>\n");
+    }
+
+    /// What success means here, and how many cases met it.
+    fn success_section(&self, h: &mut String) {
+        h.push_str("<section id=\"success\">\n<h2>What success means</h2>\n");
+        let has_success = self.table.is_some_and(|t| t.column("success").is_some());
+        let rule = if has_success {
+            "A case is <span class=\"r-ok\">successful</span> when its run finished \
+             (<code>status</code> = <code>ok</code>) and it met its scenario's success criteria \
+             (<code>success</code> column true)."
+        } else {
+            "A case is <span class=\"r-ok\">successful</span> when its run finished \
+             (<code>status</code> = <code>ok</code>). This output has no <code>success</code> \
+             column, so convergence and tracking criteria are not checked: read the tracking \
+             columns (e.g. <code>converged</code>) before trusting a ranking."
+        };
+        let _ = writeln!(h, "<p>{rule}</p>");
+        let bad = self.infos.values().filter(|i| i.unsuccessful).count();
+        if !self.infos.is_empty() {
+            let _ = writeln!(
+                h,
+                "<p>{} of {} cases successful, <span class=\"r-badword\">{bad} unsuccessful</span>. \
+                 Unsuccessful cases are shaded red in the tables and framed red in the drawings.</p>",
+                self.infos.len() - bad,
+                self.infos.len()
+            );
+        }
+        h.push_str("</section>\n");
+    }
+
+    /// A drawing of every design named in the tables.
+    fn designs_section(&self, h: &mut String) {
+        h.push_str("<section id=\"designs\">\n<h2>Designs named in the tables</h2>\n");
+        if self.drawings.is_empty() {
+            h.push_str("<p class=\"r-note\">No design drawings (no case is named in the tables, or the study file could not be read).</p>\n</section>\n");
+            return;
+        }
+        h.push_str("<p>Top, side and front views of each design, straight and at rest, to scale. Click a drawing (or a case number in a table) to enlarge it.</p>\n<div class=\"r-grid\">\n");
+        for d in self.drawings {
+            let first = d.cases[0];
+            let info = |c: &i64| self.infos.get(c).cloned().unwrap_or_default();
+            let bad: Vec<String> = d
+                .cases
+                .iter()
+                .filter(|c| info(c).unsuccessful)
+                .map(|c| {
+                    let why = info(c).why;
+                    format!(
+                        "#{c} ({})",
+                        if why.is_empty() {
+                            "see the tables".into()
+                        } else {
+                            why
+                        }
+                    )
+                })
+                .collect();
+            let ids: Vec<String> = d.cases.iter().map(|c| format!("#{c}")).collect();
+            // Framed red when every case of this design was unsuccessful.
+            let all_bad = bad.len() == d.cases.len();
+            let _ = writeln!(
+                h,
+                "<figure class=\"r-card{}\" id=\"case-{first}\"><a href=\"#case-{first}\">{}</a>\
+                 <figcaption><strong>{}</strong> {}{}</figcaption></figure>",
+                if all_bad { " bad" } else { "" },
+                inline_svg(&d.svg, &format!("c{first}-")),
+                escape(&ids.join(", ")),
+                escape(&info(&first).name),
+                if bad.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " — <span class=\"r-badword\">unsuccessful</span>: {}",
+                        escape(&bad.join("; "))
+                    )
+                }
+            );
+        }
+        h.push_str("</div>\n</section>\n");
+    }
+
+    /// The tables of `summary.md`, case references linked.
+    fn tables_section(&self, h: &mut String) {
+        h.push_str("<section id=\"tables\">\n");
+        match self.summary {
+            Some(md) => h.push_str(&markdown_to_html(md, 1, &|id| self.link(id))),
+            None => h.push_str(
+                "<h2>Tables</h2>\n<p class=\"r-note\">No summary.md in this directory.</p>\n",
+            ),
+        }
+        h.push_str("</section>\n");
+    }
+}
+
+/// A manifest value as text: strings bare, objects as `key: value` pairs, null as `–`.
+fn json_text(v: &serde_json::Value) -> String {
+    match v {
+        serde_json::Value::String(s) => s.clone(),
+        serde_json::Value::Null => "–".into(),
+        serde_json::Value::Object(o) => o
+            .iter()
+            .map(|(k, v)| format!("{k}: {}", json_text(v)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        other => other.to_string(),
+    }
+}
+
+/// Every figure, inline.
+fn plots_section(h: &mut String, figures: &[PathBuf], warnings: &mut Vec<String>) {
+    h.push_str("<section id=\"plots\">\n<h2>Plots</h2>\n");
+    if figures.is_empty() {
+        h.push_str("<p class=\"r-note\">No plots in this directory.</p>\n");
+    }
+    for (k, p) in figures.iter().enumerate() {
+        let name = p
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        match std::fs::read_to_string(p) {
+            Ok(svg) => {
+                let _ = writeln!(
+                    h,
+                    "<figure class=\"r-plot\" id=\"plot-{k}\">{}<figcaption>{}</figcaption></figure>",
+                    inline_svg(&svg, &format!("p{k}-")),
+                    escape(&name)
+                );
+            }
+            Err(e) => warnings.push(format!("{}: {e}", p.display())),
+        }
+    }
+    h.push_str("</section>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::ColumnData;
+    use crate::study::records::STATUS;
+
+    #[test]
+    fn outcomes_read_status_and_an_optional_success_column() {
+        let mut t = Table::default();
+        t.push(CASE_ID, ColumnData::I64(vec![0, 1, 2])).unwrap();
+        let status = ["ok", "failed", "ok"].map(String::from).to_vec();
+        t.push(STATUS, ColumnData::Str(status)).unwrap();
+        let reason = ["", "diverged", ""].map(String::from).to_vec();
+        t.push(REASON, ColumnData::Str(reason)).unwrap();
+        t.push("design.links", ColumnData::F64(vec![3.0, 4.0, 5.0]))
+            .unwrap();
+        let axes = ["design.links"];
+        let i = case_infos(&t, &axes);
+        assert!(!i[&0].unsuccessful && i[&1].unsuccessful && !i[&2].unsuccessful);
+        assert_eq!((i[&1].why.as_str(), i[&1].name.as_str()), ("diverged", "4"));
+        // With a `success` column, an ok run that missed its criteria is unsuccessful too.
+        t.push("success", ColumnData::Bool(vec![true, false, false]))
+            .unwrap();
+        let i = case_infos(&t, &axes);
+        assert!(!i[&0].unsuccessful && i[&1].unsuccessful && i[&2].unsuccessful);
+    }
+
+    #[test]
+    fn case_references_come_from_table_rows_only_once_each() {
+        let md =
+            "# Sweep\n\nCase #7 in a sentence.\n\n| a | b |\n|---|---|\n| #3 | #12 |\n| #3 | x |\n";
+        assert_eq!(referenced_cases(md), [3, 12]);
+    }
+}
