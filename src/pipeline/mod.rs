@@ -8,7 +8,8 @@
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
-//! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
+//! - [`allocate`]: one thrust-allocation case file, validated and solved with each method;
+//! - [`optimise`]: the files of an optimisation (history, best point, summary, plots).
 //!
 //! The batch sweep's pipeline lives in [`crate::study`]. No pipeline prints: progress and
 //! per-run outcomes reach the caller through callbacks.
@@ -18,6 +19,7 @@ pub mod antonelli;
 pub mod draw;
 pub mod error;
 pub mod inspect;
+pub mod optimise;
 pub mod paper;
 pub mod simulate;
 pub mod tcm;
