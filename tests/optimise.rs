@@ -9,11 +9,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use usm_study::input::keypath::KeyPath;
 use usm_study::optimise::evaluate::pick;
-use usm_study::optimise::history::{history_table, Record, JOURNAL_FILE};
+use usm_study::optimise::history::{history_table, Evaluation, Record, JOURNAL_FILE};
 use usm_study::optimise::problem::{
     Combine, Method, Objective, SolverSettings, Spec, Term, Variant,
 };
-use usm_study::optimise::search::{Evaluation, Evaluator};
+use usm_study::optimise::search::Evaluator;
 use usm_study::optimise::space::{Param, Scale, Space};
 use usm_study::optimise::{minimise, parse_problem, run, Options, Outcome};
 use usm_study::study::schema::Target;
@@ -121,9 +121,17 @@ fn solve(f: fn(&[f64]) -> f64, spec: &Spec, jobs: usize) -> Outcome {
 fn each_solver_finds_the_rosenbrock_minimum() {
     let box2 = || vec![param("a.x", -2.0, 2.0, -1.2), param("a.y", -2.0, 2.0, 1.0)];
     let cases = [
-        (Method::NelderMead, solver(Method::NelderMead, 2000, 3000, 1e-14), 1e-3),
+        (
+            Method::NelderMead,
+            solver(Method::NelderMead, 2000, 3000, 1e-14),
+            1e-3,
+        ),
         (Method::Lbfgs, solver(Method::Lbfgs, 500, 5000, 1e-10), 1e-3),
-        (Method::ParticleSwarm, solver(Method::ParticleSwarm, 400, 20_000, 1e-6), 5e-2),
+        (
+            Method::ParticleSwarm,
+            solver(Method::ParticleSwarm, 400, 20_000, 1e-6),
+            5e-2,
+        ),
     ];
     for (m, s, tol) in cases {
         let o = solve(rosenbrock, &spec(box2(), s), 2);
@@ -152,16 +160,30 @@ fn each_solver_finds_the_bounded_quadratic_minimum_on_the_bound() {
             o.stops
         );
         // Every evaluated point lies inside the bounds.
-        assert!(o.records.iter().all(|r| r.x.iter().all(|x| (0.0..=1.0).contains(x))));
+        assert!(o
+            .records
+            .iter()
+            .all(|r| r.x.iter().all(|x| (0.0..=1.0).contains(x))));
     }
 }
 
 #[test]
 fn the_evaluation_budget_is_exact() {
     let s = solver(Method::ParticleSwarm, 1000, 37, 1e-12);
-    let o = solve(rosenbrock, &spec(vec![param("a.x", -2.0, 2.0, 0.0), param("a.y", -2.0, 2.0, 0.0)], s), 2);
+    let o = solve(
+        rosenbrock,
+        &spec(
+            vec![param("a.x", -2.0, 2.0, 0.0), param("a.y", -2.0, 2.0, 0.0)],
+            s,
+        ),
+        2,
+    );
     assert_eq!(o.fresh_evaluations(), 37);
-    assert!(o.stops.iter().any(|s| s.contains("budget")), "{:?}", o.stops);
+    assert!(
+        o.stops.iter().any(|s| s.contains("budget")),
+        "{:?}",
+        o.stops
+    );
 }
 
 fn table(o: &Outcome, spec: &Spec) -> usm_study::report::Table {
@@ -285,7 +307,10 @@ seed = 9
 #[test]
 fn history_and_best_do_not_depend_on_the_number_of_threads() {
     let p = parse_problem(SMALL, Path::new("small.toml")).unwrap();
-    let runs: Vec<Outcome> = [1, 2, 3].iter().map(|&j| run(&p, &options(j)).unwrap()).collect();
+    let runs: Vec<Outcome> = [1, 2, 3]
+        .iter()
+        .map(|&j| run(&p, &options(j)).unwrap())
+        .collect();
     let params: Vec<String> = p.spec.space.params.iter().map(|q| q.name.clone()).collect();
     let names = ["calm".to_string(), "current".to_string()];
     let t0 = history_table(&runs[0].records, &params, &runs[0].metrics, &names).unwrap();
@@ -325,14 +350,20 @@ fn best_toml_reproduces_the_best_objective() {
 fn the_metric_catalogue_names_every_metric_a_run_reports() {
     use usm_study::metrics::run_summary::is_run_metric;
     use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, Mode};
-    for (preset, mode) in [("transport-method2", Mode::Transport), ("work-setpoint", Mode::Work)] {
+    for (preset, mode) in [
+        ("transport-method2", Mode::Transport),
+        ("work-setpoint", Mode::Work),
+    ] {
         let (mut t, src) = load_table(preset).unwrap();
         t["scenario"]["duration"] = toml::Value::Float(2.0);
         let f = parse_table(&t, &src).unwrap();
         let v = resolve_design(&f, &src).unwrap();
         let r = run_scenario(&v, &f).unwrap();
         for (name, _) in &r.metrics {
-            assert!(is_run_metric(mode, name), "{preset}: {name} is not in the catalogue");
+            assert!(
+                is_run_metric(mode, name),
+                "{preset}: {name} is not in the catalogue"
+            );
         }
         assert!(!is_run_metric(mode, "no_such_metric"));
     }

@@ -83,7 +83,10 @@ fn bad_problem_files_exit_2_naming_file_line_and_key_before_any_evaluation() {
         assert_eq!(o.status.code(), Some(2), "{e}");
         let want_line = if key == "param[0].name" && message.starts_with("outside") {
             // The file's current value is outside the bounds: named at the parameter.
-            TINY.lines().position(|l| l.starts_with("name = \"control.k_psi\"")).unwrap() + 1
+            TINY.lines()
+                .position(|l| l.starts_with("name = \"control.k_psi\""))
+                .unwrap()
+                + 1
         } else {
             *line
         };
@@ -93,23 +96,45 @@ fn bad_problem_files_exit_2_naming_file_line_and_key_before_any_evaluation() {
         );
         assert!(e.contains(&format!(": {key}: ")), "case {i}: {e}");
         assert!(e.contains(message), "case {i}: {e}");
-        assert!(!out_dir.exists(), "case {i}: nothing runs before the checks");
+        assert!(
+            !out_dir.exists(),
+            "case {i}: nothing runs before the checks"
+        );
     }
     // A start outside the bounds, and an empty parameter list.
     let text = TINY.replace("scale = \"log\"\n", "scale = \"log\"\nstart = 2.0\n");
     let p = write(dir.path(), "start.toml", &text);
-    let e = stderr(&run(&["optimise", arg(&p), "--out", arg(&dir.path().join("s"))]));
-    let n = text.lines().position(|l| l.starts_with("start = 2.0")).unwrap() + 1;
-    assert!(e.contains(&format!("start.toml:{n}:")) && e.contains(": param[0].start: "), "{e}");
+    let e = stderr(&run(&[
+        "optimise",
+        arg(&p),
+        "--out",
+        arg(&dir.path().join("s")),
+    ]));
+    let n = text
+        .lines()
+        .position(|l| l.starts_with("start = 2.0"))
+        .unwrap()
+        + 1;
+    assert!(
+        e.contains(&format!("start.toml:{n}:")) && e.contains(": param[0].start: "),
+        "{e}"
+    );
     let start = TINY.find("[[param]]").unwrap();
     let end = TINY.find("[objective]").unwrap();
     let text = format!("{}{}", &TINY[..start], &TINY[end..]);
     let p = write(dir.path(), "empty.toml", &text);
     let o = run(&["optimise", arg(&p), "--out", arg(&dir.path().join("e"))]);
     let e = stderr(&o);
-    let n = text.lines().position(|l| l.starts_with("[objective]")).unwrap() + 1;
+    let n = text
+        .lines()
+        .position(|l| l.starts_with("[objective]"))
+        .unwrap()
+        + 1;
     assert_eq!(o.status.code(), Some(2), "{e}");
-    assert!(e.contains(&format!("empty.toml:{n}:")) && e.contains(": param: "), "{e}");
+    assert!(
+        e.contains(&format!("empty.toml:{n}:")) && e.contains(": param: "),
+        "{e}"
+    );
     assert!(e.contains("parameter list is empty"), "{e}");
 }
 
@@ -134,8 +159,7 @@ fn a_tiny_problem_writes_every_output_and_best_toml_reproduces_the_best_objectiv
         assert!(out.join(f).is_file(), "{f}");
     }
     let m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["fresh_evaluations"], 5);
     let best = m["best"]["score"]["objective"].as_f64().unwrap();
     let scales: Vec<f64> = m["scales"]
@@ -145,14 +169,31 @@ fn a_tiny_problem_writes_every_output_and_best_toml_reproduces_the_best_objectiv
         .map(|x| x.as_f64().unwrap())
         .collect();
     let sim = dir.path().join("sim");
-    let o = run(&["simulate", arg(&out.join("best.toml")), "--out", arg(&sim), "--no-plots"]);
+    let o = run(&[
+        "simulate",
+        arg(&out.join("best.toml")),
+        "--out",
+        arg(&sim),
+        "--no-plots",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let s = summary(&sim);
-    let again = metric(&s, "thruster_energy") / scales[0] + 0.5 * metric(&s, "overshoot") / scales[1];
-    assert!(((again - best) / best).abs() <= 1e-9, "simulate: {again}, optimise: {best}");
+    let again =
+        metric(&s, "thruster_energy") / scales[0] + 0.5 * metric(&s, "overshoot") / scales[1];
+    assert!(
+        ((again - best) / best).abs() <= 1e-9,
+        "simulate: {again}, optimise: {best}"
+    );
     // --resume of a finished run replays it without new evaluations and writes the same history.
     let before = std::fs::read(out.join("history.csv")).unwrap();
-    let o = run(&["optimise", arg(&p), "--out", arg(&out), "--resume", "--no-plots"]);
+    let o = run(&[
+        "optimise",
+        arg(&p),
+        "--out",
+        arg(&out),
+        "--resume",
+        "--no-plots",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("5 replayed"));
     assert_eq!(before, std::fs::read(out.join("history.csv")).unwrap());

@@ -22,11 +22,21 @@ fn tuned(file: &str, max_evals: usize) -> (f64, f64) {
         on_record: &quiet,
     };
     let o = run(&p, &opts).unwrap();
-    assert!(o.start().score.feasible, "{file}: the paper's gains meet the constraints");
+    assert!(
+        o.start().score.feasible,
+        "{file}: the paper's gains meet the constraints"
+    );
     let b = o.best();
-    assert!(b.score.feasible, "{file}: the best point meets every constraint");
+    assert!(
+        b.score.feasible,
+        "{file}: the best point meets every constraint"
+    );
     for k in 0..p.spec.constraints.len() {
-        assert_eq!(o.scorer.constraint_violation(k, &b.metrics[0]), 0.0, "{file}: {k}");
+        assert_eq!(
+            o.scorer.constraint_violation(k, &b.metrics[0]),
+            0.0,
+            "{file}: {k}"
+        );
     }
     (o.start().score.objective, b.score.objective)
 }

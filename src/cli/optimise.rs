@@ -87,24 +87,51 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
     };
     let outcome = run(&problem, &opts)?;
     progress.finish();
-    write_outputs(&problem, &outcome, &out, OptimiseFiles { plots: !a.no_plots })?;
+    write_outputs(
+        &problem,
+        &outcome,
+        &out,
+        OptimiseFiles { plots: !a.no_plots },
+    )?;
     let (st, b) = (outcome.start(), outcome.best());
-    println!("{} ({} evaluations, {} fresh, {} replayed)", s.name, outcome.records.len(), outcome.fresh_evaluations(), outcome.replayed);
+    println!(
+        "{} ({} evaluations, {} fresh, {} replayed)",
+        s.name,
+        outcome.records.len(),
+        outcome.fresh_evaluations(),
+        outcome.replayed
+    );
     for (k, p) in spec.space.params.iter().enumerate() {
-        println!("  {:<34} {:>12} -> {:>12}", p.name, fmt_num(st.x[k]), fmt_num(b.x[k]));
+        println!(
+            "  {:<34} {:>12} -> {:>12}",
+            p.name,
+            fmt_num(st.x[k]),
+            fmt_num(b.x[k])
+        );
     }
     println!(
         "  objective {} -> {} (best at evaluation {}, {})",
         fmt_num(st.score.objective),
         fmt_num(b.score.objective),
         b.index,
-        if b.score.feasible { "feasible" } else { "infeasible" }
+        if b.score.feasible {
+            "feasible"
+        } else {
+            "infeasible"
+        }
     );
-    eprintln!("[optimise] wrote {} (best point: {})", out.display(), out.join(BEST_FILE).display());
+    eprintln!(
+        "[optimise] wrote {} (best point: {})",
+        out.display(),
+        out.join(BEST_FILE).display()
+    );
     Ok(if b.score.feasible {
         ExitCode::SUCCESS
     } else {
-        eprintln!("error: no evaluated point meets every constraint (violation {})", fmt_num(b.score.violation));
+        eprintln!(
+            "error: no evaluated point meets every constraint (violation {})",
+            fmt_num(b.score.violation)
+        );
         ExitCode::from(1)
     })
 }

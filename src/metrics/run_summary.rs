@@ -77,7 +77,12 @@ pub fn metric_catalogue(mode: Mode) -> Vec<String> {
             names.extend(TRANSPORT_METRICS.iter().map(|s| s.to_string()));
         }
         Mode::Work => {
-            names.extend(WORK_METRICS.iter().chain(&ROLL_METRICS).map(|s| s.to_string()));
+            names.extend(
+                WORK_METRICS
+                    .iter()
+                    .chain(&ROLL_METRICS)
+                    .map(|s| s.to_string()),
+            );
         }
     }
     names
@@ -286,13 +291,7 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         let l = bx.len() - 1;
         ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
     };
-    let values = [
-        last(ep),
-        last(ea).to_degrees(),
-        settle_p,
-        settle_a,
-        drift,
-    ];
+    let values = [last(ep), last(ea).to_degrees(), settle_p, settle_a, drift];
     add_all(out, &WORK_METRICS, values);
     roll_metrics(out, traj, settle_p.max(settle_a));
 }

@@ -8,8 +8,9 @@
 //! static analysis samples the same joint configurations at every point, and the objective
 //! is a deterministic function of the parameters.
 
+use super::history::Evaluation;
 use super::problem::Problem;
-use super::search::{Evaluation, Evaluator};
+use super::search::Evaluator;
 use crate::model::design::parse_design_table;
 use crate::report::Table;
 use crate::sampling::derive_seed;
@@ -82,7 +83,10 @@ impl<'a> CaseEvaluator<'a> {
             };
             for (vals, v) in variant_values.iter_mut().zip(&spec.variants) {
                 let own = v.set.iter().find(|(p, _)| p == k).map(|(_, x)| x.clone());
-                vals.push(own.or_else(|| base.clone()).unwrap_or(toml::Value::Float(f64::NAN)));
+                vals.push(
+                    own.or_else(|| base.clone())
+                        .unwrap_or(toml::Value::Float(f64::NAN)),
+                );
             }
             study.axes.push(Axis {
                 name: k.to_string(),
@@ -110,9 +114,8 @@ impl<'a> CaseEvaluator<'a> {
     /// Run one resolved case (with its trajectory when `log`).
     pub fn run_case(&self, r: &Resolved, log: bool) -> CaseMetrics {
         let study = &self.problem.study;
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            case_metrics(study, r, log)
-        }));
+        let outcome =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| case_metrics(study, r, log)));
         outcome.unwrap_or_else(|p| {
             let msg = p
                 .downcast_ref::<&str>()
@@ -183,7 +186,11 @@ fn case_metrics(study: &Study, r: &Resolved, log: bool) -> CaseMetrics {
         }
     };
     let named = |names: &[&str], values: &[f64]| -> Vec<(String, f64)> {
-        names.iter().map(|n| n.to_string()).zip(values.iter().copied()).collect()
+        names
+            .iter()
+            .map(|n| n.to_string())
+            .zip(values.iter().copied())
+            .collect()
     };
     out.named = named(&DESIGN_COLUMNS, &design_metrics(&v));
     if study.static_enabled {

@@ -14,11 +14,19 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::score::Score;
-use super::search::Evaluation;
 use crate::report::{Column, ColumnData, Table};
 
 /// File name of the journal in an output directory.
 pub const JOURNAL_FILE: &str = "journal.jsonl";
+
+/// The metrics of one point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Evaluation {
+    /// One row per scenario, one value per metric (the evaluator's columns).
+    pub metrics: Vec<Vec<f64>>,
+    /// Why the evaluation (or one of its scenarios) failed, if it did.
+    pub failure: Option<String>,
+}
 
 /// One evaluation.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,7 +80,8 @@ fn floats(v: &[u64]) -> Vec<f64> {
 impl Journal {
     /// Start a new journal for the problem with hash `hash` (replacing any old one).
     pub fn create(path: &Path, hash: &str) -> Result<Journal, String> {
-        let mut file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut file =
+            std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let h = serde_json::to_string(&Header {
             problem_hash: hash.to_string(),
         })
@@ -112,10 +121,7 @@ impl Journal {
 
 /// The evaluations of a journal keyed by the bits of their parameter values; `Err` when the
 /// journal belongs to another problem (its hash differs) or cannot be read.
-pub fn read_journal(
-    path: &Path,
-    hash: &str,
-) -> Result<HashMap<Vec<u64>, Evaluation>, String> {
+pub fn read_journal(path: &Path, hash: &str) -> Result<HashMap<Vec<u64>, Evaluation>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
     let header: Header = lines
@@ -172,7 +178,11 @@ pub fn history_table(
     for (k, m) in metrics.iter().enumerate() {
         let mean = |r: &Record| {
             let n = r.metrics.len().max(1) as f64;
-            r.metrics.iter().map(|s| s.get(k).copied().unwrap_or(f64::NAN)).sum::<f64>() / n
+            r.metrics
+                .iter()
+                .map(|s| s.get(k).copied().unwrap_or(f64::NAN))
+                .sum::<f64>()
+                / n
         };
         cols.push(col(m, reals(&mean)));
         if scenarios.len() > 1 {
@@ -220,7 +230,8 @@ pub fn best_so_far(records: &[Record]) -> Vec<f64> {
             if best.is_none_or(|b| r.score.better_than(&b)) {
                 best = Some(r.score);
             }
-            best.filter(|b| b.feasible).map_or(f64::NAN, |b| b.objective)
+            best.filter(|b| b.feasible)
+                .map_or(f64::NAN, |b| b.objective)
         })
         .collect()
 }

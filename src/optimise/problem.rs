@@ -312,7 +312,10 @@ pub fn parse_spec(
             .find(|l| l.line.is_some())
             .unwrap_or_else(|| Location::origin(doc.origin()));
         return Err(Located {
-            at: Location { key: key("param"), ..near },
+            at: Location {
+                key: key("param"),
+                ..near
+            },
             error: "the parameter list is empty: give at least one [[param]]".into(),
         });
     }
@@ -324,11 +327,21 @@ pub fn parse_spec(
         }
         list.push(param);
     }
-    let variants = parse_variants(file.variant.unwrap_or_default(), &key("variant"), study, doc)?;
+    let variants = parse_variants(
+        file.variant.unwrap_or_default(),
+        &key("variant"),
+        study,
+        doc,
+    )?;
     let objective = parse_objective(&file.objective, &key("objective"), study, doc)?;
     let mut constraints = Vec::new();
     for (i, c) in file.constraint.unwrap_or_default().iter().enumerate() {
-        constraints.push(parse_constraint(c, &key(&format!("constraint[{i}]")), study, doc)?);
+        constraints.push(parse_constraint(
+            c,
+            &key(&format!("constraint[{i}]")),
+            study,
+            doc,
+        )?);
     }
     let solver = parse_solver(&file.solver, &key("solver"), study.seed, doc)?;
     Ok(Spec {
@@ -340,7 +353,12 @@ pub fn parse_spec(
     })
 }
 
-fn parse_param(p: &ParamFile, at: &str, study: &Study, doc: &Document) -> Result<Param, InputError> {
+fn parse_param(
+    p: &ParamFile,
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<Param, InputError> {
     let k = |f: &str| format!("{at}.{f}");
     let (target, reference) = study_target(study, &p.name)
         .map_err(|m| doc.err(&k("name"), m))?
@@ -370,7 +388,10 @@ fn parse_param(p: &ParamFile, at: &str, study: &Study, doc: &Document) -> Result
     if p.lower >= p.upper {
         return Err(doc.err(
             &k("upper"),
-            format!("needs lower < upper (lower = {}, upper = {})", p.lower, p.upper),
+            format!(
+                "needs lower < upper (lower = {}, upper = {})",
+                p.lower, p.upper
+            ),
         ));
     }
     if scale == Scale::Log && p.lower <= 0.0 {
@@ -472,10 +493,9 @@ fn known_metric(name: &str, study: &Study) -> bool {
         || (study.static_enabled && TCM_COLUMNS.contains(&name))
         || match study.mode {
             StudyMode::Static => false,
-            StudyMode::Transport => crate::metrics::run_summary::is_run_metric(
-                crate::scenario::Mode::Transport,
-                name,
-            ),
+            StudyMode::Transport => {
+                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Transport, name)
+            }
             StudyMode::Work => {
                 crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Work, name)
             }
@@ -508,7 +528,11 @@ fn check_metric(name: &str, at: &str, study: &Study, doc: &Document) -> Result<(
         format!(
             "unknown metric `{name}` for mode \"{}\"{}; valid: {}",
             study.mode,
-            if study.static_enabled { " with [static]" } else { "" },
+            if study.static_enabled {
+                " with [static]"
+            } else {
+                ""
+            },
             metric_catalogue(study).join(", ")
         ),
     ))
@@ -621,7 +645,10 @@ fn parse_solver(
         return Err(doc.err(&k("max_iters"), "must be >= 1"));
     }
     if out.max_evals < 2 {
-        return Err(doc.err(&k("max_evals"), "must be >= 2 (the start point and one more)"));
+        return Err(doc.err(
+            &k("max_evals"),
+            "must be >= 2 (the start point and one more)",
+        ));
     }
     if !(out.tolerance > 0.0 && out.tolerance.is_finite()) {
         return Err(doc.err(&k("tolerance"), "must be finite and > 0"));

@@ -29,7 +29,7 @@ use argmin::solver::quasinewton::LBFGS;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
-use super::history::{Journal, Record};
+use super::history::{Evaluation, Journal, Record};
 use super::problem::{Method, SolverSettings};
 use super::score::{Score, Scorer};
 use super::space::Space;
@@ -40,15 +40,6 @@ pub const PENALTY: f64 = 1.0;
 
 /// Finite-difference step of the L-BFGS gradients, in normalised coordinates.
 pub const FD_STEP: f64 = 1e-4;
-
-/// The metrics of one point.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Evaluation {
-    /// One row per scenario, one value per metric (the evaluator's columns).
-    pub metrics: Vec<Vec<f64>>,
-    /// Why the evaluation (or one of its scenarios) failed, if it did.
-    pub failure: Option<String>,
-}
 
 /// What the optimiser evaluates: physical parameter values → metrics per scenario.
 pub trait Evaluator: Sync {
@@ -145,7 +136,11 @@ impl<'a, E: Evaluator> Search<'a, E> {
 
     /// Plan a batch: project, map, and mark fresh points up to the budget; returns the plan
     /// and whether the budget cut it short.
-    fn plan<P: std::borrow::Borrow<Vec<f64>>>(&self, st: &SearchState, us: &[P]) -> (Vec<Planned>, bool) {
+    fn plan<P: std::borrow::Borrow<Vec<f64>>>(
+        &self,
+        st: &SearchState,
+        us: &[P],
+    ) -> (Vec<Planned>, bool) {
         let mut fresh_keys: HashSet<Vec<u64>> = HashSet::new();
         let fresh_before = st.records.iter().filter(|r| !r.repeat).count();
         let mut plan = Vec::new();
@@ -160,7 +155,13 @@ impl<'a, E: Evaluator> Search<'a, E> {
                 }
                 fresh_keys.insert(key.clone());
             }
-            plan.push(Planned { u, x, d2, key, fresh });
+            plan.push(Planned {
+                u,
+                x,
+                d2,
+                key,
+                fresh,
+            });
         }
         (plan, false)
     }
@@ -179,13 +180,17 @@ impl<'a, E: Evaluator> Search<'a, E> {
             let mut keys = HashSet::new();
             (0..plan.len())
                 .filter(|&i| {
-                    plan[i].fresh && !st.memo.contains_key(&plan[i].key) && keys.insert(&plan[i].key)
+                    plan[i].fresh
+                        && !st.memo.contains_key(&plan[i].key)
+                        && keys.insert(&plan[i].key)
                 })
                 .collect()
         };
-        let done: Vec<Evaluation> = self
-            .pool
-            .install(|| todo.par_iter().map(|&i| self.ev.evaluate(&plan[i].x)).collect());
+        let done: Vec<Evaluation> = self.pool.install(|| {
+            todo.par_iter()
+                .map(|&i| self.ev.evaluate(&plan[i].x))
+                .collect()
+        });
         let mut st = self.lock();
         for (&i, e) in todo.iter().zip(done) {
             if let Some(j) = st.journal.as_mut() {
@@ -366,8 +371,8 @@ fn particle_swarm<E: Evaluator>(
 ) -> Result<String, Error> {
     let n = search.space.dim();
     let rng = rand_chacha::ChaCha8Rng::seed_from_u64(derive_seed(s.seed, run));
-    let solver = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), s.particles)
-        .with_rng_generator(rng);
+    let solver =
+        ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), s.particles).with_rng_generator(rng);
     let res = Executor::new(Handle(search), solver)
         .configure(|st| st.max_iters(s.max_iters))
         .add_observer(observer(search), ObserverMode::Always)

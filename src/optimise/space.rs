@@ -106,7 +106,11 @@ impl Space {
 
     /// Physical values of normalised coordinates (inside the box).
     pub fn values(&self, u: &[f64]) -> Vec<f64> {
-        self.params.iter().zip(u).map(|(p, &x)| p.value(x)).collect()
+        self.params
+            .iter()
+            .zip(u)
+            .map(|(p, &x)| p.value(x))
+            .collect()
     }
 }
 

@@ -18,8 +18,8 @@ use crate::optimise::history::{best_so_far, history_table, Record};
 use crate::optimise::{Outcome, Problem};
 use crate::report::figures::run_figure;
 use crate::report::{
-    atomic_write, file_stem_safe, fmt_num, write_csv, write_parquet, Colour, Figure,
-    MarkdownTable, Panel, PanelKind, Series,
+    atomic_write, file_stem_safe, fmt_num, write_csv, write_parquet, Colour, Figure, MarkdownTable,
+    Panel, PanelKind, Series,
 };
 use crate::scenario::Mode;
 use crate::study::cases::Resolved;
@@ -56,7 +56,13 @@ pub fn write_outputs(
     out: &Path,
     files: OptimiseFiles,
 ) -> Result<(), PipelineError> {
-    let params: Vec<String> = problem.spec.space.params.iter().map(|p| p.name.clone()).collect();
+    let params: Vec<String> = problem
+        .spec
+        .space
+        .params
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
     let table = history_table(
         &outcome.records,
         &params,
@@ -67,7 +73,10 @@ pub fn write_outputs(
     write_parquet(&table, &out.join(format!("{HISTORY}.parquet")))?;
     let ev = CaseEvaluator::new(problem);
     write_best_files(problem, &ev, &outcome.best().x, out)?;
-    atomic_write(&out.join("summary.md"), summary_md(problem, outcome).as_bytes())?;
+    atomic_write(
+        &out.join("summary.md"),
+        summary_md(problem, outcome).as_bytes(),
+    )?;
     let manifest = serde_json::to_string_pretty(&manifest(problem, outcome))?;
     atomic_write(&out.join("manifest.json"), manifest.as_bytes())?;
     if files.plots {
@@ -85,7 +94,10 @@ pub fn best_file_name(problem: &Problem, v: usize) -> String {
     if v == 0 {
         BEST_FILE.to_string()
     } else {
-        format!("best_{}.toml", file_stem_safe(&problem.spec.variants[v].name))
+        format!(
+            "best_{}.toml",
+            file_stem_safe(&problem.spec.variants[v].name)
+        )
     }
 }
 
@@ -107,7 +119,9 @@ pub fn case_file_text(problem: &Problem, r: &Resolved, x: &[f64]) -> Result<Stri
         t.insert("design".into(), toml::Value::Table(r.design.clone()));
         toml::to_string(&t)
     };
-    let body = body.map_err(|e| PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(e.to_string())))?;
+    let body = body.map_err(|e| {
+        PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(e.to_string()))
+    })?;
     Ok(format!("{head}\n{body}"))
 }
 
@@ -200,20 +214,36 @@ pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
         o.records.len(),
         o.fresh_evaluations(),
         b.index,
-        if b.score.feasible { "feasible" } else { "INFEASIBLE" },
+        if b.score.feasible {
+            "feasible"
+        } else {
+            "INFEASIBLE"
+        },
     );
     md.push_str(&format!(
         "Objective {} → {} ({}); start {}, best {}.\n\nStops: {}.\n\n## Parameters\n\n",
         fmt_num(s.score.objective),
         fmt_num(b.score.objective),
         change(s.score.objective, b.score.objective),
-        if s.score.feasible { "feasible" } else { "infeasible" },
-        if b.score.feasible { "feasible" } else { "infeasible" },
+        if s.score.feasible {
+            "feasible"
+        } else {
+            "infeasible"
+        },
+        if b.score.feasible {
+            "feasible"
+        } else {
+            "infeasible"
+        },
         o.stops.join("; ")
     ));
     let mut t = MarkdownTable::new(["parameter", "lower", "upper", "scale", "start", "best"]);
     for (k, p) in spec.space.params.iter().enumerate() {
-        let scale = if p.scale == crate::optimise::space::Scale::Log { "log" } else { "lin" };
+        let scale = if p.scale == crate::optimise::space::Scale::Log {
+            "log"
+        } else {
+            "lin"
+        };
         t.row([
             p.name.clone(),
             fmt_num(p.lower),
@@ -225,7 +255,15 @@ pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
     }
     md.push_str(&t.finish());
     md.push_str("\n## Objective terms (mean over the scenarios)\n\n");
-    let mut t = MarkdownTable::new(["metric", "weight", "scale", "start", "best", "change", "best term"]);
+    let mut t = MarkdownTable::new([
+        "metric",
+        "weight",
+        "scale",
+        "start",
+        "best",
+        "change",
+        "best term",
+    ]);
     let terms = o.scorer.term_values(&b.metrics);
     for (i, term) in spec.objective.terms.iter().enumerate() {
         let k = o.scorer.term_columns[i];
@@ -255,8 +293,15 @@ fn constraints_md(problem: &Problem, o: &Outcome) -> String {
     for (k, c) in problem.spec.constraints.iter().enumerate() {
         let col = o.scorer.constraint_columns[k];
         let met = |r: &Record| {
-            let ok = r.metrics.iter().all(|m| o.scorer.constraint_violation(k, m) == 0.0);
-            if ok { "yes" } else { "no" }
+            let ok = r
+                .metrics
+                .iter()
+                .all(|m| o.scorer.constraint_violation(k, m) == 0.0);
+            if ok {
+                "yes"
+            } else {
+                "no"
+            }
         };
         let worst = |r: &Record| {
             r.metrics
@@ -347,7 +392,10 @@ fn runs_figure(
     let best = figs.pop().unwrap_or_else(|| Figure::new(""));
     let start = figs.pop().unwrap_or_else(|| Figure::new(""));
     let rows = start.panels.len().max(best.panels.len());
-    let mut fig = Figure::new(format!("{}: start (left) and best (right)", problem.study.name));
+    let mut fig = Figure::new(format!(
+        "{}: start (left) and best (right)",
+        problem.study.name
+    ));
     for (a, b) in start.panels.into_iter().zip(best.panels) {
         let tag = |mut p: Panel, s: &str| {
             p.title = format!("{s}: {}", p.title);
