@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::score::Score;
+use super::score::{mean_of, Score};
 use crate::report::{Column, ColumnData, Table};
 
 /// File name of the journal in an output directory.
@@ -176,15 +176,7 @@ pub fn history_table(
         cols.push(col(p, reals(&|r| r.x[k])));
     }
     for (k, m) in metrics.iter().enumerate() {
-        let mean = |r: &Record| {
-            let n = r.metrics.len().max(1) as f64;
-            r.metrics
-                .iter()
-                .map(|s| s.get(k).copied().unwrap_or(f64::NAN))
-                .sum::<f64>()
-                / n
-        };
-        cols.push(col(m, reals(&mean)));
+        cols.push(col(m, reals(&|r| mean_of(&r.metrics, k))));
         if scenarios.len() > 1 {
             for (v, name) in scenarios.iter().enumerate() {
                 let one = |r: &Record| {

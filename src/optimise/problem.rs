@@ -19,7 +19,6 @@ use crate::study::axes::study_target;
 use crate::study::parse::parse_study_table;
 use crate::study::records::{DESIGN_COLUMNS, TCM_COLUMNS};
 use crate::study::runner::StudyMode;
-use crate::study::schema::Target;
 use crate::study::Study;
 
 /// The optimiser's top-level sections of a problem file (removed before the study part is
@@ -660,12 +659,4 @@ fn parse_solver(
         return Err(doc.err(&k("step"), "must be in (0, 0.5]"));
     }
     Ok(out)
-}
-
-/// The key a parameter edits, for messages and best.toml: `design.…` or the scenario path.
-pub fn target_text(t: &Target) -> String {
-    match t {
-        Target::Design(p) => format!("design.{p}"),
-        Target::Scenario(p) => p.to_string(),
-    }
 }

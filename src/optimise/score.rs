@@ -185,7 +185,7 @@ impl Scorer {
 }
 
 /// Mean of column `c` over the rows (NaN when a row lacks it or any value is NaN).
-fn mean_of(rows: &[Vec<f64>], c: usize) -> f64 {
+pub fn mean_of(rows: &[Vec<f64>], c: usize) -> f64 {
     let n = rows.len().max(1) as f64;
     rows.iter()
         .map(|r| r.get(c).copied().unwrap_or(f64::NAN))

@@ -15,6 +15,7 @@ use crate::control::transport::yaw_joint_mask;
 use crate::model::design::parse_design_table;
 use crate::optimise::evaluate::CaseEvaluator;
 use crate::optimise::history::{best_so_far, history_table, Record};
+use crate::optimise::score::mean_of;
 use crate::optimise::{Outcome, Problem};
 use crate::report::figures::run_figure;
 use crate::report::{
@@ -176,16 +177,6 @@ fn manifest(problem: &Problem, o: &Outcome) -> serde_json::Value {
     })
 }
 
-/// Mean of metric column `k` over the scenarios of a record.
-fn metric_mean(r: &Record, k: usize) -> f64 {
-    let n = r.metrics.len().max(1) as f64;
-    r.metrics
-        .iter()
-        .map(|m| m.get(k).copied().unwrap_or(f64::NAN))
-        .sum::<f64>()
-        / n
-}
-
 fn change(a: f64, b: f64) -> String {
     if a.is_finite() && b.is_finite() && a != 0.0 {
         format!("{:+.1} %", 100.0 * (b - a) / a.abs())
@@ -267,7 +258,7 @@ pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
     let terms = o.scorer.term_values(&b.metrics);
     for (i, term) in spec.objective.terms.iter().enumerate() {
         let k = o.scorer.term_columns[i];
-        let (a, z) = (metric_mean(s, k), metric_mean(b, k));
+        let (a, z) = (mean_of(&s.metrics, k), mean_of(&b.metrics, k));
         t.row([
             term.metric.clone(),
             fmt_num(term.weight),
