@@ -388,8 +388,15 @@ fn runs_figure(
         problem.study.name
     ));
     for (a, b) in start.panels.into_iter().zip(best.panels) {
+        // One y range per row, so the two runs compare at a glance.
+        let range = y_extent(&a).zip(y_extent(&b)).map(|(p, q)| {
+            let (lo, hi) = (p.0.min(q.0), p.1.max(q.1));
+            let pad = 0.05 * (hi - lo);
+            (lo - pad, hi + pad)
+        });
         let tag = |mut p: Panel, s: &str| {
             p.title = format!("{s}: {}", p.title);
+            p.y_range = range.filter(|r| r.1 > r.0);
             p
         };
         fig.panels.push(tag(a, "start"));
@@ -398,4 +405,13 @@ fn runs_figure(
     fig.layout = (rows, 2);
     fig.size = (1400, (300 * rows).max(400) as u32);
     Ok(Some(fig))
+}
+
+/// The finite y extent of a panel's series.
+fn y_extent(p: &Panel) -> Option<(f64, f64)> {
+    let ys = p.series.iter().flat_map(|s| &s.y).filter(|y| y.is_finite());
+    ys.fold(None, |acc, &y| match acc {
+        None => Some((y, y)),
+        Some((lo, hi)) => Some((lo.min(y), hi.max(y))),
+    })
 }
