@@ -20,6 +20,7 @@ pub mod input;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod optimise;
 pub mod pipeline;
 pub mod report;
 pub mod sampling;

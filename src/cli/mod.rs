@@ -8,6 +8,7 @@ mod allocate;
 mod design;
 mod format;
 mod inspect;
+mod optimise;
 mod paper;
 mod progress;
 mod simulate;
@@ -48,6 +49,9 @@ enum Command {
     Merge(sweep::MergeArgs),
     /// Regenerate summary.md and plots of a sweep output directory.
     Report(sweep::ReportArgs),
+    /// Optimise gains, layouts or references of a problem file with argmin (Nelder–Mead,
+    /// particle swarm, L-BFGS), feasibility first.
+    Optimise(optimise::OptimiseArgs),
 }
 
 /// Parse `std::env::args` and run the chosen command.
@@ -63,5 +67,6 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Sweep(a) => sweep::run(a),
         Command::Merge(a) => sweep::run_merge(a),
         Command::Report(a) => sweep::run_report(a),
+        Command::Optimise(a) => optimise::run_optimise(a),
     }
 }

@@ -13,8 +13,106 @@ use crate::scenario::recorder::AllocationCounts;
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;
 
-fn add(out: &mut Metrics, name: &str, x: f64) {
-    out.push((name.to_string(), x));
+/// The metrics of every mode, in the order [`run_summary`] adds them (documented at
+/// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
+/// that computes them adds values in this order, and [`metric_catalogue`] lists them so that
+/// callers (the optimiser) can check names before anything runs.
+pub const COMMON_METRICS: [&str; 15] = [
+    "completed",
+    "simulated_time",
+    "thruster_energy",
+    "thruster_energy_static",
+    "effort_sq",
+    "effort_abs",
+    "joint_energy",
+    "joint_torque_peak",
+    "peak_thrust",
+    "saturation_fraction",
+    "singularity_exposure",
+    "sigma_min_min",
+    "sigma_min_mean",
+    "slack_fraction",
+    "allocation_failures",
+];
+
+/// Per-segment transport metrics, each named `seg{k}_{name}` for segment `k` (0-based).
+pub const SEGMENT_METRICS: [&str; 3] = ["convergence_time", "overshoot", "cross_track_rms"];
+
+/// Transport metrics over the whole run (after the per-segment ones).
+pub const TRANSPORT_METRICS: [&str; 9] = [
+    "segments_reached",
+    "converged",
+    "convergence_time",
+    "overshoot",
+    "cross_track_rms",
+    "base_cross_track_rms",
+    "final_cross_track",
+    "path_progress",
+    "energy_per_metre",
+];
+
+/// Work-mode regulation metrics (then [`ROLL_METRICS`]).
+pub const WORK_METRICS: [&str; 5] = [
+    "final_position_error",
+    "final_orientation_error_deg",
+    "settling_time_position",
+    "settling_time_orientation",
+    "base_drift",
+];
+
+/// Work-mode end-effector roll metrics (see [`roll_metrics`]).
+pub const ROLL_METRICS: [&str; 3] = [
+    "ee_roll_max_deg",
+    "ee_roll_max_settled_deg",
+    "ee_roll_std_deg",
+];
+
+/// Every metric name a run of `mode` reports, in order, with the per-segment transport
+/// metrics written as `seg{k}_…` patterns (see [`is_run_metric`]).
+pub fn metric_catalogue(mode: Mode) -> Vec<String> {
+    let mut names: Vec<String> = COMMON_METRICS.iter().map(|s| s.to_string()).collect();
+    match mode {
+        Mode::Transport => {
+            names.extend(SEGMENT_METRICS.iter().map(|s| format!("seg{{k}}_{s}")));
+            names.extend(TRANSPORT_METRICS.iter().map(|s| s.to_string()));
+        }
+        Mode::Work => {
+            names.extend(
+                WORK_METRICS
+                    .iter()
+                    .chain(&ROLL_METRICS)
+                    .map(|s| s.to_string()),
+            );
+        }
+    }
+    names
+}
+
+/// Whether `name` is a metric a run of `mode` reports: a catalogue name, or for transport
+/// `seg{k}_{name}` with `k` a segment index.
+pub fn is_run_metric(mode: Mode, name: &str) -> bool {
+    if COMMON_METRICS.contains(&name) {
+        return true;
+    }
+    match mode {
+        Mode::Transport => {
+            TRANSPORT_METRICS.contains(&name)
+                || name
+                    .strip_prefix("seg")
+                    .and_then(|r| r.split_once('_'))
+                    .is_some_and(|(k, m)| {
+                        !k.is_empty()
+                            && k.bytes().all(|b| b.is_ascii_digit())
+                            && SEGMENT_METRICS.contains(&m)
+                    })
+        }
+        Mode::Work => WORK_METRICS.contains(&name) || ROLL_METRICS.contains(&name),
+    }
+}
+
+/// Append `values` under the declared `names` (same length by construction).
+fn add_all<const N: usize>(out: &mut Metrics, names: &[&str; N], values: [f64; N]) {
+    out.extend(names.iter().zip(values).map(|(n, x)| (n.to_string(), x)));
 }
 
 /// A channel's samples, empty if the run did not log it.
@@ -62,39 +160,31 @@ fn common_metrics(
     e: &EnergyMetrics,
 ) {
     let t = channel(traj, Channel::T);
-    add(out, "completed", if failed { 0.0 } else { 1.0 });
-    add(out, "simulated_time", t.last().copied().unwrap_or(0.0));
-    add(out, "thruster_energy", e.thruster_energy);
-    add(out, "thruster_energy_static", e.thruster_energy_static);
-    add(out, "effort_sq", e.effort_sq);
-    add(out, "effort_abs", e.effort_abs);
-    add(out, "joint_energy", e.joint_energy);
-    add(out, "joint_torque_peak", e.joint_torque_peak);
-    add(out, "peak_thrust", e.peak_thrust);
-    add(out, "saturation_fraction", e.saturation_fraction);
     let sig = channel(traj, Channel::SigmaMin);
-    add(
-        out,
-        "singularity_exposure",
-        singularity_exposure(t, sig, file.metrics.threshold),
-    );
-    add(
-        out,
-        "sigma_min_min",
-        sig.iter().copied().fold(f64::INFINITY, f64::min),
-    );
-    add(
-        out,
-        "sigma_min_mean",
-        if sig.is_empty() {
-            f64::NAN
-        } else {
-            sig.iter().sum::<f64>() / sig.len() as f64
-        },
-    );
+    let sigma_mean = if sig.is_empty() {
+        f64::NAN
+    } else {
+        sig.iter().sum::<f64>() / sig.len() as f64
+    };
     let steps = counts.steps.max(1) as f64;
-    add(out, "slack_fraction", counts.slack_active as f64 / steps);
-    add(out, "allocation_failures", counts.solver_failures as f64);
+    let values = [
+        if failed { 0.0 } else { 1.0 },
+        t.last().copied().unwrap_or(0.0),
+        e.thruster_energy,
+        e.thruster_energy_static,
+        e.effort_sq,
+        e.effort_abs,
+        e.joint_energy,
+        e.joint_torque_peak,
+        e.peak_thrust,
+        e.saturation_fraction,
+        singularity_exposure(t, sig, file.metrics.threshold),
+        sig.iter().copied().fold(f64::INFINITY, f64::min),
+        sigma_mean,
+        counts.slack_active as f64 / steps,
+        counts.solver_failures as f64,
+    ];
+    add_all(out, &COMMON_METRICS, values);
 }
 
 /// Index ranges `[a, b)` of the contiguous runs of equal values in `seg` (the samples during
@@ -133,13 +223,13 @@ fn transport_metrics(
     let mut all_converged = !runs.is_empty();
     for (k, &(a, b)) in runs.iter().enumerate() {
         let st = segment_tracking(&t[a..b], &ey[a..b], spec.band);
-        add(
-            out,
-            &format!("seg{k}_convergence_time"),
-            st.convergence_time,
+        let values = [st.convergence_time, st.overshoot, st.rms_after];
+        out.extend(
+            SEGMENT_METRICS
+                .iter()
+                .zip(values)
+                .map(|(n, x)| (format!("seg{k}_{n}"), x)),
         );
-        add(out, &format!("seg{k}_overshoot"), st.overshoot);
-        add(out, &format!("seg{k}_cross_track_rms"), st.rms_after);
         if st.convergence_time.is_nan() {
             all_converged = false;
         } else {
@@ -168,23 +258,18 @@ fn transport_metrics(
             f64::NAN
         }
     };
-    add(out, "segments_reached", runs.len() as f64);
-    add(out, "converged", if all_converged { 1.0 } else { 0.0 });
-    add(
-        out,
-        "convergence_time",
+    let values = [
+        runs.len() as f64,
+        if all_converged { 1.0 } else { 0.0 },
         if all_converged { conv_max } else { f64::NAN },
-    );
-    add(out, "overshoot", overshoot_max);
-    add(out, "cross_track_rms", rms(rms_sq));
-    add(out, "base_cross_track_rms", rms(base_sq));
-    add(
-        out,
-        "final_cross_track",
+        overshoot_max,
+        rms(rms_sq),
+        rms(base_sq),
         ey.last().copied().unwrap_or(f64::NAN),
-    );
-    add(out, "path_progress", energy.path_progress);
-    add(out, "energy_per_metre", energy.energy_per_metre());
+        energy.path_progress,
+        energy.energy_per_metre(),
+    ];
+    add_all(out, &TRANSPORT_METRICS, values);
 }
 
 /// Work: final errors and settling times of the end-effector, the base's drift, and the
@@ -195,12 +280,8 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
     let ep = channel(traj, Channel::EePositionError);
     let ea = channel(traj, Channel::EeOrientationError);
     let last = |x: &[f64]| x.last().copied().unwrap_or(f64::NAN);
-    add(out, "final_position_error", last(ep));
-    add(out, "final_orientation_error_deg", last(ea).to_degrees());
     let settle_p = settling_time(t, ep, spec.position_tolerance);
     let settle_a = settling_time(t, ea, spec.orientation_tolerance_deg.to_radians());
-    add(out, "settling_time_position", settle_p);
-    add(out, "settling_time_orientation", settle_a);
     let bx = channel(traj, Channel::BasePose(Pose::X));
     let by = channel(traj, Channel::BasePose(Pose::Y));
     let bz = channel(traj, Channel::BasePose(Pose::Z));
@@ -210,7 +291,8 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         let l = bx.len() - 1;
         ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
     };
-    add(out, "base_drift", drift);
+    let values = [last(ep), last(ea).to_degrees(), settle_p, settle_a, drift];
+    add_all(out, &WORK_METRICS, values);
     roll_metrics(out, traj, settle_p.max(settle_a));
 }
 
@@ -225,7 +307,7 @@ fn roll_metrics(out: &mut Metrics, traj: &Trajectory, settled: f64) {
     let sr = channel(traj, Channel::Setpoint(Pose::Roll));
     let dev: Vec<f64> = er.iter().zip(sr).map(|(a, b)| wrap_angle(a - b)).collect();
     let peak = |d: &[f64]| d.iter().fold(0.0f64, |m, x| m.max(x.abs())).to_degrees();
-    add(out, "ee_roll_max_deg", peak(&dev));
+    let whole = peak(&dev);
     let t0 = t.first().copied().unwrap_or(0.0);
     let after: Vec<f64> = t
         .iter()
@@ -233,15 +315,14 @@ fn roll_metrics(out: &mut Metrics, traj: &Trajectory, settled: f64) {
         .filter(|(ti, _)| settled.is_finite() && **ti - t0 >= settled)
         .map(|(_, d)| *d)
         .collect();
-    if after.is_empty() {
-        add(out, "ee_roll_max_settled_deg", f64::NAN);
-        add(out, "ee_roll_std_deg", f64::NAN);
-        return;
-    }
-    let mean = after.iter().sum::<f64>() / after.len() as f64;
-    let var = after.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / after.len() as f64;
-    add(out, "ee_roll_max_settled_deg", peak(&after));
-    add(out, "ee_roll_std_deg", var.sqrt().to_degrees());
+    let (settled_peak, std) = if after.is_empty() {
+        (f64::NAN, f64::NAN)
+    } else {
+        let mean = after.iter().sum::<f64>() / after.len() as f64;
+        let var = after.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / after.len() as f64;
+        (peak(&after), var.sqrt().to_degrees())
+    };
+    add_all(out, &ROLL_METRICS, [whole, settled_peak, std]);
 }
 
 #[cfg(test)]

@@ -11,7 +11,8 @@
 //! - [`antonelli`]: Antonelli & Chiaverini's case studies (kinematic 1, 1b, 2; dynamic 3a,
 //!   3b and Table I), their CSVs and summary; [`antonelli_figures`]: their figures;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
-//! - [`allocate`]: one thrust-allocation case file, validated and solved with each method.
+//! - [`allocate`]: one thrust-allocation case file, validated and solved with each method;
+//! - [`optimise`]: the files of an optimisation (history, best point, summary, plots).
 //!
 //! The batch sweep's pipeline lives in [`crate::study`]. No pipeline prints: progress and
 //! per-run outcomes reach the caller through callbacks.
@@ -22,6 +23,7 @@ pub mod antonelli_figures;
 pub mod draw;
 pub mod error;
 pub mod inspect;
+pub mod optimise;
 pub mod paper;
 pub mod review;
 pub mod shapes;

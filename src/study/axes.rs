@@ -8,7 +8,7 @@ use serde::Deserialize;
 
 use super::error::InputError;
 use super::schema::{
-    is_scenario_table, Axis, AxisSpec, Dist, Doe, Target, GENERATOR_KEYS, MAX_CASES,
+    is_scenario_table, Axis, AxisSpec, Dist, Doe, Study, Target, GENERATOR_KEYS, MAX_CASES,
 };
 use crate::input::document::Document;
 use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
@@ -212,7 +212,35 @@ fn axis_target(
     design: &toml::Table,
     doc: &Document,
 ) -> Result<Option<(Target, Option<toml::Value>)>, InputError> {
-    let path = KeyPath::parse(&a.name).map_err(|m| doc.err(&format!("axis[{i}].name"), m))?;
+    target_of(&a.name, names, design).map_err(|m| doc.err(&format!("axis[{i}].name"), m))
+}
+
+/// The target and reference value of the key path `name` (as a sweep axis would edit it) in
+/// a parsed study: `Err` when the path does not parse, `Ok(None)` when it is not a valid
+/// parameter name of the study (the optimiser's `[[param]]` entries use this).
+pub fn study_target(
+    study: &Study,
+    name: &str,
+) -> Result<Option<(Target, Option<toml::Value>)>, String> {
+    let (mut sc, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
+    flatten(&study.scenario_full, "", &mut sc, &mut sc_arrays);
+    let names = valid_names(
+        &study.design,
+        study.generator,
+        sc,
+        sc_arrays,
+        study.scenario_full.clone(),
+    );
+    target_of(name, &names, &study.design)
+}
+
+/// [`study_target`] against prepared names.
+fn target_of(
+    name: &str,
+    names: &Names,
+    design: &toml::Table,
+) -> Result<Option<(Target, Option<toml::Value>)>, String> {
+    let path = KeyPath::parse(name)?;
     if path.head() == "design" {
         let mut rest = path.tail();
         if names.generator {

@@ -16,7 +16,7 @@ use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
 use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
-use crate::input::document::Document;
+use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{flatten, pattern_allowed};
 use crate::input::located::Location;
 use crate::model::design::{load_design_table, parse_design_table};
@@ -138,19 +138,36 @@ pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
     let origin = path.display().to_string();
     let doc = Document::parse(text, &origin)?;
     let file: StudyFile = toml::from_str(text).map_err(|e| doc.serde_error(&e))?;
+    study_from_file(file, &doc, path)
+}
+
+/// Parse and validate the study part of a larger file: `table` is `doc`'s table without the
+/// sections another reader owns (the optimiser's `[[param]]`, `[objective]`, …). Errors are
+/// placed in `doc`, so they name the file's lines; the study hash is of the whole text.
+pub fn parse_study_table(
+    doc: &Document,
+    table: &toml::Table,
+    path: &Path,
+) -> Result<Study, InputError> {
+    let file: StudyFile = deserialize_table(table, "").map_err(|e| doc.place(e))?;
+    study_from_file(file, doc, path)
+}
+
+fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study, InputError> {
+    let text = doc.text();
     let meta = &file.study;
-    check_name(&meta.name, &doc)?;
+    check_name(&meta.name, doc)?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let (design, generator) = check_design(&file, dir, &doc)?;
-    let side = scenario_side(&file, &doc)?;
+    let (design, generator) = check_design(&file, dir, doc)?;
+    let side = scenario_side(&file, doc)?;
     let names = valid_names(&design, generator, side.names, side.arrays, side.reference);
-    let doe = parse_doe(file.doe.as_ref(), &doc)?;
+    let doe = parse_doe(file.doe.as_ref(), doc)?;
     let axes = parse_axes(
         file.axis.as_deref().unwrap_or_default(),
         &names,
         &design,
         doe,
-        &doc,
+        doc,
     )?;
     let output = meta
         .output

@@ -91,7 +91,7 @@ impl Worker {
 }
 
 /// The [`DESIGN_COLUMNS`] of a vehicle.
-fn design_metrics(v: &Vehicle) -> [f64; 5] {
+pub fn design_metrics(v: &Vehicle) -> [f64; 5] {
     [
         v.bodies.len() as f64,
         v.n_joints() as f64,
@@ -123,7 +123,7 @@ fn static_phase(v: &Vehicle, r: &Resolved, row: &mut Row) -> Option<()> {
 }
 
 /// The [`TCM_COLUMNS`] of a static summary.
-fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
+pub fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
     let q = |p| s.sigma_min_quantile(p).unwrap_or(f64::NAN);
     let kq = |p: f64| {
         s.kappa

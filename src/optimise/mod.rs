@@ -1,0 +1,29 @@
+//! Optimisation of a design's or a scenario's parameters with argmin (`usm-study optimise`,
+//! docs/optimise.md): gains, layouts, references — any key a sweep axis may edit — against a
+//! weighted objective of named metrics under constraints, feasibility first.
+//!
+//! Modules in dependency order (this file only declares and re-exports):
+//!
+//! - [`space`]: parameters, bounds and scales, the normalised unit box the solvers work in.
+//! - [`problem`]: problem files → a validated [`Problem`] (study part + optimiser sections);
+//!   [`problem::parse_spec`] reads the optimiser sections under any key prefix.
+//! - [`score`]: objective normalisation, combination over scenarios, constraint violation and
+//!   the feasibility-first ranking.
+//! - [`history`]: evaluation records, the history table and the resume journal.
+//! - [`search`]: the argmin cost function, gradient, observer and the three solvers.
+//! - [`evaluate`]: a problem's point → its metrics (the sweep's case machinery).
+//! - [`engine`]: [`run`] and [`minimise`]: start point, solver runs, outcome.
+//!
+//! The library API a caller (the `optimise` verb, a sweep tuning each case) uses is
+//! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
+
+pub mod engine;
+pub mod evaluate;
+pub mod history;
+pub mod problem;
+pub mod score;
+pub mod search;
+pub mod space;
+
+pub use engine::{minimise, run, OptimiseError, Options, Outcome};
+pub use problem::{load_problem, parse_problem, Problem, Spec};

@@ -1,0 +1,662 @@
+//! Problem files → a validated [`Problem`]: a study file (`[study]`, `[design]`, the scenario
+//! side) whose sweep axes are replaced by the optimiser's sections, read by [`parse_spec`]:
+//! `[[param]]`, `[[variant]]`, `[objective]` with `[[objective.term]]`, `[[constraint]]` and
+//! `[solver]`. The format is documented in `docs/optimise.md`.
+//!
+//! Every check runs here, before any evaluation; each error names the file, the line and the
+//! key (`param[2].upper: needs lower < upper`). [`parse_spec`] reads the optimiser's sections
+//! of any table under a key prefix, so that a sweep's `[tune]` section can reuse it.
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+use super::space::{Param, Scale, Space};
+use crate::input::document::{deserialize_table, Document};
+use crate::input::keypath::join_key;
+use crate::input::located::{InputError, Located, Location};
+use crate::study::axes::study_target;
+use crate::study::parse::parse_study_table;
+use crate::study::records::{DESIGN_COLUMNS, TCM_COLUMNS};
+use crate::study::runner::StudyMode;
+use crate::study::Study;
+
+/// The optimiser's top-level sections of a problem file (removed before the study part is
+/// parsed).
+pub const SPEC_KEYS: [&str; 5] = ["param", "variant", "objective", "constraint", "solver"];
+
+/// How the objectives of several scenarios ([`Variant`]s) are combined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Combine {
+    /// The mean of the scenarios' objectives.
+    Mean,
+    /// The largest (worst) of the scenarios' objectives.
+    Worst,
+}
+
+/// One weighted term of the objective: `weight · metric / scale`, the scale being the
+/// metric's |value| at the start point (see [`Objective::normalise`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Term {
+    /// Metric name (a run-summary, design or static TCM metric).
+    pub metric: String,
+    /// Weight (negative to maximise the metric).
+    pub weight: f64,
+}
+
+/// The objective: a weighted sum of named metrics, combined over the scenarios.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Objective {
+    /// The terms.
+    pub terms: Vec<Term>,
+    /// Combination over scenarios.
+    pub combine: Combine,
+    /// Divide each term by its metric's |value| at the start (mean over the scenarios; 1 when
+    /// that is zero or not finite), so that weights are comparable across units.
+    pub normalise: bool,
+}
+
+/// A comparison of a constraint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Op {
+    /// `metric <= value`.
+    #[serde(rename = "<=")]
+    Le,
+    /// `metric >= value`.
+    #[serde(rename = ">=")]
+    Ge,
+    /// `|metric − value| <= tolerance`.
+    #[serde(rename = "==")]
+    Eq,
+}
+
+impl Op {
+    /// The operator as written.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Op::Le => "<=",
+            Op::Ge => ">=",
+            Op::Eq => "==",
+        }
+    }
+}
+
+/// A constraint `metric op value`, met in every scenario (see [`super::score`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Constraint {
+    /// Metric name.
+    pub metric: String,
+    /// Comparison.
+    pub op: Op,
+    /// Bound.
+    pub value: f64,
+    /// Slack of `==` (default 1e-9·max(1, |value|)).
+    pub tolerance: f64,
+}
+
+/// The solver of `[solver] method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Method {
+    /// Nelder–Mead simplex from the start point (local; argmin `NelderMead`).
+    #[serde(rename = "nelder-mead")]
+    NelderMead,
+    /// Particle swarm within the bounds (global; argmin `ParticleSwarm`, seeded).
+    #[serde(rename = "particle-swarm")]
+    ParticleSwarm,
+    /// L-BFGS with central finite-difference gradients (argmin `LBFGS`, Moré–Thuente line
+    /// search), for smooth static objectives.
+    #[serde(rename = "lbfgs")]
+    Lbfgs,
+}
+
+impl Method {
+    /// Every method, as written in problem files.
+    pub const ALL: [(&'static str, Method); 3] = [
+        ("nelder-mead", Method::NelderMead),
+        ("particle-swarm", Method::ParticleSwarm),
+        ("lbfgs", Method::Lbfgs),
+    ];
+
+    /// The name as written.
+    pub fn as_str(self) -> &'static str {
+        Method::ALL
+            .iter()
+            .find(|(_, m)| *m == self)
+            .map_or("", |(n, _)| n)
+    }
+}
+
+/// `[solver]`: the method, its budgets and tolerances.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SolverSettings {
+    /// The method.
+    pub method: Method,
+    /// Iterations per run of the method (argmin `max_iters`; default 100).
+    pub max_iters: u64,
+    /// Evaluations in all, the start point included (default 200); repeated points are
+    /// served from memory and not counted.
+    pub max_evals: usize,
+    /// Nelder–Mead: standard deviation of the simplex's costs; L-BFGS: gradient norm and
+    /// cost change (default 1e-6).
+    pub tolerance: f64,
+    /// Further runs after the first (Nelder–Mead and L-BFGS from the best point so far,
+    /// particle swarm with a new seed; default 0).
+    pub restarts: usize,
+    /// Seed of the particle swarm (default: `study.seed`).
+    pub seed: u64,
+    /// Particles of the swarm (default 12).
+    pub particles: usize,
+    /// Nelder–Mead initial simplex edge and finite-difference step, in the unit box of the
+    /// normalised parameters (default 0.1 and 1e-4·… see `docs/optimise.md`).
+    pub step: f64,
+}
+
+/// One scenario of a robust objective: key paths set on top of the parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variant {
+    /// Name (history columns `metric@name`).
+    pub name: String,
+    /// `(key path, value)` in the order written.
+    pub set: Vec<(String, toml::Value)>,
+}
+
+/// The optimiser's sections, validated against a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spec {
+    /// The parameters and their normalised space.
+    pub space: Space,
+    /// The scenarios (one nameless variant when none is given).
+    pub variants: Vec<Variant>,
+    /// The objective.
+    pub objective: Objective,
+    /// The constraints.
+    pub constraints: Vec<Constraint>,
+    /// The solver.
+    pub solver: SolverSettings,
+}
+
+impl Spec {
+    /// Every metric the objective and the constraints read, each once, in order of first use.
+    pub fn metrics(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        let names = self
+            .objective
+            .terms
+            .iter()
+            .map(|t| &t.metric)
+            .chain(self.constraints.iter().map(|c| &c.metric));
+        for n in names {
+            if !out.contains(n) {
+                out.push(n.clone());
+            }
+        }
+        out
+    }
+}
+
+/// A validated problem file.
+#[derive(Clone, Debug)]
+pub struct Problem {
+    /// The study part (design, scenario side, name, seed, output); no axes.
+    pub study: Study,
+    /// The optimiser's sections.
+    pub spec: Spec,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecFile {
+    param: Option<Vec<ParamFile>>,
+    variant: Option<Vec<VariantFile>>,
+    objective: ObjectiveFile,
+    constraint: Option<Vec<ConstraintFile>>,
+    solver: SolverFile,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParamFile {
+    name: String,
+    lower: f64,
+    upper: f64,
+    scale: Option<String>,
+    start: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct VariantFile {
+    name: String,
+    set: Option<toml::Table>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectiveFile {
+    term: Vec<TermFile>,
+    combine: Option<String>,
+    normalise: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TermFile {
+    metric: String,
+    weight: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConstraintFile {
+    metric: String,
+    op: String,
+    value: f64,
+    tolerance: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SolverFile {
+    method: String,
+    max_iters: Option<u64>,
+    max_evals: Option<usize>,
+    tolerance: Option<f64>,
+    restarts: Option<usize>,
+    seed: Option<u64>,
+    particles: Option<usize>,
+    step: Option<f64>,
+}
+
+/// Read and validate a problem file.
+pub fn load_problem(path: &Path) -> Result<Problem, InputError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        at: Location::origin(&origin),
+        error: format!("cannot read the problem file: {e}"),
+    })?;
+    parse_problem(&text, path)
+}
+
+/// Parse and validate problem text; `path` names the origin and anchors relative files.
+pub fn parse_problem(text: &str, path: &Path) -> Result<Problem, InputError> {
+    let doc = Document::parse(text, &path.display().to_string())?;
+    let mut table: toml::Table = doc.deserialize()?;
+    let mut spec_table = toml::Table::new();
+    for k in SPEC_KEYS {
+        if let Some(v) = table.remove(k) {
+            spec_table.insert(k.to_string(), v);
+        }
+    }
+    let study = parse_study_table(&doc, &table, path)?;
+    let spec = parse_spec(&doc, &spec_table, "", &study)?;
+    Ok(Problem { study, spec })
+}
+
+/// The optimiser's sections of `table` (found in `doc` under `prefix`, e.g. `tune`),
+/// validated against `study`: parameters, scenarios, metric names, solver settings.
+pub fn parse_spec(
+    doc: &Document,
+    table: &toml::Table,
+    prefix: &str,
+    study: &Study,
+) -> Result<Spec, InputError> {
+    let key = |k: &str| join_key(prefix, k);
+    let file: SpecFile = deserialize_table(table, prefix).map_err(|e| doc.place(e))?;
+    let params = file.param.unwrap_or_default();
+    if params.is_empty() {
+        let near = ["param", "objective", "solver"]
+            .into_iter()
+            .map(|k| doc.location(&key(k)))
+            .find(|l| l.line.is_some())
+            .unwrap_or_else(|| Location::origin(doc.origin()));
+        return Err(Located {
+            at: Location {
+                key: key("param"),
+                ..near
+            },
+            error: "the parameter list is empty: give at least one [[param]]".into(),
+        });
+    }
+    let mut list = Vec::new();
+    for (i, p) in params.iter().enumerate() {
+        let param = parse_param(p, &key(&format!("param[{i}]")), study, doc)?;
+        if list.iter().any(|q: &Param| q.name == param.name) {
+            return Err(doc.err(&key(&format!("param[{i}].name")), "duplicate parameter"));
+        }
+        list.push(param);
+    }
+    let variants = parse_variants(
+        file.variant.unwrap_or_default(),
+        &key("variant"),
+        study,
+        doc,
+    )?;
+    let objective = parse_objective(&file.objective, &key("objective"), study, doc)?;
+    let mut constraints = Vec::new();
+    for (i, c) in file.constraint.unwrap_or_default().iter().enumerate() {
+        constraints.push(parse_constraint(
+            c,
+            &key(&format!("constraint[{i}]")),
+            study,
+            doc,
+        )?);
+    }
+    let solver = parse_solver(&file.solver, &key("solver"), study.seed, doc)?;
+    Ok(Spec {
+        space: Space::new(list),
+        variants,
+        objective,
+        constraints,
+        solver,
+    })
+}
+
+fn parse_param(
+    p: &ParamFile,
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<Param, InputError> {
+    let k = |f: &str| format!("{at}.{f}");
+    let (target, reference) = study_target(study, &p.name)
+        .map_err(|m| doc.err(&k("name"), m))?
+        .ok_or_else(|| {
+            doc.err(
+                &k("name"),
+                format!(
+                    "unknown parameter `{}`: not a key a sweep axis of this file may edit \
+                     (`design.…` or a scenario-side key of mode \"{}\"; see docs/study-format.md)",
+                    p.name, study.mode
+                ),
+            )
+        })?;
+    let scale = match p.scale.as_deref().unwrap_or("lin") {
+        "lin" => Scale::Lin,
+        "log" => Scale::Log,
+        other => {
+            return Err(doc.err(
+                &k("scale"),
+                format!("unknown scale `{other}`; valid: lin, log"),
+            ))
+        }
+    };
+    if !(p.lower.is_finite() && p.upper.is_finite()) {
+        return Err(doc.err(&k("lower"), "bounds must be finite"));
+    }
+    if p.lower >= p.upper {
+        return Err(doc.err(
+            &k("upper"),
+            format!(
+                "needs lower < upper (lower = {}, upper = {})",
+                p.lower, p.upper
+            ),
+        ));
+    }
+    if scale == Scale::Log && p.lower <= 0.0 {
+        return Err(doc.err(&k("lower"), "a log scale needs lower > 0"));
+    }
+    let integer = matches!(reference, Some(toml::Value::Integer(_)));
+    let current = match &reference {
+        Some(toml::Value::Float(x)) => Some(*x),
+        Some(toml::Value::Integer(n)) => Some(*n as f64),
+        Some(other) => {
+            return Err(doc.err(
+                &k("name"),
+                format!("`{}` holds a {}, not a number", p.name, other.type_str()),
+            ))
+        }
+        None => None,
+    };
+    let (start, from) = match (p.start, current) {
+        (Some(s), _) => (s, "start"),
+        (None, Some(c)) => (c, "name"),
+        (None, None) => {
+            return Err(doc.err(
+                &k("name"),
+                format!("`{}` has no value in the file: give `start`", p.name),
+            ))
+        }
+    };
+    if !(start >= p.lower && start <= p.upper) {
+        let what = if from == "start" {
+            "start".to_string()
+        } else {
+            format!("the file's current value of `{}`", p.name)
+        };
+        return Err(doc.err(
+            &k(from),
+            format!("{what} ({start}) is outside [{}, {}]", p.lower, p.upper),
+        ));
+    }
+    Ok(Param {
+        name: p.name.clone(),
+        target,
+        lower: p.lower,
+        upper: p.upper,
+        scale,
+        start,
+        integer,
+    })
+}
+
+fn parse_variants(
+    files: Vec<VariantFile>,
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<Vec<Variant>, InputError> {
+    if files.is_empty() {
+        return Ok(vec![Variant {
+            name: String::new(),
+            set: Vec::new(),
+        }]);
+    }
+    let mut out: Vec<Variant> = Vec::new();
+    for (i, v) in files.into_iter().enumerate() {
+        let k = format!("{at}[{i}]");
+        if v.name.is_empty() || out.iter().any(|o| o.name == v.name) {
+            return Err(doc.err(&format!("{k}.name"), "must be non-empty and unique"));
+        }
+        let mut set = Vec::new();
+        for (path, value) in v.set.unwrap_or_default() {
+            let found = study_target(study, &path).map_err(|m| doc.err(&format!("{k}.set"), m))?;
+            if found.is_none() {
+                return Err(doc.err(
+                    &format!("{k}.set"),
+                    format!("unknown key `{path}`: not a key a sweep axis of this file may edit"),
+                ));
+            }
+            set.push((path, value));
+        }
+        out.push(Variant { name: v.name, set });
+    }
+    // Every key some variant sets needs a base value for the variants that do not set it.
+    for v in &out {
+        for (path, _) in &v.set {
+            let base = study_target(study, path).ok().flatten().and_then(|t| t.1);
+            if base.is_none() && out.iter().any(|w| !w.set.iter().any(|(p, _)| p == path)) {
+                return Err(doc.err(
+                    at,
+                    format!("`{path}` has no value in the file; every variant must set it"),
+                ));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Whether `name` is a metric the problem's evaluations report.
+fn known_metric(name: &str, study: &Study) -> bool {
+    DESIGN_COLUMNS.contains(&name)
+        || (study.static_enabled && TCM_COLUMNS.contains(&name))
+        || match study.mode {
+            StudyMode::Static => false,
+            StudyMode::Transport => {
+                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Transport, name)
+            }
+            StudyMode::Work => {
+                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Work, name)
+            }
+        }
+}
+
+/// The metric catalogue of a study, for messages.
+pub fn metric_catalogue(study: &Study) -> Vec<String> {
+    let mut v: Vec<String> = DESIGN_COLUMNS.iter().map(|s| s.to_string()).collect();
+    if study.static_enabled {
+        v.extend(TCM_COLUMNS.iter().map(|s| s.to_string()));
+    }
+    let mode = match study.mode {
+        StudyMode::Static => None,
+        StudyMode::Transport => Some(crate::scenario::Mode::Transport),
+        StudyMode::Work => Some(crate::scenario::Mode::Work),
+    };
+    if let Some(m) = mode {
+        v.extend(crate::metrics::run_summary::metric_catalogue(m));
+    }
+    v
+}
+
+fn check_metric(name: &str, at: &str, study: &Study, doc: &Document) -> Result<(), InputError> {
+    if known_metric(name, study) {
+        return Ok(());
+    }
+    Err(doc.err(
+        at,
+        format!(
+            "unknown metric `{name}` for mode \"{}\"{}; valid: {}",
+            study.mode,
+            if study.static_enabled {
+                " with [static]"
+            } else {
+                ""
+            },
+            metric_catalogue(study).join(", ")
+        ),
+    ))
+}
+
+fn parse_objective(
+    o: &ObjectiveFile,
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<Objective, InputError> {
+    if o.term.is_empty() {
+        return Err(doc.err(&format!("{at}.term"), "needs at least one term"));
+    }
+    let mut terms = Vec::new();
+    for (i, t) in o.term.iter().enumerate() {
+        check_metric(&t.metric, &format!("{at}.term[{i}].metric"), study, doc)?;
+        if !t.weight.is_finite() || t.weight == 0.0 {
+            return Err(doc.err(
+                &format!("{at}.term[{i}].weight"),
+                "must be finite and non-zero",
+            ));
+        }
+        terms.push(Term {
+            metric: t.metric.clone(),
+            weight: t.weight,
+        });
+    }
+    let combine = match o.combine.as_deref().unwrap_or("mean") {
+        "mean" => Combine::Mean,
+        "worst" => Combine::Worst,
+        other => {
+            return Err(doc.err(
+                &format!("{at}.combine"),
+                format!("unknown combination `{other}`; valid: mean, worst"),
+            ))
+        }
+    };
+    Ok(Objective {
+        terms,
+        combine,
+        normalise: o.normalise.unwrap_or(true),
+    })
+}
+
+fn parse_constraint(
+    c: &ConstraintFile,
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<Constraint, InputError> {
+    check_metric(&c.metric, &format!("{at}.metric"), study, doc)?;
+    let op = match c.op.as_str() {
+        "<=" => Op::Le,
+        ">=" => Op::Ge,
+        "==" => Op::Eq,
+        other => {
+            return Err(doc.err(
+                &format!("{at}.op"),
+                format!("unknown comparison `{other}`; valid: <=, >=, =="),
+            ))
+        }
+    };
+    if !c.value.is_finite() {
+        return Err(doc.err(&format!("{at}.value"), "must be finite"));
+    }
+    let tolerance = c.tolerance.unwrap_or(1e-9 * c.value.abs().max(1.0));
+    if !(tolerance >= 0.0 && tolerance.is_finite()) {
+        return Err(doc.err(&format!("{at}.tolerance"), "must be finite and >= 0"));
+    }
+    Ok(Constraint {
+        metric: c.metric.clone(),
+        op,
+        value: c.value,
+        tolerance,
+    })
+}
+
+fn parse_solver(
+    s: &SolverFile,
+    at: &str,
+    seed: u64,
+    doc: &Document,
+) -> Result<SolverSettings, InputError> {
+    let k = |f: &str| format!("{at}.{f}");
+    let method = Method::ALL
+        .iter()
+        .find(|(n, _)| *n == s.method)
+        .map(|(_, m)| *m)
+        .ok_or_else(|| {
+            doc.err(
+                &k("method"),
+                format!(
+                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs",
+                    s.method
+                ),
+            )
+        })?;
+    let out = SolverSettings {
+        method,
+        max_iters: s.max_iters.unwrap_or(100),
+        max_evals: s.max_evals.unwrap_or(200),
+        tolerance: s.tolerance.unwrap_or(1e-6),
+        restarts: s.restarts.unwrap_or(0),
+        seed: s.seed.unwrap_or(seed),
+        particles: s.particles.unwrap_or(12),
+        step: s.step.unwrap_or(0.1),
+    };
+    if out.max_iters == 0 {
+        return Err(doc.err(&k("max_iters"), "must be >= 1"));
+    }
+    if out.max_evals < 2 {
+        return Err(doc.err(
+            &k("max_evals"),
+            "must be >= 2 (the start point and one more)",
+        ));
+    }
+    if !(out.tolerance > 0.0 && out.tolerance.is_finite()) {
+        return Err(doc.err(&k("tolerance"), "must be finite and > 0"));
+    }
+    if out.particles < 2 {
+        return Err(doc.err(&k("particles"), "must be >= 2"));
+    }
+    if !(out.step > 0.0 && out.step <= 0.5) {
+        return Err(doc.err(&k("step"), "must be in (0, 0.5]"));
+    }
+    Ok(out)
+}

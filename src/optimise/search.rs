@@ -1,0 +1,397 @@
+//! The argmin wiring: one cost function ([`Search`]) over the normalised unit box for every
+//! solver, evaluating points through an [`Evaluator`] — the closed-loop cases of a problem
+//! file, or an analytic function in the tests, through the same code.
+//!
+//! - Points are projected onto the unit box and mapped to physical values
+//!   ([`Space`]); the cost is [`Score::cost`] plus `PENALTY · (distance moved)²`.
+//! - `bulk_cost` (particle swarm, finite differences) evaluates a batch on the run's own rayon
+//!   pool (`--jobs`) and records it in the batch's order, so the history does not depend on
+//!   the number of threads.
+//! - A point seen before in this run is served from memory (recorded with `repeat`, not
+//!   counted against `max_evals`). Points simulated by an earlier, interrupted run of the same
+//!   problem (the journal) are served from memory too but count as they did then, so a resumed
+//!   run replays the interrupted one exactly and then carries on.
+//! - The evaluation budget is enforced inside the cost function: once `max_evals` points are
+//!   recorded, it returns an error that ends the argmin run; the history decides the best.
+//! - An argmin observer tracks the iteration each evaluation belongs to (0: the solver's
+//!   initialisation) for the history.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use argmin::core::observers::{Observe, ObserverMode};
+use argmin::core::{CostFunction, Error, Executor, Gradient, State, KV};
+use argmin::solver::linesearch::MoreThuenteLineSearch;
+use argmin::solver::neldermead::NelderMead;
+use argmin::solver::particleswarm::ParticleSwarm;
+use argmin::solver::quasinewton::LBFGS;
+use rand::SeedableRng;
+use rayon::prelude::*;
+
+use super::history::{Evaluation, Journal, Record};
+use super::problem::{Method, SolverSettings};
+use super::score::{Score, Scorer};
+use super::space::Space;
+use crate::sampling::derive_seed;
+
+/// Weight of the squared distance outside the unit box added to the cost.
+pub const PENALTY: f64 = 1.0;
+
+/// Finite-difference step of the L-BFGS gradients, in normalised coordinates.
+pub const FD_STEP: f64 = 1e-4;
+
+/// What the optimiser evaluates: physical parameter values → metrics per scenario.
+pub trait Evaluator: Sync {
+    /// The metric names (columns of [`Evaluation::metrics`]).
+    fn metrics(&self) -> &[String];
+    /// Evaluate the point `x` (physical values, in parameter order).
+    fn evaluate(&self, x: &[f64]) -> Evaluation;
+}
+
+/// Bits of a point, the memory's key.
+fn key(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+/// The shared, locked part of a search.
+struct SearchState {
+    records: Vec<Record>,
+    memo: HashMap<Vec<u64>, Evaluation>,
+    seen: HashSet<Vec<u64>>,
+    scorer: Option<Scorer>,
+    exhausted: bool,
+    run: usize,
+    journal: Option<Journal>,
+    journal_error: Option<String>,
+}
+
+/// The cost function the solvers see (see the module docs).
+pub struct Search<'a, E: Evaluator> {
+    space: &'a Space,
+    ev: &'a E,
+    pool: &'a rayon::ThreadPool,
+    budget: usize,
+    iteration: Arc<AtomicU64>,
+    on_record: &'a (dyn Fn(&Record) + Sync),
+    state: Mutex<SearchState>,
+}
+
+/// One planned point of a batch.
+struct Planned {
+    u: Vec<f64>,
+    x: Vec<f64>,
+    d2: f64,
+    key: Vec<u64>,
+    fresh: bool,
+}
+
+impl<'a, E: Evaluator> Search<'a, E> {
+    /// A search of `space` through `ev` on `pool`, with at most `budget` fresh evaluations;
+    /// `memo` holds the evaluations of an interrupted run, `journal` records new ones.
+    pub fn new(
+        space: &'a Space,
+        ev: &'a E,
+        pool: &'a rayon::ThreadPool,
+        budget: usize,
+        memo: HashMap<Vec<u64>, Evaluation>,
+        journal: Option<Journal>,
+        on_record: &'a (dyn Fn(&Record) + Sync),
+    ) -> Self {
+        Search {
+            space,
+            ev,
+            pool,
+            budget,
+            iteration: Arc::new(AtomicU64::new(0)),
+            on_record,
+            state: Mutex::new(SearchState {
+                records: Vec::new(),
+                memo,
+                seen: HashSet::new(),
+                scorer: None,
+                exhausted: false,
+                run: 0,
+                journal,
+                journal_error: None,
+            }),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, SearchState> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Evaluate the start point and fix the objective's scales from it.
+    pub fn start(&self, make_scorer: impl FnOnce(&[Vec<f64>]) -> Scorer) -> Result<(), Error> {
+        self.batch(&[self.space.start()])?;
+        let mut st = self.lock();
+        let scorer = make_scorer(&st.records[0].metrics);
+        let score = scorer.score(&st.records[0].metrics);
+        st.records[0].score = score;
+        st.scorer = Some(scorer);
+        (self.on_record)(&st.records[0]);
+        Ok(())
+    }
+
+    /// Plan a batch: project, map, and mark fresh points up to the budget; returns the plan
+    /// and whether the budget cut it short.
+    fn plan<P: std::borrow::Borrow<Vec<f64>>>(
+        &self,
+        st: &SearchState,
+        us: &[P],
+    ) -> (Vec<Planned>, bool) {
+        let mut fresh_keys: HashSet<Vec<u64>> = HashSet::new();
+        let fresh_before = st.records.iter().filter(|r| !r.repeat).count();
+        let mut plan = Vec::new();
+        for u in us {
+            let (u, d2) = self.space.project(u.borrow());
+            let x = self.space.values(&u);
+            let key = key(&x);
+            let fresh = !st.seen.contains(&key) && !fresh_keys.contains(&key);
+            if fresh {
+                if fresh_before + fresh_keys.len() >= self.budget {
+                    return (plan, true);
+                }
+                fresh_keys.insert(key.clone());
+            }
+            plan.push(Planned {
+                u,
+                x,
+                d2,
+                key,
+                fresh,
+            });
+        }
+        (plan, false)
+    }
+
+    /// Evaluate a batch in order (see the module docs); the costs, or the budget error.
+    fn batch<P: std::borrow::Borrow<Vec<f64>>>(&self, us: &[P]) -> Result<Vec<f64>, Error> {
+        let (plan, cut) = {
+            let st = self.lock();
+            if st.exhausted {
+                return Err(Error::msg("evaluation budget reached"));
+            }
+            self.plan(&st, us)
+        };
+        let todo: Vec<usize> = {
+            let st = self.lock();
+            let mut keys = HashSet::new();
+            (0..plan.len())
+                .filter(|&i| {
+                    plan[i].fresh
+                        && !st.memo.contains_key(&plan[i].key)
+                        && keys.insert(&plan[i].key)
+                })
+                .collect()
+        };
+        let done: Vec<Evaluation> = self.pool.install(|| {
+            todo.par_iter()
+                .map(|&i| self.ev.evaluate(&plan[i].x))
+                .collect()
+        });
+        let mut st = self.lock();
+        for (&i, e) in todo.iter().zip(done) {
+            if let Some(j) = st.journal.as_mut() {
+                if let Err(err) = j.append(&plan[i].x, &e) {
+                    st.journal_error.get_or_insert(err);
+                }
+            }
+            st.memo.insert(plan[i].key.clone(), e);
+        }
+        let iteration = self.iteration.load(Ordering::Relaxed);
+        let mut costs = Vec::with_capacity(plan.len());
+        for p in plan {
+            let e = st.memo.get(&p.key).cloned().unwrap_or(Evaluation {
+                metrics: Vec::new(),
+                failure: Some("not evaluated".into()),
+            });
+            let score = match &st.scorer {
+                Some(s) => s.score(&e.metrics),
+                None => Score {
+                    objective: f64::NAN,
+                    violation: 0.0,
+                    feasible: false,
+                },
+            };
+            st.seen.insert(p.key);
+            let record = Record {
+                index: st.records.len(),
+                run: st.run,
+                iteration,
+                u: p.u,
+                x: p.x,
+                metrics: e.metrics,
+                failure: e.failure,
+                repeat: !p.fresh,
+                score,
+            };
+            if st.scorer.is_some() {
+                (self.on_record)(&record);
+            }
+            st.records.push(record);
+            costs.push(score.cost() + PENALTY * p.d2);
+        }
+        if cut {
+            st.exhausted = true;
+            return Err(Error::msg("evaluation budget reached"));
+        }
+        Ok(costs)
+    }
+
+    /// The records so far, the number of fresh evaluations, and any journal write error.
+    pub fn finish(self) -> (Vec<Record>, Option<String>) {
+        let st = self.state.into_inner().unwrap_or_else(|e| e.into_inner());
+        (st.records, st.journal_error)
+    }
+
+    fn best_u(&self) -> Vec<f64> {
+        let st = self.lock();
+        super::score::best_index(st.records.iter().map(|r| r.score))
+            .map(|i| st.records[i].u.clone())
+            .unwrap_or_else(|| self.space.start())
+    }
+
+    fn exhausted(&self) -> bool {
+        self.lock().exhausted
+    }
+}
+
+/// The problem handed to argmin (a reference: the search outlives each run).
+struct Handle<'s, 'a, E: Evaluator>(&'s Search<'a, E>);
+
+impl<E: Evaluator> CostFunction for Handle<'_, '_, E> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, u: &Vec<f64>) -> Result<f64, Error> {
+        Ok(self.0.batch(&[u])?[0])
+    }
+
+    fn bulk_cost<P>(&self, params: &[P]) -> Result<Vec<f64>, Error>
+    where
+        P: std::borrow::Borrow<Vec<f64>> + argmin::core::SyncAlias,
+        f64: argmin::core::SendAlias,
+        Self: argmin::core::SyncAlias,
+    {
+        self.0.batch(params)
+    }
+}
+
+impl<E: Evaluator> Gradient for Handle<'_, '_, E> {
+    type Param = Vec<f64>;
+    type Gradient = Vec<f64>;
+
+    /// Central differences with step [`FD_STEP`], all 2n points in one batch.
+    fn gradient(&self, u: &Vec<f64>) -> Result<Vec<f64>, Error> {
+        let mut points = Vec::with_capacity(2 * u.len());
+        for i in 0..u.len() {
+            for s in [1.0, -1.0] {
+                let mut p = u.clone();
+                p[i] += s * FD_STEP;
+                points.push(p);
+            }
+        }
+        let c = self.0.batch(&points)?;
+        Ok((0..u.len())
+            .map(|i| (c[2 * i] - c[2 * i + 1]) / (2.0 * FD_STEP))
+            .collect())
+    }
+}
+
+/// The observer: after iteration `k` the next evaluations belong to iteration `k + 1`.
+struct IterationObserver(Arc<AtomicU64>);
+
+impl<I: State> Observe<I> for IterationObserver {
+    fn observe_iter(&mut self, state: &I, _kv: &KV) -> Result<(), Error> {
+        self.0.store(state.get_iter() + 1, Ordering::Relaxed);
+        Ok(())
+    }
+}
+
+/// Run the configured solver (and its restarts) on a started search; returns one line per
+/// run saying why it stopped.
+pub fn run_solver<E: Evaluator>(search: &Search<'_, E>, s: &SolverSettings) -> Vec<String> {
+    let mut reasons = Vec::new();
+    for run in 0..=s.restarts {
+        search.lock().run = run + 1;
+        search.iteration.store(0, Ordering::Relaxed);
+        let u0 = search.best_u();
+        let result = match s.method {
+            Method::NelderMead => nelder_mead(search, u0, s),
+            Method::ParticleSwarm => particle_swarm(search, s, run as u64),
+            Method::Lbfgs => lbfgs(search, u0, s),
+        };
+        match result {
+            Ok(r) => reasons.push(format!("run {}: {r}", run + 1)),
+            Err(_) if search.exhausted() => {
+                reasons.push(format!("run {}: evaluation budget reached", run + 1));
+                break;
+            }
+            Err(e) => reasons.push(format!("run {}: stopped: {e}", run + 1)),
+        }
+    }
+    reasons
+}
+
+fn observer<E: Evaluator>(search: &Search<'_, E>) -> IterationObserver {
+    IterationObserver(search.iteration.clone())
+}
+
+/// Nelder–Mead from `u0`, initial simplex `u0 + step·e_i` (mirrored at the upper bound).
+fn nelder_mead<E: Evaluator>(
+    search: &Search<'_, E>,
+    u0: Vec<f64>,
+    s: &SolverSettings,
+) -> Result<String, Error> {
+    let mut simplex = vec![u0.clone()];
+    for i in 0..u0.len() {
+        let mut v = u0.clone();
+        v[i] = if v[i] + s.step <= 1.0 {
+            v[i] + s.step
+        } else {
+            v[i] - s.step
+        };
+        simplex.push(v);
+    }
+    let solver = NelderMead::new(simplex).with_sd_tolerance(s.tolerance)?;
+    let res = Executor::new(Handle(search), solver)
+        .configure(|st| st.max_iters(s.max_iters))
+        .add_observer(observer(search), ObserverMode::Always)
+        .run()?;
+    Ok(res.state().get_termination_status().to_string())
+}
+
+/// Particle swarm in the unit box, seeded by `derive_seed(seed, run)` (ChaCha8).
+fn particle_swarm<E: Evaluator>(
+    search: &Search<'_, E>,
+    s: &SolverSettings,
+    run: u64,
+) -> Result<String, Error> {
+    let n = search.space.dim();
+    let rng = rand_chacha::ChaCha8Rng::seed_from_u64(derive_seed(s.seed, run));
+    let solver =
+        ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), s.particles).with_rng_generator(rng);
+    let res = Executor::new(Handle(search), solver)
+        .configure(|st| st.max_iters(s.max_iters))
+        .add_observer(observer(search), ObserverMode::Always)
+        .run()?;
+    Ok(res.state().get_termination_status().to_string())
+}
+
+/// L-BFGS from `u0` (memory 7, Moré–Thuente line search, finite-difference gradients).
+fn lbfgs<E: Evaluator>(
+    search: &Search<'_, E>,
+    u0: Vec<f64>,
+    s: &SolverSettings,
+) -> Result<String, Error> {
+    let solver = LBFGS::new(MoreThuenteLineSearch::new(), 7)
+        .with_tolerance_grad(s.tolerance)?
+        .with_tolerance_cost(s.tolerance * 1e-3)?;
+    let res = Executor::new(Handle(search), solver)
+        .configure(|st| st.param(u0).max_iters(s.max_iters))
+        .add_observer(observer(search), ObserverMode::Always)
+        .run()?;
+    Ok(res.state().get_termination_status().to_string())
+}

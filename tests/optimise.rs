@@ -1,0 +1,370 @@
+//! The optimiser's library API (`usm_study::optimise`): each solver as configured finds the
+//! known optimum of analytic functions through the same wiring the verb uses (`minimise`);
+//! results do not depend on the number of threads; a resumed run equals an uninterrupted one;
+//! the metric catalogue names every metric a run reports; `best.toml` reproduces the best
+//! objective.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use usm_study::input::keypath::KeyPath;
+use usm_study::optimise::evaluate::pick;
+use usm_study::optimise::history::{history_table, Evaluation, Record, JOURNAL_FILE};
+use usm_study::optimise::problem::{
+    Combine, Method, Objective, SolverSettings, Spec, Term, Variant,
+};
+use usm_study::optimise::search::Evaluator;
+use usm_study::optimise::space::{Param, Scale, Space};
+use usm_study::optimise::{minimise, parse_problem, run, Options, Outcome};
+use usm_study::study::schema::Target;
+
+/// An analytic objective `f` of the physical parameters, counting its evaluations.
+struct Analytic {
+    f: fn(&[f64]) -> f64,
+    names: Vec<String>,
+    calls: AtomicUsize,
+}
+
+impl Analytic {
+    fn new(f: fn(&[f64]) -> f64) -> Self {
+        Analytic {
+            f,
+            names: vec!["f".into()],
+            calls: AtomicUsize::new(0),
+        }
+    }
+}
+
+impl Evaluator for Analytic {
+    fn metrics(&self) -> &[String] {
+        &self.names
+    }
+    fn evaluate(&self, x: &[f64]) -> Evaluation {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        Evaluation {
+            metrics: vec![vec![(self.f)(x)]],
+            failure: None,
+        }
+    }
+}
+
+fn rosenbrock(x: &[f64]) -> f64 {
+    (1.0 - x[0]).powi(2) + 100.0 * (x[1] - x[0] * x[0]).powi(2)
+}
+
+/// Minimum at (0.3, 1.0): the second coordinate's unconstrained optimum 1.5 is outside the box.
+fn bounded_quadratic(x: &[f64]) -> f64 {
+    (x[0] - 0.3).powi(2) + 2.0 * (x[1] - 1.5).powi(2)
+}
+
+fn param(name: &str, lower: f64, upper: f64, start: f64) -> Param {
+    Param {
+        name: name.into(),
+        target: Target::Scenario(KeyPath::parse(name).unwrap()),
+        lower,
+        upper,
+        scale: Scale::Lin,
+        start,
+        integer: false,
+    }
+}
+
+fn spec(params: Vec<Param>, solver: SolverSettings) -> Spec {
+    Spec {
+        space: Space::new(params),
+        variants: vec![Variant {
+            name: String::new(),
+            set: Vec::new(),
+        }],
+        objective: Objective {
+            terms: vec![Term {
+                metric: "f".into(),
+                weight: 1.0,
+            }],
+            combine: Combine::Mean,
+            normalise: true,
+        },
+        constraints: Vec::new(),
+        solver,
+    }
+}
+
+fn solver(method: Method, max_iters: u64, max_evals: usize, tolerance: f64) -> SolverSettings {
+    SolverSettings {
+        method,
+        max_iters,
+        max_evals,
+        tolerance,
+        restarts: 0,
+        seed: 11,
+        particles: 24,
+        step: 0.1,
+    }
+}
+
+fn quiet(_: &Record) {}
+
+fn options(jobs: usize) -> Options<'static> {
+    Options {
+        jobs,
+        journal: None,
+        resume: false,
+        on_record: &quiet,
+    }
+}
+
+fn solve(f: fn(&[f64]) -> f64, spec: &Spec, jobs: usize) -> Outcome {
+    minimise(spec, &Analytic::new(f), "analytic", &options(jobs)).unwrap()
+}
+
+#[test]
+fn each_solver_finds_the_rosenbrock_minimum() {
+    let box2 = || vec![param("a.x", -2.0, 2.0, -1.2), param("a.y", -2.0, 2.0, 1.0)];
+    let cases = [
+        (
+            Method::NelderMead,
+            solver(Method::NelderMead, 2000, 3000, 1e-14),
+            1e-3,
+        ),
+        (Method::Lbfgs, solver(Method::Lbfgs, 500, 5000, 1e-10), 1e-3),
+        (
+            Method::ParticleSwarm,
+            solver(Method::ParticleSwarm, 400, 20_000, 1e-6),
+            5e-2,
+        ),
+    ];
+    for (m, s, tol) in cases {
+        let o = solve(rosenbrock, &spec(box2(), s), 2);
+        let b = &o.best().x;
+        assert!(
+            (b[0] - 1.0).abs() < tol && (b[1] - 1.0).abs() < 2.0 * tol,
+            "{m:?}: best {b:?} after {} evaluations ({:?})",
+            o.records.len(),
+            o.stops
+        );
+        // The objective is normalised by its start value 24.2.
+        assert!((o.scorer.scales[0] - 24.2).abs() < 1e-9, "{m:?}");
+    }
+}
+
+#[test]
+fn each_solver_finds_the_bounded_quadratic_minimum_on_the_bound() {
+    let box2 = || vec![param("a.x", 0.0, 1.0, 0.8), param("a.y", 0.0, 1.0, 0.2)];
+    for m in [Method::NelderMead, Method::Lbfgs, Method::ParticleSwarm] {
+        let s = solver(m, 300, 3000, 1e-12);
+        let o = solve(bounded_quadratic, &spec(box2(), s), 1);
+        let b = &o.best().x;
+        assert!(
+            (b[0] - 0.3).abs() < 1e-3 && (b[1] - 1.0).abs() < 1e-3,
+            "{m:?}: best {b:?} ({:?})",
+            o.stops
+        );
+        // Every evaluated point lies inside the bounds.
+        assert!(o
+            .records
+            .iter()
+            .all(|r| r.x.iter().all(|x| (0.0..=1.0).contains(x))));
+    }
+}
+
+#[test]
+fn the_evaluation_budget_is_exact() {
+    let s = solver(Method::ParticleSwarm, 1000, 37, 1e-12);
+    let o = solve(
+        rosenbrock,
+        &spec(
+            vec![param("a.x", -2.0, 2.0, 0.0), param("a.y", -2.0, 2.0, 0.0)],
+            s,
+        ),
+        2,
+    );
+    assert_eq!(o.fresh_evaluations(), 37);
+    assert!(
+        o.stops.iter().any(|s| s.contains("budget")),
+        "{:?}",
+        o.stops
+    );
+}
+
+fn table(o: &Outcome, spec: &Spec) -> usm_study::report::Table {
+    let params: Vec<String> = spec.space.params.iter().map(|p| p.name.clone()).collect();
+    history_table(&o.records, &params, &o.metrics, &[String::new()]).unwrap()
+}
+
+#[test]
+fn resume_after_an_interruption_equals_the_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let journal = dir.path().join(JOURNAL_FILE);
+    let sp = spec(
+        vec![param("a.x", -2.0, 2.0, -1.2), param("a.y", -2.0, 2.0, 1.0)],
+        solver(Method::ParticleSwarm, 50, 120, 1e-12),
+    );
+    let full_ev = Analytic::new(rosenbrock);
+    let opts = Options {
+        journal: Some(&journal),
+        ..options(2)
+    };
+    let full = minimise(&sp, &full_ev, "h", &opts).unwrap();
+    assert_eq!(full_ev.calls.load(Ordering::Relaxed), 120);
+    // Kill after 50 journal lines, in the middle of writing the 51st.
+    let text = std::fs::read_to_string(&journal).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let torn = format!("{}\n{}", lines[..51].join("\n"), &lines[51][..10]);
+    std::fs::write(&journal, torn).unwrap();
+    let resumed_ev = Analytic::new(rosenbrock);
+    let resumed = minimise(
+        &sp,
+        &resumed_ev,
+        "h",
+        &Options {
+            resume: true,
+            ..opts
+        },
+    )
+    .unwrap();
+    assert_eq!(resumed_ev.calls.load(Ordering::Relaxed), 70);
+    assert_eq!(resumed.replayed, 50);
+    assert!(table(&full, &sp).bit_eq(&table(&resumed, &sp)));
+    assert_eq!(full.best, resumed.best);
+    // A journal of another problem is refused.
+    let other = minimise(
+        &sp,
+        &Analytic::new(rosenbrock),
+        "another",
+        &Options {
+            resume: true,
+            ..opts
+        },
+    );
+    assert!(other.is_err());
+}
+
+/// A small closed-loop problem: two gains of transport Method 2, a 12 s run, two scenarios
+/// (with and without a 0.2 m/s cross current), objective energy + overshoot, worst case.
+const SMALL: &str = r#"
+[study]
+name = "small"
+seed = 3
+
+[design]
+preset = "usm-paper"
+
+[scenario]
+mode = "transport"
+duration = 12.0
+
+[allocation]
+method = "pinv"
+lambda = 0.1
+
+[[variant]]
+name = "calm"
+
+[[variant]]
+name = "current"
+set = { "physics.current" = [0.0, 0.2, 0.0] }
+
+[[param]]
+name = "control.k_psi"
+lower = 0.1
+upper = 1.0
+scale = "log"
+
+[[param]]
+name = "control.k_6p"
+lower = 0.002
+upper = 0.05
+scale = "log"
+
+[objective]
+combine = "worst"
+
+[[objective.term]]
+metric = "thruster_energy"
+weight = 1.0
+
+[[objective.term]]
+metric = "overshoot"
+weight = 0.5
+
+[[constraint]]
+metric = "completed"
+op = "=="
+value = 1
+
+[[constraint]]
+metric = "peak_thrust"
+op = "<="
+value = 40.0
+
+[solver]
+method = "particle-swarm"
+particles = 5
+max_evals = 16
+seed = 9
+"#;
+
+#[test]
+fn history_and_best_do_not_depend_on_the_number_of_threads() {
+    let p = parse_problem(SMALL, Path::new("small.toml")).unwrap();
+    let runs: Vec<Outcome> = [1, 2, 3]
+        .iter()
+        .map(|&j| run(&p, &options(j)).unwrap())
+        .collect();
+    let params: Vec<String> = p.spec.space.params.iter().map(|q| q.name.clone()).collect();
+    let names = ["calm".to_string(), "current".to_string()];
+    let t0 = history_table(&runs[0].records, &params, &runs[0].metrics, &names).unwrap();
+    assert_eq!(runs[0].fresh_evaluations(), 16);
+    for o in &runs[1..] {
+        let t = history_table(&o.records, &params, &o.metrics, &names).unwrap();
+        assert!(t0.bit_eq(&t));
+        assert_eq!(o.best, runs[0].best);
+    }
+}
+
+#[test]
+fn best_toml_reproduces_the_best_objective() {
+    use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles};
+    use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario};
+    let p = parse_problem(SMALL, Path::new("small.toml")).unwrap();
+    let o = run(&p, &options(2)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    write_outputs(&p, &o, dir.path(), OptimiseFiles { plots: false }).unwrap();
+    let mut rows = Vec::new();
+    for file in ["best.toml", "best_current.toml"] {
+        let path = dir.path().join(file);
+        let (t, src) = load_table(path.to_str().unwrap()).unwrap();
+        let f = parse_table(&t, &src).unwrap();
+        let v = resolve_design(&f, &src).unwrap();
+        rows.push(pick(&run_scenario(&v, &f).unwrap().metrics, &o.metrics));
+    }
+    let again = o.scorer.score(&rows).objective;
+    let best = o.best().score.objective;
+    assert!(
+        ((again - best) / best).abs() <= 1e-9,
+        "simulate best.toml: {again}, optimiser: {best}"
+    );
+}
+
+#[test]
+fn the_metric_catalogue_names_every_metric_a_run_reports() {
+    use usm_study::metrics::run_summary::is_run_metric;
+    use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, Mode};
+    for (preset, mode) in [
+        ("transport-method2", Mode::Transport),
+        ("work-setpoint", Mode::Work),
+    ] {
+        let (mut t, src) = load_table(preset).unwrap();
+        t["scenario"]["duration"] = toml::Value::Float(2.0);
+        let f = parse_table(&t, &src).unwrap();
+        let v = resolve_design(&f, &src).unwrap();
+        let r = run_scenario(&v, &f).unwrap();
+        for (name, _) in &r.metrics {
+            assert!(
+                is_run_metric(mode, name),
+                "{preset}: {name} is not in the catalogue"
+            );
+        }
+        assert!(!is_run_metric(mode, "no_such_metric"));
+    }
+}
