@@ -80,6 +80,10 @@ fn print_summary(r: &RunResult) {
     for (k, v) in &r.metrics {
         println!("  {k:<30} {}", fmt_num(*v));
     }
+    match &r.missed {
+        None => println!("  success: every [success] criterion met"),
+        Some(m) => println!("  success: missed {m}"),
+    }
     let t = &r.timing;
     println!(
         "  wall time {:.3} s ({:.0}x real time): dynamics {:.3} s, allocation {:.3} s, control {:.3} s, logging {:.3} s",

@@ -162,9 +162,10 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         eprintln!("[sweep] warning: {w}");
     }
     eprintln!(
-        "[sweep] {} cases: {} ok, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
+        "[sweep] {} cases: {} ok, {} unsuccessful, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
         outcome.in_shard,
         outcome.ok,
+        outcome.unsuccessful,
         outcome.failed,
         outcome.skipped,
         outcome.elapsed_s,
@@ -200,10 +201,11 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
         eprintln!("[merge] warning: {w}");
     }
     eprintln!(
-        "[merge] {} directories: {} cases ({} ok, {} failed, {} skipped); wrote {}",
+        "[merge] {} directories: {} cases ({} ok, {} unsuccessful, {} failed, {} skipped); wrote {}",
         a.dirs.len(),
         m.cases.in_output,
         m.cases.ok,
+        m.cases.unsuccessful,
         m.cases.failed,
         m.cases.skipped,
         a.out.display()

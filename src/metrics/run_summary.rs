@@ -2,13 +2,14 @@
 //! looked up by [`Channel`], and of the effort and energy integrals the loop accumulated
 //! (at the control and physics rates, not from the log), in a fixed order for the mode — the common effort, energy,
 //! singularity and allocation metrics, then the transport tracking or the work regulation
-//! metrics.
+//! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
 use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
 use crate::control::wrap_angle;
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
+use crate::scenario::success::{judge, Missed};
 
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;
@@ -40,6 +41,15 @@ pub fn run_summary(
         Mode::Work => work_metrics(&mut out, &file.metrics, traj),
     }
     out
+}
+
+/// Judge the run by its `metrics` against `file`'s `[success]` criteria
+/// ([`crate::scenario::success::judge`]) and append `success` (1 = every criterion met,
+/// 0 = not); returns the first criterion missed.
+pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
+    let missed = judge(&file.success, file.scenario.mode, metrics);
+    add(metrics, "success", if missed.is_none() { 1.0 } else { 0.0 });
+    missed
 }
 
 /// Completion, energy and effort (SPEC §6, integrated along the run, not from the log: see

@@ -36,6 +36,7 @@ mod error;
 pub(crate) mod recorder;
 pub mod run;
 mod setup;
+pub mod success;
 
 pub use channels::{Channel, Trajectory};
 pub use config::{Mode, ScenarioFile};
@@ -304,6 +305,10 @@ pub struct CaseRun {
     pub trajectory: Option<Trajectory>,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// The first success criterion the run missed, as `criterion: detail`
+    /// ([`success::Missed`]; `no_failure` for a run that stopped early); `None` when it met
+    /// them all.
+    pub missed: Option<String>,
 }
 
 /// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
@@ -323,6 +328,7 @@ pub fn run_case(
         failure: r
             .failure
             .map(|(t, c)| format!("run stopped at t = {t:.3} s: {c}")),
+        missed: r.missed.map(|m| m.to_string()),
     })
 }
 
