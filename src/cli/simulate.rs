@@ -14,7 +14,7 @@ use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario,
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint,
-    /// transport-method1-torque-limited.
+    /// transport-method1-torque-limited, work-setpoint-far.
     pub scenario: String,
     /// Output directory (default: out/<scenario name>).
     #[arg(long)]

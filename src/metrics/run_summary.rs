@@ -197,9 +197,11 @@ fn transport_metrics(
     add(out, "energy_per_metre", energy.energy_per_metre());
 }
 
-/// Work: final errors and settling times of the end-effector, the base's drift, and the
+/// Work: final errors and settling times of the end-effector, the base's drift, the
 /// end-effector roll about its setpoint over the whole run and after settling
-/// ([`roll_metrics`]).
+/// ([`roll_metrics`]), and how much the singularity-robust damping of `J_e^#` acted:
+/// `ee_damped_fraction` of the logged samples with λ > 0 and its largest value
+/// `ee_damping_max`.
 fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
     let t = channel(traj, Channel::T);
     let ep = channel(traj, Channel::EePositionError);
@@ -221,6 +223,18 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
     };
     add(out, "base_drift", drift);
+    let damp = channel(traj, Channel::EeDamping);
+    let damped = damp.iter().filter(|l| **l > 0.0).count();
+    add(
+        out,
+        "ee_damped_fraction",
+        damped as f64 / damp.len().max(1) as f64,
+    );
+    add(
+        out,
+        "ee_damping_max",
+        damp.iter().fold(0.0, |m: f64, l| m.max(*l)),
+    );
     roll_metrics(out, traj, settle_p.max(settle_a));
 }
 

@@ -7,7 +7,9 @@
 //!
 //! Presets reproduce the paper's simulations: `transport-method1`, `transport-method2`
 //! (USM Table III, u_c = 0.5 m/s, straight segments parallel to X, a 180° turn commanded at
-//! t = 95 s, 140 s) and `work-setpoint` (USM-42 with the paper's k_e, k_b, W, K_p, λ = 0.1);
+//! t = 95 s, 140 s) and `work-setpoint` (USM-42 with the paper's k_e, k_b, W, K_p, at a pose
+//! the joints reach with the base at home; `work-setpoint-far` is the paper-like pose beyond
+//! the body's reach, where the base has to move);
 //! `transport-method1-torque-limited` is Method 1 with torque-level PD joint servos saturating
 //! at 50 N·m, so the joint torque at the turn is bounded (`joint_torque_peak`).
 //!
@@ -51,11 +53,12 @@ use crate::model::Vehicle;
 use std::path::{Path, PathBuf};
 
 /// Names of the built-in scenarios.
-pub const PRESETS: [&str; 4] = [
+pub const PRESETS: [&str; 5] = [
     "transport-method1",
     "transport-method2",
     "work-setpoint",
     "transport-method1-torque-limited",
+    "work-setpoint-far",
 ];
 
 const TRANSPORT_COMMON: &str = r#"
@@ -117,9 +120,12 @@ method = "method{method}"
     )
 }
 
-const WORK_SETPOINT: &str = r#"
+/// The work-mode preset named `name` reaching for `setpoint` (a `[setpoint]` table body).
+fn work_preset(name: &str, setpoint: &str) -> String {
+    format!(
+        r#"
 [scenario]
-name = "work-setpoint"
+name = "{name}"
 mode = "work"
 design = "usm-paper"
 duration = 80.0
@@ -128,17 +134,16 @@ control_dt = 0.05
 log_dt = 0.1
 
 [setpoint]
-# A 6-DOF end-effector pose away from the straight start (end-effector at (3.3, 0, 0)):
-# 0.4 m forward, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0.
-position = [3.7, 0.5, -0.3]
-rpy_deg = [0.0, 10.0, 25.0]
-
+{setpoint}
 [control]
-# USM-42: k_e, k_b and the usage weights W of the paper (section VI-C); lambda = 0.1.
+# USM-42: k_e, k_b and the usage weights W of the paper (section VI-C). J_e^# is the weighted
+# pseudoinverse as printed, damped (lambda up to 0.1, the paper's allocator value) only where
+# sigma_min(J_e U^1/2) < singular_region (singularity-robust; the straight start is singular).
 k_e = [0.2, 0.2, 0.2, 0.4, 0.4, 0.4]
 k_b = [0.15, 0.15, 0.15]
 weights = [0.3, 0.3, 0.3, 0.0, 0.3, 0.3, 0.7, 0.7, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
 damping = 0.1
+singular_region = 0.3
 
 [base_control]
 # USM-33 without the nonlinear term, K_p = diag(1,1,1,0,1,1), no integral (paper).
@@ -150,6 +155,24 @@ nonlinear = false
 # The paper's damped pseudoinverse, lambda = 0.1.
 method = "pinv"
 lambda = 0.1
+"#
+    )
+}
+
+/// `work-setpoint`: a pose the joints reach with the base at home (the straight body's end
+/// effector is at (3.3, 0, 0)), so both USM-42 tasks are feasible.
+const WORK_SETPOINT_NEAR: &str = r#"# A 6-DOF end-effector pose inside the reach of the 3.3 m body with the base at home: 0.3 m
+# back from the straight tip, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0.
+position = [3.0, 0.5, -0.3]
+rpy_deg = [0.0, 10.0, 25.0]
+"#;
+
+/// `work-setpoint-far`: the paper-like setpoint beyond the body's reach (x = 3.7 m > 3.3 m),
+/// where the base must leave home and the base task conflicts with the end-effector task.
+const WORK_SETPOINT_FAR: &str = r#"# Beyond the reach of the 3.3 m body with the base at home: 0.4 m forward of the straight
+# tip, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0. The base must move.
+position = [3.7, 0.5, -0.3]
+rpy_deg = [0.0, 10.0, 25.0]
 "#;
 
 /// The TOML text of a preset, or `None`.
@@ -158,7 +181,8 @@ pub fn preset_text(name: &str) -> Option<String> {
         "transport-method1" => Some(transport_preset(name, 1, "")),
         "transport-method2" => Some(transport_preset(name, 2, "")),
         "transport-method1-torque-limited" => Some(transport_preset(name, 1, TORQUE_LIMITED_SERVO)),
-        "work-setpoint" => Some(WORK_SETPOINT.to_string()),
+        "work-setpoint" => Some(work_preset(name, WORK_SETPOINT_NEAR)),
+        "work-setpoint-far" => Some(work_preset(name, WORK_SETPOINT_FAR)),
         _ => None,
     }
 }
