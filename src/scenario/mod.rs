@@ -77,6 +77,14 @@ segments = [
 
 [allocation]
 method = "qp"
+
+[success]
+# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# ends within 0.1 m of the path, and each segment converges (|e_y| < metrics.band and staying)
+# within 60 s of becoming active.
+max_saturation_fraction = 0.05
+cross_track_bound = 0.1
+convergence_window = 60.0
 "#;
 
 /// The joint servos of `transport-method1-torque-limited`: torque-level PD servos whose
@@ -155,6 +163,13 @@ nonlinear = false
 # The paper's damped pseudoinverse, lambda = 0.1.
 method = "pinv"
 lambda = 0.1
+
+[success]
+# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# final end-effector errors within 2 cm and 2 deg (roll excluded).
+max_saturation_fraction = 0.05
+position_tolerance = 0.02
+orientation_tolerance_deg = 2.0
 "#
     )
 }
@@ -466,6 +481,20 @@ mod tests {
                 "kp = [1.0, -1.0, 1.0, 0.0, 1.0, 1.0]",
                 "base_control.kp[1]",
                 "must be >= 0",
+            ),
+            (
+                "work-setpoint",
+                "position_tolerance =",
+                "position_tolerance = -0.1",
+                "success.position_tolerance",
+                "must be a finite number > 0",
+            ),
+            (
+                "transport-method2",
+                "convergence_window =",
+                "convergence_window = \"long\"",
+                "success.convergence_window",
+                "invalid type",
             ),
         ];
         for (preset, old, line, path, message) in cases {

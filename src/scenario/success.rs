@@ -185,8 +185,8 @@ pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Optio
             .map_or(f64::NAN, |x| x.1)
     };
     let missed = |criterion, detail: String| Some(Missed { criterion, detail });
-    // `!(x <= bound)` so that NaN misses.
-    let above = |x: f64, bound: f64| !(x <= bound);
+    // NaN misses.
+    let above = |x: f64, bound: f64| x.is_nan() || x > bound;
     if get("completed") != 1.0 {
         return missed(Criterion::NoFailure, "the run stopped early".into());
     }
@@ -231,7 +231,7 @@ pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Optio
 /// convergence window in the order the segments became active.
 fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
     let e = get("final_cross_track");
-    if !(e.abs() <= spec.cross_track_bound) {
+    if e.is_nan() || e.abs() > spec.cross_track_bound {
         return Some(Missed {
             criterion: Criterion::CrossTrackBound,
             detail: format!(
