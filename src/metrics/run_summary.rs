@@ -4,12 +4,13 @@
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
+use super::success::judge;
 use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
 use crate::control::wrap_angle;
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
-use crate::scenario::success::{judge, Missed};
+use crate::scenario::success::Missed;
 
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;
@@ -44,7 +45,7 @@ pub fn run_summary(
 }
 
 /// Judge the run by its `metrics` against `file`'s `[success]` criteria
-/// ([`crate::scenario::success::judge`]) and append `success` (1 = every criterion met,
+/// ([`super::success::judge`]) and append `success` (1 = every criterion met,
 /// 0 = not); returns the first criterion missed.
 pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
     let missed = judge(&file.success, file.scenario.mode, metrics);
