@@ -170,10 +170,14 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
     );
     let _ = writeln!(
         md,
-        "**Only the {} successful cases** (status `ok`: every `[success]` criterion of the \
-         scenario met) are ranked, averaged and put on the Pareto front; {} (see \
-         [the cases left out](#cases-left-out)).\n",
+        "**Only the {} successful cases** (status `ok`{}) are ranked, averaged and put on the \
+         Pareto front; {} (see [the cases left out](#cases-left-out)).\n",
         c.ok_rows.len(),
+        if m.mode.is_dynamic() {
+            ": the run met every `[success]` criterion of the scenario"
+        } else {
+            ""
+        },
         left_out_text(c)
     );
     if let Some(o) = &c.sel.objective {
