@@ -1,4 +1,5 @@
-//! End-to-end tests of `usm-study sweep`, `merge`, `report` and `tcm` on small static studies.
+//! End-to-end tests of `usm-study sweep`, `merge`, `report` and `tcm` on small static studies,
+//! and of the success criteria on a small transport study.
 
 mod common;
 
@@ -257,7 +258,7 @@ values = [0.085, -1.0]
     );
     let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
     assert!(
-        md.contains("## Failed and skipped cases") && md.contains("| failed |"),
+        md.contains("## Cases left out") && md.contains("| failed | no_failure | 1 |"),
         "{md}"
     );
 }
@@ -379,4 +380,179 @@ fn closed_output_pipe_ends_quietly() {
     let err = stderr(&out);
     assert!(!err.contains("panicked"), "{err}");
     assert_ne!(out.status.code(), Some(101), "{err}");
+}
+
+/// 6 short transport cases: three start offsets (final cross-track errors of both signs) ×
+/// two final cross-track bounds, the tight one missed by every case. `metrics.band` is wide,
+/// so every segment counts as converged at once and the bound alone decides success.
+const SIGNED: &str = r#"
+[study]
+name = "signed"
+seed = 3
+pareto = ["energy_per_metre", "final_cross_track"]
+
+[design]
+preset = "usm-paper"
+
+[scenario]
+mode = "transport"
+duration = 20.0
+
+[metrics]
+band = 100.0
+
+[[axis]]
+name = "initial.position"
+values = [[0.0, -3.0, 0.0], [0.0, -1.0, 0.0], [0.0, 2.0, 0.0]]
+
+[[axis]]
+name = "success.cross_track_bound"
+values = [10.0, 1e-6]
+"#;
+
+/// The case ids (`#id` in the third cell) of the table rows of `section` of `md` (up to the
+/// next `## ` heading), skipping the header row.
+fn section_ids(md: &str, section: &str) -> Vec<i64> {
+    let start = md
+        .find(section)
+        .unwrap_or_else(|| panic!("{section} in {md}"));
+    let body = &md[start + section.len()..];
+    let body = &body[..body.find("\n## ").unwrap_or(body.len())];
+    body.lines()
+        .filter(|l| l.starts_with('|'))
+        .filter_map(|l| {
+            let cell = l.split('|').map(str::trim).find(|c| c.starts_with('#'))?;
+            cell[1..].parse().ok()
+        })
+        .collect()
+}
+
+#[test]
+fn unsuccessful_cases_are_left_out_of_the_ranking() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "signed.toml", SIGNED);
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &["--jobs", "2"]);
+    // Unsuccessful cases are not failures: exit 0.
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("3 ok, 3 unsuccessful, 0 failed"),
+        "{}",
+        stderr(&o)
+    );
+    let csv = String::from_utf8(read(&out.join("cases.csv"))).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    // Rows without the quoted axis arrays (their commas), so that columns line up.
+    let rows: Vec<Vec<String>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut cells = Vec::new();
+            let mut rest = l;
+            while !rest.is_empty() {
+                let (cell, tail) = if let Some(r) = rest.strip_prefix('"') {
+                    let end = r.find('"').unwrap();
+                    (&r[..end], r[end + 1..].strip_prefix(',').unwrap_or(""))
+                } else {
+                    rest.split_once(',').unwrap_or((rest, ""))
+                };
+                cells.push(cell.to_string());
+                rest = tail;
+            }
+            cells
+        })
+        .collect();
+    let (status, reason, ct) = (col("status"), col("reason"), col("final_cross_track"));
+    let ok: Vec<i64> = (0..6)
+        .filter(|&i| rows[i as usize][status] == "ok")
+        .collect();
+    assert_eq!(ok, vec![0, 2, 4], "{csv}");
+    for i in [1, 3, 5] {
+        assert_eq!(rows[i][status], "unsuccessful", "{csv}");
+        assert!(
+            rows[i][reason].starts_with("cross_track_bound: |final_cross_track| = "),
+            "{csv}"
+        );
+        assert_eq!(rows[i][col("success")].parse::<f64>().unwrap(), 0.0);
+    }
+    let m: serde_json::Value = serde_json::from_slice(&read(&out.join("manifest.json"))).unwrap();
+    assert_eq!(m["cases"]["unsuccessful"], 3);
+
+    let md = String::from_utf8(read(&out.join("summary.md"))).unwrap();
+    assert!(
+        md.contains("3 left out: 3 missed `cross_track_bound`"),
+        "{md}"
+    );
+    let best = section_ids(&md, "## Best case by each metric");
+    assert!(
+        !best.is_empty() && best.iter().all(|i| ok.contains(i)),
+        "{best:?}\n{md}"
+    );
+    let front = section_ids(&md, "## Pareto-optimal cases");
+    assert!(
+        !front.is_empty() && front.iter().all(|i| ok.contains(i)),
+        "{front:?}\n{md}"
+    );
+    let left = section_ids(&md, "## Cases left out");
+    assert_eq!(left, vec![1, 3, 5], "{md}");
+    assert!(
+        md.contains("| unsuccessful | cross_track_bound | 3 |"),
+        "{md}"
+    );
+
+    // The signed final cross-track error is ranked by magnitude: the best case is the one
+    // nearest the path, not the most negative one (a precondition checks they differ).
+    let x = |i: i64| rows[i as usize][ct].parse::<f64>().unwrap();
+    let by_value = *ok.iter().min_by(|a, b| x(**a).total_cmp(&x(**b))).unwrap();
+    let by_abs = *ok
+        .iter()
+        .min_by(|a, b| x(**a).abs().total_cmp(&x(**b).abs()))
+        .unwrap();
+    assert_ne!(by_value, by_abs, "{csv}");
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("| `final_cross_track` |"))
+        .unwrap();
+    assert!(line.contains(&format!("| min |x| | #{by_abs} |")), "{line}");
+    // On the front too: |x| makes the case nearest the path dominate the most negative one.
+    assert!(
+        !front.contains(&by_value) || by_value == by_abs,
+        "{front:?}"
+    );
+}
+
+#[test]
+fn bad_success_definitions_name_file_line_and_key() {
+    let d = tempfile::tempdir().unwrap();
+    for (name, line, key) in [
+        (
+            "neg.toml",
+            "convergence_window = -1.0",
+            "success.convergence_window",
+        ),
+        (
+            "text.toml",
+            "cross_track_bound = \"far\"",
+            "success.cross_track_bound",
+        ),
+        (
+            "frac.toml",
+            "max_saturation_fraction = 1.5",
+            "success.max_saturation_fraction",
+        ),
+    ] {
+        let text = SIGNED.replace("[metrics]", &format!("[success]\n{line}\n\n[metrics]"));
+        let n = text.lines().position(|l| l == line).unwrap() + 1;
+        let s = write(d.path(), name, &text);
+        let out = d.path().join(name);
+        let o = sweep(&s, &out.with_extension("out"), &[]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains(&format!("{name}:{n}:")) && e.contains(key),
+            "{e}"
+        );
+        assert!(!out.with_extension("out").exists(), "nothing may run: {e}");
+    }
 }

@@ -50,8 +50,10 @@ values = [3.0, 5.0, 2000.0]
     let csv = std::fs::read_to_string(out.join("cases.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
     assert_eq!(rows.len(), 3, "{csv}");
+    // The other two complete; 5 s is far too short to reach the path from 3 m off (the
+    // thrusters saturate for 8–9 % of it), so they are `unsuccessful`, not failed.
     assert_eq!(
-        rows.iter().filter(|r| r.contains(",ok,")).count(),
+        rows.iter().filter(|r| r.contains(",unsuccessful,")).count(),
         2,
         "{csv}"
     );

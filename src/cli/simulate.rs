@@ -15,8 +15,8 @@ use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario,
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Scenario file (TOML) or preset: transport-method1, transport-method2, work-setpoint,
-    /// transport-method1-torque-limited; or one of Antonelli & Chiaverini's cases
-    /// antonelli-case1, -case1b, -case2, -case3a, -case3b (fixed set-ups: no overrides).
+    /// transport-method1-torque-limited, work-setpoint-far; or one of Antonelli & Chiaverini's
+    /// cases antonelli-case1, -case1b, -case2, -case3a, -case3b (fixed set-ups: no overrides).
     pub scenario: String,
     /// Output directory (default: out/<scenario name>).
     #[arg(long)]
@@ -85,6 +85,10 @@ fn print_summary(r: &RunResult) {
     println!("{} ({} mode)", r.name, r.mode);
     for (k, v) in &r.metrics {
         println!("  {k:<30} {}", fmt_num(*v));
+    }
+    match &r.missed {
+        None => println!("  success: every [success] criterion met"),
+        Some(m) => println!("  success: missed {m}"),
     }
     let t = &r.timing;
     println!(

@@ -166,9 +166,10 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     }
     review("sweep", &outcome.out)?;
     eprintln!(
-        "[sweep] {} cases: {} ok, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
+        "[sweep] {} cases: {} ok, {} unsuccessful, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
         outcome.in_shard,
         outcome.ok,
+        outcome.unsuccessful,
         outcome.failed,
         outcome.skipped,
         outcome.elapsed_s,
@@ -205,10 +206,11 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
     }
     review("merge", &a.out)?;
     eprintln!(
-        "[merge] {} directories: {} cases ({} ok, {} failed, {} skipped); wrote {}",
+        "[merge] {} directories: {} cases ({} ok, {} unsuccessful, {} failed, {} skipped); wrote {}",
         a.dirs.len(),
         m.cases.in_output,
         m.cases.ok,
+        m.cases.unsuccessful,
         m.cases.failed,
         m.cases.skipped,
         a.out.display()

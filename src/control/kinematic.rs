@@ -384,6 +384,13 @@ impl Srmtp {
         self.lambda
     }
 
+    /// Set the damping λ ≥ 0 (negative or NaN: 0) of the stacked projectors from the next
+    /// projection on — for a damping that varies with the configuration (singularity-robust).
+    pub fn set_damping(&mut self, lambda: f64) {
+        self.lambda = lambda.max(0.0);
+        self.null_dirty = true;
+    }
+
     /// The pseudoinverse workspace's counters (regularised / failed factorisations).
     pub fn pinv_stats(&self) -> (u64, u64) {
         (self.pinv.regularised(), self.pinv.failed())

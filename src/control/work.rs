@@ -3,8 +3,15 @@
 //!
 //! `ζ_r = J_e^#(q) (V_e,d + k_e ẽ) + (I − J_e^# J_e) J_b⁺ k_b p̃_b`
 //!
-//! - `J_e` the end-effector Jacobian (6×(6+n), `F_e`, USM-18), `J_e^#` its damped weighted
-//!   pseudoinverse with usage weights `U` and damping λ (USM-31);
+//! - `J_e` the end-effector Jacobian (6×(6+n), `F_e`, USM-18), `J_e^#` its weighted
+//!   pseudoinverse with usage weights `U`, as printed: `U J_eᵀ (J_e U J_eᵀ)⁻¹` (SPEC §5 reads
+//!   the paper's `W` as a usage weight). Damping is only a singularity-robust option: with
+//!   `σ = σ_min(J_e U^{1/2})` below the singular region ε ([`WorkGains::singular_region`]),
+//!   `J_e^# = U J_eᵀ (J_e U J_eᵀ + λ² I)⁻¹` with the variable damping
+//!   `λ² = λ_max² (1 − (σ/ε)²)` ([`singularity_robust_damping`], as in Chiaverini 1997, after
+//!   Nakamura & Hanafusa 1986), and the projector `I − J_e^# J_e` uses the same λ. The paper's
+//!   usage weights exclude base roll (`U` = 0), so a straight body, which cannot roll its end
+//!   effector with its joints, is such a singularity (σ = 0);
 //! - `ẽ = [p̃_e; ε̃_e]` the end-effector pose error in `F_e` ([`super::kinematic::ee_pose_error`]),
 //!   `V_e,d` the desired end-effector twist in `F_e` (zero for setpoints);
 //! - `J_b = [R_Ib 0]` and `p̃_b = p_b,home − p_Ib` (inertial, m); `J_b⁺` is the plain
@@ -25,7 +32,7 @@ use crate::kinematics::{ee_jacobian, BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};
 use faer::Mat;
-use nalgebra::UnitQuaternion;
+use nalgebra::{Matrix6, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
 /// Work-mode gains (USM-42, USM section VI-C). Defaults are the paper's values.
@@ -40,8 +47,18 @@ pub struct WorkGains {
     /// `[0.3, 0.3, 0.3, 0.0, 0.3, 0.3]` for the base (the zero excludes base roll), then 0.7 for
     /// the first two joints and 1 for the rest (for n = 8 exactly the paper's W).
     pub weights: Option<Vec<f64>>,
-    /// Damping λ of `J_e^#` and of the null-space projector (paper: 0.1).
+    /// Largest damping `λ_max` of `J_e^#` and of the null-space projector, applied only
+    /// inside the singular region (see [`WorkGains::singular_region`]); 0 = USM-42 as printed
+    /// everywhere. Default 0.1 (the paper's λ, given for the allocator).
     pub damping: f64,
+    /// Singular region ε of the singularity-robust damping: `σ_min(J_e U^{1/2})` below which
+    /// `J_e^#` is damped, `λ² = λ_max² (1 − (σ/ε)²)`; 0 = never (USM-42 as printed, which
+    /// fails at the straight start); a large ε (1e9) damps by `λ_max` everywhere (the constant
+    /// damping used before). Default 0.3 (inferred: on the paper design at `work-setpoint`,
+    /// regions of 0.05–0.1 leave the undamped inverse to drive end-effector roll excursions of
+    /// 30–110° with saturated thrusters; from 0.3 on the run is smooth and undamped ~90 % of
+    /// the time).
+    pub singular_region: f64,
     /// Damping of the base task's pseudoinverse `J_b⁺` (0: exact).
     pub base_task_damping: f64,
     /// Whether the base-position task is used (the paper: yes).
@@ -57,6 +74,7 @@ impl Default for WorkGains {
             k_b: [0.15, 0.15, 0.15],
             weights: None,
             damping: 0.1,
+            singular_region: 0.3,
             base_task_damping: 0.0,
             base_task: true,
             joint_limits: JointLimitSettings::default(),
@@ -103,6 +121,7 @@ impl WorkGains {
             }
         }
         check_nonneg("work.damping", self.damping)?;
+        check_nonneg("work.singular_region", self.singular_region)?;
         check_nonneg("work.base_task_damping", self.base_task_damping)?;
         self.joint_limits
             .validate()
@@ -134,6 +153,27 @@ pub struct WorkOutput {
     pub base_error: Vec3,
     /// Number of joints held by the joint-limit task in this step.
     pub active_limits: usize,
+    /// The damping λ of `J_e^#` in this step (0 outside the singular region).
+    pub damping: f64,
+}
+
+/// The singularity-robust damping of a weighted pseudoinverse whose smallest weighted
+/// singular value is `sigma`: `λ = λ_max √(1 − (σ/ε)²)` inside the singular region
+/// `σ < ε`, 0 outside it (and for `ε = 0`).
+pub fn singularity_robust_damping(sigma: f64, lambda_max: f64, region: f64) -> f64 {
+    if sigma < region {
+        lambda_max * (1.0 - (sigma / region).powi(2)).max(0.0).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// The smallest singular value of `J U^{1/2}` for a 6-row `j` and usage weights `u`:
+/// `√λ_min(J U Jᵀ)` (the conditioning that governs `J^#`). Allocation-free.
+fn weighted_sigma_min(j: &Mat<f64>, u: &[f64]) -> f64 {
+    let a: Matrix6<f64> =
+        Matrix6::from_fn(|r, s| (0..j.ncols()).map(|c| j[(r, c)] * u[c] * j[(s, c)]).sum());
+    a.symmetric_eigenvalues().min().max(0.0).sqrt()
 }
 
 /// The work-mode kinematic controller: SRMTP buffers, Jacobians and the joint-reference
@@ -234,7 +274,10 @@ impl WorkController {
         base_position_jacobian(&r_ib, &mut self.j_b);
 
         self.jl.clear();
-        let lambda = self.gains.damping;
+        let sigma = weighted_sigma_min(&self.j_e, self.srmtp.weights());
+        let lambda =
+            singularity_robust_damping(sigma, self.gains.damping, self.gains.singular_region);
+        self.srmtp.set_damping(lambda);
         let base_inv = TaskInverse::plain(self.gains.base_task_damping);
         // Dimensions are fixed at construction, so the pushes below cannot fail; a failure
         // would leave ζ_r partial, never panic.
@@ -271,6 +314,7 @@ impl WorkController {
             ee_error: e,
             base_error: p_b,
             active_limits: self.jl.count(),
+            damping: lambda,
         }
     }
 
@@ -399,6 +443,73 @@ mod tests {
         let pf = *pos.last().unwrap();
         assert!(pf > 1e-3 && pf < 0.02, "{pf}");
         assert!(moved > 0.2);
+    }
+
+    #[test]
+    fn singularity_robust_damping_only_inside_the_region() {
+        // λ = λ_max √(1 − (σ/ε)²): λ_max at σ = 0, 0 from σ = ε on, 0 everywhere for ε = 0.
+        assert_eq!(singularity_robust_damping(0.0, 0.1, 0.3), 0.1);
+        let mid = singularity_robust_damping(0.15, 0.1, 0.3);
+        assert!((mid - 0.1 * 0.75f64.sqrt()).abs() < 1e-15, "{mid}");
+        assert_eq!(singularity_robust_damping(0.3, 0.1, 0.3), 0.0);
+        assert_eq!(singularity_robust_damping(2.0, 0.1, 0.3), 0.0);
+        assert_eq!(singularity_robust_damping(0.0, 0.1, 0.0), 0.0);
+    }
+
+    #[test]
+    fn ee_task_is_the_printed_weighted_pseudoinverse_outside_the_singular_region() {
+        let v = usm_paper();
+        let mut ws = KinWorkspace::new(&v);
+        let base = BasePose::default();
+        let g0 = |ws: &KinWorkspace| ee_pose(&base, &ws.g_be);
+        let target_of = |g: &crate::spatial::Se3| WorkTarget {
+            ee_position: g.p + Vec3::new(-0.1, 0.1, 0.05),
+            ee_orientation: UnitQuaternion::from_rotation_matrix(
+                &nalgebra::Rotation3::from_matrix_unchecked(g.r),
+            ),
+            ee_twist: Vec6::zeros(),
+            base_position: base.position,
+        };
+        let only_ee = WorkGains {
+            base_task: false,
+            ..Default::default()
+        };
+        // Straight: the end effector cannot roll without base roll (U = 0 there), σ = 0, so
+        // the full λ_max applies.
+        forward_kinematics(&v, &[0.0; 8], &mut ws);
+        let mut ctl = WorkController::new(&v, &only_ee).unwrap();
+        let out = ctl.resolve(&base, &ws, &target_of(&g0(&ws)));
+        assert_eq!(out.damping, only_ee.damping);
+        // Well bent: σ_min(J_e U^½) is above the region, no damping, and J_e ζ_r = k_e ẽ
+        // exactly (USM-42 as printed); the constant-damping reading misses it.
+        let q = [0.6, 0.5, -0.6, 0.4, 0.6, -0.5, -0.6, 0.4];
+        forward_kinematics(&v, &q, &mut ws);
+        let target = target_of(&g0(&ws));
+        let mut j = Mat::zeros(6, 14);
+        ee_jacobian(&ws, &mut j);
+        let residual = |gains: &WorkGains| {
+            let mut ctl = WorkController::new(&v, gains).unwrap();
+            let out = ctl.resolve(&base, &ws, &target);
+            let z = ctl.zeta_r();
+            let r = (0..6)
+                .map(|a| {
+                    let jz: f64 = (0..14).map(|c| j[(a, c)] * z[c]).sum();
+                    (jz - gains.k_e[a] * out.ee_error[a]).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            (out.damping, r)
+        };
+        let (lambda, r) = residual(&only_ee);
+        assert!(weighted_sigma_min(&j, &only_ee.weights_for(8)) > only_ee.singular_region);
+        assert_eq!(lambda, 0.0);
+        assert!(r < 1e-9, "{r}");
+        let constant = WorkGains {
+            singular_region: 1e9,
+            ..only_ee
+        };
+        let (lambda, r) = residual(&constant);
+        assert!(lambda > 0.09 && r > 1e-5, "{lambda} {r}");
     }
 
     #[test]

@@ -2,4 +2,5 @@
 
 pub mod run_summary;
 pub mod singularity;
+pub mod success;
 pub mod trajectory;

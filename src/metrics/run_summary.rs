@@ -2,13 +2,15 @@
 //! looked up by [`Channel`], and of the effort and energy integrals the loop accumulated
 //! (at the control and physics rates, not from the log), in a fixed order for the mode — the common effort, energy,
 //! singularity and allocation metrics, then the transport tracking or the work regulation
-//! metrics.
+//! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
+use super::success::judge;
 use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
 use crate::control::wrap_angle;
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
+use crate::scenario::success::Missed;
 
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;
@@ -52,13 +54,19 @@ pub const TRANSPORT_METRICS: [&str; 9] = [
 ];
 
 /// Work-mode regulation metrics (then [`ROLL_METRICS`]).
-pub const WORK_METRICS: [&str; 5] = [
+pub const WORK_METRICS: [&str; 7] = [
     "final_position_error",
     "final_orientation_error_deg",
     "settling_time_position",
     "settling_time_orientation",
     "base_drift",
+    "ee_damped_fraction",
+    "ee_damping_max",
 ];
+
+/// The last metric of every run: 1 when it met its `[success]` criteria, else 0 (see
+/// [`add_success`]).
+pub const SUCCESS_METRIC: &str = "success";
 
 /// Work-mode end-effector roll metrics (see [`roll_metrics`]).
 pub const ROLL_METRICS: [&str; 3] = [
@@ -85,13 +93,14 @@ pub fn metric_catalogue(mode: Mode) -> Vec<String> {
             );
         }
     }
+    names.push(SUCCESS_METRIC.to_string());
     names
 }
 
 /// Whether `name` is a metric a run of `mode` reports: a catalogue name, or for transport
 /// `seg{k}_{name}` with `k` a segment index.
 pub fn is_run_metric(mode: Mode, name: &str) -> bool {
-    if COMMON_METRICS.contains(&name) {
+    if COMMON_METRICS.contains(&name) || name == SUCCESS_METRIC {
         return true;
     }
     match mode {
@@ -138,6 +147,15 @@ pub fn run_summary(
         Mode::Work => work_metrics(&mut out, &file.metrics, traj),
     }
     out
+}
+
+/// Judge the run by its `metrics` against `file`'s `[success]` criteria
+/// ([`super::success::judge`]) and append `success` (1 = every criterion met,
+/// 0 = not); returns the first criterion missed.
+pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
+    let missed = judge(&file.success, file.scenario.mode, metrics);
+    add(metrics, SUCCESS_METRIC, if missed.is_none() { 1.0 } else { 0.0 });
+    missed
 }
 
 /// Completion, energy and effort (SPEC §6, integrated along the run, not from the log: see
@@ -272,9 +290,11 @@ fn transport_metrics(
     add_all(out, &TRANSPORT_METRICS, values);
 }
 
-/// Work: final errors and settling times of the end-effector, the base's drift, and the
+/// Work: final errors and settling times of the end-effector, the base's drift, the
 /// end-effector roll about its setpoint over the whole run and after settling
-/// ([`roll_metrics`]).
+/// ([`roll_metrics`]), and how much the singularity-robust damping of `J_e^#` acted:
+/// `ee_damped_fraction` of the logged samples with λ > 0 and its largest value
+/// `ee_damping_max`.
 fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
     let t = channel(traj, Channel::T);
     let ep = channel(traj, Channel::EePositionError);
@@ -291,7 +311,17 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
         let l = bx.len() - 1;
         ((bx[l] - bx[0]).powi(2) + (by[l] - by[0]).powi(2) + (bz[l] - bz[0]).powi(2)).sqrt()
     };
-    let values = [last(ep), last(ea).to_degrees(), settle_p, settle_a, drift];
+    let damp = channel(traj, Channel::EeDamping);
+    let damped = damp.iter().filter(|l| **l > 0.0).count();
+    let values = [
+        last(ep),
+        last(ea).to_degrees(),
+        settle_p,
+        settle_a,
+        drift,
+        damped as f64 / damp.len().max(1) as f64,
+        damp.iter().fold(0.0, |m: f64, l| m.max(*l)),
+    ];
     add_all(out, &WORK_METRICS, values);
     roll_metrics(out, traj, settle_p.max(settle_a));
 }

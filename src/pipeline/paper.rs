@@ -30,7 +30,7 @@ const TRANSPORT_KEYS: [&str; 14] = [
     "saturation_fraction",
 ];
 /// Metrics shown in the work-mode table.
-const WORK_KEYS: [&str; 9] = [
+const WORK_KEYS: [&str; 11] = [
     "final_position_error",
     "final_orientation_error_deg",
     "settling_time_position",
@@ -38,8 +38,10 @@ const WORK_KEYS: [&str; 9] = [
     "base_drift",
     "ee_roll_max_deg",
     "ee_roll_max_settled_deg",
+    "ee_damped_fraction",
     "thruster_energy",
     "peak_thrust",
+    "success",
 ];
 /// Metrics shown in the allocator tables.
 const ALLOC_KEYS: [&str; 6] = [
@@ -163,9 +165,9 @@ fn write_tables(md: &mut String, rows: &[(String, Vec<(String, f64)>)]) {
     table(
         md,
         rows,
-        "Work mode (USM-42)",
+        "Work mode (USM-42): a pose within reach, and the paper-like pose beyond it",
         &WORK_KEYS,
-        &["work-setpoint".into()],
+        &["work-setpoint".into(), "work-setpoint-far".into()],
     );
     let allocators = |base: &str| -> Vec<String> {
         ["pinv", "qp", "minimax", "power"]

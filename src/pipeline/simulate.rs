@@ -26,8 +26,9 @@ pub fn set_allocation_method(table: &mut toml::Table, m: Method) {
     }
 }
 
-/// The `summary.json` of a run of `design`: scenario, mode, status, failure, metrics
-/// (non-finite values as strings), allocation counts and timing.
+/// The `summary.json` of a run of `design`: scenario, mode, status, failure, the success
+/// verdict (`met`, and the first missed `criterion` with its `detail`, or null), metrics
+/// (non-finite values as strings; `success` among them), allocation counts and timing.
 fn summary_json(r: &RunResult, design: &str) -> serde_json::Value {
     let metrics: serde_json::Map<String, serde_json::Value> = r
         .metrics
@@ -49,6 +50,11 @@ fn summary_json(r: &RunResult, design: &str) -> serde_json::Value {
         "design": design,
         "status": if r.failure.is_some() { "failed" } else { "ok" },
         "failure": r.failure.as_ref().map(|(t, c)| json!({"time": t, "cause": c})),
+        "success": {
+            "met": r.missed.is_none(),
+            "criterion": r.missed.as_ref().map(|m| m.criterion.as_str()),
+            "detail": r.missed.as_ref().map(|m| m.detail.as_str()),
+        },
         "metrics": metrics,
         "allocation": r.allocation_counts,
         "timing": r.timing,

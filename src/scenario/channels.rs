@@ -121,6 +121,9 @@ pub enum Channel {
     EePositionError,
     /// Work: end-effector pointing error (angle between the actual and desired x axes) [rad].
     EeOrientationError,
+    /// Work: damping λ of the end-effector task's pseudoinverse J_e^# (USM-42) at this step;
+    /// 0 outside the singular region (see `control::work::singularity_robust_damping`).
+    EeDamping,
     /// Work: base velocity reference v_r (USM-42) in the base frame.
     TwistRef(Twist),
     /// Joint angle q_k [rad].
@@ -182,6 +185,7 @@ impl Channel {
             Channel::PathY => "path_y",
             Channel::EePositionError => "ee_position_error",
             Channel::EeOrientationError => "ee_orientation_error",
+            Channel::EeDamping => "ee_damping",
             Channel::SigmaMin => "sigma_min",
             Channel::SlackNorm => "slack_norm",
             Channel::AllocStatus => "alloc_status",
@@ -218,7 +222,11 @@ pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Ch
         Mode::Transport => c.extend(TRANSPORT),
         Mode::Work => {
             c.extend(Pose::ALL.map(Channel::Setpoint));
-            c.extend([Channel::EePositionError, Channel::EeOrientationError]);
+            c.extend([
+                Channel::EePositionError,
+                Channel::EeOrientationError,
+                Channel::EeDamping,
+            ]);
             c.extend(Twist::ALL.map(Channel::TwistRef));
         }
     }
@@ -320,8 +328,9 @@ mod tests {
             .map(Channel::name)
             .collect();
         let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
-            ee_orientation_error ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_0 u_0 power_0 inflow_0";
-        assert_eq!(work[25..44].join(" "), expected);
+            ee_orientation_error ee_damping ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_0 \
+            u_0 power_0 inflow_0";
+        assert_eq!(work[25..45].join(" "), expected);
     }
 
     #[test]

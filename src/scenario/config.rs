@@ -29,11 +29,13 @@
 //! [thrusters]                 # thruster dynamics
 //! [physics]                   # which effects, current, integrator (rk4 | dopri5), rtol, atol
 //! [metrics]                   # thresholds, power model
+//! [success]                   # what counts as a successful run (scenario::success)
 //! ```
 //!
 //! A `[design]` table (the design-file schema) may replace `scenario.design`; the sweep engine
 //! uses it to pass a modified design.
 
+use super::success::SuccessSpec;
 use crate::allocation::{AllocSettings, Method, RateSettings};
 use crate::control::dynamic::DynamicGains;
 use crate::control::guidance::PathSpec;
@@ -401,6 +403,9 @@ pub struct ScenarioFile {
     /// Metric settings.
     #[serde(default)]
     pub metrics: MetricsSpec,
+    /// Success criteria (SPEC §6).
+    #[serde(default)]
+    pub success: SuccessSpec,
 }
 
 /// Mode-specific gains, parsed from `[control]`.
@@ -549,6 +554,7 @@ impl ScenarioFile {
             finite("setpoint.rpy_deg", &sp.rpy_deg)?;
         }
         self.validate_metrics()?;
+        self.success.validate()?;
         self.mode_gains()?;
         self.base_gains().validate().map_err(file_key_error)?;
         self.sim_config()?;

@@ -31,13 +31,15 @@ pub(crate) struct TransportSignals {
 }
 
 /// What the work law logs each control period: the `Setpoint`, `EePositionError`,
-/// `EeOrientationError` and `TwistRef` channels.
+/// `EeOrientationError`, `EeDamping` and `TwistRef` channels.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct WorkSignals {
     /// Setpoint position [m] and ZYX angles [rad], inertial frame.
     pub setpoint: [f64; 6],
     pub position_error: f64,
     pub orientation_error: f64,
+    /// Damping λ of J_e^# in this period.
+    pub damping: f64,
     /// Base velocity reference v_r in the base frame.
     pub twist_ref: Vec6,
 }
@@ -209,6 +211,7 @@ impl ModeController {
                     setpoint: [p.x, p.y, p.z, sp.x, sp.y, sp.z],
                     position_error: (g_ie.p - target.ee_position).norm(),
                     orientation_error: x_d.dot(&x_e).clamp(-1.0, 1.0).acos(),
+                    damping: out.damping,
                     twist_ref: out.v_r,
                 };
             }

@@ -7,7 +7,9 @@
 //!
 //! Presets reproduce the paper's simulations: `transport-method1`, `transport-method2`
 //! (USM Table III, u_c = 0.5 m/s, straight segments parallel to X, a 180° turn commanded at
-//! t = 95 s, 140 s) and `work-setpoint` (USM-42 with the paper's k_e, k_b, W, K_p, λ = 0.1);
+//! t = 95 s, 140 s) and `work-setpoint` (USM-42 with the paper's k_e, k_b, W, K_p, at a pose
+//! the joints reach with the base at home; `work-setpoint-far` is the paper-like pose beyond
+//! the body's reach, where the base has to move);
 //! `transport-method1-torque-limited` is Method 1 with torque-level PD joint servos saturating
 //! at 50 N·m, so the joint torque at the turn is bounded (`joint_torque_peak`).
 //!
@@ -36,6 +38,7 @@ mod error;
 pub(crate) mod recorder;
 pub mod run;
 mod setup;
+pub mod success;
 
 pub use channels::{Channel, Trajectory};
 pub use config::{Mode, ScenarioFile};
@@ -50,11 +53,12 @@ use crate::model::Vehicle;
 use std::path::{Path, PathBuf};
 
 /// Names of the built-in scenarios.
-pub const PRESETS: [&str; 4] = [
+pub const PRESETS: [&str; 5] = [
     "transport-method1",
     "transport-method2",
     "work-setpoint",
     "transport-method1-torque-limited",
+    "work-setpoint-far",
 ];
 
 const TRANSPORT_COMMON: &str = r#"
@@ -73,6 +77,14 @@ segments = [
 
 [allocation]
 method = "qp"
+
+[success]
+# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# ends within 0.1 m of the path, and each segment converges (|e_y| < metrics.band and staying)
+# within 60 s of becoming active.
+max_saturation_fraction = 0.05
+cross_track_bound = 0.1
+convergence_window = 60.0
 "#;
 
 /// The joint servos of `transport-method1-torque-limited`: torque-level PD servos whose
@@ -116,9 +128,12 @@ method = "method{method}"
     )
 }
 
-const WORK_SETPOINT: &str = r#"
+/// The work-mode preset named `name` reaching for `setpoint` (a `[setpoint]` table body).
+fn work_preset(name: &str, setpoint: &str) -> String {
+    format!(
+        r#"
 [scenario]
-name = "work-setpoint"
+name = "{name}"
 mode = "work"
 design = "usm-paper"
 duration = 80.0
@@ -127,17 +142,16 @@ control_dt = 0.05
 log_dt = 0.1
 
 [setpoint]
-# A 6-DOF end-effector pose away from the straight start (end-effector at (3.3, 0, 0)):
-# 0.4 m forward, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0.
-position = [3.7, 0.5, -0.3]
-rpy_deg = [0.0, 10.0, 25.0]
-
+{setpoint}
 [control]
-# USM-42: k_e, k_b and the usage weights W of the paper (section VI-C); lambda = 0.1.
+# USM-42: k_e, k_b and the usage weights W of the paper (section VI-C). J_e^# is the weighted
+# pseudoinverse as printed, damped (lambda up to 0.1, the paper's allocator value) only where
+# sigma_min(J_e U^1/2) < singular_region (singularity-robust; the straight start is singular).
 k_e = [0.2, 0.2, 0.2, 0.4, 0.4, 0.4]
 k_b = [0.15, 0.15, 0.15]
 weights = [0.3, 0.3, 0.3, 0.0, 0.3, 0.3, 0.7, 0.7, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]
 damping = 0.1
+singular_region = 0.3
 
 [base_control]
 # USM-33 without the nonlinear term, K_p = diag(1,1,1,0,1,1), no integral (paper).
@@ -149,6 +163,31 @@ nonlinear = false
 # The paper's damped pseudoinverse, lambda = 0.1.
 method = "pinv"
 lambda = 0.1
+
+[success]
+# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# final end-effector errors within 2 cm and 2 deg (roll excluded).
+max_saturation_fraction = 0.05
+position_tolerance = 0.02
+orientation_tolerance_deg = 2.0
+"#
+    )
+}
+
+/// `work-setpoint`: a pose the joints reach with the base at home (the straight body's end
+/// effector is at (3.3, 0, 0)), so both USM-42 tasks are feasible.
+const WORK_SETPOINT_NEAR: &str = r#"# A 6-DOF end-effector pose inside the reach of the 3.3 m body with the base at home: 0.3 m
+# back from the straight tip, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0.
+position = [3.0, 0.5, -0.3]
+rpy_deg = [0.0, 10.0, 25.0]
+"#;
+
+/// `work-setpoint-far`: the paper-like setpoint beyond the body's reach (x = 3.7 m > 3.3 m),
+/// where the base must leave home and the base task conflicts with the end-effector task.
+const WORK_SETPOINT_FAR: &str = r#"# Beyond the reach of the 3.3 m body with the base at home: 0.4 m forward of the straight
+# tip, 0.5 m left, 0.3 m down, yawed 25 deg and pitched 10 deg; roll 0. The base must move.
+position = [3.7, 0.5, -0.3]
+rpy_deg = [0.0, 10.0, 25.0]
 "#;
 
 /// The TOML text of a preset, or `None`.
@@ -157,7 +196,8 @@ pub fn preset_text(name: &str) -> Option<String> {
         "transport-method1" => Some(transport_preset(name, 1, "")),
         "transport-method2" => Some(transport_preset(name, 2, "")),
         "transport-method1-torque-limited" => Some(transport_preset(name, 1, TORQUE_LIMITED_SERVO)),
-        "work-setpoint" => Some(WORK_SETPOINT.to_string()),
+        "work-setpoint" => Some(work_preset(name, WORK_SETPOINT_NEAR)),
+        "work-setpoint-far" => Some(work_preset(name, WORK_SETPOINT_FAR)),
         _ => None,
     }
 }
@@ -304,6 +344,10 @@ pub struct CaseRun {
     pub trajectory: Option<Trajectory>,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// The first success criterion the run missed, as `criterion: detail`
+    /// ([`success::Missed`]; `no_failure` for a run that stopped early); `None` when it met
+    /// them all.
+    pub missed: Option<String>,
 }
 
 /// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
@@ -323,6 +367,7 @@ pub fn run_case(
         failure: r
             .failure
             .map(|(t, c)| format!("run stopped at t = {t:.3} s: {c}")),
+        missed: r.missed.map(|m| m.to_string()),
     })
 }
 
@@ -436,6 +481,20 @@ mod tests {
                 "kp = [1.0, -1.0, 1.0, 0.0, 1.0, 1.0]",
                 "base_control.kp[1]",
                 "must be >= 0",
+            ),
+            (
+                "work-setpoint",
+                "position_tolerance =",
+                "position_tolerance = -0.1",
+                "success.position_tolerance",
+                "must be a finite number > 0",
+            ),
+            (
+                "transport-method2",
+                "convergence_window =",
+                "convergence_window = \"long\"",
+                "success.convergence_window",
+                "invalid type",
             ),
         ];
         for (preset, old, line, path, message) in cases {

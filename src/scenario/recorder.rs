@@ -299,6 +299,7 @@ impl Recorder {
                 w.put_all(Pose::ALL.map(Channel::Setpoint).into_iter().zip(s.setpoint));
                 w.put(Channel::EePositionError, s.position_error);
                 w.put(Channel::EeOrientationError, s.orientation_error);
+                w.put(Channel::EeDamping, s.damping);
                 let twist_ref = s.twist_ref.iter().copied();
                 w.put_all(Twist::ALL.map(Channel::TwistRef).into_iter().zip(twist_ref));
             }

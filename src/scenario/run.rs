@@ -15,9 +15,10 @@ use super::controller::Measurement;
 use super::error::ScenarioError;
 use super::recorder::{timed, AllocationCounts, Recorder, Timing};
 use super::setup::ClosedLoop;
+use super::success::Missed;
 use crate::dynamics::ActuatorCommand;
 use crate::kinematics::{forward_kinematics, thruster_matrix, BasePose};
-use crate::metrics::run_summary::run_summary;
+use crate::metrics::run_summary::{add_success, run_summary};
 use crate::model::Vehicle;
 use crate::spatial::Vec6;
 use nalgebra::Matrix6;
@@ -37,6 +38,9 @@ pub struct RunResult {
     pub metrics: Vec<(String, f64)>,
     /// Why the run stopped early, if it did: (simulation time [s], cause).
     pub failure: Option<(f64, String)>,
+    /// The first `[success]` criterion the run missed; `None` for a successful run (metric
+    /// `success` = 1).
+    pub missed: Option<Missed>,
     /// Allocation outcomes.
     pub allocation_counts: AllocationCounts,
     /// Wall-clock breakdown.
@@ -161,13 +165,15 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
     rec.energy
         .set_joints(lp.sim.joint_work(), lp.sim.joint_torque_peak());
     let (trajectory, counts, energy, timing) = rec.finish(started);
-    let metrics = run_summary(file, &trajectory, failure.is_some(), &counts, &energy);
+    let mut metrics = run_summary(file, &trajectory, failure.is_some(), &counts, &energy);
+    let missed = add_success(&mut metrics, file);
     Ok(RunResult {
         name: file.scenario.name.clone(),
         mode: file.scenario.mode,
         trajectory,
         metrics,
         failure,
+        missed,
         allocation_counts: counts,
         timing,
     })

@@ -7,7 +7,8 @@
 //!   `name=value;…`). `--resume` reads it; at the end it is compacted (sorted by case id,
 //!   deduplicated by hash, rows of other study versions dropped). `merge` reads it.
 //! - `cases.csv`, `cases.parquet`: the final table, sorted by case id: `case_id`, `hash`, one
-//!   column per axis, the metrics, `status` (`ok`, `failed`, `skipped`), `reason`. No times.
+//!   column per axis, the metrics, `status` (`ok`, `unsuccessful`, `failed`, `skipped`),
+//!   `reason`. No times.
 //! - `manifest.json`: provenance, counts, timings, the raw schema and the report settings.
 //! - `study.toml`: a copy of the study file.
 //!
@@ -75,6 +76,8 @@ pub struct SweepOutcome {
     pub in_shard: usize,
     /// Counts by status.
     pub ok: usize,
+    /// Cases that ran but missed a success criterion.
+    pub unsuccessful: usize,
     /// Failed cases.
     pub failed: usize,
     /// Skipped cases.
@@ -181,6 +184,7 @@ pub fn run_sweep(
     }
     .with_status(StatusCounts {
         ok: outcome.ok,
+        unsuccessful: outcome.unsuccessful,
         failed: outcome.failed,
         skipped: outcome.skipped,
     });
@@ -195,6 +199,7 @@ pub fn run_sweep(
 impl SweepOutcome {
     fn set_counts(&mut self, c: StatusCounts) {
         self.ok = c.ok;
+        self.unsuccessful = c.unsuccessful;
         self.failed = c.failed;
         self.skipped = c.skipped;
     }

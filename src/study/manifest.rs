@@ -43,6 +43,9 @@ pub struct Counts {
     pub in_output: usize,
     /// `ok` rows.
     pub ok: usize,
+    /// `unsuccessful` rows (ran, missed a success criterion); absent in older manifests.
+    #[serde(default)]
+    pub unsuccessful: usize,
     /// `failed` rows.
     pub failed: usize,
     /// `skipped` rows.
@@ -58,6 +61,7 @@ impl Counts {
     pub fn with_status(self, s: StatusCounts) -> Self {
         Counts {
             ok: s.ok,
+            unsuccessful: s.unsuccessful,
             failed: s.failed,
             skipped: s.skipped,
             ..self

@@ -39,6 +39,7 @@ struct StudyFile {
     setpoint: Option<toml::Table>,
     servo: Option<toml::Table>,
     thrusters: Option<toml::Table>,
+    success: Option<toml::Table>,
     axis: Option<Vec<AxisFile>>,
     doe: Option<DoeFile>,
 }
@@ -277,6 +278,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("setpoint", &file.setpoint),
         ("servo", &file.servo),
         ("thrusters", &file.thrusters),
+        ("success", &file.success),
     ] {
         if let Some(t) = t {
             own.insert(k.into(), toml::Value::Table(t.clone()));
@@ -304,6 +306,10 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     }
     let mut reference = defaults;
     merge_into(&mut reference, &own);
+    // The success criteria of the base must parse and hold (dynamic modes).
+    if mode.is_dynamic() {
+        runner::check_success(&reference).map_err(|e| doc.place(e))?;
+    }
     // Static settings of the base must parse.
     if static_enabled {
         if let Err(m) = static_spec(&reference, 0) {

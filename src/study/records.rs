@@ -16,11 +16,15 @@ use crate::report::{
     format_f64, write_csv, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
 };
 
-/// How a case ended (the `status` column: `ok`, `failed`, `skipped`).
+/// How a case ended (the `status` column: `ok`, `unsuccessful`, `failed`, `skipped`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum CaseStatus {
-    /// Every metric was computed.
+    /// Every metric was computed and, for a closed-loop run, every `[success]` criterion met:
+    /// the cases a report ranks.
     Ok,
+    /// The run completed but missed a `[success]` criterion: the reason is
+    /// `criterion: detail`, the criterion id first ([`missed_criterion`]).
+    Unsuccessful,
     /// The analysis or the run failed (the reason says why; metrics computed so far are kept).
     Failed,
     /// The case could not be set up (an override that does not apply, an invalid design).
@@ -29,12 +33,18 @@ pub enum CaseStatus {
 
 impl CaseStatus {
     /// Every status, in table order.
-    pub const ALL: [CaseStatus; 3] = [CaseStatus::Ok, CaseStatus::Failed, CaseStatus::Skipped];
+    pub const ALL: [CaseStatus; 4] = [
+        CaseStatus::Ok,
+        CaseStatus::Unsuccessful,
+        CaseStatus::Failed,
+        CaseStatus::Skipped,
+    ];
 
     /// The text in the `status` column.
     pub fn as_str(self) -> &'static str {
         match self {
             CaseStatus::Ok => "ok",
+            CaseStatus::Unsuccessful => "unsuccessful",
             CaseStatus::Failed => "failed",
             CaseStatus::Skipped => "skipped",
         }
@@ -43,6 +53,17 @@ impl CaseStatus {
     /// The status of a `status` cell; `None` for any other text.
     pub fn parse(s: &str) -> Option<Self> {
         CaseStatus::ALL.into_iter().find(|c| c.as_str() == s)
+    }
+}
+
+/// The criterion a case with `status` and `reason` missed, for the report: the id before
+/// the first `:` of an `unsuccessful` case's reason; `no_failure` for a `failed` case; `None`
+/// for `ok` and `skipped` cases (a skipped case never ran).
+pub fn missed_criterion(status: CaseStatus, reason: &str) -> Option<&str> {
+    match status {
+        CaseStatus::Unsuccessful => Some(reason.split_once(':').map_or(reason, |x| x.0).trim()),
+        CaseStatus::Failed => Some("no_failure"),
+        CaseStatus::Ok | CaseStatus::Skipped => None,
     }
 }
 
@@ -64,6 +85,8 @@ impl FromStr for CaseStatus {
 pub struct StatusCounts {
     /// `ok` cases.
     pub ok: usize,
+    /// `unsuccessful` cases.
+    pub unsuccessful: usize,
     /// `failed` cases.
     pub failed: usize,
     /// `skipped` cases.
@@ -75,6 +98,7 @@ impl StatusCounts {
     pub fn add(&mut self, s: CaseStatus) {
         match s {
             CaseStatus::Ok => self.ok += 1,
+            CaseStatus::Unsuccessful => self.unsuccessful += 1,
             CaseStatus::Failed => self.failed += 1,
             CaseStatus::Skipped => self.skipped += 1,
         }

@@ -7,6 +7,7 @@
 //!   scenario side of a study file — a table with the sub-tables `scenario`, `control`,
 //!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
 //!   valid axis names and to reject unknown keys before anything runs.
+//! - [`check_success`]: validate the `[success]` criteria of a scenario-side table.
 //! - [`run_case`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
 //!   case's fully resolved scenario-side table (same shape, overrides applied) and the case
 //!   seed; returns named scalar metrics and, when `log` is set, a trajectory table.
@@ -17,8 +18,11 @@
 use std::fmt;
 use std::str::FromStr;
 
+use crate::input::document::deserialize_table;
+use crate::input::located::KeyError;
 use crate::model::Vehicle;
 use crate::report::Table;
+use crate::scenario::success::SuccessSpec;
 use crate::scenario::Mode as ScenarioMode;
 
 /// The result of one dynamic case.
@@ -32,11 +36,14 @@ pub struct CaseOutcome {
     /// Why the run stopped early (diverged, …): the case is recorded as `failed` with this
     /// reason, its metrics are kept.
     pub failure: Option<String>,
+    /// The first `[success]` criterion a completed run missed, as `criterion: detail` (the
+    /// criterion id first): the case is recorded as `unsuccessful` with this reason.
+    pub missed: Option<String>,
 }
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
 /// `[static]`); must cover the top-level keys of [`default_table`].
-pub const SCENARIO_TABLES: [&str; 11] = [
+pub const SCENARIO_TABLES: [&str; 12] = [
     "scenario",
     "control",
     "base_control",
@@ -48,6 +55,7 @@ pub const SCENARIO_TABLES: [&str; 11] = [
     "setpoint",
     "servo",
     "thrusters",
+    "success",
 ];
 
 /// The mode of a study (`scenario.mode`; written as lower-case text in study files and
@@ -138,5 +146,17 @@ pub fn run_case(
         metrics: run.metrics,
         trajectory,
         failure: run.failure,
+        missed: run.missed,
     })
+}
+
+/// Check the `[success]` table of a resolved scenario-side table (absent: the defaults), so
+/// that a bad success definition is reported with its key before any case runs.
+pub fn check_success(scenario: &toml::Table) -> Result<(), KeyError> {
+    let spec: SuccessSpec = match scenario.get("success") {
+        Some(toml::Value::Table(t)) => deserialize_table(t, "success")?,
+        Some(_) => return Err(KeyError::new("success", "must be a table")),
+        None => SuccessSpec::default(),
+    };
+    spec.validate()
 }

@@ -1,6 +1,10 @@
 //! What the sweep report looks at: the metric columns, their direction, the objective and the
 //! trade-off ([`Selection`]), and the helpers both the Markdown summary and the plots use
 //! (number formatting, the levels of an axis, means over rows, thinning).
+//!
+//! Only successful cases (status `ok`: for a closed-loop run, every `[success]` criterion
+//! met) are ranked, averaged or put on the Pareto front; signed metrics
+//! ([`BY_MAGNITUDE`]) are ranked by their magnitude.
 
 use std::collections::HashSet;
 
@@ -20,12 +24,25 @@ pub(crate) fn thin(rows: &[usize]) -> Vec<usize> {
     rows.iter().copied().step_by(k).collect()
 }
 
+/// Signed metrics whose best value is the one nearest zero: ranked, and put on a Pareto
+/// front, by |x| (the final cross-track error of transport, positive to the left).
+pub const BY_MAGNITUDE: [&str; 1] = ["final_cross_track"];
+
+/// Default objective of a transport study when present: thruster energy per metre of path
+/// covered, which compares designs of different speeds.
+pub const ENERGY_PER_METRE: &str = "energy_per_metre";
+
+/// The 0/1 success metric of a closed-loop run (1 on every ranked case).
+pub const SUCCESS: &str = "success";
+
 /// Which metrics the report looks at and in which direction.
 pub struct Selection {
     /// Every metric column (f64, not an axis).
     pub metrics: Vec<String>,
     /// Metrics where larger is better.
     pub maximise: HashSet<String>,
+    /// Signed metrics ranked by magnitude (smaller |x| is better), see [`BY_MAGNITUDE`].
+    pub magnitude: HashSet<String>,
     /// Objective for best/worst.
     pub objective: Option<String>,
     /// Pareto trade-off `(x, y)`.
@@ -53,6 +70,7 @@ impl Selection {
                 || matches!(
                     m.as_str(),
                     "completed"
+                        | SUCCESS
                         | "converged"
                         | "segments_reached"
                         | "simulated_time"
@@ -62,7 +80,16 @@ impl Selection {
                 maximise.insert(m.clone());
             }
         }
-        let energy = metrics.iter().find(|m| m.contains("energy")).cloned();
+        let energy = metrics
+            .iter()
+            .find(|m| *m == ENERGY_PER_METRE)
+            .or_else(|| metrics.iter().find(|m| m.contains("energy")))
+            .cloned();
+        let magnitude: HashSet<String> = metrics
+            .iter()
+            .filter(|m| BY_MAGNITUDE.contains(&m.as_str()))
+            .cloned()
+            .collect();
         let objective = manifest
             .report
             .objective
@@ -86,12 +113,34 @@ impl Selection {
         Selection {
             metrics,
             maximise,
+            magnitude,
             objective,
             pareto,
         }
     }
 
+    /// The value `x` of `metric` as ranked: |x| for a metric ranked by magnitude.
+    pub(crate) fn ranked(&self, metric: &str, x: f64) -> f64 {
+        if self.magnitude.contains(metric) {
+            x.abs()
+        } else {
+            x
+        }
+    }
+
+    /// The goal of `metric` as written in the report: `max`, `min` or `min |x|`.
+    pub(crate) fn goal(&self, metric: &str) -> &'static str {
+        if self.maximise.contains(metric) {
+            "max"
+        } else if self.magnitude.contains(metric) {
+            "min |x|"
+        } else {
+            "min"
+        }
+    }
+
     fn better(&self, metric: &str, a: f64, b: f64) -> bool {
+        let (a, b) = (self.ranked(metric, a), self.ranked(metric, b));
         if self.maximise.contains(metric) {
             a > b
         } else {
@@ -99,7 +148,7 @@ impl Selection {
         }
     }
 
-    /// Row of the best value of `metric` among `ok` rows (first on ties).
+    /// Row of the best value of `metric` among the successful (`ok`) rows (first on ties).
     pub(crate) fn best_row(&self, table: &Table, metric: &str, worst: bool) -> Option<usize> {
         let v = table.f64(metric).ok()?;
         let status = table.str(STATUS).ok()?;
@@ -148,8 +197,11 @@ impl Selection {
             push(x);
             push(y);
         }
+        if let Some(m) = self.metrics.iter().find(|x| *x == ENERGY_PER_METRE) {
+            push(m);
+        }
         for m in &self.metrics {
-            if !m.starts_with("design_") && !m.starts_with("tcm_lost_") {
+            if !m.starts_with("design_") && !m.starts_with("tcm_lost_") && m != SUCCESS {
                 push(m);
             }
         }
@@ -252,7 +304,7 @@ pub(crate) fn mean(v: &[f64], rows: &[usize]) -> f64 {
     }
 }
 
-/// The rows whose status is `ok`.
+/// The rows whose status is `ok`: the successful cases, the only ones ranked.
 pub(crate) fn ok_rows(table: &Table) -> Vec<usize> {
     let status = table.str(STATUS).unwrap_or(&[]);
     (0..table.n_rows())
@@ -277,16 +329,19 @@ pub(crate) struct Front<'a> {
 }
 
 impl Selection {
-    /// The Pareto front of the selection's trade-off over `ok_rows` (each metric minimised or
-    /// maximised as the selection says); `None` without a trade-off.
+    /// The Pareto front of the selection's trade-off over `ok_rows` (each metric minimised,
+    /// maximised or minimised in magnitude as the selection says); `None` without a
+    /// trade-off.
     pub(crate) fn front<'a>(&'a self, table: &'a Table, ok_rows: &[usize]) -> Option<Front<'a>> {
         let (x, y) = self.pareto.as_ref()?;
         let (xs, ys) = (table.f64(x).unwrap_or(&[]), table.f64(y).unwrap_or(&[]));
-        let sign = |mname: &str| {
+        // Minimise both: negate what is maximised, |x| for what is ranked by magnitude.
+        let key = |mname: &str, v: f64| {
+            let v = self.ranked(mname, v);
             if self.maximise.contains(mname) {
-                -1.0
+                -v
             } else {
-                1.0
+                v
             }
         };
         let rows: Vec<usize> = ok_rows
@@ -296,7 +351,7 @@ impl Selection {
             .collect();
         let pts: Vec<(f64, f64)> = rows
             .iter()
-            .map(|&r| (sign(x) * xs[r], sign(y) * ys[r]))
+            .map(|&r| (key(x, xs[r]), key(y, ys[r])))
             .collect();
         let front = pareto_front(&pts);
         Some(Front {

@@ -4,7 +4,11 @@
 //!
 //! `summary.md`: counts, the best case by each metric, the main effects of each axis (mean of
 //! the key metrics per axis value; numeric axes with many values binned), the Pareto-optimal
-//! cases of the trade-off (energy vs singularity exposure by default), failures.
+//! cases of the trade-off (energy vs singularity exposure by default), the cases left out.
+//!
+//! Only successful cases (status `ok`) are ranked, averaged and put on the Pareto front; the
+//! summary says how many were left out and why (per missed `[success]` criterion, failures,
+//! skips) and lists them with the criterion they missed.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -12,9 +16,9 @@ use std::path::Path;
 
 use super::manifest::Manifest;
 use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
-use super::records::{CaseStatus, CASE_ID, REASON, STATUS};
+use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::DoeKind;
-use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection};
+use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
 use crate::report::{fmt_short, MarkdownTable, Table};
 
 /// What every section of the summary reads.
@@ -22,7 +26,11 @@ struct Ctx<'a> {
     table: &'a Table,
     sel: Selection,
     ids: Vec<i64>,
+    /// The successful rows: the only ones ranked.
     ok_rows: Vec<usize>,
+    /// The rows left out, each with its status and the criterion it missed (`None` for a
+    /// skipped case).
+    left_out: Vec<(usize, CaseStatus, Option<&'a str>)>,
     axes: Vec<&'a str>,
     key: Vec<String>,
 }
@@ -58,6 +66,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         sel,
         ids: table.i64(CASE_ID).map(|s| s.to_vec()).unwrap_or_default(),
         ok_rows: ok_rows(table),
+        left_out: left_out(table),
         axes: m.axes.iter().map(|a| a.name.as_str()).collect(),
         key,
     };
@@ -69,7 +78,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         pareto_plot(table, &c.axes, &f, &plots, &mut warnings);
         let _ = writeln!(md);
     }
-    failures_section(&c, &mut md);
+    left_out_section(&c, &mut md);
     if let Err(e) = crate::report::atomic_write(&dir.join("summary.md"), md.as_bytes()) {
         warnings.push(e.to_string());
     }
@@ -83,6 +92,54 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     warnings
 }
 
+/// The rows whose status is not `ok`, with their status and missed criterion.
+fn left_out(table: &Table) -> Vec<(usize, CaseStatus, Option<&str>)> {
+    let status = table.str(STATUS).unwrap_or(&[]);
+    let reasons = table.str(REASON).unwrap_or(&[]);
+    (0..table.n_rows())
+        .filter_map(|i| {
+            let s = CaseStatus::parse(status.get(i)?)?;
+            let r = reasons.get(i).map_or("", String::as_str);
+            (s != CaseStatus::Ok).then(|| (i, s, missed_criterion(s, r)))
+        })
+        .collect()
+}
+
+/// How many cases were left out of the ranking per (status, missed criterion), in that
+/// order.
+fn left_out_counts<'a>(c: &Ctx<'a>) -> BTreeMap<(CaseStatus, Option<&'a str>), usize> {
+    let mut groups = BTreeMap::new();
+    for &(_, s, k) in &c.left_out {
+        *groups.entry((s, k)).or_insert(0) += 1;
+    }
+    groups
+}
+
+/// `left out: 40 missed `cross_track_bound`, 2 failed, 1 skipped` (or `none left out`).
+fn left_out_text(c: &Ctx) -> String {
+    let parts: Vec<String> = left_out_counts(c)
+        .iter()
+        .map(|((s, k), n)| match (s, k) {
+            (CaseStatus::Unsuccessful, Some(k)) => format!("{n} missed `{k}`"),
+            (s, _) => format!("{n} {s}"),
+        })
+        .collect();
+    if parts.is_empty() {
+        "none left out".into()
+    } else {
+        format!("{} left out: {}", c.left_out.len(), parts.join(", "))
+    }
+}
+
+/// The reason of a left-out case without the criterion an unsuccessful case's reason starts
+/// with (the table shows it in its own column).
+fn detail(s: CaseStatus, reason: &str) -> &str {
+    match (s, reason.split_once(": ")) {
+        (CaseStatus::Unsuccessful, Some((_, d))) => d,
+        _ => reason,
+    }
+}
+
 /// Title, description, counts and the objective.
 fn header_section(c: &Ctx, m: &Manifest) -> String {
     let mut md = String::new();
@@ -93,7 +150,7 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
     let _ = writeln!(
         md,
         "Mode `{}`{}, design of experiments `{}`, seed {}, {} of {} cases in this output: \
-         **{} ok, {} failed, {} skipped**. Study hash `{}`, usm-study {}.\n",
+         **{} ok, {} unsuccessful, {} failed, {} skipped**. Study hash `{}`, usm-study {}.\n",
         m.mode,
         if m.static_analysis {
             " + static TCM analysis"
@@ -105,19 +162,32 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
         m.cases.in_output,
         m.cases.planned,
         m.cases.ok,
+        m.cases.unsuccessful,
         m.cases.failed,
         m.cases.skipped,
         &m.study_hash[..16.min(m.study_hash.len())],
         m.tool_version
     );
+    let _ = writeln!(
+        md,
+        "**Only the {} successful cases** (status `ok`{}) are ranked, averaged and put on the \
+         Pareto front; {} (see [the cases left out](#cases-left-out)).\n",
+        c.ok_rows.len(),
+        if m.mode.is_dynamic() {
+            ": the run met every `[success]` criterion of the scenario"
+        } else {
+            ""
+        },
+        left_out_text(c)
+    );
     if let Some(o) = &c.sel.objective {
         let _ = writeln!(
             md,
             "Objective (best/worst case): `{o}` ({}).\n",
-            if c.sel.maximise.contains(o) {
-                "larger is better"
-            } else {
-                "smaller is better"
+            match c.sel.goal(o) {
+                "max" => "larger is better",
+                "min |x|" => "smaller magnitude is better",
+                _ => "smaller is better",
             }
         );
     }
@@ -127,13 +197,20 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
 /// The best case by each metric (design columns aside).
 fn best_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "## Best case by each metric\n");
+    let _ = writeln!(
+        md,
+        "Among the {} successful cases ({}); signed metrics by magnitude (`min |x|`).\n",
+        c.ok_rows.len(),
+        left_out_text(c)
+    );
     let mut t = c.table(&["metric", "goal", "case", "value"]);
-    for metric in c.sel.metrics.iter().filter(|m| !m.starts_with("design_")) {
-        let goal = if c.sel.maximise.contains(metric) {
-            "max"
-        } else {
-            "min"
-        };
+    let shown = c
+        .sel
+        .metrics
+        .iter()
+        .filter(|m| !m.starts_with("design_") && *m != SUCCESS);
+    for metric in shown {
+        let goal = c.sel.goal(metric);
         let best = c.sel.best_row(c.table, metric, false);
         let (case, value) = match best {
             Some(r) => (format!("#{}", c.ids[r]), cell_text(c.table, metric, r)),
@@ -148,42 +225,68 @@ fn best_section(c: &Ctx, md: &mut String) {
     md.push_str(&t.finish());
 }
 
-/// Main effects: the mean of each key metric at each level of each axis.
+/// Main effects: per axis value, how many cases ran and how many succeeded, and the mean
+/// of each key metric over the successful ones.
 fn effects_section(c: &Ctx, md: &mut String) {
     if c.axes.is_empty() || c.ok_rows.is_empty() {
         return;
     }
-    let _ = writeln!(md, "\n## Effect of each axis\n\nMean of each key metric over the `ok` cases at each axis value.\n");
+    let _ = writeln!(
+        md,
+        "\n## Effect of each axis\n\nPer axis value: the cases that ran (`ok` or \
+         `unsuccessful`), how many of them succeeded, and the mean of each key metric over the \
+         successful ones.\n"
+    );
+    let mut ran: Vec<usize> = c.ok_rows.clone();
+    ran.extend(
+        c.left_out
+            .iter()
+            .filter(|x| x.1 == CaseStatus::Unsuccessful)
+            .map(|x| x.0),
+    );
+    ran.sort_unstable();
     for a in &c.axes {
         let _ = writeln!(md, "### `{a}`\n");
-        let header = ["value", "cases"]
+        let header = ["value", "cases", "successful"]
             .into_iter()
             .chain(c.key.iter().map(String::as_str));
         let mut t = MarkdownTable::new(header);
-        for (label, _, rows) in levels(c.table, a, &c.ok_rows) {
+        for (label, _, rows) in levels(c.table, a, &ran) {
+            let ok: Vec<usize> = rows
+                .iter()
+                .copied()
+                .filter(|r| c.ok_rows.binary_search(r).is_ok())
+                .collect();
             let means = c
                 .key
                 .iter()
-                .map(|k| fmt_short(c.table.f64(k).map(|v| mean(v, &rows)).unwrap_or(f64::NAN)));
+                .map(|k| fmt_short(c.table.f64(k).map(|v| mean(v, &ok)).unwrap_or(f64::NAN)));
             t.row(
-                [label.replace('|', "\\|"), rows.len().to_string()]
-                    .into_iter()
-                    .chain(means),
+                [
+                    label.replace('|', "\\|"),
+                    rows.len().to_string(),
+                    ok.len().to_string(),
+                ]
+                .into_iter()
+                .chain(means),
             );
         }
         let _ = writeln!(md, "{}", t.finish());
     }
 }
 
-/// The Pareto-optimal cases (at most 50 listed).
+/// The Pareto-optimal successful cases (at most 50 listed).
 fn pareto_section(c: &Ctx, f: &Front, md: &mut String) {
     let (x, y) = (f.x, f.y);
     let _ = writeln!(md, "## Pareto-optimal cases: `{x}` vs `{y}`\n");
     let _ = writeln!(
         md,
-        "{} non-dominated of {} `ok` cases.\n",
+        "{} non-dominated of {} successful cases with both metrics ({}; `{x}`: {}, `{y}`: {}).\n",
         f.front.len(),
-        f.rows.len()
+        f.rows.len(),
+        left_out_text(c),
+        c.sel.goal(x),
+        c.sel.goal(y)
     );
     let mut t = c.table(&["case", x, y]);
     for &k in f.front.iter().take(50) {
@@ -198,36 +301,37 @@ fn pareto_section(c: &Ctx, f: &Front, md: &mut String) {
     md.push_str(&t.finish());
 }
 
-/// Failed and skipped cases: grouped by reason, then the first 100.
-fn failures_section(c: &Ctx, md: &mut String) {
-    let status = c.table.str(STATUS).unwrap_or(&[]);
-    let bad: Vec<usize> = (0..c.table.n_rows())
-        .filter(|&i| CaseStatus::parse(&status[i]) != Some(CaseStatus::Ok))
-        .collect();
-    let _ = writeln!(md, "## Failed and skipped cases\n");
-    if bad.is_empty() {
-        let _ = writeln!(md, "None.");
+/// The cases left out of the ranking: counts per status and missed criterion, then the
+/// first 100 with the criterion they missed and the reason.
+fn left_out_section(c: &Ctx, md: &mut String) {
+    let _ = writeln!(md, "## Cases left out\n");
+    if c.left_out.is_empty() {
+        let _ = writeln!(md, "None: every case succeeded.");
         return;
     }
-    let reasons = c.table.str(REASON).unwrap_or(&[]);
-    let mut groups: BTreeMap<(&str, &str), usize> = BTreeMap::new();
-    for &i in &bad {
-        *groups
-            .entry((status[i].as_str(), reasons[i].as_str()))
-            .or_default() += 1;
-    }
-    let mut t = MarkdownTable::new(["status", "cases", "reason"]);
-    for ((s, r), n) in &groups {
-        t.row([s.to_string(), n.to_string(), r.replace('|', "\\|")]);
+    let _ = writeln!(
+        md,
+        "Unsuccessful cases ran but missed the `[success]` criterion named (the first one \
+         missed); failed cases stopped early (`no_failure`); skipped cases never ran.\n"
+    );
+    let mut t = MarkdownTable::new(["status", "criterion missed", "cases"]);
+    for ((s, k), n) in left_out_counts(c) {
+        t.row([s.to_string(), k.unwrap_or("–").to_string(), n.to_string()]);
     }
     let _ = writeln!(md, "{}", t.finish());
-    let mut t = MarkdownTable::new(["case", "status", "reason"]);
-    for &i in bad.iter().take(100) {
-        let id = format!("#{}", c.ids[i]);
-        t.row([id, status[i].clone(), reasons[i].replace('|', "\\|")]);
+    let reasons = c.table.str(REASON).unwrap_or(&[]);
+    let mut t = c.table(&["case", "status", "criterion missed", "reason"]);
+    for &(i, s, k) in c.left_out.iter().take(100) {
+        let first = vec![
+            format!("#{}", c.ids[i]),
+            s.to_string(),
+            k.unwrap_or("–").to_string(),
+            detail(s, reasons.get(i).map_or("", String::as_str)).replace('|', "\\|"),
+        ];
+        c.row(&mut t, first, Some(i));
     }
     md.push_str(&t.finish());
-    if bad.len() > 100 {
-        let _ = writeln!(md, "\n({} more; see cases.csv)", bad.len() - 100);
+    if c.left_out.len() > 100 {
+        let _ = writeln!(md, "\n({} more; see cases.csv)", c.left_out.len() - 100);
     }
 }

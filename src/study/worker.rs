@@ -160,6 +160,8 @@ fn dynamic_phase(v: &Vehicle, r: &Resolved, log: bool, row: &mut Row) -> Option<
         Ok(out) => {
             if let Some(f) = &out.failure {
                 row.end(CaseStatus::Failed, f);
+            } else if let Some(m) = &out.missed {
+                row.end(CaseStatus::Unsuccessful, m);
             }
             row.scenario = pack_metrics(&out.metrics);
             out.trajectory

@@ -1,0 +1,186 @@
+//! The verdict on a closed-loop run (SPEC §6 "Success"): its summary metrics judged against
+//! the scenario's `[success]` criteria ([`SuccessSpec`]), in the order of [`Criterion::ALL`].
+
+use crate::scenario::config::Mode;
+use crate::scenario::success::{Criterion, Missed, SuccessSpec};
+
+/// Judge a run of `mode` by its summary `metrics` (see [`super::run_summary`]) against
+/// `spec`: `None` when it met every criterion, else the first one missed. `metrics` must
+/// hold `completed`, `peak_thrust`, `saturation_fraction` and the mode's metrics; a
+/// missing or NaN value misses its criterion.
+pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Option<Missed> {
+    let get = |k: &str| {
+        metrics
+            .iter()
+            .find(|(n, _)| n == k)
+            .map_or(f64::NAN, |x| x.1)
+    };
+    let missed = |criterion, detail: String| Some(Missed { criterion, detail });
+    // NaN misses.
+    let above = |x: f64, bound: f64| x.is_nan() || x > bound;
+    if get("completed") != 1.0 {
+        return missed(Criterion::NoFailure, "the run stopped early".into());
+    }
+    let peak = get("peak_thrust");
+    if spec.max_peak_thrust > 0.0 && above(peak, spec.max_peak_thrust) {
+        let d = format!("peak_thrust = {peak:.4} N > {} N", spec.max_peak_thrust);
+        return missed(Criterion::MaxPeakThrust, d);
+    }
+    let sat = get("saturation_fraction");
+    if above(sat, spec.max_saturation_fraction) {
+        let d = format!(
+            "saturation_fraction = {sat:.4} > {}",
+            spec.max_saturation_fraction
+        );
+        return missed(Criterion::MaxSaturationFraction, d);
+    }
+    match mode {
+        Mode::Transport => judge_transport(spec, &get),
+        Mode::Work => {
+            let p = get("final_position_error");
+            if above(p, spec.position_tolerance) {
+                let d = format!(
+                    "final_position_error = {p:.4} m > {} m",
+                    spec.position_tolerance
+                );
+                return missed(Criterion::PositionTolerance, d);
+            }
+            let a = get("final_orientation_error_deg");
+            if above(a, spec.orientation_tolerance_deg) {
+                let d = format!(
+                    "final_orientation_error_deg = {a:.4} > {}",
+                    spec.orientation_tolerance_deg
+                );
+                return missed(Criterion::OrientationTolerance, d);
+            }
+            None
+        }
+    }
+}
+
+/// The transport criteria: the final cross-track bound, then each reached segment's
+/// convergence window in the order the segments became active.
+fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
+    let e = get("final_cross_track");
+    if e.is_nan() || e.abs() > spec.cross_track_bound {
+        return Some(Missed {
+            criterion: Criterion::CrossTrackBound,
+            detail: format!(
+                "|final_cross_track| = {:.4} m > {} m",
+                e.abs(),
+                spec.cross_track_bound
+            ),
+        });
+    }
+    let reached = get("segments_reached");
+    let n = if reached.is_finite() && reached > 0.0 {
+        reached as usize
+    } else {
+        0
+    };
+    for k in 0..n {
+        let c = get(&format!("seg{k}_convergence_time"));
+        let detail = if c.is_nan() {
+            format!("segment {k} never stayed within metrics.band before it ended")
+        } else if c > spec.convergence_window {
+            format!(
+                "segment {k} converged after {c:.1} s > {} s",
+                spec.convergence_window
+            )
+        } else {
+            continue;
+        };
+        return Some(Missed {
+            criterion: Criterion::ConvergenceWindow,
+            detail,
+        });
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::metrics::success::judge;
+    use crate::scenario::config::Mode;
+    use crate::scenario::success::{Criterion, SuccessSpec};
+
+    fn metrics(kv: &[(&str, f64)]) -> Vec<(String, f64)> {
+        kv.iter().map(|(k, v)| (k.to_string(), *v)).collect()
+    }
+
+    const COMMON: [(&str, f64); 3] = [
+        ("completed", 1.0),
+        ("peak_thrust", 40.0),
+        ("saturation_fraction", 0.01),
+    ];
+
+    fn transport(final_ct: f64, seg: &[f64]) -> Vec<(String, f64)> {
+        let mut m = metrics(&COMMON);
+        m.extend(
+            seg.iter()
+                .enumerate()
+                .map(|(k, c)| (format!("seg{k}_convergence_time"), *c)),
+        );
+        m.extend(metrics(&[
+            ("segments_reached", seg.len() as f64),
+            ("final_cross_track", final_ct),
+        ]));
+        m
+    }
+
+    #[test]
+    fn transport_criteria_in_order() {
+        let s = SuccessSpec::default();
+        let id = |m: &[(String, f64)]| judge(&s, Mode::Transport, m).map(|x| x.criterion);
+        assert_eq!(id(&transport(-0.05, &[30.0, 44.0])), None);
+        // Signed cross-track: judged by magnitude.
+        assert_eq!(
+            id(&transport(-1.24, &[f64::NAN, f64::NAN])),
+            Some(Criterion::CrossTrackBound)
+        );
+        assert_eq!(
+            id(&transport(0.05, &[71.5, 40.0])),
+            Some(Criterion::ConvergenceWindow)
+        );
+        let m = judge(&s, Mode::Transport, &transport(0.05, &[30.0, f64::NAN])).unwrap();
+        assert!(m.detail.starts_with("segment 1 never"), "{}", m.detail);
+        assert!(m.to_string().starts_with("convergence_window: segment 1"));
+        // Earlier criteria come first: a run that stopped early misses `no_failure` only.
+        let mut stopped = transport(-1.24, &[f64::NAN]);
+        stopped[0].1 = 0.0;
+        assert_eq!(id(&stopped), Some(Criterion::NoFailure));
+        let mut sat = transport(0.0, &[1.0]);
+        sat[2].1 = 0.2;
+        assert_eq!(id(&sat), Some(Criterion::MaxSaturationFraction));
+        // The peak bound only binds when set.
+        let tight = SuccessSpec {
+            max_peak_thrust: 30.0,
+            ..SuccessSpec::default()
+        };
+        let m = judge(&tight, Mode::Transport, &transport(0.0, &[1.0]));
+        assert_eq!(m.map(|x| x.criterion), Some(Criterion::MaxPeakThrust));
+    }
+
+    #[test]
+    fn work_criteria_and_missing_metrics() {
+        let s = SuccessSpec::default();
+        let mut m = metrics(&COMMON);
+        m.extend(metrics(&[
+            ("final_position_error", 0.01),
+            ("final_orientation_error_deg", 0.1),
+        ]));
+        assert_eq!(judge(&s, Mode::Work, &m), None);
+        m[3].1 = 0.5;
+        let x = judge(&s, Mode::Work, &m).unwrap();
+        assert_eq!(x.criterion, Criterion::PositionTolerance);
+        m[3].1 = 0.01;
+        m[4].1 = f64::NAN;
+        let x = judge(&s, Mode::Work, &m).unwrap();
+        assert_eq!(x.criterion, Criterion::OrientationTolerance);
+        // A missing metric misses its criterion.
+        assert_eq!(
+            judge(&s, Mode::Work, &metrics(&COMMON)).map(|x| x.criterion),
+            Some(Criterion::PositionTolerance)
+        );
+    }
+}

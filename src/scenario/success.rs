@@ -1,0 +1,204 @@
+//! `[success]`: what a closed-loop run must achieve to count as a success (SPEC §6
+//! "Success"), the criteria and the verdict on a run ([`Missed`]: the first criterion it
+//! missed), as judged by `metrics::success::judge`.
+//!
+//! ```toml
+//! [success]
+//! # both modes (a run that stopped early always misses `no_failure`)
+//! max_peak_thrust = 0.0          # N; 0 = the thrusters' own limits
+//! max_saturation_fraction = 0.05 # of the run with a thruster at a limit
+//! # transport
+//! cross_track_bound = 0.1        # m, |cross-track error| at the end of the run
+//! convergence_window = 60.0      # s after a segment becomes active
+//! # work
+//! position_tolerance = 0.02      # m, final end-effector position error
+//! orientation_tolerance_deg = 2.0 # deg, final pointing error (roll excluded)
+//! ```
+//!
+//! Criteria are checked in the order of [`Criterion::ALL`]; a verdict names the first one
+//! missed by its id, which is the `[success]` key that bounds it (`no_failure` has none).
+//! Studies rank and compare only successful runs (`study::summary`).
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use crate::input::located::KeyError;
+
+/// `[success]`: the bounds a run must keep to count as a success. Defaults beside each field.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SuccessSpec {
+    /// Largest thrust of any thruster at any control tick [N] (metric `peak_thrust`); 0 (the
+    /// default) = the thrusters' own limits, which the delivered thrust never exceeds (the
+    /// thrusters saturate): set it below them to demand headroom.
+    pub max_peak_thrust: f64,
+    /// Largest fraction of the run during which a thruster sits at a limit (metric
+    /// `saturation_fraction`, within `metrics.saturation_tolerance`). Default 0.05.
+    pub max_saturation_fraction: f64,
+    /// Transport: the run ends within this distance of the path, `|final_cross_track|` [m].
+    /// Default 0.1 m (the `metrics.band` default).
+    pub cross_track_bound: f64,
+    /// Transport: every segment the run reaches converges — `|e_y|` enters `metrics.band`
+    /// and stays there until the segment ends — within this time after it becomes active
+    /// [s] (metrics `seg<k>_convergence_time`). Default 60 s.
+    pub convergence_window: f64,
+    /// Work: final end-effector position error (metric `final_position_error`) [m]. Default
+    /// 0.02 m.
+    pub position_tolerance: f64,
+    /// Work: final end-effector pointing error, roll excluded (metric
+    /// `final_orientation_error_deg`) [deg]. Default 2°.
+    pub orientation_tolerance_deg: f64,
+}
+
+impl Default for SuccessSpec {
+    fn default() -> Self {
+        Self {
+            max_peak_thrust: 0.0,
+            max_saturation_fraction: 0.05,
+            cross_track_bound: 0.1,
+            convergence_window: 60.0,
+            position_tolerance: 0.02,
+            orientation_tolerance_deg: 2.0,
+        }
+    }
+}
+
+impl SuccessSpec {
+    /// Check the bounds; errors name `success.<key>`.
+    pub fn validate(&self) -> Result<(), KeyError> {
+        let bad = |k: &str, what: &str, v: f64| {
+            Err(KeyError::new(
+                format!("success.{k}"),
+                format!("must be {what}, got {v}"),
+            ))
+        };
+        for (k, v) in [
+            ("cross_track_bound", self.cross_track_bound),
+            ("convergence_window", self.convergence_window),
+            ("position_tolerance", self.position_tolerance),
+            ("orientation_tolerance_deg", self.orientation_tolerance_deg),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return bad(k, "a finite number > 0", v);
+            }
+        }
+        if !self.max_peak_thrust.is_finite() || self.max_peak_thrust < 0.0 {
+            return bad(
+                "max_peak_thrust",
+                "finite and >= 0 (0 = the thrusters' limits)",
+                self.max_peak_thrust,
+            );
+        }
+        if !(0.0..=1.0).contains(&self.max_saturation_fraction) {
+            return bad(
+                "max_saturation_fraction",
+                "in [0, 1]",
+                self.max_saturation_fraction,
+            );
+        }
+        Ok(())
+    }
+}
+
+/// One success criterion; its id ([`Criterion::as_str`]) is the `[success]` key bounding it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Criterion {
+    /// The run completed (did not diverge or fail numerically).
+    NoFailure,
+    /// [`SuccessSpec::max_peak_thrust`].
+    MaxPeakThrust,
+    /// [`SuccessSpec::max_saturation_fraction`].
+    MaxSaturationFraction,
+    /// [`SuccessSpec::cross_track_bound`] (transport).
+    CrossTrackBound,
+    /// [`SuccessSpec::convergence_window`] (transport).
+    ConvergenceWindow,
+    /// [`SuccessSpec::position_tolerance`] (work).
+    PositionTolerance,
+    /// [`SuccessSpec::orientation_tolerance_deg`] (work).
+    OrientationTolerance,
+}
+
+impl Criterion {
+    /// Every criterion, in the order a run is judged.
+    pub const ALL: [Criterion; 7] = [
+        Criterion::NoFailure,
+        Criterion::MaxPeakThrust,
+        Criterion::MaxSaturationFraction,
+        Criterion::CrossTrackBound,
+        Criterion::ConvergenceWindow,
+        Criterion::PositionTolerance,
+        Criterion::OrientationTolerance,
+    ];
+
+    /// The machine-readable id.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Criterion::NoFailure => "no_failure",
+            Criterion::MaxPeakThrust => "max_peak_thrust",
+            Criterion::MaxSaturationFraction => "max_saturation_fraction",
+            Criterion::CrossTrackBound => "cross_track_bound",
+            Criterion::ConvergenceWindow => "convergence_window",
+            Criterion::PositionTolerance => "position_tolerance",
+            Criterion::OrientationTolerance => "orientation_tolerance_deg",
+        }
+    }
+
+    /// The criterion of an id; `None` for any other text.
+    pub fn parse(s: &str) -> Option<Self> {
+        Criterion::ALL.into_iter().find(|c| c.as_str() == s)
+    }
+}
+
+impl fmt::Display for Criterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The first criterion a run missed, and by how much.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Missed {
+    /// Which criterion.
+    pub criterion: Criterion,
+    /// The value against its bound, one line (`|final_cross_track| = 1.243 m > 0.1 m`).
+    pub detail: String,
+}
+
+impl fmt::Display for Missed {
+    /// `criterion: detail` — the form of a sweep's `reason` cell for an unsuccessful case.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.criterion, self.detail)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scenario::success::{Criterion, SuccessSpec};
+
+    #[test]
+    fn ids_round_trip_and_validation_names_the_key() {
+        for c in Criterion::ALL {
+            assert_eq!(Criterion::parse(c.as_str()), Some(c));
+        }
+        assert_eq!(Criterion::parse("nope"), None);
+        assert!(SuccessSpec::default().validate().is_ok());
+        let bad = SuccessSpec {
+            convergence_window: -1.0,
+            ..SuccessSpec::default()
+        };
+        assert_eq!(
+            bad.validate().unwrap_err().key,
+            "success.convergence_window"
+        );
+        let bad = SuccessSpec {
+            max_saturation_fraction: 1.5,
+            ..SuccessSpec::default()
+        };
+        assert_eq!(
+            bad.validate().unwrap_err().key,
+            "success.max_saturation_fraction"
+        );
+    }
+}
