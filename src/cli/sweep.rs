@@ -9,6 +9,7 @@ use anyhow::{anyhow, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Duration;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
@@ -40,6 +41,26 @@ pub struct SweepArgs {
     /// Stop after running K cases, without final outputs (simulates an interruption).
     #[arg(long, hide = true)]
     pub max_cases: Option<usize>,
+    /// Wall-clock budget of one case in seconds (0: none). A case still running after it is
+    /// recorded as failed with reason `timeout: …` and the batch goes on.
+    #[arg(long, default_value_t = DEFAULT_CASE_TIMEOUT_S, value_name = "SECONDS")]
+    pub case_timeout: f64,
+    /// Replace another study's output in the output directory (its tables, manifest, summary
+    /// and plots are removed first).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Default `--case-timeout` [s]: ten times the longest shipped case (a 170 s transport run,
+/// about 30 s of wall time on one loaded core).
+pub const DEFAULT_CASE_TIMEOUT_S: f64 = 600.0;
+
+/// The `--case-timeout` value as a budget (`None` for 0).
+fn case_budget(seconds: f64) -> anyhow::Result<Option<Duration>> {
+    if !(seconds.is_finite() && seconds >= 0.0 && seconds <= 1e9) {
+        bail!("--case-timeout: must be a number of seconds in 0..=1e9 (0: none), got {seconds}");
+    }
+    Ok((seconds > 0.0).then(|| Duration::from_secs_f64(seconds)))
 }
 
 /// A `--shard` value.
@@ -108,6 +129,8 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         shard,
         out: a.out.clone(),
         max_cases: a.max_cases,
+        case_timeout: case_budget(a.case_timeout)?,
+        force: a.force,
     };
     if a.dry_run {
         let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
@@ -146,10 +169,19 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     })
     .map_err(study_err)?;
     progress.finish();
+    for w in &outcome.warnings {
+        eprintln!("[sweep] warning: {w}");
+    }
     eprintln!(
         "[sweep] resumed {} cases, ran {}",
         outcome.resumed, outcome.ran
     );
+    if outcome.timeouts > 0 {
+        eprintln!(
+            "[sweep] {} cases ran out of their --case-timeout of {} s (failed, reason `timeout`)",
+            outcome.timeouts, a.case_timeout
+        );
+    }
     if outcome.interrupted {
         eprintln!(
             "[sweep] stopped after {} cases (--max-cases); rerun with --resume to finish {}",
@@ -157,9 +189,6 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
             outcome.out.display()
         );
         return Ok(ExitCode::SUCCESS);
-    }
-    for w in &outcome.warnings {
-        eprintln!("[sweep] warning: {w}");
     }
     eprintln!(
         "[sweep] {} cases: {} ok, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
@@ -222,11 +251,19 @@ pub struct ReportArgs {
     pub dir: PathBuf,
 }
 
-/// Run `usm-study report`.
+/// Run `usm-study report`. Every warning of the report is a file it could not write: any
+/// makes the exit code 2 (an I/O error), after all of them are listed.
 pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
     let warnings = report(&a.dir).map_err(study_err)?;
     for w in &warnings {
         eprintln!("[report] warning: {w}");
+    }
+    if !warnings.is_empty() {
+        bail!(
+            "the report in {} is incomplete: {} outputs could not be written",
+            a.dir.display(),
+            warnings.len()
+        );
     }
     eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
     Ok(ExitCode::SUCCESS)

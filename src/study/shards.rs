@@ -1,11 +1,13 @@
 //! Merging shard outputs into one: same study, raw rows concatenated, sorted by case id,
-//! deduplicated by hash; then the final tables, the manifest and the report.
+//! deduplicated by hash; then the final tables, the manifest and the report (under the output
+//! directory's lock, see [`super::outdir`]; the merged output keeps no journal).
 
 use std::path::{Path, PathBuf};
 
 use super::error::StudyError;
 use super::finish::finish_report;
 use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manifest};
+use super::outdir;
 use super::parse::load_study;
 use super::records::{compact, write_tables, StatusCounts, PARTIAL_FILE, STUDY_COPY};
 use crate::report::{read_csv_typed, Table};
@@ -29,7 +31,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
         tables.push(read_csv_typed(&d.join(PARTIAL_FILE), &schema)?);
     }
     let raw = compact(&Table::concat(&tables)?, None)?;
-    std::fs::create_dir_all(out).map_err(|e| StudyError::io(out, e))?;
+    let _lock = outdir::lock(out)?;
+    let mut warnings = outdir::claim(out, &m0.study_name, false)?;
     let table = write_tables(&raw, out)?;
     if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
         std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
@@ -51,7 +54,6 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
     m.elapsed_s = manifests.iter().map(|m| m.elapsed_s).fold(0.0, f64::max);
     m.throughput_cases_per_s = manifests.iter().map(|m| m.throughput_cases_per_s).sum();
     write_manifest(out, &m)?;
-    let mut warnings = Vec::new();
     if table.n_rows() < m.cases.planned {
         warnings.push(format!(
             "merged {} of {} cases: some shards are missing or unfinished",
@@ -64,6 +66,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
         .ok()
         .filter(|s| s.hash == m.study_hash);
     warnings.extend(finish_report(out, &table, &m, study.as_ref()));
+    // The merged rows are in cases.csv: no journal is left behind.
+    let journal = out.join(PARTIAL_FILE);
+    std::fs::remove_file(&journal).map_err(|e| StudyError::io(&journal, e))?;
     Ok((m, warnings))
 }
 
