@@ -7,13 +7,14 @@
 use super::progress::Progress;
 use anyhow::{anyhow, bail};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
 use usm_study::study::records::axis_text;
+use usm_study::study::shards::{slurm_script, SlurmPlan};
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -49,6 +50,46 @@ pub struct SweepArgs {
     /// and plots are removed first).
     #[arg(long)]
     pub force: bool,
+    /// Write a Slurm submission script for the study to FILE instead of running it: a job
+    /// array (`--shard slurm`, one shard per task) and a merge job after it. Run it with bash.
+    #[arg(long, value_name = "FILE")]
+    pub emit_slurm: Option<PathBuf>,
+    /// Cases per Slurm array task (with --emit-slurm).
+    #[arg(long, default_value_t = 10, value_name = "K")]
+    pub cases_per_task: usize,
+}
+
+/// Write the Slurm submission script of `--emit-slurm`.
+fn emit_slurm(a: &SweepArgs, study: &usm_study::study::Study, file: &Path) -> anyhow::Result<()> {
+    if a.cases_per_task == 0 {
+        bail!("--cases-per-task: must be >= 1");
+    }
+    if a.shard.is_some() || a.resume || a.dry_run {
+        bail!("--emit-slurm: the script shards and resumes itself; drop --shard, --resume and --dry-run");
+    }
+    let cwd = std::env::current_dir()?;
+    let out = cwd.join(a.out.as_ref().unwrap_or(&study.output));
+    let plan = SlurmPlan {
+        exe: std::env::current_exe()?,
+        study: std::fs::canonicalize(&a.study)?,
+        out,
+        cases: usm_study::study::doe::case_count(study),
+        cases_per_task: a.cases_per_task,
+        cpus: if a.jobs == 0 { 1 } else { a.jobs },
+        case_timeout_s: a.case_timeout,
+        name: study.name.clone(),
+    };
+    usm_study::report::atomic_write(file, slurm_script(&plan).as_bytes())
+        .map_err(|e| anyhow!(e.to_string()))?;
+    eprintln!(
+        "[sweep] wrote {}: {} array tasks of {} cases, merged into {}; submit with `bash {}`",
+        file.display(),
+        plan.tasks(),
+        plan.cases_per_task,
+        plan.out.display(),
+        file.display()
+    );
+    Ok(())
 }
 
 /// Default `--case-timeout` [s]: ten times the longest shipped case (a 170 s transport run,
@@ -123,6 +164,10 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),
         Some(ShardArg::Slurm) => Some(slurm_shard()?),
     };
+    if let Some(file) = &a.emit_slurm {
+        emit_slurm(a, &study, file)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let opts = SweepOptions {
         jobs: a.jobs,
         resume: a.resume,

@@ -217,6 +217,12 @@ pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     parse_source(&text, arg, dir)
 }
 
+/// Scenario-file text (as if read from a file named `origin` in the current directory) as a
+/// table and its [`Source`]; errors give `origin:line:col`. [`load_table`] for text in memory.
+pub fn parse_text(text: &str, origin: &str) -> Result<(toml::Table, Source), ScenarioError> {
+    parse_source(text, origin, Some(PathBuf::from(".")))
+}
+
 /// A scenario's text as a table and its [`Source`]. `dir` is the directory of a file the
 /// user wrote (its errors name lines); `None` for a preset (errors name keys only: the
 /// preset's text is not a file the user can open).

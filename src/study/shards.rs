@@ -95,3 +95,116 @@ fn check_same_study(dirs: &[PathBuf], manifests: &[Manifest]) -> Result<(), Stud
     }
     Ok(())
 }
+
+/// What a Slurm submission of a study needs besides the study.
+#[derive(Clone, Debug)]
+pub struct SlurmPlan {
+    /// The `usm-study` executable the jobs run (absolute).
+    pub exe: PathBuf,
+    /// The study file (absolute).
+    pub study: PathBuf,
+    /// The merged output directory (absolute); shard `i` writes `OUT/shard-i-of-N`.
+    pub out: PathBuf,
+    /// Cases of the study.
+    pub cases: usize,
+    /// Cases per array task (≥ 1): the array has `⌈cases / cases_per_task⌉` tasks.
+    pub cases_per_task: usize,
+    /// Threads per task (`--cpus-per-task`, `--jobs`).
+    pub cpus: usize,
+    /// Per-case budget [s] (0: none); sets each task's `--time` with a margin.
+    pub case_timeout_s: f64,
+    /// Job name.
+    pub name: String,
+}
+
+impl SlurmPlan {
+    /// Array tasks: `⌈cases / cases_per_task⌉`, at least 1.
+    pub fn tasks(&self) -> usize {
+        self.cases.div_ceil(self.cases_per_task.max(1)).max(1)
+    }
+}
+
+/// A shell word quoted for bash (`'…'`, with `'` as `'\''`).
+fn sh_quote(s: &str) -> String {
+    format!("'{}'", s.replace('\'', r"'\''"))
+}
+
+/// The submission script of a study on Slurm: a job array of [`SlurmPlan::tasks`] tasks, each
+/// `usm-study sweep STUDY --shard slurm` into `OUT/shard-I-of-N` (resuming, so a requeued
+/// task keeps its finished cases), then the merge into `OUT` as a job depending on the whole
+/// array (`afterok`). Run it with `bash`; it prints the two job ids. `SBATCH_*` environment
+/// variables (e.g. `SBATCH_PARTITION`) apply to both jobs as usual.
+pub fn slurm_script(p: &SlurmPlan) -> String {
+    let n = p.tasks();
+    let exe = sh_quote(&p.exe.display().to_string());
+    let study = sh_quote(&p.study.display().to_string());
+    let out = sh_quote(&p.out.display().to_string());
+    let time = if p.case_timeout_s > 0.0 {
+        let minutes = (p.case_timeout_s * p.cases_per_task as f64 / 60.0).ceil() as u64 + 5;
+        format!(" --time={minutes}")
+    } else {
+        String::new()
+    };
+    let shards: Vec<String> = (0..n)
+        .map(|i| format!("\"$OUT\"/shard-{i}-of-{n}"))
+        .collect();
+    format!(
+        r#"#!/usr/bin/env bash
+# Slurm submission of study `{name}`: {cases} cases in a job array of {n} tasks
+# ({cpt} cases per task), then a merge job after the whole array succeeded.
+# Written by `usm-study sweep --emit-slurm`; run it with bash on a Slurm login node.
+set -euo pipefail
+EXE={exe}
+STUDY={study}
+OUT={out}
+mkdir -p "$OUT"
+array=$(sbatch --parsable --job-name={jname}-sweep --array=0-{last} \
+  --cpus-per-task={cpus}{time} --output="$OUT/slurm-%A_%a.log" \
+  --wrap="exec \"$EXE\" sweep \"$STUDY\" --shard slurm --resume --jobs {cpus} \
+--case-timeout {timeout} --out \"$OUT/shard-\${{SLURM_ARRAY_TASK_ID}}-of-{n}\"")
+array=${{array%%;*}}
+merge=$(sbatch --parsable --job-name={jname}-merge --dependency=afterok:"$array" \
+  --output="$OUT/slurm-merge-%j.log" \
+  --wrap="exec \"$EXE\" merge {shards} --out \"$OUT\"")
+echo "array job $array ({n} tasks), merge job ${{merge%%;*}}; merged output in $OUT"
+"#,
+        name = p.name,
+        cases = p.cases,
+        cpt = p.cases_per_task,
+        jname = crate::report::file_stem_safe(&p.name),
+        last = n - 1,
+        cpus = p.cpus.max(1),
+        timeout = p.case_timeout_s,
+        shards = shards.join(" ").replace('"', "\\\""),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_slurm_script_names_every_shard_once_and_merges_after_the_array() {
+        let p = SlurmPlan {
+            exe: "/opt/usm study/usm-study".into(),
+            study: "/w/s.toml".into(),
+            out: "/w/out".into(),
+            cases: 25,
+            cases_per_task: 10,
+            cpus: 2,
+            case_timeout_s: 600.0,
+            name: "gains".into(),
+        };
+        assert_eq!(p.tasks(), 3);
+        let s = slurm_script(&p);
+        assert!(s.contains("EXE='/opt/usm study/usm-study'"), "{s}");
+        assert!(s.contains("--array=0-2 "), "{s}");
+        assert!(s.contains("--time=105"), "{s}");
+        assert!(s.contains("--shard slurm --resume --jobs 2"), "{s}");
+        assert!(s.contains("shard-\\${SLURM_ARRAY_TASK_ID}-of-3"), "{s}");
+        assert!(s.contains("--dependency=afterok:\"$array\""), "{s}");
+        for i in 0..3 {
+            assert_eq!(s.matches(&format!("shard-{i}-of-3")).count(), 1, "{s}");
+        }
+    }
+}
