@@ -98,7 +98,7 @@ pub const DEFAULT_CASE_TIMEOUT_S: f64 = 600.0;
 
 /// The `--case-timeout` value as a budget (`None` for 0).
 fn case_budget(seconds: f64) -> anyhow::Result<Option<Duration>> {
-    if !(seconds.is_finite() && seconds >= 0.0 && seconds <= 1e9) {
+    if !(0.0..=1e9).contains(&seconds) {
         bail!("--case-timeout: must be a number of seconds in 0..=1e9 (0: none), got {seconds}");
     }
     Ok((seconds > 0.0).then(|| Duration::from_secs_f64(seconds)))

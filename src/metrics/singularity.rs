@@ -110,8 +110,9 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
     let mut tl = Matrix6xX::<f64>::zeros(n_thrusters.max(6));
     tl.columns_mut(0, n_thrusters)
         .copy_from(&scale_moment_rows(t, char_length));
-    // Capped: nalgebra's uncapped SVD iterates forever when scaling overflowed to ±inf.
-    let Some(svd) = tl.try_svd(true, false, f64::EPSILON, SVD_MAX_ITERATIONS) else {
+    // Capped: nalgebra's uncapped SVD iterates forever when scaling overflowed to ±inf. The
+    // tolerance is `svd()`'s own (5ε), so the values are bit-identical to it.
+    let Some(svd) = tl.try_svd(true, false, 5.0 * f64::EPSILON, SVD_MAX_ITERATIONS) else {
         return ([f64::NAN; 6], nalgebra::Matrix6::zeros());
     };
     let mut idx = [0usize, 1, 2, 3, 4, 5];
