@@ -8,9 +8,10 @@
 //!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
 //!   valid axis names and to reject unknown keys before anything runs.
 //! - [`check_case`]: validate a resolved table against a vehicle without running it.
-//! - [`run_case`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
-//!   case's fully resolved scenario-side table (same shape, overrides applied) and the case
-//!   seed; returns named scalar metrics and, when `log` is set, a trajectory table.
+//! - [`run_case`] / [`run_case_until`]: run one case of a dynamic mode (`transport`, `work`)
+//!   on a vehicle with the case's fully resolved scenario-side table (same shape, overrides
+//!   applied) and the case seed (the latter within a wall-clock deadline); returns named
+//!   scalar metrics and, when `log` is set, a trajectory table.
 //!
 //! Both delegate to `crate::scenario` (`default_table`, `run_case`); trajectories are turned
 //! into report tables here so that the scenario module stays free of polars.
@@ -130,12 +131,22 @@ pub fn default_table(mode: StudyMode) -> Result<toml::Table, String> {
     }
 }
 
+/// Run one dynamic case without a time budget: [`run_case_until`] with no deadline.
+pub fn run_case(
+    vehicle: &Vehicle,
+    scenario: &toml::Table,
+    seed: u64,
+    log: bool,
+) -> Result<CaseOutcome, String> {
+    run_case_until(vehicle, scenario, seed, log, None)
+}
+
 /// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case seed,
 /// `log` asks for the trajectory, `deadline` is the case's wall-clock budget (checked before
 /// every control period). An `Err` (invalid settings) is recorded as a failed case with
 /// the message as its reason; a run that stops early (diverges, NaN, the deadline: a
 /// `timeout: …` failure) returns its metrics with `failure` naming the time and the cause.
-pub fn run_case(
+pub fn run_case_until(
     vehicle: &Vehicle,
     scenario: &toml::Table,
     seed: u64,

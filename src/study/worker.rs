@@ -194,7 +194,7 @@ fn dynamic_phase(
 ) -> Option<Table> {
     let mut sc = r.scenario.clone();
     sc.remove(STATIC_TABLE);
-    match runner::run_case(v, &sc, r.seed, log, deadline) {
+    match runner::run_case_until(v, &sc, r.seed, log, deadline) {
         Ok(out) => {
             if let Some(f) = &out.failure {
                 row.end(CaseStatus::Failed, f);
