@@ -42,6 +42,20 @@ pub enum AllocError {
         /// The offending value.
         value: f64,
     },
+    /// A matrix entry beyond [`MAX_T_ENTRY`] in magnitude: `T W⁻¹ Tᵀ` would overflow.
+    #[error(
+        "`{arg}[{row}][{col}]` = {value:e} exceeds 1e150 in magnitude (T W⁻¹ Tᵀ would overflow)"
+    )]
+    HugeMatrix {
+        /// Argument name.
+        arg: &'static str,
+        /// Row index.
+        row: usize,
+        /// Column index.
+        col: usize,
+        /// The offending value.
+        value: f64,
+    },
     /// `u_min[i] > u_max[i]`.
     #[error("`u_min[{index}]` = {min} exceeds `u_max[{index}]` = {max}")]
     BoundsOrder {
@@ -132,6 +146,14 @@ pub(crate) fn check_t(t: &Matrix6xX<f64>, n_thrusters: Option<usize>) -> Result<
                     value,
                 });
             }
+            if value.abs() > MAX_T_ENTRY {
+                return Err(AllocError::HugeMatrix {
+                    arg: "T",
+                    row,
+                    col,
+                    value,
+                });
+            }
         }
     }
     Ok(())
@@ -159,6 +181,10 @@ pub(super) fn check_setting(
         })
     }
 }
+
+/// Largest magnitude of an entry of `T` accepted (N/N, N·m/N): products of two entries stay
+/// finite. Real thruster matrices hold directions and lever arms of a few metres.
+pub const MAX_T_ENTRY: f64 = 1e150;
 
 /// Largest damping λ accepted (USM-37 uses λ²; beyond 1e150 it overflows to infinity and the
 /// damped pseudoinverse has no meaningful value).

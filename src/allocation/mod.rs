@@ -50,7 +50,7 @@ pub use allocator::{AllocPath, AllocStatus, Allocation, Allocator};
 pub use attainable::{attainable_wrench, AttainableWrench};
 pub(crate) use error::check_t;
 use error::{check_lambda, check_tau, check_vec};
-pub use error::{AllocError, MAX_LAMBDA};
+pub use error::{AllocError, MAX_LAMBDA, MAX_T_ENTRY};
 use pinv::pinv_into;
 pub use pinv::wrench;
 pub use settings::{

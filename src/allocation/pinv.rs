@@ -18,7 +18,9 @@ pub fn wrench(t: &Matrix6xX<f64>, u: &[f64]) -> Vector6<f64> {
 /// Damped weighted pseudoinverse (USM-37): `u = W⁻¹Tᵀ(TW⁻¹Tᵀ + λ²I)⁻¹τ`, written into `u`
 /// (length `n_thrusters`). `w_inv` is the diagonal of `W⁻¹`. Uses a fixed 6×6 Cholesky factorisation and
 /// allocates nothing; if the 6×6 matrix is not positive definite (λ = 0 and `T` singular) the
-/// minimum-norm solution from a 6×6 SVD is used instead.
+/// minimum-norm solution from a 6×6 SVD is used instead. If `TW⁻¹Tᵀ` overflows (extreme
+/// weights on large entries) there is no meaningful solution: `u` is NaN, which the callers
+/// report (nalgebra's SVD panics on such data, so it is never attempted).
 pub(super) fn pinv_into(
     t: &Matrix6xX<f64>,
     tau: &Vector6<f64>,
@@ -30,6 +32,10 @@ pub(super) fn pinv_into(
     for (j, &wi) in w_inv.iter().enumerate() {
         let c = t.fixed_view::<6, 1>(0, j);
         a.ger(wi, &c, &c, 1.0);
+    }
+    if !a.iter().all(|x| x.is_finite()) {
+        u.fill(f64::NAN);
+        return;
     }
     let y = match a.cholesky() {
         Some(ch) => ch.solve(tau),

@@ -48,10 +48,9 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     }
     let file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(&file.scenario.name));
+    let out = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from("out").join(usm_study::report::file_stem_safe(&file.scenario.name))
+    });
     create_dir(&out)?;
     eprintln!(
         "[simulate] {} ({} mode, design {}, {} s, allocation {})",

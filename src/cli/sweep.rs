@@ -16,6 +16,8 @@ use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
+use std::time::Duration;
+use usm_study::study::shards::{slurm_script, SlurmPlan};
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -43,6 +45,66 @@ pub struct SweepArgs {
     /// Stop after running K cases, without final outputs (simulates an interruption).
     #[arg(long, hide = true)]
     pub max_cases: Option<usize>,
+    /// Wall-clock budget of one case in seconds (0: none). A case still running after it is
+    /// recorded as failed with reason `timeout: …` and the batch goes on.
+    #[arg(long, default_value_t = DEFAULT_CASE_TIMEOUT_S, value_name = "SECONDS")]
+    pub case_timeout: f64,
+    /// Replace another study's output in the output directory (its tables, manifest, summary
+    /// and plots are removed first).
+    #[arg(long)]
+    pub force: bool,
+    /// Write a Slurm submission script for the study to FILE instead of running it: a job
+    /// array (`--shard slurm`, one shard per task) and a merge job after it. Run it with bash.
+    #[arg(long, value_name = "FILE")]
+    pub emit_slurm: Option<PathBuf>,
+    /// Cases per Slurm array task (with --emit-slurm).
+    #[arg(long, default_value_t = 10, value_name = "K")]
+    pub cases_per_task: usize,
+}
+
+/// Write the Slurm submission script of `--emit-slurm`.
+fn emit_slurm(a: &SweepArgs, study: &usm_study::study::Study, file: &Path) -> anyhow::Result<()> {
+    if a.cases_per_task == 0 {
+        bail!("--cases-per-task: must be >= 1");
+    }
+    if a.shard.is_some() || a.resume || a.dry_run {
+        bail!("--emit-slurm: the script shards and resumes itself; drop --shard, --resume and --dry-run");
+    }
+    let cwd = std::env::current_dir()?;
+    let out = cwd.join(a.out.as_ref().unwrap_or(&study.output));
+    let plan = SlurmPlan {
+        exe: std::env::current_exe()?,
+        study: std::fs::canonicalize(&a.study)?,
+        out,
+        cases: usm_study::study::doe::case_count(study),
+        cases_per_task: a.cases_per_task,
+        cpus: if a.jobs == 0 { 1 } else { a.jobs },
+        case_timeout_s: a.case_timeout,
+        name: study.name.clone(),
+    };
+    usm_study::report::atomic_write(file, slurm_script(&plan).as_bytes())
+        .map_err(|e| anyhow!(e.to_string()))?;
+    eprintln!(
+        "[sweep] wrote {}: {} array tasks of {} cases, merged into {}; submit with `bash {}`",
+        file.display(),
+        plan.tasks(),
+        plan.cases_per_task,
+        plan.out.display(),
+        file.display()
+    );
+    Ok(())
+}
+
+/// Default `--case-timeout` [s]: ten times the longest shipped case (a 170 s transport run,
+/// about 30 s of wall time on one loaded core).
+pub const DEFAULT_CASE_TIMEOUT_S: f64 = 600.0;
+
+/// The `--case-timeout` value as a budget (`None` for 0).
+fn case_budget(seconds: f64) -> anyhow::Result<Option<Duration>> {
+    if !(0.0..=1e9).contains(&seconds) {
+        bail!("--case-timeout: must be a number of seconds in 0..=1e9 (0: none), got {seconds}");
+    }
+    Ok((seconds > 0.0).then(|| Duration::from_secs_f64(seconds)))
 }
 
 /// A `--shard` value.
@@ -105,12 +167,18 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),
         Some(ShardArg::Slurm) => Some(slurm_shard()?),
     };
+    if let Some(file) = &a.emit_slurm {
+        emit_slurm(a, &study, file)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let opts = SweepOptions {
         jobs: a.jobs,
         resume: a.resume,
         shard,
         out: a.out.clone(),
         max_cases: a.max_cases,
+        case_timeout: case_budget(a.case_timeout)?,
+        force: a.force,
     };
     if a.dry_run {
         let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
@@ -149,10 +217,19 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     })
     .map_err(study_err)?;
     progress.finish();
+    for w in &outcome.warnings {
+        eprintln!("[sweep] warning: {w}");
+    }
     eprintln!(
         "[sweep] resumed {} cases, ran {}",
         outcome.resumed, outcome.ran
     );
+    if outcome.timeouts > 0 {
+        eprintln!(
+            "[sweep] {} cases ran out of their --case-timeout of {} s (failed, reason `timeout`)",
+            outcome.timeouts, a.case_timeout
+        );
+    }
     if outcome.interrupted {
         eprintln!(
             "[sweep] stopped after {} cases (--max-cases); rerun with --resume to finish {}",
@@ -160,9 +237,6 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
             outcome.out.display()
         );
         return Ok(ExitCode::SUCCESS);
-    }
-    for w in &outcome.warnings {
-        eprintln!("[sweep] warning: {w}");
     }
     review("sweep", &outcome.out)?;
     eprintln!(
@@ -255,6 +329,13 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
         let warnings = report(&a.dir).map_err(study_err)?;
         for w in &warnings {
             eprintln!("[report] warning: {w}");
+        }
+        if !warnings.is_empty() {
+            bail!(
+                "the report in {} is incomplete: {} outputs could not be written",
+                a.dir.display(),
+                warnings.len()
+            );
         }
         eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
     }

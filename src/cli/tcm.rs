@@ -14,6 +14,10 @@ use usm_study::report::fmt_num;
 use usm_study::sampling::Sampling;
 use usm_study::study::static_tcm::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
 
+/// Most `--samples` accepted: 16 bytes are kept per sample (0.8 GB at the cap); more would
+/// end in an allocation abort instead of a message.
+const MAX_SAMPLES: usize = 50_000_000;
+
 /// Arguments of `tcm`.
 #[derive(Debug, Args)]
 pub struct TcmArgs {
@@ -76,6 +80,14 @@ pub fn run(a: &TcmArgs) -> anyhow::Result<ExitCode> {
         if i >= n || j >= n || i == j {
             bail!("--slice {i},{j}: needs two different joint indices in 0..{n}");
         }
+    }
+    if a.samples > MAX_SAMPLES {
+        bail!(
+            "--samples: {} samples would keep {:.1} GB of per-sample values (σ_min and κ, for \
+             exact quantiles); at most {MAX_SAMPLES}",
+            a.samples,
+            a.samples as f64 * 16.0 / 1e9
+        );
     }
     let config = TcmConfig {
         spec: StaticSpec {

@@ -15,6 +15,11 @@
 
 use super::DynError;
 
+/// Iteration cap of [`Dopri5::span`]: trial steps (accepted or rejected) over one span. The
+/// step-size floor alone (1e-12 of the span) would allow 1e12 steps; a run needing more than
+/// this fails with the time of the span instead of running for hours.
+pub(super) const MAX_STEPS_PER_SPAN: usize = 100_000;
+
 /// Nodes `c_i` of the Dormand–Prince tableau.
 const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
 
@@ -131,7 +136,21 @@ impl Dopri5 {
         let [k0, ..] = &mut self.k;
         f(0.0, x, k0, true).map_err(|e| (0.0, e))?;
         let h_min = 1e-12 * span.max(1e-300);
+        let mut trials = 0usize;
         while s < span {
+            trials += 1;
+            if trials > MAX_STEPS_PER_SPAN {
+                return Err((
+                    s,
+                    DynError::new(
+                        "integrator.step",
+                        format!(
+                            "more than {MAX_STEPS_PER_SPAN} steps in one span of {span} s: the \
+                             tolerance cannot be met at a reasonable cost"
+                        ),
+                    ),
+                ));
+            }
             // Take the remainder when it is within 1 % of the step (no sliver step).
             let mut h = self.h.min(span - s);
             if span - s - h < 0.01 * h {

@@ -98,8 +98,11 @@ fn check_inputs(
     Ok(())
 }
 
+/// Iteration cap of the SVD of `T_L` (a 6 × n SVD converges in a few dozen sweeps).
+const SVD_MAX_ITERATIONS: usize = 1000;
+
 /// Singular values of `T_L` (SPEC §6), six of them, descending (zeros appended when
-/// n_thrusters < 6).
+/// n_thrusters < 6); NaN when the SVD does not converge within [`SVD_MAX_ITERATIONS`].
 /// `t` must be finite (checked by the public entry points).
 fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matrix6<f64>) {
     let n_thrusters = t.ncols();
@@ -107,7 +110,11 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
     let mut tl = Matrix6xX::<f64>::zeros(n_thrusters.max(6));
     tl.columns_mut(0, n_thrusters)
         .copy_from(&scale_moment_rows(t, char_length));
-    let svd = tl.svd(true, false);
+    // Capped: nalgebra's uncapped SVD iterates forever when scaling overflowed to ±inf. The
+    // tolerance is `svd()`'s own (5ε), so the values are bit-identical to it.
+    let Some(svd) = tl.try_svd(true, false, 5.0 * f64::EPSILON, SVD_MAX_ITERATIONS) else {
+        return ([f64::NAN; 6], nalgebra::Matrix6::zeros());
+    };
     let mut idx = [0usize, 1, 2, 3, 4, 5];
     idx.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
     let mut sv = [0.0; 6];

@@ -129,12 +129,16 @@ pub fn read_case(path: &Path) -> Result<Case, CaseFileError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let invalid = |source| CaseFileError::Invalid {
+    parse_case(&text).map_err(|source| CaseFileError::Invalid {
         path: path.to_path_buf(),
         source,
-    };
-    let raw: RawCase = serde_json::from_str(&text).map_err(|e| invalid(CaseError::Json(e)))?;
-    build_case(raw).map_err(invalid)
+    })
+}
+
+/// Parses and validates case-file text (JSON, the schema of the module documentation).
+pub fn parse_case(text: &str) -> Result<Case, CaseError> {
+    let raw: RawCase = serde_json::from_str(text).map_err(CaseError::Json)?;
+    build_case(raw)
 }
 
 fn build_case(raw: RawCase) -> Result<Case, CaseError> {

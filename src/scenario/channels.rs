@@ -6,7 +6,9 @@
 //! [`channel_layout`] gives the column order of a run. Units are SI, angles in rad; poses are
 //! in the inertial frame (ZYX Euler angles, SPEC §2), twists in the body's own frame.
 
-use super::config::Mode;
+use super::config::{Mode, ScenarioFile};
+use crate::input::located::KeyError;
+use crate::model::Vehicle;
 
 /// A pose coordinate: position in the inertial frame [m] or a ZYX Euler angle [rad].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -304,6 +306,31 @@ impl Trajectory {
             c.push(*x);
         }
     }
+}
+
+/// Largest in-memory log of one run [bytes]: a request above it is refused before the run
+/// (the trajectory reserves its columns up front; refusing beats an allocation abort).
+pub const MAX_LOG_BYTES: f64 = 1.0e9;
+
+/// The run's log must fit in [`MAX_LOG_BYTES`]: `duration / log_dt` rows of the mode's
+/// channels (8 bytes each).
+pub fn check_log_size(f: &ScenarioFile, v: &Vehicle) -> Result<(), KeyError> {
+    let s = &f.scenario;
+    let rows = (s.duration / s.log_dt).floor() + 2.0;
+    let cols = channel_layout(s.mode, v.n_joints(), v.n_thrusters()).len() as f64;
+    let bytes = rows * cols * 8.0;
+    if bytes > MAX_LOG_BYTES {
+        return Err(KeyError::new(
+            "scenario.log_dt",
+            format!(
+                "the log would hold {rows:.0} rows × {cols:.0} channels ≈ {:.1} GB, more than \
+                 {:.0} GB: raise scenario.log_dt or shorten scenario.duration",
+                bytes / 1e9,
+                MAX_LOG_BYTES / 1e9
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

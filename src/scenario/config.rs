@@ -594,6 +594,16 @@ impl ScenarioFile {
                 ),
             ));
         }
+        if s.control_dt / s.dt > MAX_SUBSTEPS {
+            return Err(KeyError::new(
+                "scenario.control_dt",
+                format!(
+                    "gives {:.0} steps of scenario.dt per control period, more than {MAX_SUBSTEPS:e} \
+                     (a run's time budget is checked once per control period)",
+                    s.control_dt / s.dt
+                ),
+            ));
+        }
         if s.duration / s.dt > 5.0e7 {
             return Err(KeyError::new(
                 "scenario.duration",
@@ -632,6 +642,9 @@ impl ScenarioFile {
         Ok(())
     }
 }
+
+/// Most physics steps of `scenario.dt` in one control period.
+pub const MAX_SUBSTEPS: f64 = 1.0e5;
 
 /// `key` must be a finite number > 0.
 fn positive(key: &str, v: f64) -> Result<(), KeyError> {

@@ -40,11 +40,11 @@ pub mod run;
 mod setup;
 pub mod success;
 
-pub use channels::{Channel, Trajectory};
+pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
-pub use run::{run_scenario, RunResult};
+pub use run::{run_scenario, run_scenario_until, RunResult, TIMEOUT};
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::KeyError;
@@ -257,6 +257,12 @@ pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     parse_source(&text, arg, dir)
 }
 
+/// Scenario-file text (as if read from a file named `origin` in the current directory) as a
+/// table and its [`Source`]; errors give `origin:line:col`. [`load_table`] for text in memory.
+pub fn parse_text(text: &str, origin: &str) -> Result<(toml::Table, Source), ScenarioError> {
+    parse_source(text, origin, Some(PathBuf::from(".")))
+}
+
 /// A scenario's text as a table and its [`Source`]. `dir` is the directory of a file the
 /// user wrote (its errors name lines); `None` for a preset (errors name keys only: the
 /// preset's text is not a file the user can open).
@@ -305,6 +311,7 @@ pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, Scen
         load_design(&arg).map_err(|e| ScenarioError::Invalid(e.to_string()))?
     };
     file.check_design(&v).map_err(|e| src.invalid(e))?;
+    check_log_size(file, &v).map_err(|e| src.invalid(e))?;
     Ok(v)
 }
 
@@ -351,24 +358,40 @@ pub struct CaseRun {
 }
 
 /// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
-/// runs are deterministic).
+/// runs are deterministic). A run still going at `deadline` stops with a failure starting
+/// with [`TIMEOUT`] (`timeout: …`).
 pub fn run_case(
     vehicle: &Vehicle,
     scenario: &toml::Table,
     seed: u64,
     log: bool,
+    deadline: Option<std::time::Instant>,
 ) -> Result<CaseRun, ScenarioError> {
     let _ = seed;
     let f = parse_table(scenario, &Source::unplaced("scenario"))?;
-    let r = run_scenario(vehicle, &f)?;
+    let r = run_scenario_until(vehicle, &f, deadline)?;
     Ok(CaseRun {
         metrics: r.metrics,
         trajectory: if log { Some(r.trajectory) } else { None },
-        failure: r
-            .failure
-            .map(|(t, c)| format!("run stopped at t = {t:.3} s: {c}")),
+        failure: r.failure.map(|(t, c)| {
+            if c == TIMEOUT {
+                format!("{TIMEOUT}: the case's wall-clock budget ran out at t = {t:.3} s")
+            } else {
+                format!("run stopped at t = {t:.3} s: {c}")
+            }
+        }),
         missed: r.missed.map(|m| m.to_string()),
     })
+}
+
+/// Check a scenario-side table against a vehicle without running it: the schema, every
+/// setting ([`ScenarioFile::validate`]), the mode's gains against the design and the size of
+/// the run's log ([`check_log_size`]). Errors name the key.
+pub fn check_table(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), KeyError> {
+    let f: ScenarioFile = deserialize_table(scenario, "")?;
+    f.validate()?;
+    f.check_design(vehicle)?;
+    check_log_size(&f, vehicle)
 }
 
 #[cfg(test)]

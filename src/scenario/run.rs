@@ -150,14 +150,35 @@ impl ClosedLoop<'_> {
     }
 }
 
+/// The failure cause of a run stopped by its wall-clock deadline ([`run_scenario_until`]).
+pub const TIMEOUT: &str = "timeout";
+
 /// Run a scenario on a vehicle. Never panics on bad input: settings problems return
 /// [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges, NaN,
 /// singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
 pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, ScenarioError> {
+    run_scenario_until(v, file, None)
+}
+
+/// [`run_scenario`] with a wall-clock `deadline`, checked cooperatively before every control
+/// period: a run still going at the deadline stops there with the failure cause [`TIMEOUT`]
+/// (the metrics and trajectory up to then are kept, as for any failure). A control period is
+/// bounded in work: at most `MAX_SUBSTEPS` (1e5) RK4 steps (`scenario.control_dt / dt`,
+/// checked by validation) or `MAX_STEPS_PER_SPAN` (1e5) Dormand–Prince trials.
+pub fn run_scenario_until(
+    v: &Vehicle,
+    file: &ScenarioFile,
+    deadline: Option<Instant>,
+) -> Result<RunResult, ScenarioError> {
     let started = Instant::now();
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
-    let failure = (0..=lp.n_control).find_map(|k| lp.period(k, &mut rec).err());
+    let failure = (0..=lp.n_control).find_map(|k| {
+        if deadline.is_some_and(|d| Instant::now() >= d) {
+            return Some((k as f64 * file.scenario.control_dt, TIMEOUT.to_string()));
+        }
+        lp.period(k, &mut rec).err()
+    });
     let stats = lp.sim.step_stats();
     rec.timing.physics_steps = stats.steps;
     rec.timing.physics_rejected = stats.rejected;

@@ -2,6 +2,7 @@
 //! build the simulator at the initial state, the controllers and the allocator, and size
 //! every buffer the loop needs once, so that no time step allocates.
 
+use super::channels::check_log_size;
 use super::config::ScenarioFile;
 use super::controller::{Command, ModeController};
 use super::error::ScenarioError;
@@ -90,6 +91,7 @@ impl<'f> ClosedLoop<'f> {
         file.validate()
             .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let s = &file.scenario;
+        check_log_size(file, v).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let mut vehicle = v.clone();
         vehicle.fluid.current = Vec3::from(file.physics.current);
         let v = &vehicle;

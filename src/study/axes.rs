@@ -132,6 +132,22 @@ pub(crate) fn parse_axes(
         if axes.iter().any(|b: &Axis| b.name == axis.name) {
             return Err(doc.err(&format!("axis[{i}].name"), "duplicate axis name"));
         }
+        if let Some((j, b)) = axes
+            .iter()
+            .enumerate()
+            .find(|(_, b)| overlaps(&b.target, &axis.target))
+        {
+            return Err(doc.err(
+                &format!("axis[{i}].name"),
+                format!(
+                    "`{}` sets the same parameter as axis[{j}] `{}` (both resolve to {}); \
+                     keep one of them",
+                    axis.name,
+                    b.name,
+                    target_text(&axis.target)
+                ),
+            ));
+        }
         axes.push(axis);
     }
     if let Doe::Sampled { kind, .. } = doe {
@@ -142,19 +158,70 @@ pub(crate) fn parse_axes(
             ));
         }
     }
-    if doe == Doe::Grid {
-        let mut n: usize = 1;
-        for a in &axes {
-            n = n.saturating_mul(a.spec.grid_len());
+    let n = match doe {
+        Doe::Grid => {
+            let mut n: usize = 1;
+            for a in &axes {
+                n = n.saturating_mul(a.spec.grid_len());
+            }
+            if n > MAX_CASES {
+                return Err(doc.err(
+                    "axis",
+                    format!("the grid has {n} cases, more than {MAX_CASES}"),
+                ));
+            }
+            n
         }
-        if n > MAX_CASES {
-            return Err(doc.err(
-                "axis",
-                format!("the grid has {n} cases, more than {MAX_CASES}"),
-            ));
-        }
+        Doe::Sampled { cases, .. } => cases,
+    };
+    let bytes = n as f64 * (CASE_BYTES + AXIS_VALUE_BYTES * axes.len() as f64);
+    if bytes > MAX_PLAN_BYTES {
+        let key = if doe == Doe::Grid {
+            "axis"
+        } else {
+            "doe.cases"
+        };
+        return Err(doc.err(
+            key,
+            format!(
+                "{n} cases × {} axes need about {:.1} GB for the case list and the journal, \
+                 more than {:.0} GB: use fewer cases or split the study",
+                axes.len(),
+                bytes / 1e9,
+                MAX_PLAN_BYTES / 1e9
+            ),
+        ));
     }
     Ok(axes)
+}
+
+/// Memory of one case besides its axis values while a sweep runs [bytes]: its id, hash and
+/// plan entry, its journal row read back (estimate).
+const CASE_BYTES: f64 = 200.0;
+/// Memory of one axis value of one case (a TOML value and its text in the tables) [bytes].
+const AXIS_VALUE_BYTES: f64 = 64.0;
+/// Largest case plan a study may ask for [bytes]: refused before anything runs.
+const MAX_PLAN_BYTES: f64 = 4.0e9;
+
+/// Whether two axis targets set the same parameter: equal paths, or one inside the other
+/// (`design.thruster[2].position` and `design.thruster[2].position[0]`).
+fn overlaps(a: &Target, b: &Target) -> bool {
+    let (pa, pb) = match (a, b) {
+        (Target::Design(x), Target::Design(y)) | (Target::Scenario(x), Target::Scenario(y)) => {
+            (x, y)
+        }
+        _ => return false,
+    };
+    let n = pa.0.len().min(pb.0.len());
+    pa.0[..n] == pb.0[..n]
+}
+
+/// A target as the parameter path of a study file.
+fn target_text(t: &Target) -> String {
+    match t {
+        Target::Design(p) => format!("design.{p}"),
+        Target::Scenario(p) => p.to_string(),
+    }
 }
 
 fn validate_axis(

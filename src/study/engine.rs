@@ -2,15 +2,24 @@
 //! sharding, then the final tables, the manifest and the report.
 //!
 //! Files in the output directory:
-//! - `cases.partial.csv`: one raw row per finished case, appended and flushed as cases complete
-//!   (in completion order; scenario metrics packed in one `scenario_metrics` column as
-//!   `name=value;…`). `--resume` reads it; at the end it is compacted (sorted by case id,
-//!   deduplicated by hash, rows of other study versions dropped). `merge` reads it.
+//! - `cases.partial.csv`: the journal, one raw row per finished case, appended and flushed as
+//!   cases complete (in completion order; scenario metrics packed in one `scenario_metrics`
+//!   column as `name=value;…`). `--resume` reads it (malformed rows are reported with their
+//!   line and run again, see [`super::journal`]); at the end it is compacted (sorted by case
+//!   id, deduplicated by hash, rows of other study versions dropped). A finished unsharded
+//!   sweep removes it (its rows are in `cases.csv`); a shard keeps it as its raw output, which
+//!   `merge` reads.
 //! - `cases.csv`, `cases.parquet`: the final table, sorted by case id: `case_id`, `hash`, one
 //!   column per axis, the metrics, `status` (`ok`, `unsuccessful`, `failed`, `skipped`),
 //!   `reason`. No times.
 //! - `manifest.json`: provenance, counts, timings, the raw schema and the report settings.
 //! - `study.toml`: a copy of the study file.
+//! - `.usm-study.lock`: held while the sweep runs ([`super::outdir`]): one run per directory.
+//!
+//! Every case has a wall-clock budget (`case_timeout`), checked cooperatively inside the
+//! simulation loop (see [`super::worker`]): a case past it is recorded `failed` with a reason
+//! starting `timeout`, and the batch goes on. Timed-out rows depend on the machine's speed;
+//! every other row does not.
 //!
 //! Determinism: a case's row depends only on the study and the case id (per-case seed
 //! `derive_seed(study_seed, case_id)`, no parallel reductions), and rows are sorted by id,
@@ -20,7 +29,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
@@ -28,11 +37,16 @@ use super::cases::{case_hash, resolve_case};
 use super::doe::{case_count, expand, Case};
 use super::error::StudyError;
 use super::finish::finish_report;
-use super::manifest::{git_commit, now_rfc3339, write_manifest, AxisInfo, Counts, Manifest};
+use super::journal;
+use super::manifest::{
+    git_commit, now_rfc3339, read_manifest, write_manifest, AxisInfo, Counts, Manifest,
+};
+use super::outdir;
 use super::records::{
     axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH,
     PARTIAL_FILE, STUDY_COPY,
 };
+use super::runner::TIMEOUT;
 use super::schema::Study;
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
@@ -50,6 +64,11 @@ pub struct SweepOptions {
     pub out: Option<PathBuf>,
     /// Stop after running this many cases (testing interruptions; no final outputs).
     pub max_cases: Option<usize>,
+    /// Wall-clock budget of one case (`None`: unlimited); a case past it is `failed` with
+    /// reason `timeout: …`.
+    pub case_timeout: Option<Duration>,
+    /// Replace the output of another study in the output directory.
+    pub force: bool,
 }
 
 /// Progress of a sweep, reported after every finished case.
@@ -90,7 +109,10 @@ pub struct SweepOutcome {
     pub interrupted: bool,
     /// Wall time [s].
     pub elapsed_s: f64,
-    /// Problems with the report (plots etc.), not fatal.
+    /// Cases stopped by their time budget (failed, reason `timeout: …`), of those run now.
+    pub timeouts: usize,
+    /// Problems with the report (plots etc.) and notes on the output directory (malformed
+    /// journal rows dropped, `--force` removals, stale temporary files), not fatal.
     pub warnings: Vec<String>,
 }
 
@@ -127,10 +149,19 @@ pub fn run_sweep(
     }
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
     let out = output_dir(study, opts);
-    std::fs::create_dir_all(&out).map_err(|e| StudyError::io(&out, e))?;
+    let _lock = outdir::lock(&out)?;
+    let mut notes = outdir::claim(&out, &study.name, opts.force)?;
+    let partial = out.join(PARTIAL_FILE);
+    if opts.resume && !partial.exists() {
+        if let Some(done) = already_complete(study, opts, &out, cases.len()) {
+            return Ok(done);
+        }
+    }
     std::fs::write(out.join(STUDY_COPY), &study.text).map_err(|e| StudyError::io(&out, e))?;
     let schema = raw_schema(study);
-    let partial = out.join(PARTIAL_FILE);
+    if opts.resume {
+        notes.extend(journal::repair(&partial, &schema)?);
+    }
     let (mut appender, done) = open_partial(&partial, &schema, opts.resume)?;
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -141,8 +172,13 @@ pub fn run_sweep(
         .num_threads(jobs)
         .build()
         .map_err(|e| StudyError::Other(format!("thread pool: {e}")))?;
-    let max = opts.max_cases.unwrap_or(usize::MAX);
-    let streamed = stream_cases(study, &cases, &done, max, &pool, &mut appender, progress)?;
+    let run = RunSpec {
+        study,
+        done: &done,
+        max: opts.max_cases.unwrap_or(usize::MAX),
+        budget: opts.case_timeout,
+    };
+    let streamed = stream_cases(&run, &cases, &pool, &mut appender, progress)?;
     let _ = appender.sync();
     drop(appender);
     let ev = streamed.progress;
@@ -153,6 +189,8 @@ pub fn run_sweep(
         resumed: ev.resumed,
         ran: ev.ran,
         interrupted: streamed.not_run > 0,
+        timeouts: streamed.timeouts,
+        warnings: notes,
         ..Default::default()
     };
     if outcome.interrupted {
@@ -191,9 +229,38 @@ pub fn run_sweep(
     write_manifest(&out, &manifest)?;
     if opts.shard.is_none() {
         // Inside the sweep's pool, so the best/worst reruns respect --jobs.
-        outcome.warnings = pool.install(|| finish_report(&out, &table, &manifest, Some(study)));
+        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study)));
+        outcome.warnings.extend(w);
+        // Last: a kill before this leaves a journal that --resume completes from.
+        std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
     }
     Ok(outcome)
+}
+
+/// With `--resume` and no journal: the outcome of an output that is already complete for
+/// this study (its manifest has this study's hash and every case of the run), else `None`.
+fn already_complete(
+    study: &Study,
+    opts: &SweepOptions,
+    out: &Path,
+    in_shard: usize,
+) -> Option<SweepOutcome> {
+    let m = read_manifest(out).ok()?;
+    let complete = m.study_hash == study.hash
+        && m.shard == opts.shard.map(|(i, n)| [i, n])
+        && m.cases.in_output == in_shard
+        && out.join(super::records::CASES_CSV).is_file();
+    complete.then(|| SweepOutcome {
+        out: out.to_path_buf(),
+        planned: m.cases.planned,
+        in_shard,
+        ok: m.cases.ok,
+        failed: m.cases.failed,
+        skipped: m.cases.skipped,
+        resumed: m.cases.in_output,
+        warnings: vec![format!("{} is already complete", out.display())],
+        ..Default::default()
+    })
 }
 
 impl SweepOutcome {
@@ -238,15 +305,25 @@ struct Streamed {
     not_run: usize,
     /// Status counts of the cases run now.
     counts: StatusCounts,
+    /// Cases run now that ran out of time.
+    timeouts: usize,
 }
 
-/// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs), appending each row
-/// to the partial file as it arrives and reporting progress after each.
-fn stream_cases(
-    study: &Study,
-    cases: &[Case],
-    done: &HashSet<String>,
+/// What every case of one run shares: the study, the hashes already done, the cap on cases
+/// run (`max_cases`) and the per-case time budget.
+struct RunSpec<'a> {
+    study: &'a Study,
+    done: &'a HashSet<String>,
     max: usize,
+    budget: Option<Duration>,
+}
+
+/// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs, each within the
+/// budget), appending each row to the partial file as it arrives and reporting progress after
+/// each.
+fn stream_cases(
+    run: &RunSpec,
+    cases: &[Case],
     pool: &rayon::ThreadPool,
     appender: &mut CsvAppender,
     progress: &mut dyn FnMut(&ProgressEvent),
@@ -263,6 +340,7 @@ fn stream_cases(
         plan_hashes: HashSet::with_capacity(cases.len()),
         not_run: 0,
         counts: StatusCounts::default(),
+        timeouts: 0,
     };
     let mut write_error: Option<StudyError> = None;
     std::thread::scope(|s| {
@@ -271,9 +349,9 @@ fn stream_cases(
         s.spawn(move || {
             pool.install(|| {
                 cases.par_iter().for_each_init(
-                    || (tx.clone(), Worker::new()),
+                    || (tx.clone(), Worker::with_budget(run.budget)),
                     |(tx, w), case| {
-                        let msg = process(study, case, w, done, cancel, started, max);
+                        let msg = process(run, case, w, cancel, started);
                         let _ = tx.send(msg);
                     },
                 );
@@ -290,9 +368,12 @@ fn stream_cases(
                     st.plan_hashes.insert(row.hash.clone());
                     st.progress.ran += 1;
                     st.counts.add(row.status);
+                    if row.status == CaseStatus::Failed && row.reason.starts_with(TIMEOUT) {
+                        st.timeouts += 1;
+                    }
                     if write_error.is_none() {
                         let texts: Vec<String> = row.axes.iter().map(axis_text).collect();
-                        if let Err(e) = appender.append(&row.values(study, &texts)) {
+                        if let Err(e) = appender.append(&row.values(run.study, &texts)) {
                             write_error = Some(e.into());
                             cancel.store(true, Ordering::Relaxed);
                         }
@@ -314,23 +395,22 @@ fn stream_cases(
 }
 
 fn process(
-    study: &Study,
+    run: &RunSpec,
     case: &Case,
     w: &mut Worker,
-    done: &HashSet<String>,
     cancel: &AtomicBool,
     started: &AtomicUsize,
-    max: usize,
 ) -> Msg {
     if cancel.load(Ordering::Relaxed) {
         return Msg::NotRun;
     }
+    let study = run.study;
     let resolved = resolve_case(study, case);
     let hash = case_hash(study, case, &resolved);
-    if done.contains(&hash) {
+    if run.done.contains(&hash) {
         return Msg::Resumed(hash);
     }
-    if started.fetch_add(1, Ordering::Relaxed) >= max {
+    if started.fetch_add(1, Ordering::Relaxed) >= run.max {
         return Msg::NotRun;
     }
     let row = match resolved {

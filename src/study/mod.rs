@@ -17,6 +17,8 @@
 //! - [`records`]: case status, row, columns of the raw and final tables.
 //! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
 //! - [`manifest`]: the `manifest.json` of an output directory.
+//! - [`outdir`]: the output directory's lock, its ownership by one study, stale temporaries.
+//! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
 //! - [`engine`]: running, resuming and sharding a sweep.
@@ -29,7 +31,9 @@ pub mod engine;
 pub mod error;
 pub mod finish;
 pub mod hash;
+pub mod journal;
 pub mod manifest;
+pub mod outdir;
 pub mod parse;
 pub mod plots;
 pub mod records;

@@ -14,7 +14,7 @@ use super::axes::{parse_axes, valid_names, AxisFile};
 use super::error::InputError;
 use super::hash::study_hash;
 use super::runner::{self, StudyMode};
-use super::schema::{Doe, DoeKind, ReportSettings, Study, MAX_CASES};
+use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
 use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{flatten, pattern_allowed};
@@ -170,6 +170,9 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         doe,
         doc,
     )?;
+    if side.mode.is_dynamic() {
+        check_base_scenario(&design, &names.scenario_ref, &axes, &doc)?;
+    }
     let output = meta
         .output
         .as_ref()
@@ -246,6 +249,39 @@ fn check_design(
         });
     }
     Ok((design, generator))
+}
+
+/// The base scenario (the study's scenario side over the mode's defaults) run on the base
+/// design must be valid, as the base design must be: otherwise every case would fail for the
+/// same reason. A problem at a key some axis sets is left to the cases (the axis may fix it).
+fn check_base_scenario(
+    design: &toml::Table,
+    reference: &toml::Table,
+    axes: &[Axis],
+    doc: &Document,
+) -> Result<(), InputError> {
+    let Ok(v) = parse_design_table(design, "design") else {
+        return Ok(()); // reported by check_design
+    };
+    let mut sc = reference.clone();
+    sc.remove(STATIC_TABLE);
+    let Err((key, message)) = runner::check_case(&v, &sc) else {
+        return Ok(());
+    };
+    let swept = axes.iter().any(|a| match &a.target {
+        Target::Scenario(p) => {
+            let p = p.to_string();
+            key == p || key.starts_with(&format!("{p}.")) || key.starts_with(&format!("{p}["))
+        }
+        Target::Design(_) => false,
+    });
+    if swept {
+        return Ok(());
+    }
+    Err(doc.err(
+        &key,
+        format!("{message} (in the base scenario: every case would fail)"),
+    ))
 }
 
 /// The scenario side of a study file, checked against the mode's defaults.

@@ -8,15 +8,18 @@
 //!   `allocation` and `metrics` (the batch engine adds `static` itself). Used for the list of
 //!   valid axis names and to reject unknown keys before anything runs.
 //! - [`check_success`]: validate the `[success]` criteria of a scenario-side table.
-//! - [`run_case`]: run one case of a dynamic mode (`transport`, `work`) on a vehicle with the
-//!   case's fully resolved scenario-side table (same shape, overrides applied) and the case
-//!   seed; returns named scalar metrics and, when `log` is set, a trajectory table.
+//! - [`check_case`]: validate a resolved table against a vehicle without running it.
+//! - [`run_case`] / [`run_case_until`]: run one case of a dynamic mode (`transport`, `work`)
+//!   on a vehicle with the case's fully resolved scenario-side table (same shape, overrides
+//!   applied) and the case seed (the latter within a wall-clock deadline); returns named
+//!   scalar metrics and, when `log` is set, a trajectory table.
 //!
 //! Both delegate to `crate::scenario` (`default_table`, `run_case`); trajectories are turned
 //! into report tables here so that the scenario module stays free of polars.
 
 use std::fmt;
 use std::str::FromStr;
+use std::time::Instant;
 
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
@@ -111,6 +114,15 @@ impl FromStr for StudyMode {
     }
 }
 
+/// Check a resolved scenario-side table of a dynamic mode against `vehicle` without running
+/// it (schema, settings, gains against the design, log size): `Err((key, message))`.
+pub fn check_case(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), (String, String)> {
+    crate::scenario::check_table(vehicle, scenario).map_err(|e| (e.key.clone(), e.message.clone()))
+}
+
+/// The reason of a case stopped by its wall-clock budget starts with this word.
+pub const TIMEOUT: &str = crate::scenario::TIMEOUT;
+
 /// Every scenario-side key with its default for `mode` (see the module docs for the shape):
 /// `crate::scenario::default_table` for the dynamic modes.
 pub fn default_table(mode: StudyMode) -> Result<toml::Table, String> {
@@ -127,17 +139,30 @@ pub fn default_table(mode: StudyMode) -> Result<toml::Table, String> {
     }
 }
 
-/// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case seed,
-/// `log` asks for the trajectory. An `Err` (invalid settings) is recorded as a failed case with
-/// the message as its reason; a run that stops early (diverges, NaN) returns its metrics with
-/// `failure` naming the time and the cause.
+/// Run one dynamic case without a time budget: [`run_case_until`] with no deadline.
 pub fn run_case(
     vehicle: &Vehicle,
     scenario: &toml::Table,
     seed: u64,
     log: bool,
 ) -> Result<CaseOutcome, String> {
-    let run = crate::scenario::run_case(vehicle, scenario, seed, log).map_err(|e| e.to_string())?;
+    run_case_until(vehicle, scenario, seed, log, None)
+}
+
+/// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case seed,
+/// `log` asks for the trajectory, `deadline` is the case's wall-clock budget (checked before
+/// every control period). An `Err` (invalid settings) is recorded as a failed case with
+/// the message as its reason; a run that stops early (diverges, NaN, the deadline: a
+/// `timeout: …` failure) returns its metrics with `failure` naming the time and the cause.
+pub fn run_case_until(
+    vehicle: &Vehicle,
+    scenario: &toml::Table,
+    seed: u64,
+    log: bool,
+    deadline: Option<Instant>,
+) -> Result<CaseOutcome, String> {
+    let run = crate::scenario::run_case(vehicle, scenario, seed, log, deadline)
+        .map_err(|e| e.to_string())?;
     let trajectory = match run.trajectory {
         Some(t) => Some(crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?),
         None => None,

@@ -73,5 +73,17 @@ pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, Stri
         worst: 0,
     };
     spec.validate().map_err(|e| e.to_string())?;
+    if spec.samples > MAX_CASE_SAMPLES {
+        return Err(format!(
+            "static.samples: {} samples per case would keep {:.1} GB of per-sample values \
+             (σ_min and κ, for exact quantiles); at most {MAX_CASE_SAMPLES} per case",
+            spec.samples,
+            spec.samples as f64 * 16.0 / 1e9
+        ));
+    }
     Ok(spec)
 }
+
+/// Most static samples of one sweep case: 16 bytes each are kept (σ_min and κ), 160 MB at the
+/// cap, per worker thread.
+pub const MAX_CASE_SAMPLES: usize = 10_000_000;

@@ -2,6 +2,11 @@
 //! the design columns, run the static TCM analysis and the closed-loop scenario as the study
 //! asks. A panic, an invalid design or a failed run becomes the row's status and reason; it
 //! never aborts the sweep.
+//!
+//! A worker may carry a per-case wall-clock budget ([`Worker::with_budget`]): it is checked
+//! cooperatively (before every control period of a closed-loop run, after every chunk of
+//! static samples), and a case past it ends `failed` with a reason starting `timeout`. No
+//! thread is ever killed.
 
 use super::cases::Resolved;
 use super::doe::Case;
@@ -9,23 +14,35 @@ use super::records::{pack_metrics, CaseStatus, Row, DESIGN_COLUMNS, TCM_COLUMNS}
 use super::runner;
 use super::schema::Study;
 use super::static_table::{static_spec, STATIC_TABLE};
-use super::static_tcm::{analyse, StaticSummary};
+use super::static_tcm::{analyse, StaticError, StaticSummary};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
 use crate::sampling::derive_seed;
+use std::time::{Duration, Instant};
 
 /// Per-worker state of a sweep (one per rayon worker): a one-entry vehicle cache keyed by
 /// the design hash, so consecutive cases of one design build it once.
 #[derive(Default)]
 pub struct Worker {
     cache: Option<(String, Vehicle)>,
+    /// Wall-clock budget of one case (`None`: unlimited).
+    budget: Option<Duration>,
 }
 
 impl Worker {
-    /// A fresh worker.
+    /// A fresh worker without a time budget.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A fresh worker giving every case at most `budget` of wall-clock time (`None`:
+    /// unlimited).
+    pub fn with_budget(budget: Option<Duration>) -> Self {
+        Self {
+            cache: None,
+            budget,
+        }
     }
 
     /// Evaluate a resolved case; returns the row and (with `log`) the trajectory.
@@ -37,8 +54,9 @@ impl Worker {
         log: bool,
     ) -> (Row, Option<Table>) {
         let mut row = Row::new(study, case.id, r.hash.clone(), case.values.clone());
+        let deadline = self.budget.map(|b| Instant::now() + b);
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            self.evaluate_phases(study, case, r, log, &mut row)
+            self.evaluate_phases(study, case, r, log, deadline, &mut row)
         }));
         match result {
             Ok(traj) => (row, traj),
@@ -61,15 +79,16 @@ impl Worker {
         case: &Case,
         r: &Resolved,
         log: bool,
+        deadline: Option<Instant>,
         row: &mut Row,
     ) -> Option<Table> {
         let v = self.vehicle(case, r, row)?;
         row.metrics[..DESIGN_COLUMNS.len()].copy_from_slice(&design_metrics(v));
         if study.static_enabled {
-            static_phase(v, r, row)?;
+            static_phase(v, r, deadline, row)?;
         }
         if study.mode.is_dynamic() {
-            return dynamic_phase(v, r, log, row);
+            return dynamic_phase(v, r, log, deadline, row);
         }
         None
     }
@@ -101,8 +120,9 @@ pub fn design_metrics(v: &Vehicle) -> [f64; 5] {
     ]
 }
 
-/// The static TCM analysis into the [`TCM_COLUMNS`]; `None` when the row ended.
-fn static_phase(v: &Vehicle, r: &Resolved, row: &mut Row) -> Option<()> {
+/// The static TCM analysis into the [`TCM_COLUMNS`]; `None` when the row ended (a `timeout`
+/// when `deadline` passed: it is checked for every sample handed over, so after each chunk).
+fn static_phase(v: &Vehicle, r: &Resolved, deadline: Option<Instant>, row: &mut Row) -> Option<()> {
     let spec = match static_spec(&r.scenario, derive_seed(r.seed, 1)) {
         Ok(s) => s,
         Err(m) => {
@@ -110,10 +130,22 @@ fn static_phase(v: &Vehicle, r: &Resolved, row: &mut Row) -> Option<()> {
             return None;
         }
     };
-    match analyse(v, &spec, 1, &mut |_| Ok(()), &|_| {}) {
+    let mut on_time = |_: &_| match deadline {
+        Some(d) if Instant::now() >= d => Err(runner::TIMEOUT.to_string()),
+        _ => Ok(()),
+    };
+    match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
         Ok(s) => {
             row.metrics[DESIGN_COLUMNS.len()..].copy_from_slice(&tcm_metrics(&s));
             Some(())
+        }
+        Err(StaticError::Sink(_)) => {
+            let reason = format!(
+                "{}: the case's wall-clock budget ran out in the static analysis",
+                runner::TIMEOUT
+            );
+            row.end(CaseStatus::Failed, &reason);
+            None
         }
         Err(e) => {
             row.end(CaseStatus::Failed, &e.to_string());
@@ -153,10 +185,16 @@ pub fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
 }
 
 /// The closed-loop run into the packed scenario metrics; returns the trajectory (with `log`).
-fn dynamic_phase(v: &Vehicle, r: &Resolved, log: bool, row: &mut Row) -> Option<Table> {
+fn dynamic_phase(
+    v: &Vehicle,
+    r: &Resolved,
+    log: bool,
+    deadline: Option<Instant>,
+    row: &mut Row,
+) -> Option<Table> {
     let mut sc = r.scenario.clone();
     sc.remove(STATIC_TABLE);
-    match runner::run_case(v, &sc, r.seed, log) {
+    match runner::run_case_until(v, &sc, r.seed, log, deadline) {
         Ok(out) => {
             if let Some(f) = &out.failure {
                 row.end(CaseStatus::Failed, f);
