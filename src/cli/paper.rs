@@ -1,12 +1,14 @@
-//! `usm-study paper [usm|antonelli] [--out DIR]`: regenerate a seed paper's simulations — the
-//! USM paper (see [`usm_study::pipeline::paper`], the default) or Antonelli & Chiaverini's
-//! kinematic case studies (see [`usm_study::pipeline::antonelli`]).
+//! `usm-study paper [usm|antonelli|readings] [--out DIR]`: regenerate a seed paper's simulations
+//! — the USM paper (see [`usm_study::pipeline::paper`], the default), Antonelli & Chiaverini's
+//! kinematic case studies (see [`usm_study::pipeline::antonelli`]), or the USM transport
+//! readings comparison (see [`usm_study::pipeline::readings`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::pipeline::antonelli::run_antonelli;
 use usm_study::pipeline::paper::run_paper;
+use usm_study::pipeline::readings::run_readings;
 
 /// Which paper to regenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -15,6 +17,9 @@ pub enum PaperName {
     Usm,
     /// Antonelli & Chiaverini (1998): kinematic case studies 1, 1b and 2 on `uvms-planar`.
     Antonelli,
+    /// The USM paper's transport mode under every reading of its open choices (USM-33/34,
+    /// USM-40/41): `readings.csv` and `readings.md`.
+    Readings,
 }
 
 /// Arguments of `paper`.
@@ -24,7 +29,7 @@ pub struct PaperArgs {
     #[arg(value_enum, default_value = "usm")]
     pub paper: PaperName,
     /// Output directory (default `results/paper` for `usm`, `results/antonelli` for
-    /// `antonelli`).
+    /// `antonelli`, `results/paper/readings` for `readings`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Also write each run's time series (CSV and Parquet; about 2 MB per run; `usm` only).
@@ -47,6 +52,30 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             );
         })?;
         eprintln!("[paper antonelli] wrote {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    if a.paper == PaperName::Readings {
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| "results/paper/readings".into());
+        let outcome = run_readings(&out, &mut |r| {
+            eprintln!(
+                "[paper readings] {} {:?}: {}",
+                r.reading.key(),
+                r.method,
+                if r.converged() {
+                    "converged"
+                } else {
+                    "not converged"
+                }
+            );
+        })?;
+        match outcome.adopted {
+            Some(r) => eprintln!("[paper readings] adopted: {}", r.key()),
+            None => eprintln!("[paper readings] no reading makes both methods converge"),
+        }
+        eprintln!("[paper readings] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
     let out = a.out.clone().unwrap_or_else(|| "results/paper".into());

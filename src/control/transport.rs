@@ -27,15 +27,23 @@
 //! - **Yaw (USM-41)**: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)`, applied as the base yaw
 //!   acceleration (z of `F_b`). `ψ̇` is, by default, the rate of the same heading ψ (the front
 //!   link's, [`YawRateSource::FrontHeading`]) so that the law is a PD on one signal; the base
-//!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]).
+//!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]), and so is
+//!   dropping the reference rate `ψ̇_r` ([`TransportGains::yaw_rate_reference`]).
 //! - The other components of `a^b`: the paper says they are "set to zero". We read this as
 //!   USM-34 with a zero reference on those axes, `a_i = −K_p,i v_b,i` (sway, heave, roll,
 //!   pitch; the paper's `K_p = diag(1,1,1,0,1,1)`), applied with `τ_c = M_11 a^b` in
 //!   [`super::dynamic::DynamicController::transport_control`], without `n` by default
 //!   ([`super::dynamic::DynamicGains::transport`]). Both are interpretation choices, justified
-//!   below; the literal form is `base_control.nonlinear = true, kp = [0, 0, 0, 0, 0, 0]`.
+//!   below; the literal form is `base_control.nonlinear = true, uncommanded_feedback = false`.
 //!
 //! # Interpretation choices and why (results/paper/FINDINGS.md has the numbers)
+//!
+//! `usm-study paper readings` (`crate::pipeline::readings`) runs both Table III methods under
+//! all 32 combinations of the open choices (n or not, feedback on the uncommanded axes or not,
+//! front-heading or base yaw rate, with or without `ψ̇_r`, PI or PD surge). Only the default
+//! below (no `n`, feedback, front-heading rate, `ψ̇ − ψ̇_r`, PI: two departures from the
+//! printed text) makes both methods converge; under none is Method 2 the faster one, and with
+//! the two rows' yaw gains and Δ swapped the ordering follows the gains, not the surge source.
 //!
 //! - **Zero-velocity feedback on the uncommanded axes.** With `n` included and those
 //!   accelerations literally zero, USM-33 makes sway, heave and pitch pure integrators
@@ -140,6 +148,10 @@ pub struct TransportGains {
     pub surge_source: SurgeSource,
     /// Which yaw rate is ψ̇.
     pub yaw_rate_source: YawRateSource,
+    /// Whether USM-41 damps the rate error `ψ̇ − ψ̇_r` (true, as printed; `ψ̇_r` the LOS
+    /// reference rate of [`super::guidance`]) or the rate `ψ̇` alone (false: a reading of the
+    /// OCR'd "k_6d(ψ̇ − ψ̇," that drops the reference rate). Default true.
+    pub yaw_rate_reference: bool,
     /// Sign `s_q` of USM-38 in our joint convention (default −1; see the module docs).
     pub joint_sign: f64,
     /// Bound on `|∫(u − u_c) dt|` [m] (anti-windup; `None` = unbounded, as in the paper).
@@ -162,6 +174,7 @@ impl TransportGains {
             surge_law: SurgeLaw::ProportionalIntegral,
             surge_source: SurgeSource::Base,
             yaw_rate_source: YawRateSource::FrontHeading,
+            yaw_rate_reference: true,
             joint_sign: -1.0,
             integral_limit: None,
             derivative_time_constant: 0.5,
@@ -247,6 +260,7 @@ struct TransportGainsSpec {
     surge_law: Option<SurgeLaw>,
     surge_source: Option<SurgeSource>,
     yaw_rate_source: Option<YawRateSource>,
+    yaw_rate_reference: Option<bool>,
     joint_sign: Option<f64>,
     integral_limit: Option<f64>,
     derivative_time_constant: Option<f64>,
@@ -271,6 +285,7 @@ impl TryFrom<TransportGainsSpec> for TransportGains {
             surge_law,
             surge_source,
             yaw_rate_source,
+            yaw_rate_reference,
             joint_sign,
             derivative_time_constant
         );
@@ -478,9 +493,15 @@ impl TransportController {
         }
     }
 
-    /// USM-41: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)` [rad/s²].
+    /// USM-41: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)` [rad/s²]; `ψ̇_r` is dropped
+    /// (`− k_6d ψ̇`) unless [`TransportGains::yaw_rate_reference`].
     pub fn yaw_acceleration(&self, psi: f64, psi_dot: f64, psi_r: f64, psi_r_dot: f64) -> f64 {
-        -self.gains.k_6p * wrap_angle(psi - psi_r) - self.gains.k_6d * (psi_dot - psi_r_dot)
+        let rate_ref = if self.gains.yaw_rate_reference {
+            psi_r_dot
+        } else {
+            0.0
+        };
+        -self.gains.k_6p * wrap_angle(psi - psi_r) - self.gains.k_6d * (psi_dot - rate_ref)
     }
 
     /// One transport step at time `t` [s] over `dt` [s]: LOS guidance at the end-effector

@@ -5,6 +5,7 @@
 //! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
+//! - [`readings`]: transport mode under every reading of the paper's open choices;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
@@ -19,6 +20,7 @@ pub mod draw;
 pub mod error;
 pub mod inspect;
 pub mod paper;
+pub mod readings;
 pub mod simulate;
 pub mod tcm;
 
