@@ -1,7 +1,8 @@
-//! `usm-study paper [usm|antonelli|readings] [--out DIR]`: regenerate a seed paper's simulations
+//! `usm-study paper [usm|antonelli|readings|secondary] [--out DIR]`: regenerate a seed paper's simulations
 //! — the USM paper (see [`usm_study::pipeline::paper`], the default), Antonelli & Chiaverini's
 //! kinematic case studies (see [`usm_study::pipeline::antonelli`]), or the USM transport
-//! readings comparison (see [`usm_study::pipeline::readings`]).
+//! readings comparison (see [`usm_study::pipeline::readings`]), or the secondary objectives
+//! comparison (see [`usm_study::pipeline::secondary`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
@@ -9,6 +10,7 @@ use std::process::ExitCode;
 use usm_study::pipeline::antonelli::run_antonelli;
 use usm_study::pipeline::paper::run_paper;
 use usm_study::pipeline::readings::run_readings;
+use usm_study::pipeline::secondary::run_secondary_comparison;
 
 /// Which paper to regenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -20,6 +22,9 @@ pub enum PaperName {
     /// The USM paper's transport mode under every reading of its open choices (USM-33/34,
     /// USM-40/41): `readings.csv` and `readings.md`.
     Readings,
+    /// The USM paper's secondary objectives (manipulability, controllability) on and off, in
+    /// work mode and transport: `secondary.csv` and `secondary.md`.
+    Secondary,
 }
 
 /// Arguments of `paper`.
@@ -29,7 +34,8 @@ pub struct PaperArgs {
     #[arg(value_enum, default_value = "usm")]
     pub paper: PaperName,
     /// Output directory (default `results/paper` for `usm`, `results/antonelli` for
-    /// `antonelli`, `results/paper/readings` for `readings`).
+    /// `antonelli`, `results/paper/readings` for `readings`, `results/paper/secondary` for
+    /// `secondary`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Also write each run's time series (CSV and Parquet; about 2 MB per run; `usm` only).
@@ -76,6 +82,22 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             None => eprintln!("[paper readings] no reading makes both methods converge"),
         }
         eprintln!("[paper readings] wrote {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    if a.paper == PaperName::Secondary {
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| "results/paper/secondary".into());
+        run_secondary_comparison(&out, &mut |r| {
+            eprintln!(
+                "[paper secondary] {} {}: min commanded σ_min {:.4}",
+                r.scenario,
+                r.case,
+                r.get("sigma_c_min")
+            );
+        })?;
+        eprintln!("[paper secondary] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
     let out = a.out.clone().unwrap_or_else(|| "results/paper".into());

@@ -29,6 +29,11 @@
 //!   link's, [`YawRateSource::FrontHeading`]) so that the law is a PD on one signal; the base
 //!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]), and so is
 //!   dropping the reference rate `ψ̇_r` ([`TransportGains::yaw_rate_reference`]).
+//! - **Secondary objectives** (optional, `[secondary]`; [`TransportController::set_secondary`]):
+//!   a bounded joint offset δ in the null space of the head's heading and pitch relative to
+//!   the tail, climbing the commanded-subspace σ_min / manipulability. Off by default: a
+//!   persistent null-space bend biases the steering, and neither method then converges to the
+//!   second segment (`usm-study paper secondary`).
 //! - The other components of `a^b`: the paper says they are "set to zero". We read this as
 //!   USM-34 with a zero reference on those axes, `a_i = −K_p,i v_b,i` (sway, heave, roll,
 //!   pitch; the paper's `K_p = diag(1,1,1,0,1,1)`), applied with `τ_c = M_11 a^b` in
@@ -70,6 +75,7 @@
 //!   rate; ω_n = 1 rad/s halves it. We keep the servo and report it.
 
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
+use super::kinematic::SecondaryTasks;
 use super::{
     check_finite, check_nonneg, check_pos, heading, heading_rate, wrap_angle, ControlError,
 };
@@ -404,6 +410,10 @@ pub struct TransportController {
     integral: f64,
     prev_error: Option<f64>,
     error_rate: f64,
+    secondary: Option<Box<SecondaryTasks>>,
+    offset: Vec<f64>,
+    q_sec: Vec<f64>,
+    step: Vec<f64>,
 }
 
 impl TransportController {
@@ -420,7 +430,65 @@ impl TransportController {
             integral: 0.0,
             prev_error: None,
             error_rate: 0.0,
+            secondary: None,
+            offset: vec![0.0; v.n_joints()],
+            q_sec: vec![0.0; v.n_joints()],
+            step: vec![0.0; v.n_joints()],
         })
+    }
+
+    /// Add the paper's secondary objectives (USM section IV-A; [`SecondaryTasks`]) below
+    /// USM-38: the joint references become `q_r = q_r,USM-38 + δ`, with the offset δ integrating
+    /// the secondary joint velocity projected onto `Σ_yaw δ = 0, Σ_pitch δ = 0` (the null space
+    /// of the head's heading and pitch relative to the tail, so steering is unchanged to first
+    /// order), each `|δ_i|` bounded by `max_offset`.
+    pub fn set_secondary(&mut self, tasks: SecondaryTasks) {
+        self.secondary = Some(Box::new(tasks));
+    }
+
+    /// The secondary offset δ [rad] of the joint references (zeros without secondary tasks).
+    pub fn secondary_offset(&self) -> &[f64] {
+        &self.offset
+    }
+
+    /// Advance δ over `dt` [s] at the current references and add it to them (see
+    /// [`TransportController::set_secondary`]). Allocation-free.
+    fn apply_secondary(&mut self, dt: f64) {
+        let Some(sec) = self.secondary.as_deref_mut() else {
+            return;
+        };
+        let n = self.q_ref.len();
+        let max = sec.settings().max_offset;
+        if dt.is_finite() && dt > 0.0 {
+            for i in 0..n {
+                self.q_sec[i] = self.q_ref[i] + self.offset[i];
+            }
+            let v = sec.joint_velocity(&self.q_sec);
+            // Project onto Σ_yaw δ̇ = 0, Σ_other δ̇ = 0: remove each group's mean.
+            let (mut sum, mut count) = ([0.0; 2], [0usize; 2]);
+            for i in 0..n {
+                let g = usize::from(!self.yaw[i]);
+                sum[g] += v[i];
+                count[g] += 1;
+            }
+            let mean = |g: usize| sum[g] / count[g].max(1) as f64;
+            let mut alpha: f64 = 1.0;
+            for i in 0..n {
+                let step = (v[i] - mean(usize::from(!self.yaw[i]))) * dt;
+                self.step[i] = step;
+                if step != 0.0 && (self.offset[i] + step).abs() > max {
+                    let room = (max.copysign(step) - self.offset[i]) / step;
+                    alpha = alpha.min(room.max(0.0));
+                }
+            }
+            for i in 0..n {
+                self.offset[i] += alpha * self.step[i];
+            }
+        }
+        for i in 0..n {
+            let (lo, hi) = self.limits[i];
+            self.q_ref[i] = (self.q_ref[i] + self.offset[i]).clamp(lo, hi);
+        }
     }
 
     /// The gains.
@@ -455,6 +523,7 @@ impl TransportController {
         self.error_rate = 0.0;
         self.guidance.reset();
         self.q_ref.fill(0.0);
+        self.offset.fill(0.0);
     }
 
     /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
@@ -519,6 +588,7 @@ impl TransportController {
             los.psi_r,
             &mut self.q_ref,
         );
+        self.apply_secondary(dt);
         let u = match self.gains.surge_source {
             SurgeSource::EndEffector => meas.surge_ee,
             SurgeSource::Base => meas.surge_base,

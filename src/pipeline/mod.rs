@@ -6,6 +6,7 @@
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
 //! - [`readings`]: transport mode under every reading of the paper's open choices;
+//! - [`secondary`]: the paper's secondary objectives on and off, work mode and transport;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies, their CSVs and summary;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
@@ -21,6 +22,7 @@ pub mod error;
 pub mod inspect;
 pub mod paper;
 pub mod readings;
+pub mod secondary;
 pub mod simulate;
 pub mod tcm;
 

@@ -2,13 +2,15 @@
 //! (Fig. 8 a–h and Fig. 9 of the paper, and the torque-limited transport variant) and the
 //! allocator comparison — with their figures,
 //! summaries and the comparison tables of `README.md`, and the transport readings comparison
-//! ([`super::readings`]) in `readings/`.
+//! ([`super::readings`]) in `readings/` and the secondary-objectives comparison
+//! ([`super::secondary`]) in `secondary/`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::error::{create_dir, PipelineError};
 use super::readings::run_readings;
+use super::secondary::run_secondary_comparison;
 use super::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use crate::allocation::Method;
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
@@ -61,7 +63,8 @@ const INTRO: &str = "# The USM paper's simulations, regenerated\n\n\
      paper's 140 s, which leaves 45 s after the segment commanded at 95 s: a NaN\n\
      convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n\
      `readings/readings.md` compares both transport methods under every reading of the\n\
-     paper's open choices (`paper readings` regenerates only that).\n";
+     paper's open choices (`paper readings` regenerates only that);\n\
+     `secondary/secondary.md` the paper's secondary objectives on and off (`paper secondary`).\n";
 
 /// One finished run, as reported to the caller.
 #[derive(Clone, Debug)]
@@ -147,6 +150,7 @@ pub fn run_paper(
     write_tables(&mut md, &rows);
     atomic_write(&out.join("README.md"), md.as_bytes())?;
     run_readings(&out.join("readings"), &mut |_| {})?;
+    run_secondary_comparison(&out.join("secondary"), &mut |_| {})?;
     Ok(PaperOutcome { failed })
 }
 
