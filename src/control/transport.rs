@@ -466,15 +466,15 @@ impl TransportController {
             let v = sec.joint_velocity(&self.q_sec);
             // Project onto Σ_yaw δ̇ = 0, Σ_other δ̇ = 0: remove each group's mean.
             let (mut sum, mut count) = ([0.0; 2], [0usize; 2]);
-            for i in 0..n {
-                let g = usize::from(!self.yaw[i]);
-                sum[g] += v[i];
+            for (&vi, &yaw) in v.iter().zip(&self.yaw) {
+                let g = usize::from(!yaw);
+                sum[g] += vi;
                 count[g] += 1;
             }
             let mean = |g: usize| sum[g] / count[g].max(1) as f64;
             let mut alpha: f64 = 1.0;
-            for i in 0..n {
-                let step = (v[i] - mean(usize::from(!self.yaw[i]))) * dt;
+            for (i, &vi) in v.iter().enumerate() {
+                let step = (vi - mean(usize::from(!self.yaw[i]))) * dt;
                 self.step[i] = step;
                 if step != 0.0 && (self.offset[i] + step).abs() > max {
                     let room = (max.copysign(step) - self.offset[i]) / step;

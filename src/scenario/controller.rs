@@ -45,9 +45,10 @@ pub(crate) struct WorkSignals {
 
 /// The mode's control law and what it needs beyond the measurement.
 pub(crate) enum ModeController {
-    /// LOS path following; the path also gives the base's lateral offset.
+    /// LOS path following; the path also gives the base's lateral offset (boxed: the
+    /// transport law with its secondary-task buffers is large).
     Transport {
-        law: TransportController,
+        law: Box<TransportController>,
         path: PathSpec,
         signals: TransportSignals,
     },
@@ -126,8 +127,10 @@ impl ModeController {
                     .path
                     .clone()
                     .ok_or_else(|| invalid("path: transport mode needs a [path] table".into()))?;
-                let mut law = TransportController::new(v, g, &path)
-                    .map_err(|e| invalid(format!("control.{e}")))?;
+                let mut law = Box::new(
+                    TransportController::new(v, g, &path)
+                        .map_err(|e| invalid(format!("control.{e}")))?,
+                );
                 if file.secondary.enabled() {
                     law.set_secondary(secondary_tasks(v, file)?);
                 }

@@ -204,12 +204,12 @@ impl SecondaryTasks {
             self.settings.step,
         );
         self.q.copy_from_slice(q);
-        for i in 0..q.len() {
-            self.q[i] = q[i] + h;
+        for (i, &qi) in q.iter().enumerate() {
+            self.q[i] = qi + h;
             let (sp, mp) = self.measures();
-            self.q[i] = q[i] - h;
+            self.q[i] = qi - h;
             let (sm, mm) = self.measures();
-            self.q[i] = q[i];
+            self.q[i] = qi;
             let g = kc * (sp - sm) / (2.0 * h) + km * (mp - mm) / (2.0 * h);
             self.grad[i] = if g.is_finite() { g } else { 0.0 };
         }
