@@ -1,31 +1,26 @@
 //! Transport mode (USM section V-A, VI-B) in closed loop on the full hydrodynamic model with
 //! the QP allocator, both Table III methods, plus the physics sanity checks behind the
-//! findings in results/paper/FINDINGS.md. The assertions state what the model achieves, not
-//! what the paper reports: Method 1 converges within 60 s of each segment change, Method 2
-//! converges on both segments but needs ~72 s (the paper's "Method 2 is faster" does not hold
-//! here).
+//! findings in results/paper/FINDINGS.md. Tests named `reproduced_…` pin the paper's findings
+//! the model reproduces; tests named `known_disagreement_…` pin where it does not (Method 2
+//! slower, more overshoot, a looser tail; the printed reading not converging), with the
+//! numbers and the reason in their comments.
 
+use usm_study::control::transport::TransportMethod;
 use usm_study::dynamics::{ActuatorCommand, SimConfig, Simulator};
 use usm_study::model::presets::usm_paper;
+use usm_study::pipeline::readings::{run_reading, ReadingRun, TransportReading};
 use usm_study::scenario::{
     load_table, parse_table, resolve_design, run_scenario, Channel, RunResult,
 };
 
 /// Run a preset, extended from the paper's 140 s to 170 s so that convergence within 60 s
-/// of the segment commanded at 95 s can be judged, with `overrides` applied.
-fn run(preset: &str, overrides: &[(&str, &str, toml::Value)]) -> RunResult {
+/// of the segment commanded at 95 s can be judged.
+fn run(preset: &str) -> RunResult {
     let (mut t, src) = load_table(preset).unwrap();
     t["scenario"]
         .as_table_mut()
         .unwrap()
         .insert("duration".into(), toml::Value::Float(170.0));
-    for (sec, key, val) in overrides {
-        t.entry(sec.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
-            .as_table_mut()
-            .unwrap()
-            .insert(key.to_string(), val.clone());
-    }
     let f = parse_table(&t, &src).unwrap();
     let v = resolve_design(&f, &src).unwrap();
     let r = run_scenario(&v, &f).unwrap();
@@ -49,10 +44,24 @@ fn peak_thrust(r: &RunResult, a: f64, b: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Both methods under the project's default reading (`TransportReading::DEFAULT`, adopted by
+/// `usm-study paper readings` as the reading closest to the printed text under which both
+/// Table III methods converge), 170 s.
+fn default_runs() -> (ReadingRun, ReadingRun) {
+    let r = TransportReading::DEFAULT;
+    (
+        run_reading(r, TransportMethod::Method1, None).unwrap(),
+        run_reading(r, TransportMethod::Method2, None).unwrap(),
+    )
+}
+
 #[test]
-fn transport_both_methods_converge_with_qp() {
-    let r1 = run("transport-method1", &[]);
-    let r2 = run("transport-method2", &[]);
+fn reproduced_both_methods_converge_turn_and_cruise_far_below_the_thrust_limit() {
+    // The paper's findings this model reproduces (USM section VI-B): both methods converge to
+    // the path and complete the 180° turn; thrust stays far below the 40 N limit except in the
+    // commanded transients (start and turn); Method 2 uses slightly more thruster effort.
+    let r1 = run("transport-method1");
+    let r2 = run("transport-method2");
     for (name, r) in [("method1", &r1), ("method2", &r2)] {
         assert_eq!(metric(r, "completed"), 1.0, "{name}");
         assert_eq!(metric(r, "segments_reached"), 2.0, "{name}");
@@ -66,38 +75,75 @@ fn transport_both_methods_converge_with_qp() {
         assert!(cruise < 10.0, "{name}: cruise peak {cruise}");
         assert!(metric(r, "base_cross_track_rms") < 0.2, "{name}");
     }
-    // Method 1: within 60 s of each segment change, small overshoot.
-    for k in 0..2 {
-        let c = metric(&r1, &format!("seg{k}_convergence_time"));
-        assert!(c < 40.0, "method1 seg{k}: {c}");
-    }
-    assert!(metric(&r1, "overshoot") < 0.2);
-    // Method 2: converges, but slower than 60 s and with more overshoot than Method 1 —
-    // the opposite of the paper's finding (reported, not tuned away).
-    for k in 0..2 {
-        let c = metric(&r2, &format!("seg{k}_convergence_time"));
-        assert!(c > 60.0 && c < 75.0, "method2 seg{k}: {c}");
-    }
-    assert!(metric(&r2, "overshoot") > metric(&r1, "overshoot"));
-    assert!(metric(&r2, "convergence_time") > metric(&r1, "convergence_time"));
+    // "Method 2 uses slightly more thruster effort": +1.5 % here (2369 vs 2333 N·s).
+    let (e1, e2) = (metric(&r1, "effort_abs"), metric(&r2, "effort_abs"));
+    assert!(e2 > e1 && e2 < 1.05 * e1, "{e1} {e2}");
+    // The presets run the default reading.
+    let (d1, d2) = default_runs();
+    assert_eq!(d1.get("effort_abs"), e1);
+    assert_eq!(d2.get("effort_abs"), e2);
 }
 
 #[test]
-fn paper_literal_base_control_does_not_converge() {
-    // USM-33 with n and the remaining accelerations literally zero: bounded, not converged
-    // (Method 2: slow oscillation; Method 1: limit cycle / offset).
-    let lit = [
-        ("base_control", "nonlinear", toml::Value::Boolean(true)),
-        (
-            "base_control",
-            "kp",
-            toml::Value::Array(vec![toml::Value::Float(0.0); 6]),
-        ),
-    ];
-    for preset in ["transport-method1", "transport-method2"] {
-        let r = run(preset, &lit);
-        assert_eq!(metric(&r, "converged"), 0.0, "{preset}");
-        assert!(metric(&r, "final_cross_track").abs() < 5.0, "{preset}");
+fn known_disagreement_method2_converges_slower_with_more_overshoot_and_a_looser_tail() {
+    // KNOWN DISAGREEMENT with the paper, pinned so that a change is noticed: the paper finds
+    // Method 2 faster, with less overshoot, its tail following the front's track more closely.
+    // Under the default reading it is the reverse (results/paper/readings/readings.md: no
+    // reading of the 32 makes Method 2 converge faster). Method 1: 24.6 / 26.4 s, overshoot
+    // 0.10 m, tail 0.068 m; Method 2: 71.7 / 71.4 s, 1.64 m, 0.21 m.
+    let (r1, r2) = default_runs();
+    assert!(r1.converged() && r2.converged());
+    for k in ["seg0_convergence_time", "seg1_convergence_time"] {
+        let (a, b) = (r1.get(k), r2.get(k));
+        assert!(a < 40.0 && b > 60.0 && b < 75.0, "{k}: {a} {b}");
+    }
+    let over = |r: &ReadingRun| r.get("seg0_overshoot").max(r.get("seg1_overshoot"));
+    assert!(
+        over(&r1) < 0.2 && over(&r2) > 1.0,
+        "{} {}",
+        over(&r1),
+        over(&r2)
+    );
+    for k in ["tail_deviation_rms", "base_cross_track_rms"] {
+        assert!(
+            r2.get(k) > 1.5 * r1.get(k),
+            "{k}: {} {}",
+            r1.get(k),
+            r2.get(k)
+        );
+    }
+}
+
+#[test]
+fn known_disagreement_comes_from_the_table_iii_yaw_gains_not_the_surge_source() {
+    // Why Method 2 is slower here: its Table III yaw gains (k_6p = 0.01, k_6d = 0.2, Δ = 2 m),
+    // not its base-surge regulation. With the yaw gains and Δ swapped, the ordering follows
+    // the gains: base surge with Method 1's yaw gains converges as fast as Method 1 (24.6 s on
+    // segment 0), front surge with Method 2's as slowly as Method 2 (68.8 s).
+    let r = TransportReading::DEFAULT;
+    let base_fast =
+        run_reading(r, TransportMethod::Method2, Some(TransportMethod::Method1)).unwrap();
+    let front_slow =
+        run_reading(r, TransportMethod::Method1, Some(TransportMethod::Method2)).unwrap();
+    assert!(base_fast.converged() && front_slow.converged());
+    let (fast, slow) = (
+        base_fast.get("seg0_convergence_time"),
+        front_slow.get("seg0_convergence_time"),
+    );
+    assert!(fast < 30.0 && slow > 60.0, "{fast} {slow}");
+}
+
+#[test]
+fn known_disagreement_printed_reading_does_not_converge() {
+    // KNOWN DISAGREEMENT: the printed reading (USM-33 with n, the remaining accelerations
+    // literally zero) leaves sway/heave/pitch as pure integrators and cancels the bent body's
+    // steering force; neither method converges (bounded: Method 1 limit cycle / offset,
+    // Method 2 slow oscillation). See control::transport for the closed-loop analysis.
+    for method in [TransportMethod::Method1, TransportMethod::Method2] {
+        let r = run_reading(TransportReading::PRINTED, method, None).unwrap();
+        assert!(!r.failed, "{method:?}");
+        assert!(!r.converged(), "{method:?}");
+        assert!(r.get("final_cross_track").abs() < 5.0, "{method:?}");
     }
 }
 

@@ -1,12 +1,16 @@
-//! `usm-study paper [usm|antonelli] [--out DIR]`: regenerate a seed paper's simulations — the
-//! USM paper (see [`usm_study::pipeline::paper`], the default) or Antonelli & Chiaverini's
-//! case studies and Table I (see [`usm_study::pipeline::antonelli`]).
+//! `usm-study paper [usm|antonelli|readings|secondary] [--out DIR]`: regenerate a seed paper's
+//! simulations — the USM paper (see [`usm_study::pipeline::paper`], the default), Antonelli &
+//! Chiaverini's case studies and Table I (see [`usm_study::pipeline::antonelli`]), the USM
+//! transport readings comparison (see [`usm_study::pipeline::readings`]), or the secondary
+//! objectives comparison (see [`usm_study::pipeline::secondary`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::pipeline::antonelli::run_antonelli;
 use usm_study::pipeline::paper::run_paper;
+use usm_study::pipeline::readings::run_readings;
+use usm_study::pipeline::secondary::run_secondary_comparison;
 
 /// Which paper to regenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -16,6 +20,12 @@ pub enum PaperName {
     /// Antonelli & Chiaverini (1998): kinematic case studies 1, 1b and 2 on `uvms-planar`,
     /// case 3 (NPS AUV II under current, Table I) and the paper-like figures.
     Antonelli,
+    /// The USM paper's transport mode under every reading of its open choices (USM-33/34,
+    /// USM-40/41): `readings.csv` and `readings.md`.
+    Readings,
+    /// The USM paper's secondary objectives (manipulability, controllability) on and off, in
+    /// work mode and transport: `secondary.csv` and `secondary.md`.
+    Secondary,
 }
 
 /// Arguments of `paper`.
@@ -25,7 +35,8 @@ pub struct PaperArgs {
     #[arg(value_enum, default_value = "usm")]
     pub paper: PaperName,
     /// Output directory (default `results/paper` for `usm`, `results/antonelli` for
-    /// `antonelli`).
+    /// `antonelli`, `results/paper/readings` for `readings`, `results/paper/secondary` for
+    /// `secondary`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Also write each run's time series (CSV and Parquet; about 2 MB per run; `usm` only).
@@ -61,6 +72,46 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             t.paper.moment_integral_b
         );
         eprintln!("[paper antonelli] wrote {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    if a.paper == PaperName::Readings {
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| "results/paper/readings".into());
+        let outcome = run_readings(&out, &mut |r| {
+            eprintln!(
+                "[paper readings] {} {:?}: {}",
+                r.reading.key(),
+                r.method,
+                if r.converged() {
+                    "converged"
+                } else {
+                    "not converged"
+                }
+            );
+        })?;
+        match outcome.adopted {
+            Some(r) => eprintln!("[paper readings] adopted: {}", r.key()),
+            None => eprintln!("[paper readings] no reading makes both methods converge"),
+        }
+        eprintln!("[paper readings] wrote {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    if a.paper == PaperName::Secondary {
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| "results/paper/secondary".into());
+        run_secondary_comparison(&out, &mut |r| {
+            eprintln!(
+                "[paper secondary] {} {}: min commanded σ_min {:.4}",
+                r.scenario,
+                r.case,
+                r.get("sigma_c_min")
+            );
+        })?;
+        eprintln!("[paper secondary] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
     let out = a.out.clone().unwrap_or_else(|| "results/paper".into());

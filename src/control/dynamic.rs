@@ -39,6 +39,11 @@ pub struct DynamicGains {
     /// Bound on each component of `|∫Ṽ dt|` (anti-windup; `None` = unbounded). Default
     /// `None`.
     pub integral_limit: Option<f64>,
+    /// Transport mode only: whether the axes transport does not command (sway, heave, roll,
+    /// pitch) get USM-34 with a zero reference, `a_i = −K_p,i v_b,i` (true), or the paper's
+    /// literal "remaining acceleration components are set to zero", `a_i = 0` (false)
+    /// ([`DynamicController::transport_control`]). Default true.
+    pub uncommanded_feedback: bool,
 }
 
 impl Default for DynamicGains {
@@ -58,6 +63,7 @@ impl DynamicGains {
             feedforward: true,
             feedforward_time_constant: 0.1,
             integral_limit: None,
+            uncommanded_feedback: true,
         }
     }
 
@@ -66,7 +72,9 @@ impl DynamicGains {
     /// `K_p = diag(1, 1, 1, 0, 1, 1)` used on the axes transport does not command (sway 1,
     /// heave 1, roll 0, pitch 1: [`DynamicController::transport_control`]); surge and yaw come
     /// from USM-40/41, so `K_p,0`, `K_p,5` and `K_i` are unused. The paper-literal form is
-    /// `nonlinear = true, kp = [0, 0, 0, 0, 0, 0]`.
+    /// `nonlinear = true, uncommanded_feedback = false`; the readings comparison
+    /// (`usm-study paper readings`) runs every combination and keeps this one as the default
+    /// because it is the only one under which both Table III methods converge.
     pub fn transport() -> Self {
         Self::work_mode()
     }
@@ -149,13 +157,14 @@ impl DynamicController {
         }
     }
 
-    /// Transport mode (USM section V-A): USM-33 with `a^b` from USM-40/41 on surge and yaw and
-    /// USM-34 with `V_r = V̇_r = 0` on the axes transport does not command (sway, heave, roll,
-    /// pitch): `a_i = −K_p,i v_b,i` for `i ∈ {1, 2, 3, 4}`; `K_p,0` and `K_p,5` are not used
-    /// (see the transport-mode module docs, [`super::transport`], for why the paper's "remaining
-    /// acceleration components are set to zero" is read this way). `K_p = 0` on those axes is
-    /// the literal reading. `v_b` is the measured base twist in `F_b`. Returns `τ_c` and the
-    /// `a^b` actually used.
+    /// Transport mode (USM section V-A): USM-33 with `a^b` from USM-40/41 on surge and yaw and,
+    /// if [`DynamicGains::uncommanded_feedback`], USM-34 with `V_r = V̇_r = 0` on the axes
+    /// transport does not command (sway, heave, roll, pitch): `a_i = −K_p,i v_b,i` for
+    /// `i ∈ {1, 2, 3, 4}`; `K_p,0` and `K_p,5` are not used (see the transport-mode module docs,
+    /// [`super::transport`], for why the paper's "remaining acceleration components are set to
+    /// zero" is read this way). Without it (or with `K_p = 0` on those axes) `a_i = 0`, the
+    /// literal reading. `v_b` is the measured base twist in `F_b`. Returns `τ_c` and the `a^b`
+    /// actually used.
     pub fn transport_control(
         &self,
         m11: &Matrix6<f64>,
@@ -164,8 +173,10 @@ impl DynamicController {
         v_b: &Vec6,
     ) -> (Vec6, Vec6) {
         let mut a = *a_cmd;
-        for i in 1..5 {
-            a[i] -= self.gains.kp[i] * v_b[i];
+        if self.gains.uncommanded_feedback {
+            for i in 1..5 {
+                a[i] -= self.gains.kp[i] * v_b[i];
+            }
         }
         (self.acceleration_control(m11, n, &a), a)
     }
@@ -298,14 +309,23 @@ mod tests {
         let expect = Vec6::new(0.1, -0.2, 0.1, 0.0, -0.05, -0.2);
         assert!((used - expect).norm() < 1e-15, "{used}");
         assert!((tau - m * expect).norm() < 1e-15);
-        // The literal reading (K_p = 0, with n) is τ = M a + n.
-        let lit = DynamicController::new(DynamicGains {
-            kp: [0.0; 6],
-            nonlinear: true,
-            ..DynamicGains::transport()
-        })
-        .unwrap();
-        assert_eq!(lit.transport_control(&m, &n, &a, &v).0, m * a + n);
+        // The literal reading (no feedback on the free axes, with n) is τ = M a + n, and so is
+        // K_p = 0 on those axes.
+        for lit in [
+            DynamicGains {
+                uncommanded_feedback: false,
+                nonlinear: true,
+                ..DynamicGains::transport()
+            },
+            DynamicGains {
+                kp: [0.0; 6],
+                nonlinear: true,
+                ..DynamicGains::transport()
+            },
+        ] {
+            let lit = DynamicController::new(lit).unwrap();
+            assert_eq!(lit.transport_control(&m, &n, &a, &v).0, m * a + n);
+        }
     }
 
     #[test]

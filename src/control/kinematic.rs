@@ -23,10 +23,10 @@
 //!   base position ([`base_position_jacobian`]), joint limits (set-based, [`JointLimitTask`]),
 //!   and inertial-frame task variables ([`InertialTask`] of [`TaskVariable`]s: end-effector and
 //!   base position and heading, joint angles; AC-10…13) with the closed-loop rate of AC-8/9.
-//!   The paper's other secondary objectives — manipulability and TCM conditioning — are **not
-//!   implemented yet** (TODO): they need configuration gradients (analytic derivatives of the
-//!   Jacobian / of `T(q)`); [`Srmtp::push_velocity`] is the hook that will project such a
-//!   gradient step into the remaining null space.
+//!   The paper's other secondary objectives — manipulability and controllability (the
+//!   commanded-subspace σ_min of `T(q)`) — are gradient steps ([`SecondaryTasks`], finite
+//!   differences over the joint angles) that [`Srmtp::push_velocity`] projects into the null
+//!   space of every task above them.
 //!
 //! Dimensions: `N = 6 + n` generalised velocities `ζ = [V_b; q̇]` (base twist in `F_b`, m/s and
 //! rad/s, then joint rates rad/s). Matrices are faer `Mat<f64>`; the small SPD systems are solved
@@ -46,6 +46,8 @@ use serde::{Deserialize, Serialize};
 
 mod inertial;
 pub use inertial::{InertialTask, TaskVariable};
+mod secondary;
+pub use secondary::{SecondarySettings, SecondaryTasks};
 
 /// Usage weight `u_c` of column `c` (1 when no weights are given).
 #[inline]

@@ -27,15 +27,28 @@
 //! - **Yaw (USM-41)**: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)`, applied as the base yaw
 //!   acceleration (z of `F_b`). `ψ̇` is, by default, the rate of the same heading ψ (the front
 //!   link's, [`YawRateSource::FrontHeading`]) so that the law is a PD on one signal; the base
-//!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]).
+//!   body yaw rate `r = ω_b,z` is selectable ([`YawRateSource::BaseYawRate`]), and so is
+//!   dropping the reference rate `ψ̇_r` ([`TransportGains::yaw_rate_reference`]).
+//! - **Secondary objectives** (optional, `[secondary]`; [`TransportController::set_secondary`]):
+//!   a bounded joint offset δ in the null space of the head's heading and pitch relative to
+//!   the tail, climbing the commanded-subspace σ_min / manipulability. Off by default: a
+//!   persistent null-space bend biases the steering, and neither method then converges to the
+//!   second segment (`usm-study paper secondary`).
 //! - The other components of `a^b`: the paper says they are "set to zero". We read this as
 //!   USM-34 with a zero reference on those axes, `a_i = −K_p,i v_b,i` (sway, heave, roll,
 //!   pitch; the paper's `K_p = diag(1,1,1,0,1,1)`), applied with `τ_c = M_11 a^b` in
 //!   [`super::dynamic::DynamicController::transport_control`], without `n` by default
 //!   ([`super::dynamic::DynamicGains::transport`]). Both are interpretation choices, justified
-//!   below; the literal form is `base_control.nonlinear = true, kp = [0, 0, 0, 0, 0, 0]`.
+//!   below; the literal form is `base_control.nonlinear = true, uncommanded_feedback = false`.
 //!
 //! # Interpretation choices and why (results/paper/FINDINGS.md has the numbers)
+//!
+//! `usm-study paper readings` (`crate::pipeline::readings`) runs both Table III methods under
+//! all 32 combinations of the open choices (n or not, feedback on the uncommanded axes or not,
+//! front-heading or base yaw rate, with or without `ψ̇_r`, PI or PD surge). Only the default
+//! below (no `n`, feedback, front-heading rate, `ψ̇ − ψ̇_r`, PI: two departures from the
+//! printed text) makes both methods converge; under none is Method 2 the faster one, and with
+//! the two rows' yaw gains and Δ swapped the ordering follows the gains, not the surge source.
 //!
 //! - **Zero-velocity feedback on the uncommanded axes.** With `n` included and those
 //!   accelerations literally zero, USM-33 makes sway, heave and pitch pure integrators
@@ -62,6 +75,7 @@
 //!   rate; ω_n = 1 rad/s halves it. We keep the servo and report it.
 
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
+use super::kinematic::SecondaryTasks;
 use super::{
     check_finite, check_nonneg, check_pos, heading, heading_rate, wrap_angle, ControlError,
 };
@@ -140,6 +154,10 @@ pub struct TransportGains {
     pub surge_source: SurgeSource,
     /// Which yaw rate is ψ̇.
     pub yaw_rate_source: YawRateSource,
+    /// Whether USM-41 damps the rate error `ψ̇ − ψ̇_r` (true, as printed; `ψ̇_r` the LOS
+    /// reference rate of [`super::guidance`]) or the rate `ψ̇` alone (false: a reading of the
+    /// OCR'd "k_6d(ψ̇ − ψ̇," that drops the reference rate). Default true.
+    pub yaw_rate_reference: bool,
     /// Sign `s_q` of USM-38 in our joint convention (default −1; see the module docs).
     pub joint_sign: f64,
     /// Bound on `|∫(u − u_c) dt|` [m] (anti-windup; `None` = unbounded, as in the paper).
@@ -162,6 +180,7 @@ impl TransportGains {
             surge_law: SurgeLaw::ProportionalIntegral,
             surge_source: SurgeSource::Base,
             yaw_rate_source: YawRateSource::FrontHeading,
+            yaw_rate_reference: true,
             joint_sign: -1.0,
             integral_limit: None,
             derivative_time_constant: 0.5,
@@ -247,6 +266,7 @@ struct TransportGainsSpec {
     surge_law: Option<SurgeLaw>,
     surge_source: Option<SurgeSource>,
     yaw_rate_source: Option<YawRateSource>,
+    yaw_rate_reference: Option<bool>,
     joint_sign: Option<f64>,
     integral_limit: Option<f64>,
     derivative_time_constant: Option<f64>,
@@ -271,6 +291,7 @@ impl TryFrom<TransportGainsSpec> for TransportGains {
             surge_law,
             surge_source,
             yaw_rate_source,
+            yaw_rate_reference,
             joint_sign,
             derivative_time_constant
         );
@@ -389,6 +410,10 @@ pub struct TransportController {
     integral: f64,
     prev_error: Option<f64>,
     error_rate: f64,
+    secondary: Option<Box<SecondaryTasks>>,
+    offset: Vec<f64>,
+    q_sec: Vec<f64>,
+    step: Vec<f64>,
 }
 
 impl TransportController {
@@ -405,7 +430,65 @@ impl TransportController {
             integral: 0.0,
             prev_error: None,
             error_rate: 0.0,
+            secondary: None,
+            offset: vec![0.0; v.n_joints()],
+            q_sec: vec![0.0; v.n_joints()],
+            step: vec![0.0; v.n_joints()],
         })
+    }
+
+    /// Add the paper's secondary objectives (USM section IV-A; [`SecondaryTasks`]) below
+    /// USM-38: the joint references become `q_r = q_r,USM-38 + δ`, with the offset δ integrating
+    /// the secondary joint velocity projected onto `Σ_yaw δ = 0, Σ_pitch δ = 0` (the null space
+    /// of the head's heading and pitch relative to the tail, so steering is unchanged to first
+    /// order), each `|δ_i|` bounded by `max_offset`.
+    pub fn set_secondary(&mut self, tasks: SecondaryTasks) {
+        self.secondary = Some(Box::new(tasks));
+    }
+
+    /// The secondary offset δ [rad] of the joint references (zeros without secondary tasks).
+    pub fn secondary_offset(&self) -> &[f64] {
+        &self.offset
+    }
+
+    /// Advance δ over `dt` [s] at the current references and add it to them (see
+    /// [`TransportController::set_secondary`]). Allocation-free.
+    fn apply_secondary(&mut self, dt: f64) {
+        let Some(sec) = self.secondary.as_deref_mut() else {
+            return;
+        };
+        let n = self.q_ref.len();
+        let max = sec.settings().max_offset;
+        if dt.is_finite() && dt > 0.0 {
+            for i in 0..n {
+                self.q_sec[i] = self.q_ref[i] + self.offset[i];
+            }
+            let v = sec.joint_velocity(&self.q_sec);
+            // Project onto Σ_yaw δ̇ = 0, Σ_other δ̇ = 0: remove each group's mean.
+            let (mut sum, mut count) = ([0.0; 2], [0usize; 2]);
+            for (&vi, &yaw) in v.iter().zip(&self.yaw) {
+                let g = usize::from(!yaw);
+                sum[g] += vi;
+                count[g] += 1;
+            }
+            let mean = |g: usize| sum[g] / count[g].max(1) as f64;
+            let mut alpha: f64 = 1.0;
+            for (i, &vi) in v.iter().enumerate() {
+                let step = (vi - mean(usize::from(!self.yaw[i]))) * dt;
+                self.step[i] = step;
+                if step != 0.0 && (self.offset[i] + step).abs() > max {
+                    let room = (max.copysign(step) - self.offset[i]) / step;
+                    alpha = alpha.min(room.max(0.0));
+                }
+            }
+            for i in 0..n {
+                self.offset[i] += alpha * self.step[i];
+            }
+        }
+        for i in 0..n {
+            let (lo, hi) = self.limits[i];
+            self.q_ref[i] = (self.q_ref[i] + self.offset[i]).clamp(lo, hi);
+        }
     }
 
     /// The gains.
@@ -440,6 +523,7 @@ impl TransportController {
         self.error_rate = 0.0;
         self.guidance.reset();
         self.q_ref.fill(0.0);
+        self.offset.fill(0.0);
     }
 
     /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
@@ -478,9 +562,15 @@ impl TransportController {
         }
     }
 
-    /// USM-41: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)` [rad/s²].
+    /// USM-41: `a_6 = −k_6p wrap(ψ − ψ_r) − k_6d (ψ̇ − ψ̇_r)` [rad/s²]; `ψ̇_r` is dropped
+    /// (`− k_6d ψ̇`) unless [`TransportGains::yaw_rate_reference`].
     pub fn yaw_acceleration(&self, psi: f64, psi_dot: f64, psi_r: f64, psi_r_dot: f64) -> f64 {
-        -self.gains.k_6p * wrap_angle(psi - psi_r) - self.gains.k_6d * (psi_dot - psi_r_dot)
+        let rate_ref = if self.gains.yaw_rate_reference {
+            psi_r_dot
+        } else {
+            0.0
+        };
+        -self.gains.k_6p * wrap_angle(psi - psi_r) - self.gains.k_6d * (psi_dot - rate_ref)
     }
 
     /// One transport step at time `t` [s] over `dt` [s]: LOS guidance at the end-effector
@@ -498,6 +588,7 @@ impl TransportController {
             los.psi_r,
             &mut self.q_ref,
         );
+        self.apply_secondary(dt);
         let u = match self.gains.surge_source {
             SurgeSource::EndEffector => meas.surge_ee,
             SurgeSource::Base => meas.surge_base,

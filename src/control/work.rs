@@ -17,15 +17,18 @@
 //! - `J_b = [R_Ib 0]` and `p̃_b = p_b,home − p_Ib` (inertial, m); `J_b⁺` is the plain
 //!   pseudoinverse (damping [`WorkGains::base_task_damping`], default 0 — exact, `J_b` has full
 //!   row rank);
-//! - optionally (off by default, as in the paper) a set-based joint-limit task on top of both.
+//! - optionally (off by default, as in the paper) a set-based joint-limit task on top of both,
+//!   and the paper's secondary objectives (manipulability, controllability:
+//!   [`super::kinematic::SecondaryTasks`]) below both, `ζ_r += N_{e,b} [0; q̇_s]` at the joint
+//!   references ([`WorkController::set_secondary`]).
 //!
 //! Outputs: the reference base twist `V_r` (in `F_b`) for the dynamic controller (USM-33/34) and
 //! joint rate references `q̇_r`; the joint angle references `q_r` are their time integral, kept
 //! in the controller and clamped to the joint limits.
 
 use super::kinematic::{
-    base_position_jacobian, ee_pose, ee_pose_error, JointLimitSettings, JointLimitTask, Srmtp,
-    TaskInverse,
+    base_position_jacobian, ee_pose, ee_pose_error, JointLimitSettings, JointLimitTask,
+    SecondaryTasks, Srmtp, TaskInverse,
 };
 use super::{check_nonneg, ControlError};
 use crate::kinematics::{ee_jacobian, BasePose, KinWorkspace};
@@ -189,6 +192,8 @@ pub struct WorkController {
     jl: JointLimitTask,
     q_ref: Vec<f64>,
     qd_ref: Vec<f64>,
+    secondary: Option<Box<SecondaryTasks>>,
+    secondary_zeta: Vec<f64>,
 }
 
 impl WorkController {
@@ -209,7 +214,16 @@ impl WorkController {
             jl: JointLimitTask::new(n, gains.joint_limits.clone()),
             q_ref: vec![0.0; n],
             qd_ref: vec![0.0; n],
+            secondary: None,
+            secondary_zeta: vec![0.0; 6 + n],
         })
+    }
+
+    /// Add the secondary objectives at the lowest priority (USM section IV-A objectives 2, 3):
+    /// each step their joint velocity at the joint references `q_r` is projected into the null
+    /// space of the end-effector and base tasks.
+    pub fn set_secondary(&mut self, tasks: SecondaryTasks) {
+        self.secondary = Some(Box::new(tasks));
     }
 
     /// The gains.
@@ -306,6 +320,10 @@ impl WorkController {
                 }
                 solve(self);
             }
+        }
+        if let Some(sec) = &mut self.secondary {
+            self.secondary_zeta[6..].copy_from_slice(sec.joint_velocity(&self.q_ref));
+            let _ = self.srmtp.push_velocity(&self.secondary_zeta);
         }
         let z = self.srmtp.zeta();
         self.qd_ref.copy_from_slice(&z[6..]);

@@ -6,6 +6,8 @@
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`shapes`]: the body along a run (`shapes.svg`, `animation.svg`);
 //! - [`paper`]: the USM paper's simulations, their files and comparison tables;
+//! - [`readings`]: transport mode under every reading of the paper's open choices;
+//! - [`secondary`]: the paper's secondary objectives on and off, work mode and transport;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`review`]: `report.html`, the design-review page of a study output directory;
 //! - [`antonelli`]: Antonelli & Chiaverini's case studies (kinematic 1, 1b, 2; dynamic 3a,
@@ -25,7 +27,9 @@ pub mod error;
 pub mod inspect;
 pub mod optimise;
 pub mod paper;
+pub mod readings;
 pub mod review;
+pub mod secondary;
 pub mod shapes;
 pub mod simulate;
 pub mod tcm;

@@ -1,12 +1,16 @@
 //! The `paper` pipeline: regenerate the USM paper's simulations — the scenario presets
 //! (Fig. 8 a–h and Fig. 9 of the paper, and the torque-limited transport variant) and the
 //! allocator comparison — with their figures,
-//! summaries and the comparison tables of `README.md`.
+//! summaries and the comparison tables of `README.md`, and the transport readings comparison
+//! ([`super::readings`]) in `readings/` and the secondary-objectives comparison
+//! ([`super::secondary`]) in `secondary/`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::error::{create_dir, PipelineError};
+use super::readings::run_readings;
+use super::secondary::run_secondary_comparison;
 use super::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use crate::allocation::Method;
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
@@ -59,7 +63,10 @@ const INTRO: &str = "# The USM paper's simulations, regenerated\n\n\
      Each directory holds `summary.json` (metrics, allocation counts, timing) and\n\
      `figure.svg` (laid out like the paper's Fig. 8 / Fig. 9). Transport runs last the\n\
      paper's 140 s, which leaves 45 s after the segment commanded at 95 s: a NaN\n\
-     convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n";
+     convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n\
+     `readings/readings.md` compares both transport methods under every reading of the\n\
+     paper's open choices (`paper readings` regenerates only that);\n\
+     `secondary/secondary.md` the paper's secondary objectives on and off (`paper secondary`).\n";
 
 /// One finished run, as reported to the caller.
 #[derive(Clone, Debug)]
@@ -145,6 +152,8 @@ pub fn run_paper(
     }
     write_tables(&mut md, &rows);
     atomic_write(&out.join("README.md"), md.as_bytes())?;
+    run_readings(&out.join("readings"), &mut |_| {})?;
+    run_secondary_comparison(&out.join("secondary"), &mut |_| {})?;
     Ok(PaperOutcome { failed })
 }
 

@@ -24,6 +24,7 @@
 //!
 //! [control]                   # transport: TransportGains keys; work: WorkGains keys
 //! [base_control]              # USM-33/34 gains (DynamicGains)
+//! [secondary]                 # manipulability / controllability objectives (off by default)
 //! [allocation]                # method, lambda, q, eps, weights, rate limits
 //! [servo]                     # joint servos
 //! [thrusters]                 # thruster dynamics
@@ -39,12 +40,14 @@ use super::success::SuccessSpec;
 use crate::allocation::{AllocSettings, Method, RateSettings};
 use crate::control::dynamic::DynamicGains;
 use crate::control::guidance::PathSpec;
+use crate::control::kinematic::SecondarySettings;
 use crate::control::transport::TransportGains;
 use crate::control::work::WorkGains;
 use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
+use crate::metrics::singularity::CommandedDofs;
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
 use serde::{Deserialize, Serialize};
@@ -388,6 +391,10 @@ pub struct ScenarioFile {
     /// Base control gains (USM-33/34); defaults depend on the mode.
     #[serde(default)]
     pub base_control: Option<DynamicGains>,
+    /// The paper's secondary objectives (USM section IV-A: manipulability, controllability),
+    /// below the mode's tasks; off by default.
+    #[serde(default)]
+    pub secondary: SecondarySettings,
     /// Thrust allocation.
     #[serde(default)]
     pub allocation: AllocationSpec,
@@ -449,6 +456,34 @@ impl ScenarioFile {
                 Mode::Transport => DynamicGains::transport(),
                 Mode::Work => DynamicGains::work_mode(),
             })
+    }
+
+    /// The base axes the mode commands (SPEC §6, the rows `S` of the commanded-subspace σ_min):
+    /// transport — surge, yaw and the axes with `K_p > 0` when the base control feeds back on
+    /// the uncommanded axes ([`CommandedDofs::transport`]); work — the axes with a positive base
+    /// usage weight or base-control gain ([`CommandedDofs::work`]). Gains that do not parse
+    /// count as the mode's defaults.
+    pub fn commanded_dofs(&self, v: &Vehicle) -> CommandedDofs {
+        let b = self.base_gains();
+        match self.mode_gains() {
+            Ok(ModeGains::Work(g)) => {
+                let u = g.weights_for(v.n_joints());
+                let base_u = std::array::from_fn(|i| u.get(i).copied().unwrap_or(0.0));
+                CommandedDofs::work(&base_u, &b.kp, &b.ki)
+            }
+            _ if b.uncommanded_feedback => CommandedDofs::transport(&b.kp),
+            _ => CommandedDofs::transport(&[0.0; 6]),
+        }
+    }
+
+    /// The characteristic length L [m] of the scaled TCM: `metrics.char_length`, or half the
+    /// length of `v` when that is 0 (SPEC §6).
+    pub fn char_length(&self, v: &Vehicle) -> f64 {
+        if self.metrics.char_length > 0.0 {
+            self.metrics.char_length
+        } else {
+            v.characteristic_length()
+        }
     }
 
     /// The simulator configuration.
@@ -557,6 +592,7 @@ impl ScenarioFile {
         self.success.validate()?;
         self.mode_gains()?;
         self.base_gains().validate().map_err(file_key_error)?;
+        self.secondary.validate().map_err(file_key_error)?;
         self.sim_config()?;
         Ok(())
     }

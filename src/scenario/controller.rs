@@ -8,6 +8,7 @@ use super::config::{ModeGains, ScenarioFile};
 use super::error::ScenarioError;
 use crate::control::dynamic::DynamicController;
 use crate::control::guidance::PathSpec;
+use crate::control::kinematic::SecondaryTasks;
 use crate::control::transport::{measure_transport, TransportController};
 use crate::control::work::{WorkController, WorkTarget};
 use crate::kinematics::{BasePose, KinWorkspace};
@@ -46,9 +47,10 @@ pub(crate) struct WorkSignals {
 
 /// The mode's control law and what it needs beyond the measurement.
 pub(crate) enum ModeController {
-    /// LOS path following; the path also gives the base's lateral offset.
+    /// LOS path following; the path also gives the base's lateral offset (boxed: the
+    /// transport law with its secondary-task buffers is large).
     Transport {
-        law: TransportController,
+        law: Box<TransportController>,
         path: PathSpec,
         signals: TransportSignals,
     },
@@ -99,6 +101,18 @@ fn lateral_offset(p: &Vec3, from: [f64; 2], to: [f64; 2]) -> f64 {
     (d[0] * (p.y - from[1]) - d[1] * (p.x - from[0])) / l
 }
 
+/// The `[secondary]` objectives of `file` on `v`, for the axes the mode commands
+/// ([`ScenarioFile::commanded_dofs`]).
+fn secondary_tasks(v: &Vehicle, file: &ScenarioFile) -> Result<SecondaryTasks, ScenarioError> {
+    SecondaryTasks::new(
+        v,
+        file.secondary.clone(),
+        file.commanded_dofs(v),
+        file.char_length(v),
+    )
+    .map_err(|e| ScenarioError::Invalid(e.to_string()))
+}
+
 impl ModeController {
     /// The mode's controller from the file and its parsed `gains`; `q0` are the initial joint
     /// angles [rad].
@@ -115,8 +129,13 @@ impl ModeController {
                     .path
                     .clone()
                     .ok_or_else(|| invalid("path: transport mode needs a [path] table".into()))?;
-                let law = TransportController::new(v, g, &path)
-                    .map_err(|e| invalid(format!("control.{e}")))?;
+                let mut law = Box::new(
+                    TransportController::new(v, g, &path)
+                        .map_err(|e| invalid(format!("control.{e}")))?,
+                );
+                if file.secondary.enabled() {
+                    law.set_secondary(secondary_tasks(v, file)?);
+                }
                 ModeController::Transport {
                     law,
                     path,
@@ -130,6 +149,9 @@ impl ModeController {
                 let mut law =
                     WorkController::new(v, &g).map_err(|e| invalid(format!("control.{e}")))?;
                 law.reset(q0);
+                if file.secondary.enabled() {
+                    law.set_secondary(secondary_tasks(v, file)?);
+                }
                 let r = sp.rpy_deg.map(f64::to_radians);
                 let target = WorkTarget {
                     ee_position: Vec3::from(sp.position),

@@ -27,8 +27,9 @@
 //!   `--set scenario.duration=170` (the tests do);
 //! - transport base control: USM-33 without `n`, the paper's `K_p` on the uncommanded axes
 //!   (see `control::transport` for why; `[base_control] nonlinear = true,
-//!   kp = [0, 0, 0, 0, 0, 0]` is the literal reading). A partial `[base_control]` table takes
-//!   its missing keys from the work-mode defaults.
+//!   uncommanded_feedback = false` is the literal reading; `usm-study paper readings` compares
+//!   every reading). A partial `[base_control]` table takes its missing keys from the
+//!   work-mode defaults.
 
 pub mod antonelli;
 pub mod channels;

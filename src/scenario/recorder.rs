@@ -210,11 +210,7 @@ impl Recorder {
             traj: Trajectory::with_channels(channels, n_log),
             row,
             log_every: (s.log_dt / s.control_dt).round() as usize,
-            char_length: if file.metrics.char_length > 0.0 {
-                file.metrics.char_length
-            } else {
-                v.characteristic_length()
-            },
+            char_length: file.char_length(v),
             power: file.power_model(v.fluid.rho),
             limits: v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect(),
             sat_tol: file.metrics.saturation_tolerance,
