@@ -152,6 +152,327 @@ pub fn sigma_min_scaled_gram(t: &Matrix6xX<f64>, char_length: f64) -> f64 {
     ev.min().max(0.0).sqrt()
 }
 
+/// The base wrench axes a controller commands (SPEC §5): a subset of surge, sway, heave, roll,
+/// pitch, yaw, in the row order of `T`. The selection matrix `S` of the commanded-subspace
+/// metrics keeps exactly these rows of `T_L`.
+///
+/// Derived from the controller's gains, not from a preset: in transport the base controller
+/// always commands surge and yaw (USM-40/41) and regulates sway, heave, roll and pitch only where
+/// `K_p,i > 0` (USM-34; the paper's `K_p` leaves roll free), see
+/// [`CommandedDofs::transport`]; in work mode an axis is commanded when the kinematic controller
+/// may move it (base usage weight `U_i > 0`, USM-42) or the base controller regulates it
+/// (`K_p,i > 0` or `K_i,i > 0`, USM-34), see [`CommandedDofs::work`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub struct CommandedDofs([bool; 6]);
+
+impl CommandedDofs {
+    /// All six axes (the full 6-DOF figure).
+    pub const ALL: Self = Self([true; 6]);
+
+    /// The axes whose entry in `mask` (surge … yaw) is true.
+    pub const fn new(mask: [bool; 6]) -> Self {
+        Self(mask)
+    }
+
+    /// Transport mode (USM-34, USM-40/41): surge and yaw always, the other axes where the
+    /// base controller's proportional gain `kp[i]` [1/s] is positive.
+    pub fn transport(kp: &[f64; 6]) -> Self {
+        Self(std::array::from_fn(|i| i == 0 || i == 5 || kp[i] > 0.0))
+    }
+
+    /// Work mode (USM-42, USM-34): an axis is commanded when the base usage weight
+    /// `base_weights[i]` of the task-priority solver is positive (the kinematic controller
+    /// moves the base along it) or the base controller regulates it (`kp[i] > 0` [1/s] or
+    /// `ki[i] > 0` [1/s²]).
+    pub fn work(base_weights: &[f64; 6], kp: &[f64; 6], ki: &[f64; 6]) -> Self {
+        Self(std::array::from_fn(|i| {
+            base_weights[i] > 0.0 || kp[i] > 0.0 || ki[i] > 0.0
+        }))
+    }
+
+    /// The selection as a mask, surge … yaw.
+    pub const fn mask(self) -> [bool; 6] {
+        self.0
+    }
+
+    /// Whether axis `axis` (0 = surge … 5 = yaw) is commanded.
+    pub fn contains(self, axis: usize) -> bool {
+        axis < 6 && self.0[axis]
+    }
+
+    /// Number of commanded axes `k` (the rows of `S·T_L`).
+    pub fn len(self) -> usize {
+        self.0.iter().filter(|b| **b).count()
+    }
+
+    /// Whether no axis is commanded.
+    pub fn is_empty(self) -> bool {
+        self.len() == 0
+    }
+
+    /// The commanded axes' names joined by `+` (`surge+sway+heave+pitch+yaw`), `none` when
+    /// empty.
+    pub fn label(self) -> String {
+        let names: Vec<&str> = (0..6)
+            .filter(|&i| self.0[i])
+            .map(|i| AXIS_NAMES[i])
+            .collect();
+        if names.is_empty() {
+            "none".into()
+        } else {
+            names.join("+")
+        }
+    }
+}
+
+/// Singular values of the commanded rows `S·T_L` of the scaled TCM (SPEC §6): how strongly
+/// the thrusters can push along the weakest and strongest commanded wrench directions.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CommandedSigma {
+    /// The `k` singular values of `S·T_L`, descending, in the first `k` entries (the rest 0);
+    /// zero when there are fewer thrusters than commanded axes. N per N.
+    pub singular_values: [f64; 6],
+    /// Number of commanded axes `k`.
+    pub k: usize,
+    /// σ_min of `S·T_L` (N per N): the largest scaled wrench `[f; m/L]` the thrusters can make
+    /// along the weakest commanded direction per newton of thrust norm `‖u‖₂`. `+inf` when
+    /// nothing is commanded; NaN for a non-finite `T` or a bad length.
+    pub sigma_min: f64,
+    /// σ_max of `S·T_L` (N per N); 0 when nothing is commanded.
+    pub sigma_max: f64,
+    /// Condition number σ_max/σ_min; `+inf` when σ_min = 0.
+    pub condition_number: f64,
+}
+
+impl CommandedSigma {
+    /// Number of singular values above `rank_rel_tol · σ_max`.
+    pub fn rank(&self, rank_rel_tol: f64) -> usize {
+        let tol = rank_rel_tol * self.sigma_max;
+        self.singular_values[..self.k]
+            .iter()
+            .filter(|&&s| s > tol)
+            .count()
+    }
+}
+
+/// Below this ratio `λ_min/λ_max` of the Gram matrix (κ > 100) [`commanded_sigma`] leaves the
+/// Gram route for the QR + one-sided Jacobi route: the Gram eigenvalues carry an absolute error
+/// of about `ε·σ_max²`, a relative error of about `ε κ²/2` on σ_min (≤ 1e-12 for κ ≤ 100).
+pub const GRAM_MIN_RATIO: f64 = 1e-4;
+
+/// σ_min, σ_max and κ of the commanded rows `S·T_L` of the scaled TCM (SPEC §6; `S` keeps the
+/// rows of `dofs`, `T_L = diag(1, 1, 1, 1/L, 1/L, 1/L) T`, `char_length` = L [m]).
+///
+/// σ_min is the weakest commanded wrench per unit thrust: for every unit-norm direction `w` of
+/// the commanded (scaled) wrench space some thrust `u` with `‖u‖₂ = 1 N` makes `S T_L u = σ w`
+/// with `σ ≥ σ_min`, and along the weakest direction no thrust of that norm does better.
+///
+/// Pure and allocation-free (fixed 6×6 work arrays on the stack, any number of thrusters): the
+/// eigenvalues of the `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` by cyclic Jacobi, or, when that matrix
+/// is ill-conditioned (`λ_min < GRAM_MIN_RATIO·λ_max`), the singular values of the triangular
+/// factor of `(S T_L)ᵀ` (Givens QR, one thruster column at a time) by one-sided Jacobi, which
+/// keeps small singular values accurate. Agrees with a full SVD to about 1e-12 relative
+/// (absolute `ε·σ_max` for rank-deficient matrices).
+pub fn commanded_sigma(
+    t: &Matrix6xX<f64>,
+    char_length: f64,
+    dofs: CommandedDofs,
+) -> CommandedSigma {
+    let k = dofs.len();
+    let mut out = CommandedSigma {
+        singular_values: [0.0; 6],
+        k,
+        sigma_min: f64::INFINITY,
+        sigma_max: 0.0,
+        condition_number: f64::INFINITY,
+    };
+    if !(char_length.is_finite() && char_length > 0.0) || !t.iter().all(|x| x.is_finite()) {
+        out.sigma_min = f64::NAN;
+        out.sigma_max = f64::NAN;
+        out.condition_number = f64::NAN;
+        return out;
+    }
+    if k == 0 {
+        return out;
+    }
+    let rows = selected_rows(dofs);
+    let mut gram = [[0.0; 6]; 6];
+    for col in t.column_iter() {
+        let x = select_scaled(col.as_slice(), &rows, k, char_length);
+        for a in 0..k {
+            for b in 0..=a {
+                gram[a][b] += x[a] * x[b];
+            }
+        }
+    }
+    for a in 0..k {
+        for b in 0..a {
+            gram[b][a] = gram[a][b];
+        }
+    }
+    let mut ev = jacobi_eigenvalues(&mut gram, k);
+    let (lo, hi) = min_max(&ev[..k]);
+    if lo < GRAM_MIN_RATIO * hi {
+        let mut r = [[0.0; 6]; 6];
+        for col in t.column_iter() {
+            let x = select_scaled(col.as_slice(), &rows, k, char_length);
+            givens_add_row(&mut r, x, k);
+        }
+        ev = one_sided_jacobi_sq(&mut r, k);
+    }
+    let mut sv = [0.0; 6];
+    for (s, e) in sv.iter_mut().zip(&ev[..k]) {
+        *s = e.max(0.0).sqrt();
+    }
+    sv[..k].sort_by(|a, b| b.total_cmp(a));
+    out.singular_values = sv;
+    out.sigma_max = sv[0];
+    out.sigma_min = sv[k - 1];
+    out.condition_number = if out.sigma_min > 0.0 {
+        out.sigma_max / out.sigma_min
+    } else {
+        f64::INFINITY
+    };
+    out
+}
+
+/// The row indices of `dofs`, in order, in the first `dofs.len()` entries.
+fn selected_rows(dofs: CommandedDofs) -> [usize; 6] {
+    let mut rows = [0; 6];
+    let mut k = 0;
+    for (i, on) in dofs.mask().iter().enumerate() {
+        if *on {
+            rows[k] = i;
+            k += 1;
+        }
+    }
+    rows
+}
+
+/// The commanded entries of one column of `T`, moment rows divided by `l`: a column of
+/// `S·T_L`.
+#[inline]
+fn select_scaled(col: &[f64], rows: &[usize; 6], k: usize, l: f64) -> [f64; 6] {
+    let mut x = [0.0; 6];
+    for (xi, &r) in x.iter_mut().zip(rows).take(k) {
+        *xi = if r < 3 { col[r] } else { col[r] / l };
+    }
+    x
+}
+
+fn min_max(xs: &[f64]) -> (f64, f64) {
+    xs.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        })
+}
+
+/// Largest number of Jacobi sweeps (quadratic convergence needs 4–6 for 6×6).
+const MAX_SWEEPS: usize = 30;
+
+/// Rotation `(c, s)` annihilating the off-diagonal entry `apq` of the symmetric 2×2 block
+/// `[[app, apq], [apq, aqq]]` (the smaller-angle root, Golub & Van Loan §8.5.2).
+#[inline]
+fn jacobi_rotation(app: f64, aqq: f64, apq: f64) -> (f64, f64, f64) {
+    let theta = (aqq - app) / (2.0 * apq);
+    let t = if theta.abs() > 1e150 {
+        0.5 / theta
+    } else {
+        theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+    };
+    let c = 1.0 / (t * t + 1.0).sqrt();
+    (c, t * c, t)
+}
+
+/// Eigenvalues of the symmetric `k×k` leading block of `a` (destroyed) by cyclic Jacobi, in the
+/// first `k` entries (unordered). Stops when every off-diagonal entry is below
+/// `ε·√(|a_pp a_qq|)` (relative accuracy for positive definite matrices).
+fn jacobi_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
+    for _ in 0..MAX_SWEEPS {
+        let mut rotated = false;
+        for p in 0..k {
+            for q in p + 1..k {
+                let apq = a[p][q];
+                if apq == 0.0 || apq.abs() <= f64::EPSILON * (a[p][p] * a[q][q]).abs().sqrt() {
+                    continue;
+                }
+                rotated = true;
+                let (c, s, t) = jacobi_rotation(a[p][p], a[q][q], apq);
+                a[p][p] -= t * apq;
+                a[q][q] += t * apq;
+                a[p][q] = 0.0;
+                a[q][p] = 0.0;
+                for r in 0..k {
+                    if r != p && r != q {
+                        let (arp, arq) = (a[r][p], a[r][q]);
+                        let (np, nq) = (c * arp - s * arq, s * arp + c * arq);
+                        a[r][p] = np;
+                        a[p][r] = np;
+                        a[r][q] = nq;
+                        a[q][r] = nq;
+                    }
+                }
+            }
+        }
+        if !rotated {
+            break;
+        }
+    }
+    std::array::from_fn(|i| a[i][i])
+}
+
+/// Fold the row `x` (k entries) into the upper-triangular `r` by Givens rotations, so that
+/// `rᵀr` gains `x xᵀ` (QR of a matrix given one row at a time).
+#[inline]
+fn givens_add_row(r: &mut [[f64; 6]; 6], mut x: [f64; 6], k: usize) {
+    for i in 0..k {
+        if x[i] == 0.0 {
+            continue;
+        }
+        let h = r[i][i].hypot(x[i]);
+        let (c, s) = (r[i][i] / h, x[i] / h);
+        r[i][i] = h;
+        for l in i + 1..k {
+            let (ril, xl) = (r[i][l], x[l]);
+            r[i][l] = c * ril + s * xl;
+            x[l] = c * xl - s * ril;
+        }
+    }
+}
+
+/// Squared singular values of the `k×k` leading block of `w` (destroyed) by one-sided
+/// (Hestenes) Jacobi on its columns: rotate column pairs until all are orthogonal to working
+/// precision; the squared column norms are then the squared singular values.
+fn one_sided_jacobi_sq(w: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
+    for _ in 0..MAX_SWEEPS {
+        let mut rotated = false;
+        for p in 0..k {
+            for q in p + 1..k {
+                let (mut alpha, mut beta, mut gamma) = (0.0, 0.0, 0.0);
+                for row in w.iter().take(k) {
+                    alpha += row[p] * row[p];
+                    beta += row[q] * row[q];
+                    gamma += row[p] * row[q];
+                }
+                if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
+                    continue;
+                }
+                rotated = true;
+                let (c, s, _) = jacobi_rotation(alpha, beta, gamma);
+                for row in w.iter_mut().take(k) {
+                    let (a, b) = (row[p], row[q]);
+                    row[p] = c * a - s * b;
+                    row[q] = s * a + c * b;
+                }
+            }
+        }
+        if !rotated {
+            break;
+        }
+    }
+    std::array::from_fn(|j| w.iter().take(k).map(|row| row[j] * row[j]).sum())
+}
+
 /// Fraction of samples whose σ_min is below `threshold` (SPEC §6, "how often T is singular");
 /// 0 for an empty slice. NaN samples count as singular.
 pub fn singular_fraction(sigma_mins: &[f64], threshold: f64) -> f64 {
@@ -228,126 +549,5 @@ pub fn tcm_metrics(
 }
 
 #[cfg(test)]
-#[allow(clippy::needless_range_loop)]
-mod tests {
-    use super::*;
-
-    fn approx(a: f64, b: f64, tol: f64) -> bool {
-        (a - b).abs() <= tol * (1.0 + b.abs())
-    }
-
-    /// A straight USM: 7 thrusters on the body x axis, so no thruster makes a roll moment
-    /// (the allocation tests' fixture).
-    fn straight_usm() -> Matrix6xX<f64> {
-        crate::allocation::tests::straight_t()
-    }
-
-    #[test]
-    fn known_singular_values_of_diagonal_t() {
-        // T = diag(1..6), L = 2: T_L = diag(1, 2, 3, 2, 2.5, 3).
-        let mut t = Matrix6xX::zeros(6);
-        for i in 0..6 {
-            t[(i, i)] = (i + 1) as f64;
-        }
-        let r = tcm_svd_metrics(&t, 2.0, DEFAULT_RANK_REL_TOL).unwrap();
-        let want = [3.0, 3.0, 2.5, 2.0, 2.0, 1.0];
-        for k in 0..6 {
-            assert!(approx(r.singular_values[k], want[k], 1e-12), "{r:?}");
-        }
-        assert_eq!(r.rank, 6);
-        assert!(approx(r.condition_number, 3.0, 1e-12));
-        assert!(r.lost_directions.is_empty());
-    }
-
-    #[test]
-    fn straight_usm_loses_roll() {
-        let t = straight_usm();
-        let r = tcm_svd_metrics(&t, 1.0, DEFAULT_RANK_REL_TOL).unwrap();
-        assert_eq!(r.rank, 5, "{r:?}");
-        assert!(r.condition_number.is_infinite());
-        assert_eq!(r.lost_directions.len(), 1);
-        let lost = &r.lost_directions[0];
-        assert_eq!(lost.dominant_axis, "roll");
-        assert!(approx(lost.direction[3], 1.0, 1e-9), "{lost:?}");
-        assert!(r.sigma_min < 1e-9);
-    }
-
-    #[test]
-    fn fewer_than_six_thrusters_is_rank_deficient() {
-        let t = straight_usm().columns(2, 3).into_owned();
-        let r = tcm_svd_metrics(&t, 1.0, DEFAULT_RANK_REL_TOL).unwrap();
-        assert_eq!(r.rank, 3);
-        assert_eq!(r.lost_directions.len(), 3);
-        assert_eq!(r.sigma_min, 0.0);
-    }
-
-    #[test]
-    fn attainable_wrench_by_hand() {
-        // Thrusters: two along x at the origin, one along each of y, z, and pure moment
-        // "thrusters" about x, y, z. Bounds [-10, 20] N.
-        let mut t = Matrix6xX::zeros(7);
-        t[(0, 0)] = 1.0;
-        t[(0, 1)] = 1.0;
-        t[(1, 2)] = 1.0;
-        t[(2, 3)] = 1.0;
-        t[(3, 4)] = 0.5;
-        t[(4, 5)] = 2.0;
-        t[(5, 6)] = 1.0;
-        let r = tcm_metrics(&t, &[-10.0; 7], &[20.0; 7], 1.0, DEFAULT_RANK_REL_TOL).unwrap();
-        let a = r.attainable.unwrap();
-        let pos = [40.0, 20.0, 20.0, 10.0, 40.0, 20.0];
-        let neg = [20.0, 10.0, 10.0, 5.0, 20.0, 10.0];
-        for k in 0..6 {
-            assert!(approx(a.positive[k], pos[k], 1e-6), "{a:?}");
-            assert!(approx(a.negative[k], neg[k], 1e-6), "{a:?}");
-        }
-    }
-
-    #[test]
-    fn attainable_roll_of_straight_usm_is_zero() {
-        let t = straight_usm();
-        let a = attainable_wrench(&t, &[-40.0; 7], &[40.0; 7]).unwrap();
-        assert!(
-            a.positive[3].abs() < 1e-6 && a.negative[3].abs() < 1e-6,
-            "{a:?}"
-        );
-        assert!(a.positive[0] > 79.0, "{a:?}");
-    }
-
-    #[test]
-    fn bad_inputs_are_errors() {
-        let t = straight_usm();
-        assert!(matches!(
-            tcm_svd_metrics(&t, 0.0, 1e-6),
-            Err(SingularityError::CharLength(_))
-        ));
-        let mut bad = t.clone();
-        bad[(2, 3)] = f64::NAN;
-        assert!(tcm_svd_metrics(&bad, 1.0, 1e-6).is_err());
-        assert!(tcm_metrics(&t, &[1.0; 7], &[0.0; 7], 1.0, 1e-6).is_err());
-    }
-
-    #[test]
-    fn singular_fraction_counts() {
-        assert_eq!(singular_fraction(&[0.0, 0.5, 1.0, f64::NAN], 0.6), 0.75);
-        assert_eq!(singular_fraction(&[], 0.6), 0.0);
-    }
-
-    #[test]
-    fn gram_sigma_min_matches_svd_to_its_precision() {
-        // sqrt(eps)·σ_max bounds the Gram route's error; 1e-6 is far above it and far
-        // below any singularity threshold in use.
-        let v = crate::model::presets::usm_paper();
-        let mut ws = crate::kinematics::KinWorkspace::new(&v);
-        for k in 0..8 {
-            let mut q = vec![0.0; 8];
-            q[k] = 0.3 * (k as f64 + 1.0) / 8.0;
-            crate::kinematics::forward_kinematics(&v, &q, &mut ws);
-            let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
-            let a = sigma_min_scaled(&t, 1.65).unwrap();
-            let b = sigma_min_scaled_gram(&t, 1.65);
-            assert!((a - b).abs() < 1e-6, "joint {k}: {a} vs {b}");
-        }
-        assert!(sigma_min_scaled_gram(&Matrix6xX::zeros(3), 0.0).is_nan());
-    }
-}
+#[path = "singularity_tests.rs"]
+mod tests;

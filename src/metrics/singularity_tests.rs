@@ -1,0 +1,300 @@
+//! Tests of the TCM singularity metrics: known singular values, the straight USM's lost roll,
+//! attainable wrench by hand, and the commanded-subspace σ_min against an independent SVD.
+#![allow(clippy::needless_range_loop)]
+use super::*;
+
+fn approx(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + b.abs())
+}
+
+/// A straight USM: 7 thrusters on the body x axis, so no thruster makes a roll moment
+/// (the allocation tests' fixture).
+fn straight_usm() -> Matrix6xX<f64> {
+    crate::allocation::tests::straight_t()
+}
+
+#[test]
+fn known_singular_values_of_diagonal_t() {
+    // T = diag(1..6), L = 2: T_L = diag(1, 2, 3, 2, 2.5, 3).
+    let mut t = Matrix6xX::zeros(6);
+    for i in 0..6 {
+        t[(i, i)] = (i + 1) as f64;
+    }
+    let r = tcm_svd_metrics(&t, 2.0, DEFAULT_RANK_REL_TOL).unwrap();
+    let want = [3.0, 3.0, 2.5, 2.0, 2.0, 1.0];
+    for k in 0..6 {
+        assert!(approx(r.singular_values[k], want[k], 1e-12), "{r:?}");
+    }
+    assert_eq!(r.rank, 6);
+    assert!(approx(r.condition_number, 3.0, 1e-12));
+    assert!(r.lost_directions.is_empty());
+}
+
+#[test]
+fn straight_usm_loses_roll() {
+    let t = straight_usm();
+    let r = tcm_svd_metrics(&t, 1.0, DEFAULT_RANK_REL_TOL).unwrap();
+    assert_eq!(r.rank, 5, "{r:?}");
+    assert!(r.condition_number.is_infinite());
+    assert_eq!(r.lost_directions.len(), 1);
+    let lost = &r.lost_directions[0];
+    assert_eq!(lost.dominant_axis, "roll");
+    assert!(approx(lost.direction[3], 1.0, 1e-9), "{lost:?}");
+    assert!(r.sigma_min < 1e-9);
+}
+
+#[test]
+fn fewer_than_six_thrusters_is_rank_deficient() {
+    let t = straight_usm().columns(2, 3).into_owned();
+    let r = tcm_svd_metrics(&t, 1.0, DEFAULT_RANK_REL_TOL).unwrap();
+    assert_eq!(r.rank, 3);
+    assert_eq!(r.lost_directions.len(), 3);
+    assert_eq!(r.sigma_min, 0.0);
+}
+
+#[test]
+fn attainable_wrench_by_hand() {
+    // Thrusters: two along x at the origin, one along each of y, z, and pure moment
+    // "thrusters" about x, y, z. Bounds [-10, 20] N.
+    let mut t = Matrix6xX::zeros(7);
+    t[(0, 0)] = 1.0;
+    t[(0, 1)] = 1.0;
+    t[(1, 2)] = 1.0;
+    t[(2, 3)] = 1.0;
+    t[(3, 4)] = 0.5;
+    t[(4, 5)] = 2.0;
+    t[(5, 6)] = 1.0;
+    let r = tcm_metrics(&t, &[-10.0; 7], &[20.0; 7], 1.0, DEFAULT_RANK_REL_TOL).unwrap();
+    let a = r.attainable.unwrap();
+    let pos = [40.0, 20.0, 20.0, 10.0, 40.0, 20.0];
+    let neg = [20.0, 10.0, 10.0, 5.0, 20.0, 10.0];
+    for k in 0..6 {
+        assert!(approx(a.positive[k], pos[k], 1e-6), "{a:?}");
+        assert!(approx(a.negative[k], neg[k], 1e-6), "{a:?}");
+    }
+}
+
+#[test]
+fn attainable_roll_of_straight_usm_is_zero() {
+    let t = straight_usm();
+    let a = attainable_wrench(&t, &[-40.0; 7], &[40.0; 7]).unwrap();
+    assert!(
+        a.positive[3].abs() < 1e-6 && a.negative[3].abs() < 1e-6,
+        "{a:?}"
+    );
+    assert!(a.positive[0] > 79.0, "{a:?}");
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let t = straight_usm();
+    assert!(matches!(
+        tcm_svd_metrics(&t, 0.0, 1e-6),
+        Err(SingularityError::CharLength(_))
+    ));
+    let mut bad = t.clone();
+    bad[(2, 3)] = f64::NAN;
+    assert!(tcm_svd_metrics(&bad, 1.0, 1e-6).is_err());
+    assert!(tcm_metrics(&t, &[1.0; 7], &[0.0; 7], 1.0, 1e-6).is_err());
+}
+
+#[test]
+fn singular_fraction_counts() {
+    assert_eq!(singular_fraction(&[0.0, 0.5, 1.0, f64::NAN], 0.6), 0.75);
+    assert_eq!(singular_fraction(&[], 0.6), 0.0);
+}
+
+#[test]
+fn gram_sigma_min_matches_svd_to_its_precision() {
+    // sqrt(eps)·σ_max bounds the Gram route's error; 1e-6 is far above it and far
+    // below any singularity threshold in use.
+    let v = crate::model::presets::usm_paper();
+    let mut ws = crate::kinematics::KinWorkspace::new(&v);
+    for k in 0..8 {
+        let mut q = vec![0.0; 8];
+        q[k] = 0.3 * (k as f64 + 1.0) / 8.0;
+        crate::kinematics::forward_kinematics(&v, &q, &mut ws);
+        let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
+        let a = sigma_min_scaled(&t, 1.65).unwrap();
+        let b = sigma_min_scaled_gram(&t, 1.65);
+        assert!((a - b).abs() < 1e-6, "joint {k}: {a} vs {b}");
+    }
+    assert!(sigma_min_scaled_gram(&Matrix6xX::zeros(3), 0.0).is_nan());
+}
+
+/// σ_min of the rows `dofs` of `T_L` by nalgebra's SVD of the explicitly built `k×m` matrix
+/// (independent of [`commanded_sigma`]), with σ_max.
+fn svd_reference(t: &Matrix6xX<f64>, l: f64, dofs: CommandedDofs) -> (f64, f64) {
+    let tl = scale_moment_rows(t, l);
+    let rows: Vec<usize> = (0..6).filter(|&i| dofs.contains(i)).collect();
+    let a = nalgebra::DMatrix::from_fn(rows.len(), t.ncols(), |r, c| tl[(rows[r], c)]);
+    let sv = a.singular_values();
+    let k = rows.len();
+    let min = if t.ncols() < k { 0.0 } else { sv.min() };
+    (min, sv.max())
+}
+
+/// `|a − b| ≤ 1e-12·b + 1e-14·σ_max`: 1e-12 relative for well-conditioned matrices, the
+/// working precision of σ_max for (near-)rank-deficient ones, where any backward-stable
+/// method only determines σ_min to `ε·σ_max`.
+fn agrees(a: f64, b: f64, sigma_max: f64) -> bool {
+    (a - b).abs() <= 1e-12 * b + 1e-14 * sigma_max
+}
+
+/// Transport's commanded axes under the paper's `K_p = diag(1, 1, 1, 0, 1, 1)`.
+fn transport_dofs() -> CommandedDofs {
+    CommandedDofs::transport(&[1.0, 1.0, 1.0, 0.0, 1.0, 1.0])
+}
+
+#[test]
+fn commanded_dofs_follow_the_gains() {
+    let roll_free = CommandedDofs::new([true, true, true, false, true, true]);
+    assert_eq!(transport_dofs(), roll_free);
+    // Surge and yaw come from USM-40/41 whatever K_p says.
+    assert_eq!(
+        CommandedDofs::transport(&[0.0; 6]),
+        CommandedDofs::new([true, false, false, false, false, true])
+    );
+    let w = [0.3, 0.3, 0.3, 0.0, 0.3, 0.3];
+    let kp = [1.0, 1.0, 1.0, 0.0, 1.0, 1.0];
+    assert_eq!(CommandedDofs::work(&w, &kp, &[0.0; 6]), roll_free);
+    let mut ki = [0.0; 6];
+    ki[3] = 0.1;
+    assert_eq!(CommandedDofs::work(&w, &kp, &ki), CommandedDofs::ALL);
+    assert_eq!(roll_free.len(), 5);
+    assert_eq!(roll_free.label(), "surge+sway+heave+pitch+yaw");
+    assert_eq!(CommandedDofs::new([false; 6]).label(), "none");
+}
+
+#[test]
+fn straight_body_in_transport_by_hand() {
+    // Surge thrusters at x = 0.2, 1.8 (no moment), sway at a, b (yaw moment x), heave at c, d
+    // (pitch moment −x); L = 1. Without the roll row T_L splits into blocks: surge with
+    // Gram 2; sway/yaw and heave/pitch with Gram [[2, ±(a+b)], [±(a+b), a²+b²]], whose smaller
+    // eigenvalue is (tr − √(tr² − 4 det))/2, det = (a − b)².
+    let (a, b, c, d) = (0.5, 1.5, 0.3, 1.2);
+    let mut t = Matrix6xX::zeros(6);
+    t[(0, 0)] = 1.0;
+    t[(0, 1)] = 1.0;
+    for (j, x) in [(2, a), (3, b)] {
+        t[(1, j)] = 1.0;
+        t[(5, j)] = x;
+    }
+    for (j, x) in [(4, c), (5, d)] {
+        t[(2, j)] = 1.0;
+        t[(4, j)] = -x;
+    }
+    let small = |p: f64, q: f64| {
+        let tr = 2.0 + p * p + q * q;
+        let det = (p - q) * (p - q);
+        ((tr - (tr * tr - 4.0 * det).sqrt()) / 2.0).sqrt()
+    };
+    let want = small(a, b).min(small(c, d)).min(2f64.sqrt());
+    let r = commanded_sigma(&t, 1.0, transport_dofs());
+    assert!(approx(r.sigma_min, want, 1e-13), "{r:?} vs {want}");
+    assert_eq!(r.k, 5);
+    assert_eq!(r.rank(DEFAULT_RANK_REL_TOL), 5);
+    // The full 6-DOF figure has lost roll.
+    let full = commanded_sigma(&t, 1.0, CommandedDofs::ALL);
+    assert!(full.sigma_min < 1e-14 * full.sigma_max, "{full:?}");
+    assert_eq!(full.rank(DEFAULT_RANK_REL_TOL), 5);
+    assert!(full.condition_number > 1e13);
+}
+
+#[test]
+fn straight_paper_design_commanded_sigma_is_t_without_roll() {
+    let v = crate::model::presets::usm_paper();
+    let mut ws = crate::kinematics::KinWorkspace::new(&v);
+    crate::kinematics::forward_kinematics(&v, &vec![0.0; v.n_joints()], &mut ws);
+    let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
+    let l = v.characteristic_length();
+    let r = commanded_sigma(&t, l, transport_dofs());
+    let (want, smax) = svd_reference(&t, l, transport_dofs());
+    assert!(agrees(r.sigma_min, want, smax), "{r:?} vs {want}");
+    assert!(r.sigma_min > 0.05, "{r:?}");
+    let full = commanded_sigma(&t, l, CommandedDofs::ALL);
+    assert!(full.sigma_min < 1e-12, "{full:?}");
+}
+
+#[test]
+fn commanded_sigma_matches_svd_over_random_configurations() {
+    let v = crate::model::presets::usm_paper();
+    let mut ws = crate::kinematics::KinWorkspace::new(&v);
+    let l = v.characteristic_length();
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let sets = [
+        CommandedDofs::ALL,
+        transport_dofs(),
+        CommandedDofs::new([true, false, true, false, true, false]),
+    ];
+    for n in 0..400 {
+        // Every tenth sample straight in all but one joint (near the rank-deficient set).
+        let q: Vec<f64> = v
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| {
+                let x = j.min + unit() * (j.max - j.min);
+                if n % 10 == 0 && i != n % v.n_joints() {
+                    0.0
+                } else {
+                    x
+                }
+            })
+            .collect();
+        crate::kinematics::forward_kinematics(&v, &q, &mut ws);
+        let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
+        for dofs in sets {
+            let r = commanded_sigma(&t, l, dofs);
+            let (want, smax) = svd_reference(&t, l, dofs);
+            assert!(
+                agrees(r.sigma_min, want, smax),
+                "{n} {dofs:?}: {r:?} vs {want}"
+            );
+            assert!(
+                agrees(r.sigma_max, smax, smax),
+                "{n} {dofs:?}: {r:?} vs {smax}"
+            );
+        }
+    }
+}
+
+#[test]
+fn commanded_sigma_of_rank_deficient_and_degenerate_input() {
+    // Exactly rank-deficient (the straight USM has no roll): σ_min at working precision.
+    let t = straight_usm();
+    let r = commanded_sigma(&t, 1.0, CommandedDofs::ALL);
+    let (want, smax) = svd_reference(&t, 1.0, CommandedDofs::ALL);
+    assert!(agrees(r.sigma_min, want, smax), "{r:?} vs {want}");
+    assert!(r.sigma_min <= 1e-14 * smax);
+    // Nearly so: a 1e-7 roll authority is resolved far below the Gram route's √ε·σ_max.
+    let mut near = t.clone();
+    near[(3, 4)] = 1e-7;
+    let r = commanded_sigma(&near, 1.0, CommandedDofs::ALL);
+    let (want, smax) = svd_reference(&near, 1.0, CommandedDofs::ALL);
+    assert!(
+        want > 1e-9 && agrees(r.sigma_min, want, smax),
+        "{r:?} vs {want}"
+    );
+    // Fewer thrusters than commanded axes.
+    let few = t.columns(0, 3).into_owned();
+    let r = commanded_sigma(&few, 1.0, transport_dofs());
+    assert!(r.sigma_min <= 1e-14 * r.sigma_max, "{r:?}");
+    // Nothing commanded; bad length; non-finite T.
+    let none = commanded_sigma(&t, 1.0, CommandedDofs::new([false; 6]));
+    assert_eq!(none.sigma_min, f64::INFINITY);
+    assert!(commanded_sigma(&t, 0.0, CommandedDofs::ALL)
+        .sigma_min
+        .is_nan());
+    let mut bad = t.clone();
+    bad[(0, 0)] = f64::NAN;
+    assert!(commanded_sigma(&bad, 1.0, CommandedDofs::ALL)
+        .sigma_min
+        .is_nan());
+}
