@@ -2,4 +2,5 @@
 
 pub mod run_summary;
 pub mod singularity;
+mod small_svd;
 pub mod trajectory;

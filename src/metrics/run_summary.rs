@@ -52,7 +52,15 @@ pub fn run_summary(
 /// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint motor torques and the
 ///   joint rates at the start of every physics step; `joint_torque_peak` [N·m] the largest
 ///   |τ_q,i| among them;
-/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals.
+/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals;
+/// - `singularity_exposure`, the fraction of time σ_min of the commanded rows `S·T_L` is below
+///   `[metrics] threshold` (the controller's commanded axes, SPEC §6), and
+///   `singularity_exposure_full` the same for all six rows (a straight USM has lost roll, which
+///   neither of the paper's modes commands, so the full figure measures straightness);
+///   `sigma_min_min`/`_mean` (all rows) and `sigma_min_commanded_min`/`_mean` over the log;
+/// - `slack_fraction` of allocations whose slack was active, `allocation_failures`, and
+///   `allocation_residual_fraction`, the fraction of control steps whose allocation left the
+///   commanded wrench undelivered beyond `[metrics] residual_tolerance`.
 fn common_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,
@@ -72,29 +80,39 @@ fn common_metrics(
     add(out, "joint_torque_peak", e.joint_torque_peak);
     add(out, "peak_thrust", e.peak_thrust);
     add(out, "saturation_fraction", e.saturation_fraction);
-    let sig = channel(traj, Channel::SigmaMin);
+    let threshold = file.metrics.threshold;
+    let full = channel(traj, Channel::SigmaMin);
+    let cmd = channel(traj, Channel::SigmaMinCommanded);
     add(
         out,
         "singularity_exposure",
-        singularity_exposure(t, sig, file.metrics.threshold),
+        singularity_exposure(t, cmd, threshold),
     );
     add(
         out,
-        "sigma_min_min",
-        sig.iter().copied().fold(f64::INFINITY, f64::min),
+        "singularity_exposure_full",
+        singularity_exposure(t, full, threshold),
     );
-    add(
-        out,
-        "sigma_min_mean",
-        if sig.is_empty() {
+    let min = |x: &[f64]| x.iter().copied().fold(f64::INFINITY, f64::min);
+    let mean = |x: &[f64]| {
+        if x.is_empty() {
             f64::NAN
         } else {
-            sig.iter().sum::<f64>() / sig.len() as f64
-        },
-    );
+            x.iter().sum::<f64>() / x.len() as f64
+        }
+    };
+    add(out, "sigma_min_min", min(full));
+    add(out, "sigma_min_mean", mean(full));
+    add(out, "sigma_min_commanded_min", min(cmd));
+    add(out, "sigma_min_commanded_mean", mean(cmd));
     let steps = counts.steps.max(1) as f64;
     add(out, "slack_fraction", counts.slack_active as f64 / steps);
     add(out, "allocation_failures", counts.solver_failures as f64);
+    add(
+        out,
+        "allocation_residual_fraction",
+        counts.residual as f64 / steps,
+    );
 }
 
 /// Index ranges `[a, b)` of the contiguous runs of equal values in `seg` (the samples during

@@ -43,6 +43,7 @@ use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
+use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
 use serde::{Deserialize, Serialize};
@@ -56,6 +57,39 @@ pub enum Mode {
     Transport,
     /// End-effector setpoint regulation with the base as secondary task (USM-42).
     Work,
+}
+
+impl Mode {
+    /// The base axes the mode's default controller commands (SPEC §5): the selection `S` of
+    /// the commanded-subspace singularity metrics for a scenario without `[control]` or
+    /// `[base_control]` tables ([`ScenarioFile::commanded_dofs`] of such a file). Both of the
+    /// paper's modes leave roll free: transport by `K_p,roll = 0`, work by a zero base-roll
+    /// usage weight and `K_p,roll = 0`.
+    pub fn default_commanded_dofs(self) -> CommandedDofs {
+        match self {
+            Mode::Transport => commanded_for(
+                &ModeGains::Transport(Default::default()),
+                &DynamicGains::transport(),
+            ),
+            Mode::Work => commanded_for(
+                &ModeGains::Work(WorkGains::default()),
+                &DynamicGains::work_mode(),
+            ),
+        }
+    }
+}
+
+/// The axes commanded under the mode gains `mode` and the base gains `base` (see
+/// [`CommandedDofs::transport`], [`CommandedDofs::work`]).
+fn commanded_for(mode: &ModeGains, base: &DynamicGains) -> CommandedDofs {
+    match mode {
+        ModeGains::Transport(_) => CommandedDofs::transport(&base.kp),
+        ModeGains::Work(g) => {
+            let w = g.weights_for(0);
+            let base_w = std::array::from_fn(|i| w.get(i).copied().unwrap_or(0.0));
+            CommandedDofs::work(&base_w, &base.kp, &base.ki)
+        }
+    }
 }
 
 impl fmt::Display for Mode {
@@ -323,8 +357,15 @@ impl Default for PhysicsSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MetricsSpec {
-    /// σ_min threshold of the scaled T(q) below which a configuration counts as singular.
+    /// σ_min threshold of the scaled T(q) (N per N) below which a configuration counts as
+    /// singular, for both `singularity_exposure` (the commanded rows) and
+    /// `singularity_exposure_full` (all six). Default
+    /// [`SINGULARITY_THRESHOLD`], the one the static analysis uses too.
     pub threshold: f64,
+    /// Relative tolerance of `allocation_residual_fraction`: a control step counts when the
+    /// commanded slack exceeds this fraction of the commanded wrench
+    /// ([`crate::metrics::singularity::residual_exceeds`]). Default [`RESIDUAL_TOLERANCE`].
+    pub residual_tolerance: f64,
     /// Characteristic length for scaling moments [m]; 0 = half the vehicle length.
     pub char_length: f64,
     /// Cross-track band for convergence [m] (transport).
@@ -349,7 +390,8 @@ impl Default for MetricsSpec {
     fn default() -> Self {
         let p = PowerModel::default();
         Self {
-            threshold: 0.05,
+            threshold: SINGULARITY_THRESHOLD,
+            residual_tolerance: RESIDUAL_TOLERANCE,
             char_length: 0.0,
             band: 0.1,
             position_tolerance: 0.02,
@@ -444,6 +486,14 @@ impl ScenarioFile {
                 Mode::Transport => DynamicGains::transport(),
                 Mode::Work => DynamicGains::work_mode(),
             })
+    }
+
+    /// The base axes this scenario's controller commands (SPEC §5), from its mode, `[control]`
+    /// and `[base_control]` gains: the selection `S` of `singularity_exposure` and
+    /// `allocation_residual_fraction` ([`CommandedDofs::transport`],
+    /// [`CommandedDofs::work`]).
+    pub fn commanded_dofs(&self) -> Result<CommandedDofs, KeyError> {
+        Ok(commanded_for(&self.mode_gains()?, &self.base_gains()))
     }
 
     /// The simulator configuration.
@@ -605,6 +655,7 @@ impl ScenarioFile {
         let m = &self.metrics;
         for (k, v) in [
             ("metrics.threshold", m.threshold),
+            ("metrics.residual_tolerance", m.residual_tolerance),
             ("metrics.band", m.band),
             ("metrics.position_tolerance", m.position_tolerance),
             (

@@ -12,7 +12,7 @@ use super::setup::ClosedLoop;
 use crate::allocation::{AllocPath, AllocStatus, Allocation};
 use crate::dynamics::SimState;
 use crate::kinematics::KinWorkspace;
-use crate::metrics::singularity::sigma_min_scaled_gram;
+use crate::metrics::singularity::{commanded_sigma, residual_exceeds, CommandedDofs};
 use crate::metrics::trajectory::{
     EnergyIntegrator, EnergyMetrics, PowerModel, PowerSample, ThrusterSample,
 };
@@ -49,7 +49,7 @@ pub struct Timing {
     pub allocation_s: f64,
     /// Time in kinematics, guidance and control laws [s].
     pub control_s: f64,
-    /// Time logging (including σ_min of T(q)) [s].
+    /// Time logging (including the σ_min of T(q)) [s].
     pub logging_s: f64,
     /// Real-time factor: simulated seconds per wall second.
     pub realtime_factor: f64,
@@ -73,6 +73,10 @@ pub struct AllocationCounts {
     pub clarabel: u64,
     /// `pinv` steps ([`AllocPath::Pinv`]).
     pub pinv: u64,
+    /// Allocations that did not deliver the commanded wrench: the commanded slack exceeds
+    /// `[metrics] residual_tolerance` times the commanded wrench
+    /// ([`residual_exceeds`]; `allocation_residual_fraction = residual / steps`).
+    pub residual: u64,
 }
 
 impl AllocationCounts {
@@ -179,6 +183,10 @@ pub(crate) struct Recorder {
     log_every: usize,
     /// Characteristic length for the scaled σ_min of T(q) [m].
     char_length: f64,
+    /// The base axes the controller commands (the rows of `S·T_L`).
+    commanded: CommandedDofs,
+    /// Relative tolerance of the commanded allocation residual.
+    residual_tol: f64,
     power: PowerModel,
     /// Thruster limits `(u_min, u_max)` [N].
     limits: Vec<(f64, f64)>,
@@ -215,6 +223,10 @@ impl Recorder {
             } else {
                 v.characteristic_length()
             },
+            commanded: file
+                .commanded_dofs()
+                .unwrap_or_else(|_| s.mode.default_commanded_dofs()),
+            residual_tol: file.metrics.residual_tolerance,
             power: file.power_model(v.fluid.rho),
             limits: v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect(),
             sat_tol: file.metrics.saturation_tolerance,
@@ -230,9 +242,19 @@ impl Recorder {
     /// kinematics of the tick): the thrust the simulator will hold over the coming interval
     /// (the allocation saturated to the limits; a thruster lag or rate limit, if configured,
     /// is not followed) and each thruster's axial inflow. Also tracks the guided point along
-    /// the path (transport). The sample is for [`EnergyIntegrator::add`] once the interval
-    /// has been simulated.
+    /// the path (transport) and counts the tick's allocation if it left a commanded residual
+    /// ([`AllocationCounts::residual`]). The sample is for [`EnergyIntegrator::add`] once the
+    /// interval has been simulated.
     pub fn sample(&mut self, lp: &ClosedLoop) -> PowerSample {
+        if residual_exceeds(
+            &lp.alloc.s,
+            &lp.cmd.tau_c,
+            self.char_length,
+            self.commanded,
+            self.residual_tol,
+        ) {
+            self.counts.residual += 1;
+        }
         let (v, state) = (&lp.vehicle, lp.sim.state());
         for ((u, a), th) in self.thrust.iter_mut().zip(&lp.alloc.u).zip(&v.thrusters) {
             *u = a.clamp(th.u_min, th.u_max);
@@ -327,9 +349,14 @@ impl Recorder {
             held.enumerate()
                 .map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)),
         );
+        let l = self.char_length;
         w.put(
             Channel::SigmaMin,
-            sigma_min_scaled_gram(&lp.t_mat, self.char_length),
+            commanded_sigma(&lp.t_mat, l, CommandedDofs::ALL).sigma_min,
+        );
+        w.put(
+            Channel::SigmaMinCommanded,
+            commanded_sigma(&lp.t_mat, l, self.commanded).sigma_min,
         );
         w.put(Channel::SlackNorm, lp.alloc.s.norm());
         w.put(Channel::AllocStatus, status_code(&lp.alloc.status));

@@ -39,6 +39,8 @@ pub mod selection;
 pub mod shards;
 pub mod static_table;
 pub mod static_tcm;
+mod static_tcm_eval;
+mod static_tcm_slice;
 pub mod summary;
 pub mod worker;
 

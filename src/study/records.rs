@@ -160,8 +160,9 @@ pub const DESIGN_COLUMNS: [&str; 5] = [
     "design_mass_kg",
 ];
 
-/// Static TCM metric columns (present when the static analysis runs).
-pub const TCM_COLUMNS: [&str; 15] = [
+/// Static TCM metric columns (present when the static analysis runs): the full 6-DOF figures,
+/// then (`…_commanded`) those of the rows the mode's controller commands.
+pub const TCM_COLUMNS: [&str; 21] = [
     TCM_SINGULAR_FRACTION,
     "tcm_rank_deficient_fraction",
     "tcm_sigma_min_min",
@@ -177,6 +178,12 @@ pub const TCM_COLUMNS: [&str; 15] = [
     "tcm_lost_roll",
     "tcm_lost_pitch",
     "tcm_lost_yaw",
+    "tcm_singular_fraction_commanded",
+    "tcm_sigma_min_commanded_min",
+    "tcm_sigma_min_commanded_p05",
+    "tcm_sigma_min_commanded_p50",
+    "tcm_kappa_commanded_p50",
+    "tcm_straight_sigma_min_commanded",
 ];
 
 /// Raw column packing the scenario metrics of dynamic modes (`name=value;…`).
