@@ -291,7 +291,7 @@ pub fn commanded_sigma(
         sigma_max: 0.0,
         condition_number: f64::INFINITY,
     };
-    if !(char_length.is_finite() && char_length > 0.0) || !t.iter().all(|x| x.is_finite()) {
+    if !(char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite())) {
         out.sigma_min = f64::NAN;
         out.sigma_max = f64::NAN;
         out.condition_number = f64::NAN;
@@ -361,6 +361,7 @@ pub fn weakest_direction(
 }
 
 /// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]` (moments divided by `l`).
+#[allow(clippy::needless_range_loop)] // a symmetric fill reads clearest with indices
 fn commanded_gram(t: &Matrix6xX<f64>, l: f64, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
     let mut gram = [[0.0; 6]; 6];
     for col in t.column_iter() {

@@ -1,9 +1,11 @@
 //! Singular values of small matrices (at most 6 rows) without heap allocation, for the
-//! commanded-subspace singularity metrics (SPEC §6): cyclic Jacobi on a symmetric `k×k`
-//! (Gram) matrix's eigenvalues by Householder tridiagonalisation and implicit QL, a
-//! row-by-row Givens QR into a `k×k` triangle and one-sided (Hestenes) Jacobi on it, and shifted
-//! inverse iteration for an eigenvector. Fixed 6×6 arrays on the stack; only the leading `k×k` block is
-//! used.
+//! commanded-subspace singularity metrics (SPEC §6): the eigenvalues of a symmetric `k×k`
+//! (Gram) matrix by Householder tridiagonalisation and implicit QL; a row-by-row Givens QR into
+//! a `k×k` triangle and one-sided (Hestenes) Jacobi on it; and shifted inverse iteration for an
+//! eigenvector. Fixed 6×6 arrays on the stack; only the leading `k×k` block is used.
+
+// Dense k×k kernels read clearest with index loops over rows and columns.
+#![allow(clippy::needless_range_loop)]
 
 /// `√(a² + b²)` without `hypot`'s care for extreme exponents (several times slower in glibc):
 /// exact enough and safe for |a|, |b| < 1e150; beyond, the larger magnitude (the other term is

@@ -22,11 +22,20 @@ use serde::Serialize;
 use std::time::Instant;
 
 /// Add the wall time of an expression to a timer [s] and yield its value.
+/// With a third argument (a [`StepTimes`] series), also record the duration as one sample.
 macro_rules! timed {
     ($timer:expr, $body:expr) => {{
         let started = std::time::Instant::now();
         let value = $body;
         $timer += started.elapsed().as_secs_f64();
+        value
+    }};
+    ($timer:expr, $series:expr, $body:expr) => {{
+        let started = std::time::Instant::now();
+        let value = $body;
+        let dt = started.elapsed().as_secs_f64();
+        $timer += dt;
+        $series.push(dt);
         value
     }};
 }
@@ -53,6 +62,43 @@ pub struct Timing {
     pub logging_s: f64,
     /// Real-time factor: simulated seconds per wall second.
     pub realtime_factor: f64,
+    /// Median wall time of one allocation (one control step's thrust allocation) [µs].
+    pub allocation_step_median_us: f64,
+    /// Median wall time of one whole control period (measure, control, allocate, record and
+    /// the physics up to the next tick) [µs].
+    pub control_period_median_us: f64,
+}
+
+/// Per-step wall times of a run [s], one sample per control period, reserved for the whole
+/// run at setup so that recording them never allocates.
+pub(crate) struct StepTimes {
+    samples: Vec<f64>,
+}
+
+impl StepTimes {
+    /// Room for `n` samples.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            samples: Vec::with_capacity(n),
+        }
+    }
+
+    /// Record one duration [s] (dropped beyond the reserved capacity, so never allocates).
+    pub fn push(&mut self, dt: f64) {
+        if self.samples.len() < self.samples.capacity() {
+            self.samples.push(dt);
+        }
+    }
+
+    /// The median [µs] (the upper one of an even count); NaN without samples.
+    fn median_us(&mut self) -> f64 {
+        let n = self.samples.len();
+        if n == 0 {
+            return f64::NAN;
+        }
+        let (_, m, _) = self.samples.select_nth_unstable_by(n / 2, f64::total_cmp);
+        *m * 1e6
+    }
 }
 
 /// How the allocations of a run went, counted over control periods: outcomes, and which path
@@ -204,6 +250,10 @@ pub(crate) struct Recorder {
     pub energy: EnergyIntegrator,
     /// Wall-clock timers.
     pub timing: Timing,
+    /// Wall time of each allocation.
+    pub allocation_steps: StepTimes,
+    /// Wall time of each control period.
+    pub control_periods: StepTimes,
 }
 
 impl Recorder {
@@ -235,6 +285,8 @@ impl Recorder {
             counts: AllocationCounts::default(),
             energy: EnergyIntegrator::default(),
             timing: Timing::default(),
+            allocation_steps: StepTimes::with_capacity(lp.n_control + 1),
+            control_periods: StepTimes::with_capacity(lp.n_control + 1),
         }
     }
 
@@ -364,13 +416,16 @@ impl Recorder {
     }
 
     /// The trajectory, the allocation counts, the energy integrals and the timers, with the
-    /// total wall time since `started` and the real-time factor filled in.
+    /// total wall time since `started`, the real-time factor and the per-step medians filled
+    /// in.
     pub fn finish(
         mut self,
         started: Instant,
     ) -> (Trajectory, AllocationCounts, EnergyMetrics, Timing) {
         let timing = &mut self.timing;
         timing.total_s = started.elapsed().as_secs_f64();
+        timing.allocation_step_median_us = self.allocation_steps.median_us();
+        timing.control_period_median_us = self.control_periods.median_us();
         let simulated = self
             .traj
             .get(Channel::T)

@@ -132,7 +132,11 @@ impl ClosedLoop<'_> {
         let terms = timed!(rec.timing.dynamics_s, self.sim.base_control_terms())
             .map_err(|e| (t, e.to_string()))?;
         timed!(rec.timing.control_s, self.control(t, &measured, &terms));
-        timed!(rec.timing.allocation_s, self.allocate(t))?;
+        timed!(
+            rec.timing.allocation_s,
+            rec.allocation_steps,
+            self.allocate(t)
+        )?;
         rec.counts.count(&self.alloc);
         let sample = timed!(rec.timing.logging_s, rec.sample(self));
         timed!(rec.timing.logging_s, rec.observe(k, t, self));
@@ -153,7 +157,13 @@ pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, Scena
     let started = Instant::now();
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
-    let failure = (0..=lp.n_control).find_map(|k| lp.period(k, &mut rec).err());
+    let failure = (0..=lp.n_control).find_map(|k| {
+        let period_started = Instant::now();
+        let result = lp.period(k, &mut rec);
+        rec.control_periods
+            .push(period_started.elapsed().as_secs_f64());
+        result.err()
+    });
     let stats = lp.sim.step_stats();
     rec.timing.physics_steps = stats.steps;
     rec.timing.physics_rejected = stats.rejected;
