@@ -23,9 +23,8 @@ use crate::report::{
     atomic_write, heatmap, histogram, read_csv_typed, write_parquet, ColourScale, ColumnKind,
     CsvAppender, Value,
 };
-use crate::study::static_tcm::{
-    analyse, influential_joints, slice_grid, StaticSpec, StaticSummary,
-};
+use crate::study::static_tcm::{analyse, StaticSpec, StaticSummary};
+use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 /// Largest sample count for which `samples.parquet` is written.
 pub const PARQUET_MAX_ROWS: usize = 200_000;

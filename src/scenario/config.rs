@@ -60,11 +60,9 @@ pub enum Mode {
 }
 
 impl Mode {
-    /// The base axes the mode's default controller commands (SPEC §5): the selection `S` of
-    /// the commanded-subspace singularity metrics for a scenario without `[control]` or
-    /// `[base_control]` tables ([`ScenarioFile::commanded_dofs`] of such a file). Both of the
-    /// paper's modes leave roll free: transport by `K_p,roll = 0`, work by a zero base-roll
-    /// usage weight and `K_p,roll = 0`.
+    /// The base axes the mode's default controller commands (SPEC §5), as
+    /// [`ScenarioFile::commanded_dofs`] of a file without `[control]`/`[base_control]`: both
+    /// of the paper's modes leave roll free (`K_p,roll = 0`; work: zero base-roll weight).
     pub fn default_commanded_dofs(self) -> CommandedDofs {
         match self {
             Mode::Transport => commanded_for(

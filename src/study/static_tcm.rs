@@ -27,7 +27,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm_eval::{map_joint, Eval, Scratch};
+use super::static_tcm_eval::{local_pool, map_joint, Eval, Scratch};
 use crate::metrics::singularity::{
     CommandedDofs, SingularityError, AXIS_NAMES, DEFAULT_RANK_REL_TOL, SINGULARITY_THRESHOLD,
 };
@@ -36,7 +36,6 @@ use crate::sampling::{Sampler, Sampling};
 use crate::scenario::config::Mode;
 
 pub use super::static_tcm_eval::SampleMetrics;
-pub use super::static_tcm_slice::{influential_joints, slice_grid, SliceGrid};
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
 /// for streaming rows).
@@ -365,9 +364,8 @@ pub fn analyse(
             key: "sampling",
             message,
         })?;
-    let eval = Eval::new(vehicle, spec, l);
     let mut scratch = Scratch::new(vehicle);
-    eval.check(&mut scratch)?;
+    let eval = evaluator(vehicle, spec, l, &mut scratch)?;
     scratch.q.fill(0.0);
     let straight = SampleEval {
         index: 0,
@@ -375,7 +373,7 @@ pub fn analyse(
         metrics: eval.at(&mut scratch),
     };
     let mut tally = Tally::new(spec);
-    match local_pool(threads)? {
+    match pool(threads)? {
         None => {
             let s = &mut scratch;
             for i in 0..spec.samples {
@@ -424,15 +422,23 @@ pub fn analyse(
 }
 
 /// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
-pub(super) fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, StaticError> {
-    if threads == 1 {
-        return Ok(None);
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map(Some)
-        .map_err(|e| StaticError::Threads(e.to_string()))
+pub(super) fn pool(threads: usize) -> Result<Option<rayon::ThreadPool>, StaticError> {
+    local_pool(threads).map_err(StaticError::Threads)
+}
+
+/// The evaluator of `spec` on `v` with characteristic length `l` [m], its design checked.
+pub(super) fn evaluator<'a>(
+    v: &'a Vehicle,
+    spec: &StaticSpec,
+    l: f64,
+    scratch: &mut Scratch,
+) -> Result<Eval<'a>, StaticError> {
+    let eval = Eval::new(v, l, spec.rank_rel_tol, spec.threshold, spec.commanded);
+    eval.check(scratch).map_err(|source| StaticError::Metrics {
+        design: v.name.clone(),
+        source,
+    })?;
+    Ok(eval)
 }
 
 /// Sorted-later samples of one per-sample quantity, full and over the commanded rows.

@@ -5,10 +5,10 @@
 use nalgebra::Matrix6xX;
 use serde::Serialize;
 
-use super::static_tcm::{StaticError, StaticSpec};
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{
-    commanded_sigma, tcm_svd_metrics, weakest_direction, CommandedDofs, AXIS_NAMES,
+    commanded_sigma, tcm_svd_metrics, weakest_direction, CommandedDofs, SingularityError,
+    AXIS_NAMES,
 };
 use crate::model::Vehicle;
 
@@ -65,29 +65,25 @@ pub(super) struct Eval<'a> {
 }
 
 impl<'a> Eval<'a> {
-    /// The evaluator of `spec` on `v` with characteristic length `l` [m].
-    pub fn new(v: &'a Vehicle, spec: &StaticSpec, l: f64) -> Self {
+    /// The evaluator on `v` with characteristic length `l` [m], relative rank tolerance `tol`,
+    /// singularity threshold `threshold` (N per N) and the commanded axes `commanded`.
+    pub fn new(v: &'a Vehicle, l: f64, tol: f64, threshold: f64, commanded: CommandedDofs) -> Self {
         Self {
             v,
             l,
-            tol: spec.rank_rel_tol,
-            threshold: spec.threshold,
-            commanded: spec.commanded,
+            tol,
+            threshold,
+            commanded,
         }
     }
 
     /// Check that the design can be scored at all (thrusters present, `T` finite at the
     /// straight configuration), with the metric's own error.
-    pub fn check(&self, s: &mut Scratch) -> Result<(), StaticError> {
+    pub fn check(&self, s: &mut Scratch) -> Result<(), SingularityError> {
         s.q.fill(0.0);
         forward_kinematics(self.v, &s.q, &mut s.ws);
         thruster_matrix(self.v, &s.ws, &mut s.t);
-        tcm_svd_metrics(&s.t, self.l, self.tol)
-            .map(|_| ())
-            .map_err(|source| StaticError::Metrics {
-                design: self.v.name.clone(),
-                source,
-            })
+        tcm_svd_metrics(&s.t, self.l, self.tol).map(|_| ())
     }
 
     /// Metrics at the scratch's `q`, without allocating.
@@ -129,4 +125,16 @@ pub(super) fn map_joint(v: &Vehicle, u: &[f64], q: &mut [f64]) {
     for ((qk, uk), j) in q.iter_mut().zip(u).zip(&v.joints) {
         *qk = j.min + uk * (j.max - j.min);
     }
+}
+
+/// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
+pub(super) fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, String> {
+    if threads == 1 {
+        return Ok(None);
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map(Some)
+        .map_err(|e| e.to_string())
 }

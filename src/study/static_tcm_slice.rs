@@ -4,8 +4,8 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm::{local_pool, StaticError, StaticSpec};
-use super::static_tcm_eval::{Eval, Scratch};
+use super::static_tcm::{evaluator, pool, StaticError, StaticSpec};
+use super::static_tcm_eval::Scratch;
 use crate::model::Vehicle;
 
 /// σ_min over a 2-D slice of joint space: joints `i` and `j` on a `resolution × resolution`
@@ -50,8 +50,12 @@ pub fn slice_grid(
             message: format!("needs two different joint indices in 0..{n}, got {i},{j}"),
         });
     }
-    let eval = Eval::new(vehicle, spec, spec.char_length_for(vehicle));
-    eval.check(&mut Scratch::new(vehicle))?;
+    let eval = evaluator(
+        vehicle,
+        spec,
+        spec.char_length_for(vehicle),
+        &mut Scratch::new(vehicle),
+    )?;
     let res = resolution.clamp(2, 1000);
     let (ji, jj) = (&vehicle.joints[i], &vehicle.joints[j]);
     let x = linspace(ji.min, ji.max, res);
@@ -73,7 +77,7 @@ pub fn slice_grid(
                 .collect()
         }
     };
-    let sigma_min = match local_pool(threads)? {
+    let sigma_min = match pool(threads)? {
         None => compute(),
         Some(pool) => pool.install(compute),
     };
@@ -106,9 +110,8 @@ pub fn influential_joints(
     } else {
         (0..n).collect()
     };
-    let eval = Eval::new(vehicle, spec, spec.char_length_for(vehicle));
     let mut s = Scratch::new(vehicle);
-    eval.check(&mut s)?;
+    let eval = evaluator(vehicle, spec, spec.char_length_for(vehicle), &mut s)?;
     let mut scores = Vec::new();
     for &k in &cands {
         let j = &vehicle.joints[k];

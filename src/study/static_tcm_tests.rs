@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::model::presets::usm_paper;
+use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
     let v = usm_paper();
