@@ -12,6 +12,7 @@ use usm_study::model::design::load_design;
 use usm_study::pipeline::tcm::{run_tcm, TcmConfig};
 use usm_study::report::fmt_num;
 use usm_study::sampling::Sampling;
+use usm_study::scenario::config::Mode;
 use usm_study::study::static_tcm::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
 
 /// Most `--samples` accepted: 16 bytes are kept per sample (0.8 GB at the cap); more would
@@ -29,7 +30,8 @@ pub struct TcmArgs {
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Threshold on the scaled σ_min below which T counts as singular.
+    /// Threshold on the scaled σ_min below which T counts as singular (shared by the full and
+    /// the commanded figures, and by the trajectory metrics' default).
     #[arg(long, default_value_t = DEFAULT_THRESHOLD)]
     pub threshold: f64,
     /// Sampling of joint space: sobol, lhs or random.
@@ -51,6 +53,10 @@ pub struct TcmArgs {
     /// Grid resolution of the slice plot per joint.
     #[arg(long, default_value_t = 41)]
     pub resolution: usize,
+    /// Mode whose commanded wrench axes are scored beside the full six: transport or work
+    /// (its default controller's selection: both leave roll free).
+    #[arg(long, default_value = "transport", value_parser = parse_mode)]
+    pub mode: Mode,
     /// Number of worst (lowest σ_min) configurations reported.
     #[arg(long, default_value_t = usm_study::study::static_tcm::DEFAULT_WORST)]
     pub worst: usize,
@@ -58,6 +64,12 @@ pub struct TcmArgs {
 
 fn parse_sampling(s: &str) -> Result<Sampling, String> {
     s.parse()
+}
+
+fn parse_mode(s: &str) -> Result<Mode, String> {
+    toml::Value::String(s.into())
+        .try_into()
+        .map_err(|_| format!("unknown mode '{s}'; valid: transport, work"))
 }
 
 fn parse_pair(s: &str) -> Result<(usize, usize), String> {
@@ -98,6 +110,8 @@ pub fn run(a: &TcmArgs) -> anyhow::Result<ExitCode> {
             char_length: a.char_length,
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
             worst: a.worst,
+            mode: a.mode,
+            commanded: a.mode.default_commanded_dofs(),
         },
         out: a.out.clone().unwrap_or_else(|| {
             Path::new("results/tcm").join(usm_study::report::file_stem_safe(&vehicle.name))
@@ -141,12 +155,20 @@ fn print_summary(s: &StaticSummary, out: &Path) {
         f(s.rank_deficient_fraction)
     );
     println!(
-        "straight configuration: σ_min = {}, rank {}{}",
-        f(s.straight.sigma_min),
-        s.straight.rank,
-        s.straight
-            .lost_axis
-            .map_or(String::new(), |a| format!(", loses {a}"))
+        "{} mode commands {}: singular fraction {}   rank-deficient: {}",
+        s.mode,
+        s.commanded_axes,
+        f(s.singular_fraction_commanded),
+        f(s.rank_deficient_fraction_commanded)
+    );
+    let st = &s.straight.metrics;
+    println!(
+        "straight configuration: σ_min = {}, rank {}{}; commanded σ_min = {}",
+        f(st.sigma_min),
+        st.rank,
+        st.lost_axis
+            .map_or(String::new(), |a| format!(", loses {a}")),
+        f(st.sigma_min_commanded)
     );
     println!(
         "σ_min: min={} mean={} {}",
@@ -158,6 +180,12 @@ fn print_summary(s: &StaticSummary, out: &Path) {
         "κ:     {} (non-finite: {})",
         quantiles(&s.kappa),
         s.kappa.non_finite
+    );
+    println!(
+        "commanded σ_min: min={} mean={} {}",
+        f(s.sigma_min_commanded.min),
+        f(s.sigma_min_commanded.mean),
+        quantiles(&s.sigma_min_commanded)
     );
     let lost: Vec<String> = s
         .lost_axes
@@ -181,8 +209,8 @@ fn print_summary(s: &StaticSummary, out: &Path) {
         println!(
             "worst #{}: σ_min={} rank={} q=[{}] deg",
             w.index,
-            f(w.sigma_min),
-            w.rank,
+            f(w.metrics.sigma_min),
+            w.metrics.rank,
             q.join(", ")
         );
     }

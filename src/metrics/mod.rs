@@ -2,5 +2,6 @@
 
 pub mod run_summary;
 pub mod singularity;
+mod small_svd;
 pub mod success;
 pub mod trajectory;

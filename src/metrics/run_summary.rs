@@ -19,7 +19,7 @@ type Metrics = Vec<(String, f64)>;
 /// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
 /// that computes them adds values in this order, and [`metric_catalogue`] lists them so that
 /// callers (the optimiser) can check names before anything runs.
-pub const COMMON_METRICS: [&str; 15] = [
+pub const COMMON_METRICS: [&str; 19] = [
     "completed",
     "simulated_time",
     "thruster_energy",
@@ -31,10 +31,14 @@ pub const COMMON_METRICS: [&str; 15] = [
     "peak_thrust",
     "saturation_fraction",
     "singularity_exposure",
+    "singularity_exposure_full",
     "sigma_min_min",
     "sigma_min_mean",
+    "sigma_min_commanded_min",
+    "sigma_min_commanded_mean",
     "slack_fraction",
     "allocation_failures",
+    "allocation_residual_fraction",
 ];
 
 /// Per-segment transport metrics, each named `seg{k}_{name}` for segment `k` (0-based).
@@ -169,7 +173,15 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 /// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint motor torques and the
 ///   joint rates at the start of every physics step; `joint_torque_peak` [N·m] the largest
 ///   |τ_q,i| among them;
-/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals.
+/// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals;
+/// - `singularity_exposure`, the fraction of time σ_min of the commanded rows `S·T_L` is below
+///   `[metrics] threshold` (the controller's commanded axes, SPEC §6), and
+///   `singularity_exposure_full` the same for all six rows (a straight USM has lost roll, which
+///   neither of the paper's modes commands, so the full figure measures straightness);
+///   `sigma_min_min`/`_mean` (all rows) and `sigma_min_commanded_min`/`_mean` over the log;
+/// - `slack_fraction` of allocations whose slack was active, `allocation_failures`, and
+///   `allocation_residual_fraction`, the fraction of control steps whose allocation left the
+///   commanded wrench undelivered beyond `[metrics] residual_tolerance`.
 fn common_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,
@@ -179,11 +191,16 @@ fn common_metrics(
     e: &EnergyMetrics,
 ) {
     let t = channel(traj, Channel::T);
-    let sig = channel(traj, Channel::SigmaMin);
-    let sigma_mean = if sig.is_empty() {
-        f64::NAN
-    } else {
-        sig.iter().sum::<f64>() / sig.len() as f64
+    let threshold = file.metrics.threshold;
+    let full = channel(traj, Channel::SigmaMin);
+    let cmd = channel(traj, Channel::SigmaMinCommanded);
+    let min = |x: &[f64]| x.iter().copied().fold(f64::INFINITY, f64::min);
+    let mean = |x: &[f64]| {
+        if x.is_empty() {
+            f64::NAN
+        } else {
+            x.iter().sum::<f64>() / x.len() as f64
+        }
     };
     let steps = counts.steps.max(1) as f64;
     let values = [
@@ -197,11 +214,15 @@ fn common_metrics(
         e.joint_torque_peak,
         e.peak_thrust,
         e.saturation_fraction,
-        singularity_exposure(t, sig, file.metrics.threshold),
-        sig.iter().copied().fold(f64::INFINITY, f64::min),
-        sigma_mean,
+        singularity_exposure(t, cmd, threshold),
+        singularity_exposure(t, full, threshold),
+        min(full),
+        mean(full),
+        min(cmd),
+        mean(cmd),
         counts.slack_active as f64 / steps,
         counts.solver_failures as f64,
+        counts.residual as f64 / steps,
     ];
     add_all(out, &COMMON_METRICS, values);
 }

@@ -12,10 +12,24 @@
 use nalgebra::{Matrix6xX, Vector6};
 use serde::Serialize;
 
+use super::small_svd::{
+    givens_add_row, one_sided_jacobi_sq, shifted_inverse_iteration, tridiagonal_eigenvalues,
+};
 use crate::allocation::{attainable_wrench, AllocError, AttainableWrench};
 
 /// Default relative rank tolerance: a singular value counts as zero below `1e-6 · σ_max`.
 pub const DEFAULT_RANK_REL_TOL: f64 = 1e-6;
+
+/// The one threshold on the scaled σ_min (N per N) below which a configuration counts as
+/// singular, shared by the static analysis (`[static] threshold`, `tcm --threshold`) and the
+/// trajectory metrics (`[metrics] threshold`, `singularity_exposure`) (SPEC §6).
+/// See `docs/singularity.md` for its calibration.
+pub const SINGULARITY_THRESHOLD: f64 = 0.05;
+
+/// Default relative tolerance of [`residual_exceeds`] (`[metrics] residual_tolerance`): the
+/// allocator counts as not delivering the commanded wrench when the commanded slack exceeds
+/// 1 % of it, the allocator's own `slack_tol` (SPEC §5).
+pub const RESIDUAL_TOLERANCE: f64 = 1e-2;
 
 /// Names of the six base-frame wrench axes, in row order of `T`.
 pub const AXIS_NAMES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
@@ -98,11 +112,8 @@ fn check_inputs(
     Ok(())
 }
 
-/// Iteration cap of the SVD of `T_L` (a 6 × n SVD converges in a few dozen sweeps).
-const SVD_MAX_ITERATIONS: usize = 1000;
-
 /// Singular values of `T_L` (SPEC §6), six of them, descending (zeros appended when
-/// n_thrusters < 6); NaN when the SVD does not converge within [`SVD_MAX_ITERATIONS`].
+/// n_thrusters < 6).
 /// `t` must be finite (checked by the public entry points).
 fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matrix6<f64>) {
     let n_thrusters = t.ncols();
@@ -110,11 +121,7 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
     let mut tl = Matrix6xX::<f64>::zeros(n_thrusters.max(6));
     tl.columns_mut(0, n_thrusters)
         .copy_from(&scale_moment_rows(t, char_length));
-    // Capped: nalgebra's uncapped SVD iterates forever when scaling overflowed to ±inf. The
-    // tolerance is `svd()`'s own (5ε), so the values are bit-identical to it.
-    let Some(svd) = tl.try_svd(true, false, 5.0 * f64::EPSILON, SVD_MAX_ITERATIONS) else {
-        return ([f64::NAN; 6], nalgebra::Matrix6::zeros());
-    };
+    let svd = tl.svd(true, false);
     let mut idx = [0usize, 1, 2, 3, 4, 5];
     idx.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
     let mut sv = [0.0; 6];
@@ -128,35 +135,25 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
     (sv, u)
 }
 
-/// Smallest singular value of `T_L` (SPEC §6), the cheap score for "how often T is singular"
-/// sampling. `char_length` [m], > 0.
-pub fn sigma_min_scaled(t: &Matrix6xX<f64>, char_length: f64) -> Result<f64, SingularityError> {
-    check_inputs(t, char_length, 0.0)?;
-    Ok(scaled_svd(t, char_length).0[5])
-}
-
-/// σ_min of `T_L` (SPEC §6) from the eigenvalues of the 6×6 Gram matrix `T_L T_Lᵀ`, without
-/// heap allocation (for logging inside a simulation loop). Accurate to about
-/// `√ε · σ_max` ≈ 1e-8·σ_max, ample for comparing with singularity thresholds of 1e-2; use
-/// [`sigma_min_scaled`] where exact small singular values matter. NaN if `t` is not finite
-/// or `char_length` is not positive.
-pub fn sigma_min_scaled_gram(t: &Matrix6xX<f64>, char_length: f64) -> f64 {
-    if !(char_length.is_finite() && char_length > 0.0) {
-        return f64::NAN;
+/// Whether the allocator failed to deliver the commanded wrench (SPEC §6,
+/// `allocation_residual_fraction`): the commanded rows of the wrench slack `s = T u − τ` exceed
+/// `tol` times the commanded wrench, `‖S s_L‖ > tol·‖S τ_L‖`, both scaled like `T_L` (moments
+/// divided by `char_length` L [m]) so that forces [N] and moments [N·m] weigh alike. A zero
+/// demand met exactly is not a failure.
+pub fn residual_exceeds(
+    s: &Vector6<f64>,
+    tau: &Vector6<f64>,
+    char_length: f64,
+    dofs: CommandedDofs,
+    tol: f64,
+) -> bool {
+    let (mut ss, mut tt) = (0.0, 0.0);
+    for i in (0..6).filter(|&i| dofs.contains(i)) {
+        let w = if i < 3 { 1.0 } else { 1.0 / char_length };
+        ss += (s[i] * w).powi(2);
+        tt += (tau[i] * w).powi(2);
     }
-    let mut gram = nalgebra::Matrix6::<f64>::zeros();
-    for col in t.column_iter() {
-        let mut c: Vector6<f64> = col.into_owned();
-        for i in 3..6 {
-            c[i] /= char_length;
-        }
-        gram += c * c.transpose();
-    }
-    if !gram.iter().all(|x| x.is_finite()) {
-        return f64::NAN;
-    }
-    let ev = gram.symmetric_eigenvalues();
-    ev.min().max(0.0).sqrt()
+    ss.sqrt() > tol * tt.sqrt()
 }
 
 /// The base wrench axes a controller commands (SPEC §5): a subset of surge, sway, heave, roll,
@@ -275,7 +272,8 @@ pub const GRAM_MIN_RATIO: f64 = 1e-4;
 /// with `σ ≥ σ_min`, and along the weakest direction no thrust of that norm does better.
 ///
 /// Pure and allocation-free (fixed 6×6 work arrays on the stack, any number of thrusters): the
-/// eigenvalues of the `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` by cyclic Jacobi, or, when that matrix
+/// eigenvalues of the `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` (Householder tridiagonalisation and
+/// implicit QL), or, when that matrix
 /// is ill-conditioned (`λ_min < GRAM_MIN_RATIO·λ_max`), the singular values of the triangular
 /// factor of `(S T_L)ᵀ` (Givens QR, one thruster column at a time) by one-sided Jacobi, which
 /// keeps small singular values accurate. Agrees with a full SVD to about 1e-12 relative
@@ -293,7 +291,7 @@ pub fn commanded_sigma(
         sigma_max: 0.0,
         condition_number: f64::INFINITY,
     };
-    if !(char_length.is_finite() && char_length > 0.0) || !t.iter().all(|x| x.is_finite()) {
+    if !(char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite())) {
         out.sigma_min = f64::NAN;
         out.sigma_max = f64::NAN;
         out.condition_number = f64::NAN;
@@ -303,21 +301,8 @@ pub fn commanded_sigma(
         return out;
     }
     let rows = selected_rows(dofs);
-    let mut gram = [[0.0; 6]; 6];
-    for col in t.column_iter() {
-        let x = select_scaled(col.as_slice(), &rows, k, char_length);
-        for a in 0..k {
-            for b in 0..=a {
-                gram[a][b] += x[a] * x[b];
-            }
-        }
-    }
-    for a in 0..k {
-        for b in 0..a {
-            gram[b][a] = gram[a][b];
-        }
-    }
-    let mut ev = jacobi_eigenvalues(&mut gram, k);
+    let mut gram = commanded_gram(t, char_length, &rows, k);
+    let mut ev = tridiagonal_eigenvalues(&mut gram, k);
     let (lo, hi) = min_max(&ev[..k]);
     if lo < GRAM_MIN_RATIO * hi {
         let mut r = [[0.0; 6]; 6];
@@ -341,6 +326,58 @@ pub fn commanded_sigma(
         f64::INFINITY
     };
     out
+}
+
+/// The weakest commanded wrench direction of `S·T_L` whose smallest singular value
+/// `sigma_min` ([`commanded_sigma`]) is known: the unit left singular vector of σ_min in the
+/// scaled wrench space `[f (N); moment/L (N)]` (zero on the uncommanded axes), signed so that
+/// its largest-magnitude component is positive. By two steps of inverse iteration on the Gram
+/// matrix shifted just below σ_min² (the eigenvector converges by the factor
+/// `10⁻⁶σ_min²/(σ_2² − σ_min²)` per step; within a cluster of equal singular values any
+/// direction of the cluster). Zero when nothing is commanded or the input is bad.
+/// Allocation-free, about a tenth of the cost of [`commanded_sigma`].
+pub fn weakest_direction(
+    t: &Matrix6xX<f64>,
+    char_length: f64,
+    dofs: CommandedDofs,
+    sigma_min: f64,
+) -> [f64; 6] {
+    let k = dofs.len();
+    let mut dir = [0.0; 6];
+    if k == 0 || !sigma_min.is_finite() || !(char_length.is_finite() && char_length > 0.0) {
+        return dir;
+    }
+    let rows = selected_rows(dofs);
+    let gram = commanded_gram(t, char_length, &rows, k);
+    let y = shifted_inverse_iteration(gram, k, sigma_min * sigma_min * (1.0 - 1e-6));
+    for (a, &r) in rows.iter().take(k).enumerate() {
+        dir[r] = y[a];
+    }
+    let imax = (0..6).fold(0, |m, i| if dir[i].abs() > dir[m].abs() { i } else { m });
+    if dir[imax] < 0.0 {
+        dir.iter_mut().for_each(|x| *x = -*x);
+    }
+    dir
+}
+
+/// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]` (moments divided by `l`).
+#[allow(clippy::needless_range_loop)] // a symmetric fill reads clearest with indices
+fn commanded_gram(t: &Matrix6xX<f64>, l: f64, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
+    let mut gram = [[0.0; 6]; 6];
+    for col in t.column_iter() {
+        let x = select_scaled(col.as_slice(), rows, k, l);
+        for a in 0..k {
+            for b in 0..=a {
+                gram[a][b] += x[a] * x[b];
+            }
+        }
+    }
+    for a in 0..k {
+        for b in 0..a {
+            gram[b][a] = gram[a][b];
+        }
+    }
+    gram
 }
 
 /// The row indices of `dofs`, in order, in the first `dofs.len()` entries.
@@ -372,112 +409,6 @@ fn min_max(xs: &[f64]) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
             (lo.min(x), hi.max(x))
         })
-}
-
-/// Largest number of Jacobi sweeps (quadratic convergence needs 4–6 for 6×6).
-const MAX_SWEEPS: usize = 30;
-
-/// Rotation `(c, s)` annihilating the off-diagonal entry `apq` of the symmetric 2×2 block
-/// `[[app, apq], [apq, aqq]]` (the smaller-angle root, Golub & Van Loan §8.5.2).
-#[inline]
-fn jacobi_rotation(app: f64, aqq: f64, apq: f64) -> (f64, f64, f64) {
-    let theta = (aqq - app) / (2.0 * apq);
-    let t = if theta.abs() > 1e150 {
-        0.5 / theta
-    } else {
-        theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
-    };
-    let c = 1.0 / (t * t + 1.0).sqrt();
-    (c, t * c, t)
-}
-
-/// Eigenvalues of the symmetric `k×k` leading block of `a` (destroyed) by cyclic Jacobi, in the
-/// first `k` entries (unordered). Stops when every off-diagonal entry is below
-/// `ε·√(|a_pp a_qq|)` (relative accuracy for positive definite matrices).
-fn jacobi_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
-    for _ in 0..MAX_SWEEPS {
-        let mut rotated = false;
-        for p in 0..k {
-            for q in p + 1..k {
-                let apq = a[p][q];
-                if apq == 0.0 || apq.abs() <= f64::EPSILON * (a[p][p] * a[q][q]).abs().sqrt() {
-                    continue;
-                }
-                rotated = true;
-                let (c, s, t) = jacobi_rotation(a[p][p], a[q][q], apq);
-                a[p][p] -= t * apq;
-                a[q][q] += t * apq;
-                a[p][q] = 0.0;
-                a[q][p] = 0.0;
-                for r in 0..k {
-                    if r != p && r != q {
-                        let (arp, arq) = (a[r][p], a[r][q]);
-                        let (np, nq) = (c * arp - s * arq, s * arp + c * arq);
-                        a[r][p] = np;
-                        a[p][r] = np;
-                        a[r][q] = nq;
-                        a[q][r] = nq;
-                    }
-                }
-            }
-        }
-        if !rotated {
-            break;
-        }
-    }
-    std::array::from_fn(|i| a[i][i])
-}
-
-/// Fold the row `x` (k entries) into the upper-triangular `r` by Givens rotations, so that
-/// `rᵀr` gains `x xᵀ` (QR of a matrix given one row at a time).
-#[inline]
-fn givens_add_row(r: &mut [[f64; 6]; 6], mut x: [f64; 6], k: usize) {
-    for i in 0..k {
-        if x[i] == 0.0 {
-            continue;
-        }
-        let h = r[i][i].hypot(x[i]);
-        let (c, s) = (r[i][i] / h, x[i] / h);
-        r[i][i] = h;
-        for l in i + 1..k {
-            let (ril, xl) = (r[i][l], x[l]);
-            r[i][l] = c * ril + s * xl;
-            x[l] = c * xl - s * ril;
-        }
-    }
-}
-
-/// Squared singular values of the `k×k` leading block of `w` (destroyed) by one-sided
-/// (Hestenes) Jacobi on its columns: rotate column pairs until all are orthogonal to working
-/// precision; the squared column norms are then the squared singular values.
-fn one_sided_jacobi_sq(w: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
-    for _ in 0..MAX_SWEEPS {
-        let mut rotated = false;
-        for p in 0..k {
-            for q in p + 1..k {
-                let (mut alpha, mut beta, mut gamma) = (0.0, 0.0, 0.0);
-                for row in w.iter().take(k) {
-                    alpha += row[p] * row[p];
-                    beta += row[q] * row[q];
-                    gamma += row[p] * row[q];
-                }
-                if gamma == 0.0 || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
-                    continue;
-                }
-                rotated = true;
-                let (c, s, _) = jacobi_rotation(alpha, beta, gamma);
-                for row in w.iter_mut().take(k) {
-                    let (a, b) = (row[p], row[q]);
-                    row[p] = c * a - s * b;
-                    row[q] = s * a + c * b;
-                }
-            }
-        }
-        if !rotated {
-            break;
-        }
-    }
-    std::array::from_fn(|j| w.iter().take(k).map(|row| row[j] * row[j]).sum())
 }
 
 /// Fraction of samples whose σ_min is below `threshold` (SPEC §6, "how often T is singular");

@@ -105,21 +105,24 @@ fn singular_fraction_counts() {
 }
 
 #[test]
-fn gram_sigma_min_matches_svd_to_its_precision() {
-    // sqrt(eps)·σ_max bounds the Gram route's error; 1e-6 is far above it and far
-    // below any singularity threshold in use.
-    let v = crate::model::presets::usm_paper();
-    let mut ws = crate::kinematics::KinWorkspace::new(&v);
-    for k in 0..8 {
-        let mut q = vec![0.0; 8];
-        q[k] = 0.3 * (k as f64 + 1.0) / 8.0;
-        crate::kinematics::forward_kinematics(&v, &q, &mut ws);
-        let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
-        let a = sigma_min_scaled(&t, 1.65).unwrap();
-        let b = sigma_min_scaled_gram(&t, 1.65);
-        assert!((a - b).abs() < 1e-6, "joint {k}: {a} vs {b}");
-    }
-    assert!(sigma_min_scaled_gram(&Matrix6xX::zeros(3), 0.0).is_nan());
+fn residual_counts_only_commanded_rows() {
+    let roll_free = CommandedDofs::new([true, true, true, false, true, true]);
+    let tau = Vector6::new(10.0, 0.0, 0.0, 0.0, 0.0, 2.0);
+    // A roll slack the straight body cannot avoid is not a commanded residual.
+    let roll = Vector6::new(0.0, 0.0, 0.0, 5.0, 0.0, 0.0);
+    assert!(!residual_exceeds(&roll, &tau, 2.0, roll_free, 1e-2));
+    assert!(residual_exceeds(&roll, &tau, 2.0, CommandedDofs::ALL, 1e-2));
+    // Yaw slack 0.2 N·m at L = 2 m is 0.1 N scaled; |τ_L| = √(100 + 1): just under 1 %.
+    let yaw = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.2);
+    assert!(!residual_exceeds(&yaw, &tau, 2.0, roll_free, 1e-2));
+    assert!(residual_exceeds(&yaw, &tau, 2.0, roll_free, 0.9e-2));
+    assert!(!residual_exceeds(
+        &Vector6::zeros(),
+        &Vector6::zeros(),
+        1.0,
+        roll_free,
+        1e-2
+    ));
 }
 
 /// σ_min of the rows `dofs` of `T_L` by nalgebra's SVD of the explicitly built `k×m` matrix
@@ -297,4 +300,78 @@ fn commanded_sigma_of_rank_deficient_and_degenerate_input() {
     assert!(commanded_sigma(&bad, 1.0, CommandedDofs::ALL)
         .sigma_min
         .is_nan());
+}
+
+#[test]
+fn weakest_direction_is_the_smallest_left_singular_vector() {
+    // Straight USM: the lost direction is pure roll (σ_min at rounding level).
+    let t = straight_usm();
+    let s = commanded_sigma(&t, 1.0, CommandedDofs::ALL);
+    let d = weakest_direction(&t, 1.0, CommandedDofs::ALL, s.sigma_min);
+    assert!(s.sigma_min < 1e-12 && approx(d[3], 1.0, 1e-9), "{d:?}");
+    // Bent paper designs: ‖(S T_L)ᵀ d‖ = σ_min, d unit, zero off the selection; against the
+    // SVD's left singular vector.
+    let v = crate::model::presets::usm_paper();
+    let mut ws = crate::kinematics::KinWorkspace::new(&v);
+    let l = v.characteristic_length();
+    for bend in [0.05, 0.3, 0.8] {
+        let q: Vec<f64> = (0..v.n_joints()).map(|i| bend - 0.07 * i as f64).collect();
+        crate::kinematics::forward_kinematics(&v, &q, &mut ws);
+        let t = crate::kinematics::thruster_matrix_owned(&v, &ws);
+        for dofs in [CommandedDofs::ALL, transport_dofs()] {
+            let s = commanded_sigma(&t, l, dofs);
+            let d = weakest_direction(&t, l, dofs, s.sigma_min);
+            let tl = scale_moment_rows(&t, l);
+            let dv = Vector6::from(d);
+            assert!(approx(dv.norm(), 1.0, 1e-12));
+            let got = (tl.transpose() * dv).norm();
+            assert!(
+                (got - s.sigma_min).abs() < 1e-10 * s.sigma_max,
+                "{s:?} {d:?}"
+            );
+            assert!((0..6).all(|i| dofs.contains(i) || d[i] == 0.0));
+            if dofs == CommandedDofs::ALL {
+                let m = tcm_svd_metrics(&t, l, 1e-20).unwrap();
+                let u = nalgebra::Matrix6::from(tl.clone() * tl.transpose()).symmetric_eigen();
+                let i = u.eigenvalues.imin();
+                let dot = u.eigenvectors.column(i).dot(&dv).abs();
+                assert!(approx(dot, 1.0, 1e-9), "{bend}: {dot} {m:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn tridiagonal_eigenvalues_match_nalgebra() {
+    // Random symmetric matrices of every size, plus diagonal ones (case 0).
+    let mut seed = 12345u64;
+    let mut unit = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for k in 1..=6 {
+        for case in 0..50 {
+            let mut a = [[0.0; 6]; 6];
+            for i in 0..k {
+                for j in 0..=i {
+                    let x = if case == 0 && i != j { 0.0 } else { unit() };
+                    a[i][j] = x;
+                    a[j][i] = x;
+                }
+            }
+            let m = nalgebra::DMatrix::from_fn(k, k, |i, j| a[i][j]);
+            let mut want: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+            let mut got = super::super::small_svd::tridiagonal_eigenvalues(&mut a, k);
+            got[..k].sort_by(f64::total_cmp);
+            want.sort_by(f64::total_cmp);
+            for i in 0..k {
+                assert!(
+                    (got[i] - want[i]).abs() < 1e-14,
+                    "k={k} case {case}: {got:?} vs {want:?}"
+                );
+            }
+        }
+    }
 }

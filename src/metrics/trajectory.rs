@@ -136,7 +136,7 @@ pub fn time_fraction(t: &[f64], flag: impl Fn(usize) -> bool) -> f64 {
     (1..t.len())
         .filter(|&k| flag(k - 1))
         .map(|k| t[k] - t[k - 1])
-        .sum::<f64>()
+        .fold(0.0, |a, b| a + b)
         / span
 }
 

@@ -197,7 +197,7 @@ fn case_metrics(study: &Study, r: &Resolved, log: bool) -> CaseMetrics {
         let s = static_spec(&r.scenario, derive_seed(r.seed, 1))
             .map_err(|m| m.to_string())
             .and_then(|spec| {
-                analyse(&v, &spec, 1, &mut |_| Ok(()), &|_| {}).map_err(|e| e.to_string())
+                analyse(&v, &spec, 1, &mut |_, _, _| Ok(()), &|_| {}).map_err(|e| e.to_string())
             });
         match s {
             Ok(s) => out.named.extend(named(&TCM_COLUMNS, &tcm_metrics(&s))),

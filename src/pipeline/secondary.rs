@@ -148,7 +148,7 @@ pub fn secondary_profile(
     let mut probe = SecondaryTasks::new(
         v,
         SecondarySettings::default(),
-        file.commanded_dofs(v),
+        file.commanded(),
         file.char_length(v),
     )
     .map_err(|e| ScenarioError::Invalid(e.to_string()))?;

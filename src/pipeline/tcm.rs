@@ -4,11 +4,13 @@
 //! Writes to the output directory:
 //! - `samples.csv`: one row per sample (streamed; memory stays bounded for any N):
 //!   `index`, `q1_rad … qn_rad`, `sigma_min` (scaled σ_min, N per N), `kappa`, `rank`,
-//!   `lost_axis` (empty unless σ_min < threshold or rank < 6);
+//!   `lost_axis` (empty unless σ_min < threshold or rank < 6), then `sigma_min_commanded`
+//!   and `kappa_commanded` of the rows the mode's controller commands (SPEC §6);
 //! - `samples.parquet`: the same table, only when N ≤ [`PARQUET_MAX_ROWS`] (larger tables stay
 //!   CSV only);
 //! - `summary.json`: the [`StaticSummary`] plus the slice joints and the files written;
-//! - `sigma_min_hist.svg`: histogram of σ_min; `sigma_min_slice.svg`: σ_min over a 2-D slice
+//! - `sigma_min_hist.svg`, `sigma_min_commanded_hist.svg`: histograms of the full and the
+//!   commanded σ_min; `sigma_min_slice.svg`: σ_min over a 2-D slice
 //!   of joint space (the two most influential yaw joints, or the given pair; others 0).
 
 use std::path::{Path, PathBuf};
@@ -21,9 +23,8 @@ use crate::report::{
     atomic_write, heatmap, histogram, read_csv_typed, write_parquet, ColourScale, ColumnKind,
     CsvAppender, Value,
 };
-use crate::study::static_tcm::{
-    analyse, influential_joints, slice_grid, StaticSpec, StaticSummary,
-};
+use crate::study::static_tcm::{analyse, StaticSpec, StaticSummary};
+use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 /// Largest sample count for which `samples.parquet` is written.
 pub const PARQUET_MAX_ROWS: usize = 200_000;
@@ -61,6 +62,8 @@ fn sample_schema(n: usize) -> Vec<(String, ColumnKind)> {
         ("kappa".to_string(), ColumnKind::F64),
         ("rank".to_string(), ColumnKind::I64),
         ("lost_axis".to_string(), ColumnKind::Str),
+        ("sigma_min_commanded".to_string(), ColumnKind::F64),
+        ("kappa_commanded".to_string(), ColumnKind::F64),
     ]);
     schema
 }
@@ -85,21 +88,25 @@ pub fn run_tcm(
     let csv_path = out.join("samples.csv");
     let mut app = CsvAppender::create(&csv_path, &schema)?;
     let mut sigmas: Vec<f64> = Vec::with_capacity(spec.samples);
+    let mut commanded: Vec<f64> = Vec::with_capacity(spec.samples);
     let mut row: Vec<Value> = Vec::with_capacity(schema.len());
     let summary = analyse(
         vehicle,
         spec,
         config.jobs,
-        &mut |e| {
-            sigmas.push(e.sigma_min);
+        &mut |index, q, m| {
+            sigmas.push(m.sigma_min);
+            commanded.push(m.sigma_min_commanded);
             row.clear();
-            row.push(Value::I64(e.index as i64));
-            row.extend(e.q.iter().map(|q| Value::F64(*q)));
+            row.push(Value::I64(index as i64));
+            row.extend(q.iter().map(|q| Value::F64(*q)));
             row.extend([
-                Value::F64(e.sigma_min),
-                Value::F64(e.kappa),
-                Value::I64(e.rank as i64),
-                Value::Str(e.lost_axis.unwrap_or("")),
+                Value::F64(m.sigma_min),
+                Value::F64(m.kappa),
+                Value::I64(m.rank as i64),
+                Value::Str(m.lost_axis.unwrap_or("")),
+                Value::F64(m.sigma_min_commanded),
+                Value::F64(m.kappa_commanded),
             ]);
             app.append(&row).map_err(|e| e.to_string())
         },
@@ -113,18 +120,26 @@ pub fn run_tcm(
         write_parquet(&t, &out.join("samples.parquet"))?;
         files.push("samples.parquet".into());
     }
-    histogram(
-        &sigmas,
-        50,
-        &format!(
-            "{}: scaled σ_min of T(q), {} samples",
-            vehicle.name, spec.samples
+    for (values, file, what) in [
+        (sigmas, "sigma_min_hist.svg", "scaled σ_min of T(q)"),
+        (
+            commanded,
+            "sigma_min_commanded_hist.svg",
+            &format!(
+                "σ_min of the {} rows ({})",
+                summary.mode, summary.commanded_axes
+            ),
         ),
-        "σ_min [N/N]",
-    )
-    .write_svg(&out.join("sigma_min_hist.svg"))?;
-    files.push("sigma_min_hist.svg".into());
-    drop(sigmas);
+    ] {
+        histogram(
+            &values,
+            50,
+            &format!("{}: {what}, {} samples", vehicle.name, spec.samples),
+            "σ_min [N/N]",
+        )
+        .write_svg(&out.join(file))?;
+        files.push(file.into());
+    }
     let slice_joints = write_slice(vehicle, config, out, &mut files)?;
     files.push("summary.json".into());
     let json = serde_json::to_string_pretty(&SummaryFile {

@@ -150,8 +150,12 @@ pub enum Channel {
     /// Axial inflow V_a of thruster j [m/s]: its velocity relative to the water along the
     /// direction it pushes the vehicle (positive when moving the way it pushes).
     Inflow(usize),
-    /// Scaled σ_min of the thruster configuration matrix T(q) (SPEC §6).
+    /// Scaled σ_min of the thruster configuration matrix T(q), all six wrench axes (SPEC §6).
     SigmaMin,
+    /// Scaled σ_min of the rows of T(q) the controller commands, `S·T_L` (SPEC §6): the
+    /// weakest commanded wrench per newton of thrust norm (N per N), see
+    /// [`crate::metrics::singularity::commanded_sigma`].
+    SigmaMinCommanded,
     /// Allocation slack norm ‖s‖ [N or N·m].
     SlackNorm,
     /// Allocation status code: 0 solved, 1 slack active, 2 bounds violated, 3 failed.
@@ -189,6 +193,7 @@ impl Channel {
             Channel::EeOrientationError => "ee_orientation_error",
             Channel::EeDamping => "ee_damping",
             Channel::SigmaMin => "sigma_min",
+            Channel::SigmaMinCommanded => "sigma_min_commanded",
             Channel::SlackNorm => "slack_norm",
             Channel::AllocStatus => "alloc_status",
             Channel::JointWork => "joint_work",
@@ -213,7 +218,8 @@ impl Channel {
 
 /// The channels of a run in column order: time, base and end-effector pose and twist, the
 /// mode's channels, the per-joint blocks (q, q_ref, q̇, τ), the joint work, the per-thruster blocks
-/// (commanded, actual, power, inflow), then σ_min and the allocation outcome.
+/// (commanded, actual, power, inflow), then σ_min (all axes, then the commanded ones) and the
+/// allocation outcome.
 pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Channel> {
     let mut c = vec![Channel::T];
     c.extend(Pose::ALL.map(Channel::BasePose));
@@ -239,7 +245,12 @@ pub fn channel_layout(mode: Mode, n_joints: usize, n_thrusters: usize) -> Vec<Ch
     for family in [Channel::UCmd, Channel::U, Channel::Power, Channel::Inflow] {
         c.extend((0..n_thrusters).map(family));
     }
-    c.extend([Channel::SigmaMin, Channel::SlackNorm, Channel::AllocStatus]);
+    c.extend([
+        Channel::SigmaMin,
+        Channel::SigmaMinCommanded,
+        Channel::SlackNorm,
+        Channel::AllocStatus,
+    ]);
     c
 }
 
@@ -348,7 +359,7 @@ mod tests {
             base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
             ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
             base_cross_track path_y q_0 qref_0 qd_0 tau_0 joint_work ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
-            inflow_0 inflow_1 sigma_min slack_norm alloc_status";
+            inflow_0 inflow_1 sigma_min sigma_min_commanded slack_norm alloc_status";
         assert_eq!(names.join(" "), expected);
         let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
             .into_iter()

@@ -49,7 +49,7 @@ use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
-use crate::metrics::singularity::CommandedDofs;
+use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
 pub use physics::{PhysicsSpec, ServoSpec, ThrusterSpec};
 use crate::model::Vehicle;
@@ -64,6 +64,38 @@ pub enum Mode {
     Transport,
     /// End-effector setpoint regulation with the base as secondary task (USM-42).
     Work,
+}
+
+impl Mode {
+    /// The base axes the mode's default controller commands (SPEC §5), as
+    /// [`ScenarioFile::commanded_dofs`] of a file without `[control]`/`[base_control]`: both
+    /// of the paper's modes leave roll free (`K_p,roll = 0`; work: zero base-roll weight).
+    pub fn default_commanded_dofs(self) -> CommandedDofs {
+        match self {
+            Mode::Transport => commanded_for(
+                &ModeGains::Transport(Default::default()),
+                &DynamicGains::transport(),
+            ),
+            Mode::Work => commanded_for(
+                &ModeGains::Work(WorkGains::default()),
+                &DynamicGains::work_mode(),
+            ),
+        }
+    }
+}
+
+/// The axes commanded under the mode gains `mode` and the base gains `base` (see
+/// [`CommandedDofs::transport`], [`CommandedDofs::work`]).
+fn commanded_for(mode: &ModeGains, base: &DynamicGains) -> CommandedDofs {
+    match mode {
+        ModeGains::Transport(_) if base.uncommanded_feedback => CommandedDofs::transport(&base.kp),
+        ModeGains::Transport(_) => CommandedDofs::transport(&[0.0; 6]),
+        ModeGains::Work(g) => {
+            let w = g.weights_for(0);
+            let base_w = std::array::from_fn(|i| w.get(i).copied().unwrap_or(0.0));
+            CommandedDofs::work(&base_w, &base.kp, &base.ki)
+        }
+    }
 }
 
 impl fmt::Display for Mode {
@@ -237,8 +269,15 @@ impl AllocationSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MetricsSpec {
-    /// σ_min threshold of the scaled T(q) below which a configuration counts as singular.
+    /// σ_min threshold of the scaled T(q) (N per N) below which a configuration counts as
+    /// singular, for both `singularity_exposure` (the commanded rows) and
+    /// `singularity_exposure_full` (all six). Default
+    /// [`SINGULARITY_THRESHOLD`], the one the static analysis uses too.
     pub threshold: f64,
+    /// Relative tolerance of `allocation_residual_fraction`: a control step counts when the
+    /// commanded slack exceeds this fraction of the commanded wrench
+    /// ([`crate::metrics::singularity::residual_exceeds`]). Default [`RESIDUAL_TOLERANCE`].
+    pub residual_tolerance: f64,
     /// Characteristic length for scaling moments [m]; 0 = half the vehicle length.
     pub char_length: f64,
     /// Cross-track band for convergence [m] (transport).
@@ -263,7 +302,8 @@ impl Default for MetricsSpec {
     fn default() -> Self {
         let p = PowerModel::default();
         Self {
-            threshold: 0.05,
+            threshold: SINGULARITY_THRESHOLD,
+            residual_tolerance: RESIDUAL_TOLERANCE,
             char_length: 0.0,
             band: 0.1,
             position_tolerance: 0.02,
@@ -367,22 +407,20 @@ impl ScenarioFile {
             })
     }
 
-    /// The base axes the mode commands (SPEC §6, the rows `S` of the commanded-subspace σ_min):
-    /// transport — surge, yaw and the axes with `K_p > 0` when the base control feeds back on
-    /// the uncommanded axes ([`CommandedDofs::transport`]); work — the axes with a positive base
-    /// usage weight or base-control gain ([`CommandedDofs::work`]). Gains that do not parse
-    /// count as the mode's defaults.
-    pub fn commanded_dofs(&self, v: &Vehicle) -> CommandedDofs {
-        let b = self.base_gains();
-        match self.mode_gains() {
-            Ok(ModeGains::Work(g)) => {
-                let u = g.weights_for(v.n_joints());
-                let base_u = std::array::from_fn(|i| u.get(i).copied().unwrap_or(0.0));
-                CommandedDofs::work(&base_u, &b.kp, &b.ki)
-            }
-            _ if b.uncommanded_feedback => CommandedDofs::transport(&b.kp),
-            _ => CommandedDofs::transport(&[0.0; 6]),
-        }
+    /// The base axes this scenario's controller commands (SPEC §5), from its mode, `[control]`
+    /// and `[base_control]` gains: the selection `S` of `singularity_exposure` and
+    /// `allocation_residual_fraction` ([`CommandedDofs::transport`] — surge, yaw and the axes
+    /// with `K_p > 0` when the base control feeds back on the uncommanded axes —,
+    /// [`CommandedDofs::work`]).
+    pub fn commanded_dofs(&self) -> Result<CommandedDofs, KeyError> {
+        Ok(commanded_for(&self.mode_gains()?, &self.base_gains()))
+    }
+
+    /// [`Self::commanded_dofs`], or the mode's default controller's
+    /// ([`Mode::default_commanded_dofs`]) when the gains do not parse.
+    pub fn commanded(&self) -> CommandedDofs {
+        self.commanded_dofs()
+            .unwrap_or_else(|_| self.scenario.mode.default_commanded_dofs())
     }
 
     /// The characteristic length L [m] of the scaled TCM: `metrics.char_length`, or half the
@@ -566,6 +604,7 @@ impl ScenarioFile {
         let m = &self.metrics;
         for (k, v) in [
             ("metrics.threshold", m.threshold),
+            ("metrics.residual_tolerance", m.residual_tolerance),
             ("metrics.band", m.band),
             ("metrics.position_tolerance", m.position_tolerance),
             (

@@ -107,7 +107,7 @@ fn secondary_tasks(v: &Vehicle, file: &ScenarioFile) -> Result<SecondaryTasks, S
     SecondaryTasks::new(
         v,
         file.secondary.clone(),
-        file.commanded_dofs(v),
+        file.commanded(),
         file.char_length(v),
     )
     .map_err(|e| ScenarioError::Invalid(e.to_string()))

@@ -12,7 +12,7 @@ use super::setup::ClosedLoop;
 use crate::allocation::{AllocPath, AllocStatus, Allocation};
 use crate::dynamics::SimState;
 use crate::kinematics::KinWorkspace;
-use crate::metrics::singularity::sigma_min_scaled_gram;
+use crate::metrics::singularity::{commanded_sigma, residual_exceeds, CommandedDofs};
 use crate::metrics::trajectory::{
     EnergyIntegrator, EnergyMetrics, PowerModel, PowerSample, ThrusterSample,
 };
@@ -22,11 +22,20 @@ use serde::Serialize;
 use std::time::Instant;
 
 /// Add the wall time of an expression to a timer [s] and yield its value.
+/// With a third argument (a [`StepTimes`] series), also record the duration as one sample.
 macro_rules! timed {
     ($timer:expr, $body:expr) => {{
         let started = std::time::Instant::now();
         let value = $body;
         $timer += started.elapsed().as_secs_f64();
+        value
+    }};
+    ($timer:expr, $series:expr, $body:expr) => {{
+        let started = std::time::Instant::now();
+        let value = $body;
+        let dt = started.elapsed().as_secs_f64();
+        $timer += dt;
+        $series.push(dt);
         value
     }};
 }
@@ -49,10 +58,47 @@ pub struct Timing {
     pub allocation_s: f64,
     /// Time in kinematics, guidance and control laws [s].
     pub control_s: f64,
-    /// Time logging (including σ_min of T(q)) [s].
+    /// Time logging (including the σ_min of T(q)) [s].
     pub logging_s: f64,
     /// Real-time factor: simulated seconds per wall second.
     pub realtime_factor: f64,
+    /// Median wall time of one allocation (one control step's thrust allocation) [µs].
+    pub allocation_step_median_us: f64,
+    /// Median wall time of one whole control period (measure, control, allocate, record and
+    /// the physics up to the next tick) [µs].
+    pub control_period_median_us: f64,
+}
+
+/// Per-step wall times of a run [s], one sample per control period, reserved for the whole
+/// run at setup so that recording them never allocates.
+pub(crate) struct StepTimes {
+    samples: Vec<f64>,
+}
+
+impl StepTimes {
+    /// Room for `n` samples.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            samples: Vec::with_capacity(n),
+        }
+    }
+
+    /// Record one duration [s] (dropped beyond the reserved capacity, so never allocates).
+    pub fn push(&mut self, dt: f64) {
+        if self.samples.len() < self.samples.capacity() {
+            self.samples.push(dt);
+        }
+    }
+
+    /// The median [µs] (the upper one of an even count); NaN without samples.
+    fn median_us(&mut self) -> f64 {
+        let n = self.samples.len();
+        if n == 0 {
+            return f64::NAN;
+        }
+        let (_, m, _) = self.samples.select_nth_unstable_by(n / 2, f64::total_cmp);
+        *m * 1e6
+    }
 }
 
 /// How the allocations of a run went, counted over control periods: outcomes, and which path
@@ -73,6 +119,10 @@ pub struct AllocationCounts {
     pub clarabel: u64,
     /// `pinv` steps ([`AllocPath::Pinv`]).
     pub pinv: u64,
+    /// Allocations that did not deliver the commanded wrench: the commanded slack exceeds
+    /// `[metrics] residual_tolerance` times the commanded wrench
+    /// ([`residual_exceeds`]; `allocation_residual_fraction = residual / steps`).
+    pub residual: u64,
 }
 
 impl AllocationCounts {
@@ -179,6 +229,10 @@ pub(crate) struct Recorder {
     log_every: usize,
     /// Characteristic length for the scaled σ_min of T(q) [m].
     char_length: f64,
+    /// The base axes the controller commands (the rows of `S·T_L`).
+    commanded: CommandedDofs,
+    /// Relative tolerance of the commanded allocation residual.
+    residual_tol: f64,
     power: PowerModel,
     /// Thruster limits `(u_min, u_max)` [N].
     limits: Vec<(f64, f64)>,
@@ -196,6 +250,10 @@ pub(crate) struct Recorder {
     pub energy: EnergyIntegrator,
     /// Wall-clock timers.
     pub timing: Timing,
+    /// Wall time of each allocation.
+    pub allocation_steps: StepTimes,
+    /// Wall time of each control period.
+    pub control_periods: StepTimes,
 }
 
 impl Recorder {
@@ -211,6 +269,8 @@ impl Recorder {
             row,
             log_every: (s.log_dt / s.control_dt).round() as usize,
             char_length: file.char_length(v),
+            commanded: file.commanded(),
+            residual_tol: file.metrics.residual_tolerance,
             power: file.power_model(v.fluid.rho),
             limits: v.thrusters.iter().map(|t| (t.u_min, t.u_max)).collect(),
             sat_tol: file.metrics.saturation_tolerance,
@@ -219,6 +279,8 @@ impl Recorder {
             counts: AllocationCounts::default(),
             energy: EnergyIntegrator::default(),
             timing: Timing::default(),
+            allocation_steps: StepTimes::with_capacity(lp.n_control + 1),
+            control_periods: StepTimes::with_capacity(lp.n_control + 1),
         }
     }
 
@@ -226,9 +288,19 @@ impl Recorder {
     /// kinematics of the tick): the thrust the simulator will hold over the coming interval
     /// (the allocation saturated to the limits; a thruster lag or rate limit, if configured,
     /// is not followed) and each thruster's axial inflow. Also tracks the guided point along
-    /// the path (transport). The sample is for [`EnergyIntegrator::add`] once the interval
-    /// has been simulated.
+    /// the path (transport) and counts the tick's allocation if it left a commanded residual
+    /// ([`AllocationCounts::residual`]). The sample is for [`EnergyIntegrator::add`] once the
+    /// interval has been simulated.
     pub fn sample(&mut self, lp: &ClosedLoop) -> PowerSample {
+        if residual_exceeds(
+            &lp.alloc.s,
+            &lp.cmd.tau_c,
+            self.char_length,
+            self.commanded,
+            self.residual_tol,
+        ) {
+            self.counts.residual += 1;
+        }
         let (v, state) = (&lp.vehicle, lp.sim.state());
         for ((u, a), th) in self.thrust.iter_mut().zip(&lp.alloc.u).zip(&v.thrusters) {
             *u = a.clamp(th.u_min, th.u_max);
@@ -324,9 +396,14 @@ impl Recorder {
             held.enumerate()
                 .map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)),
         );
+        let l = self.char_length;
         w.put(
             Channel::SigmaMin,
-            sigma_min_scaled_gram(&lp.t_mat, self.char_length),
+            commanded_sigma(&lp.t_mat, l, CommandedDofs::ALL).sigma_min,
+        );
+        w.put(
+            Channel::SigmaMinCommanded,
+            commanded_sigma(&lp.t_mat, l, self.commanded).sigma_min,
         );
         w.put(Channel::SlackNorm, lp.alloc.s.norm());
         w.put(Channel::AllocStatus, status_code(&lp.alloc.status));
@@ -334,13 +411,16 @@ impl Recorder {
     }
 
     /// The trajectory, the allocation counts, the energy integrals and the timers, with the
-    /// total wall time since `started` and the real-time factor filled in.
+    /// total wall time since `started`, the real-time factor and the per-step medians filled
+    /// in.
     pub fn finish(
         mut self,
         started: Instant,
     ) -> (Trajectory, AllocationCounts, EnergyMetrics, Timing) {
         let timing = &mut self.timing;
         timing.total_s = started.elapsed().as_secs_f64();
+        timing.allocation_step_median_us = self.allocation_steps.median_us();
+        timing.control_period_median_us = self.control_periods.median_us();
         let simulated = self
             .traj
             .get(Channel::T)

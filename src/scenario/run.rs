@@ -136,7 +136,11 @@ impl ClosedLoop<'_> {
         let terms = timed!(rec.timing.dynamics_s, self.sim.base_control_terms())
             .map_err(|e| (t, e.to_string()))?;
         timed!(rec.timing.control_s, self.control(t, &measured, &terms));
-        timed!(rec.timing.allocation_s, self.allocate(t))?;
+        timed!(
+            rec.timing.allocation_s,
+            rec.allocation_steps,
+            self.allocate(t)
+        )?;
         rec.counts.count(&self.alloc);
         let sample = timed!(rec.timing.logging_s, rec.sample(self));
         timed!(rec.timing.logging_s, rec.observe(k, t, self));
@@ -177,7 +181,11 @@ pub fn run_scenario_until(
         if deadline.is_some_and(|d| Instant::now() >= d) {
             return Some((k as f64 * file.scenario.control_dt, TIMEOUT.to_string()));
         }
-        lp.period(k, &mut rec).err()
+        let period_started = Instant::now();
+        let result = lp.period(k, &mut rec);
+        rec.control_periods
+            .push(period_started.elapsed().as_secs_f64());
+        result.err()
     });
     let stats = lp.sim.step_stats();
     rec.timing.physics_steps = stats.steps;

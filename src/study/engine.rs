@@ -202,7 +202,7 @@ pub fn run_sweep(
         &read_csv_typed(&partial, &schema)?,
         Some(&streamed.plan_hashes),
     )?;
-    let table = write_tables(&raw, &out)?;
+    let table = write_tables(raw, &out)?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;

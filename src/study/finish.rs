@@ -76,7 +76,7 @@ pub fn report(dir: &Path) -> Result<Vec<String>, StudyError> {
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
         let schema = m.schema().map_err(StudyError::Input)?;
-        final_table(&read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
+        final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
     Ok(write_report(dir, &table, &m))
 }

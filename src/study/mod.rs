@@ -9,6 +9,7 @@
 //! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
 //! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
 //! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
+//! - [`static_tcm_slice`]: σ_min over 2-D slices of joint space, the most influential joints.
 //! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
 //! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
 //! - [`parse`]: study files (TOML) → validated [`Study`].
@@ -43,6 +44,8 @@ pub mod selection;
 pub mod shards;
 pub mod static_table;
 pub mod static_tcm;
+mod static_tcm_eval;
+pub mod static_tcm_slice;
 pub mod summary;
 pub mod worker;
 

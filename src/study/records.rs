@@ -184,8 +184,9 @@ pub const DESIGN_COLUMNS: [&str; 5] = [
     "design_mass_kg",
 ];
 
-/// Static TCM metric columns (present when the static analysis runs).
-pub const TCM_COLUMNS: [&str; 15] = [
+/// Static TCM metric columns (present when the static analysis runs): the full 6-DOF figures,
+/// then (`…_commanded`) those of the rows the mode's controller commands.
+pub const TCM_COLUMNS: [&str; 21] = [
     TCM_SINGULAR_FRACTION,
     "tcm_rank_deficient_fraction",
     "tcm_sigma_min_min",
@@ -201,6 +202,12 @@ pub const TCM_COLUMNS: [&str; 15] = [
     "tcm_lost_roll",
     "tcm_lost_pitch",
     "tcm_lost_yaw",
+    "tcm_singular_fraction_commanded",
+    "tcm_sigma_min_commanded_min",
+    "tcm_sigma_min_commanded_p05",
+    "tcm_sigma_min_commanded_p50",
+    "tcm_kappa_commanded_p50",
+    "tcm_straight_sigma_min_commanded",
 ];
 
 /// Raw column packing the scenario metrics of dynamic modes (`name=value;…`).
@@ -375,26 +382,36 @@ pub fn compact(raw: &Table, keep: Option<&HashSet<String>>) -> Result<Table, Stu
 
 /// The final table from compacted raw rows: `case_id`, `hash`, axes and metrics (scenario
 /// metrics unpacked into columns in order of first appearance), `status`, `reason`.
-pub fn final_table(raw: &Table) -> Result<Table, StudyError> {
+pub fn final_table(raw: Table) -> Result<Table, StudyError> {
+    // Columns are moved, not copied: the raw and the final table of a large study never
+    // coexist (issue 11: the 100 000-case static study's peak memory).
+    let mut head: Vec<Option<Column>> = vec![None, None];
+    let mut tail: Vec<Option<Column>> = vec![None, None];
     let mut cols: Vec<Column> = Vec::new();
-    let get = |n: &str| raw.column(n).cloned();
-    for n in [CASE_ID, HASH] {
-        cols.extend(get(n));
-    }
-    let mut packed: Option<&[String]> = None;
-    for c in &raw.columns {
-        if RAW_HEAD.contains(&c.name.as_str()) {
-            continue;
+    let mut packed: Option<Vec<String>> = None;
+    for c in raw.columns {
+        if let Some(k) = [CASE_ID, HASH].iter().position(|n| *n == c.name) {
+            head[k] = Some(c);
+        } else if let Some(k) = [STATUS, REASON].iter().position(|n| *n == c.name) {
+            tail[k] = Some(c);
+        } else if c.name == SCENARIO_METRICS_COLUMN {
+            match c.data {
+                ColumnData::Str(v) => packed = Some(v),
+                _ => {
+                    return Err(StudyError::Input(format!(
+                        "column {SCENARIO_METRICS_COLUMN} is not text"
+                    )))
+                }
+            }
+        } else {
+            cols.push(c);
         }
-        if c.name == SCENARIO_METRICS_COLUMN {
-            packed = Some(raw.str(&c.name)?);
-            continue;
-        }
-        cols.push(c.clone());
     }
-    if let Some(p) = packed {
+    if let Some(p) = &packed {
         for (n, d) in unpack_metrics(p) {
-            if raw.column(&n).is_some() || cols.iter().any(|c| c.name == n) {
+            if cols.iter().any(|c| c.name == n)
+                || [CASE_ID, HASH, STATUS, REASON].contains(&n.as_str())
+            {
                 continue;
             }
             cols.push(Column {
@@ -403,16 +420,15 @@ pub fn final_table(raw: &Table) -> Result<Table, StudyError> {
             });
         }
     }
-    for n in [STATUS, REASON] {
-        cols.extend(get(n));
-    }
+    let mut cols: Vec<Column> = head.into_iter().flatten().chain(cols).collect();
+    cols.extend(tail.into_iter().flatten());
     Ok(Table::from_columns(cols)?)
 }
 
 /// Write compacted raw rows to the partial file of `out` and the final table to
-/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table.
-pub fn write_tables(raw: &Table, out: &Path) -> Result<Table, StudyError> {
-    write_csv(raw, &out.join(PARTIAL_FILE))?;
+/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table (built from `raw`'s columns).
+pub fn write_tables(raw: Table, out: &Path) -> Result<Table, StudyError> {
+    write_csv(&raw, &out.join(PARTIAL_FILE))?;
     let table = final_table(raw)?;
     write_csv(&table, &out.join(CASES_CSV))?;
     write_parquet(&table, &out.join(CASES_PARQUET))?;

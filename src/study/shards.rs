@@ -33,7 +33,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
     let raw = compact(&Table::concat(&tables)?, None)?;
     let _lock = outdir::lock(out)?;
     let mut warnings = outdir::claim(out, &m0.study_name, false)?;
-    let table = write_tables(&raw, out)?;
+    let table = write_tables(raw, out)?;
     if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
         std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
     }

@@ -6,6 +6,7 @@ use serde::Deserialize;
 
 use super::static_tcm::StaticSpec;
 use crate::sampling::Sampling;
+use crate::scenario::config::{Mode, ScenarioFile};
 
 /// The key of the `[static]` table in study files and resolved scenario-side tables.
 pub const STATIC_TABLE: &str = "static";
@@ -19,6 +20,7 @@ struct StaticFile {
     sampling: Option<String>,
     char_length: Option<f64>,
     rank_rel_tol: Option<f64>,
+    mode: Option<Mode>,
 }
 
 /// Defaults of the `[static]` table, from [`StaticSpec::default`] (`char_length = 0`: half
@@ -37,12 +39,36 @@ pub fn static_default_table() -> toml::Table {
         toml::Value::Float(d.char_length.unwrap_or(0.0)),
     );
     t.insert("rank_rel_tol".into(), toml::Value::Float(d.rank_rel_tol));
+    t.insert("mode".into(), toml::Value::String(d.mode.to_string()));
     t
 }
 
+/// The closed-loop mode of a resolved scenario-side table (`[scenario] mode`), if it is one.
+fn scenario_mode(scenario: &toml::Table) -> Option<Mode> {
+    let m = scenario.get("scenario")?.get("mode")?.as_str()?;
+    toml::Value::String(m.into()).try_into().ok()
+}
+
+/// The axes commanded in `mode`: those of the study's own scenario when it runs that mode
+/// (its `[control]` and `[base_control]` gains, [`ScenarioFile::commanded_dofs`]), else the
+/// mode's default controller's ([`Mode::default_commanded_dofs`]).
+fn commanded_in(scenario: &toml::Table, mode: Mode) -> crate::metrics::singularity::CommandedDofs {
+    let own = (scenario_mode(scenario) == Some(mode))
+        .then(|| {
+            let mut sc = scenario.clone();
+            sc.remove(STATIC_TABLE);
+            toml::Value::Table(sc).try_into::<ScenarioFile>().ok()
+        })
+        .flatten()
+        .and_then(|f| f.commanded_dofs().ok());
+    own.unwrap_or_else(|| mode.default_commanded_dofs())
+}
+
 /// The static-analysis settings of a resolved scenario-side table (`[static]`, with
-/// `metrics.char_length` as the fallback characteristic length), seeded with `seed`. No
-/// configurations are kept (`worst = 0`): sweeps record only the aggregate metrics.
+/// `metrics.char_length` as the fallback characteristic length and `metrics.threshold` as the
+/// fallback threshold), seeded with `seed`. The commanded axes are those of `static.mode`
+/// (default: the study's closed-loop mode, else transport). No configurations are kept
+/// (`worst = 0`): sweeps record only the aggregate metrics.
 pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, String> {
     let t = scenario
         .get(STATIC_TABLE)
@@ -63,14 +89,21 @@ pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, Stri
         Some(l) if l != 0.0 => Some(l),
         _ => metrics_l,
     };
+    let metrics_threshold = scenario
+        .get("metrics")
+        .and_then(|m| m.get("threshold"))
+        .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)));
+    let mode = f.mode.or(scenario_mode(scenario)).unwrap_or(d.mode);
     let spec = StaticSpec {
         samples: f.samples.unwrap_or(d.samples),
         seed,
-        threshold: f.threshold.unwrap_or(d.threshold),
+        threshold: f.threshold.or(metrics_threshold).unwrap_or(d.threshold),
         sampling,
         char_length,
         rank_rel_tol: f.rank_rel_tol.unwrap_or(d.rank_rel_tol),
         worst: 0,
+        mode,
+        commanded: commanded_in(scenario, mode),
     };
     spec.validate().map_err(|e| e.to_string())?;
     if spec.samples > MAX_CASE_SAMPLES {

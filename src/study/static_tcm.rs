@@ -4,30 +4,45 @@
 //! Joint configurations are drawn uniformly within the joint limits by a
 //! [`crate::sampling::Sampler`] (random, Latin hypercube or scrambled Sobol); for each sample
 //! `T(q)` ([`crate::kinematics::thruster_matrix`]) is scored by the scaled singularity metrics
-//! of [`crate::metrics::singularity`] (moment rows divided by a characteristic length `L`).
+//! of [`crate::metrics::singularity`] (moment rows divided by a characteristic length `L`):
+//! σ_min and κ of all six rows and of the rows the mode's controller commands
+//! ([`StaticSpec::commanded`], [`crate::metrics::singularity::commanded_sigma`]), against the
+//! one threshold the trajectory metrics share
+//! ([`crate::metrics::singularity::SINGULARITY_THRESHOLD`]).
+//!
+//! Speed: the design is built once per case and shared; each configuration costs one forward
+//! kinematics pass and two small allocation-free eigenvalue problems (the Gram matrix of
+//! `S·T_L`); workers evaluate batches into preallocated
+//! buffers.
 //!
 //! Determinism: sample `i` is a pure function of `(seed, i)` (and `n` for LHS); samples are
 //! evaluated in parallel in chunks and aggregated strictly in index order, so every number of
 //! the [`StaticSummary`] — including means — is bit-identical for any thread count.
 //!
-//! Memory: per-sample rows are handed to a caller-supplied sink in index order, one chunk of
-//! [`CHUNK`] samples at a time; the summary keeps σ_min and κ of every sample for exact
-//! quantiles (16 bytes per sample) and the [`StaticSpec::worst`] lowest-σ_min configurations.
+//! Memory: per-sample rows are handed to a caller-supplied sink in index order (as borrowed
+//! slices, one chunk of [`CHUNK`] samples at a time with threads, one by one without); the
+//! summary keeps σ_min and κ, full and commanded, of every sample for exact quantiles (32 bytes
+//! per sample) and the [`StaticSpec::worst`] lowest-σ_min configurations.
 
-use nalgebra::{Matrix6, Matrix6xX};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
+use super::static_tcm_eval::{local_pool, map_joint, Eval, Scratch};
 use crate::metrics::singularity::{
-    scale_moment_rows, tcm_svd_metrics, SingularityError, AXIS_NAMES, DEFAULT_RANK_REL_TOL,
+    CommandedDofs, SingularityError, AXIS_NAMES, DEFAULT_RANK_REL_TOL, SINGULARITY_THRESHOLD,
 };
 use crate::model::Vehicle;
 use crate::sampling::{Sampler, Sampling};
+use crate::scenario::config::Mode;
+
+pub use super::static_tcm_eval::SampleMetrics;
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
 /// for streaming rows).
 pub const CHUNK: usize = 4096;
+
+/// Samples per worker batch within a chunk (one scratch per batch).
+const BATCH: usize = 256;
 
 /// Largest sample count accepted with Latin hypercube sampling (its permutation tables hold
 /// `samples × joints` 32-bit integers); use Sobol for more.
@@ -35,11 +50,15 @@ pub const MAX_LHS_SAMPLES: usize = 2_000_000;
 
 /// Default number of joint configurations sampled (`[static] samples` in study files,
 /// `tcm --samples`): the singular fraction then has a standard error of at most 1.6 %, and one
-/// case costs about 30 ms (one SVD of `T` per sample).
+/// case costs about 1–2 ms.
 pub const DEFAULT_SAMPLES: usize = 1000;
 
-/// Default threshold on the scaled σ_min below which `T` counts as (near-)singular.
-pub const DEFAULT_THRESHOLD: f64 = 0.02;
+/// Default threshold on the scaled σ_min below which `T` counts as (near-)singular: the one
+/// shared with the trajectory metrics, [`SINGULARITY_THRESHOLD`].
+pub const DEFAULT_THRESHOLD: f64 = SINGULARITY_THRESHOLD;
+
+/// Default mode whose commanded axes are scored ([`StaticSpec::mode`]).
+pub const DEFAULT_MODE: Mode = Mode::Transport;
 
 /// Default design of experiments in joint space.
 pub const DEFAULT_SAMPLING: Sampling = Sampling::Sobol;
@@ -98,6 +117,11 @@ pub struct StaticSpec {
     pub rank_rel_tol: f64,
     /// How many lowest-σ_min configurations to keep (default [`DEFAULT_WORST`]).
     pub worst: usize,
+    /// The closed-loop mode whose commanded axes are scored (default [`DEFAULT_MODE`]).
+    pub mode: Mode,
+    /// The base axes that mode's controller commands, the rows of `S·T_L` (default: the
+    /// mode's default controller, [`Mode::default_commanded_dofs`]).
+    pub commanded: CommandedDofs,
 }
 
 impl Default for StaticSpec {
@@ -110,6 +134,8 @@ impl Default for StaticSpec {
             char_length: None,
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
             worst: DEFAULT_WORST,
+            mode: DEFAULT_MODE,
+            commanded: DEFAULT_MODE.default_commanded_dofs(),
         }
     }
 }
@@ -160,23 +186,22 @@ impl StaticSpec {
     }
 }
 
-/// The metrics of one joint configuration.
+/// One joint configuration and its metrics (the worst samples and the straight configuration
+/// of a [`StaticSummary`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SampleEval {
     /// Sample index (0-based).
     pub index: usize,
     /// Joint angles [rad].
     pub q: Vec<f64>,
-    /// Smallest singular value of the scaled `T_L` (N per N).
-    pub sigma_min: f64,
-    /// Condition number σ_max/σ_min (`inf` when rank-deficient; JSON `null`).
-    pub kappa: f64,
-    /// Numerical rank of `T_L`.
-    pub rank: usize,
-    /// Dominant axis of the weakest wrench direction when σ_min is below the threshold or the
-    /// rank is below 6 (`surge` … `yaw`); `None` otherwise.
-    pub lost_axis: Option<&'static str>,
+    /// The metrics.
+    #[serde(flatten)]
+    pub metrics: SampleMetrics,
 }
+
+/// The consumer of the per-sample rows of [`analyse`], called in index order with the
+/// sample's index, joint angles [rad] and metrics; an `Err` stops the analysis.
+pub type RowSink<'a> = dyn FnMut(usize, &[f64], &SampleMetrics) -> Result<(), String> + 'a;
 
 /// Distribution of a per-sample quantity.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -191,6 +216,16 @@ pub struct Distribution {
     pub non_finite: usize,
     /// `(level, value)` pairs for [`QUANTILES`] (linear interpolation between order statistics).
     pub quantiles: Vec<(f64, f64)>,
+}
+
+impl Distribution {
+    /// The value at quantile level `p` if it is one of [`QUANTILES`].
+    pub fn quantile(&self, p: f64) -> Option<f64> {
+        self.quantiles
+            .iter()
+            .find(|(l, _)| *l == p)
+            .map(|(_, v)| *v)
+    }
 }
 
 /// How often one wrench axis is the lost (weakest) direction.
@@ -219,8 +254,12 @@ pub struct StaticSummary {
     pub seed: u64,
     /// Sampling method.
     pub sampling: String,
-    /// σ_min threshold.
+    /// σ_min threshold (N per N), shared by the full and the commanded figures.
     pub threshold: f64,
+    /// The mode whose commanded axes are scored (`transport`, `work`).
+    pub mode: String,
+    /// The commanded axes (`surge+sway+heave+pitch+yaw`).
+    pub commanded_axes: String,
     /// Characteristic length used [m].
     pub char_length: f64,
     /// Relative rank tolerance used.
@@ -233,93 +272,21 @@ pub struct StaticSummary {
     pub sigma_min: Distribution,
     /// Distribution of κ.
     pub kappa: Distribution,
+    /// Fraction of samples with the commanded σ_min below the threshold: how often the
+    /// controller loses authority over an axis it commands.
+    pub singular_fraction_commanded: f64,
+    /// Fraction of samples whose commanded rows `S·T_L` are rank-deficient.
+    pub rank_deficient_fraction_commanded: f64,
+    /// Distribution of the commanded σ_min.
+    pub sigma_min_commanded: Distribution,
+    /// Distribution of the commanded κ.
+    pub kappa_commanded: Distribution,
     /// The lowest-σ_min samples, ascending (ties by index).
     pub worst: Vec<SampleEval>,
     /// Lost-direction counts per axis, in axis order.
     pub lost_axes: Vec<AxisCount>,
     /// The straight configuration `q = 0`, for reference.
     pub straight: SampleEval,
-}
-
-impl StaticSummary {
-    /// The value of σ_min at quantile level `p` if it is one of [`QUANTILES`].
-    pub fn sigma_min_quantile(&self, p: f64) -> Option<f64> {
-        self.sigma_min
-            .quantiles
-            .iter()
-            .find(|(l, _)| *l == p)
-            .map(|(_, v)| *v)
-    }
-}
-
-/// Per-worker scratch: kinematics workspace and `T`.
-struct Scratch {
-    ws: KinWorkspace,
-    t: Matrix6xX<f64>,
-    u: Vec<f64>,
-    q: Vec<f64>,
-}
-
-impl Scratch {
-    fn new(v: &Vehicle) -> Self {
-        Self {
-            ws: KinWorkspace::new(v),
-            t: Matrix6xX::zeros(v.n_thrusters()),
-            u: vec![0.0; v.n_joints()],
-            q: vec![0.0; v.n_joints()],
-        }
-    }
-}
-
-/// Settings resolved for one vehicle.
-struct Eval<'a> {
-    v: &'a Vehicle,
-    l: f64,
-    tol: f64,
-    threshold: f64,
-}
-
-impl Eval<'_> {
-    /// Metrics at `q` (the scratch's `q`).
-    fn at(&self, s: &mut Scratch, index: usize) -> Result<SampleEval, StaticError> {
-        forward_kinematics(self.v, &s.q, &mut s.ws);
-        thruster_matrix(self.v, &s.ws, &mut s.t);
-        let m = tcm_svd_metrics(&s.t, self.l, self.tol).map_err(|source| StaticError::Metrics {
-            design: self.v.name.clone(),
-            source,
-        })?;
-        let lost_axis = if let Some(d) = m.lost_directions.first() {
-            Some(d.dominant_axis)
-        } else if m.sigma_min < self.threshold {
-            Some(weakest_axis(&s.t, self.l))
-        } else {
-            None
-        };
-        Ok(SampleEval {
-            index,
-            q: s.q.clone(),
-            sigma_min: m.sigma_min,
-            kappa: m.condition_number,
-            rank: m.rank,
-            lost_axis,
-        })
-    }
-}
-
-/// Dominant axis of the weakest direction of `T_L` (smallest eigenvector of `T_L T_Lᵀ`).
-fn weakest_axis(t: &Matrix6xX<f64>, l: f64) -> &'static str {
-    let tl = scale_moment_rows(t, l);
-    let g: Matrix6<f64> = &tl * tl.transpose();
-    let eig = g.symmetric_eigen();
-    let k = eig.eigenvalues.imin();
-    let (imax, _) = eig.eigenvectors.column(k).iamax_full();
-    AXIS_NAMES[imax]
-}
-
-fn map_joint(v: &Vehicle, u: &[f64], q: &mut [f64]) {
-    for ((qk, uk), j) in q.iter_mut().zip(u).zip(&v.joints) {
-        *qk = j.min + uk * (j.max - j.min);
-    }
 }
 
 /// Quantile at level `p` of sorted values (linear interpolation, "type 7"); `inf` propagates.
@@ -371,15 +338,17 @@ pub fn distribution(mut values: Vec<f64>) -> Distribution {
 /// Static TCM analysis of `vehicle` (SPEC §6).
 ///
 /// Samples `spec.samples` joint configurations uniformly within the joint limits, evaluates
-/// the scaled singularity metrics of `T(q)` for each, hands every sample to `sink` in index
-/// order, reports progress (samples done) through `progress`, and returns the summary.
-/// `threads`: 1 evaluates inline (no thread pool: use this inside an outer parallel loop),
-/// 0 uses all cores, `k` a local pool of `k` threads. The result does not depend on `threads`.
+/// the scaled singularity metrics of `T(q)` for each (all six rows and the commanded ones),
+/// hands every sample to `sink` in index order, reports progress (samples done) through
+/// `progress`, and returns the summary.
+/// `threads`: 1 evaluates inline (no thread pool, nothing allocated per sample: use this inside
+/// an outer parallel loop), 0 uses all cores, `k` a local pool of `k` threads evaluating
+/// batches of a chunk into preallocated buffers. The result does not depend on `threads`.
 pub fn analyse(
     vehicle: &Vehicle,
     spec: &StaticSpec,
     threads: usize,
-    sink: &mut dyn FnMut(&SampleEval) -> Result<(), String>,
+    sink: &mut RowSink,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<StaticSummary, StaticError> {
     spec.validate()?;
@@ -395,70 +364,117 @@ pub fn analyse(
             key: "sampling",
             message,
         })?;
-    let eval = Eval {
-        v: vehicle,
-        l,
-        tol: spec.rank_rel_tol,
-        threshold: spec.threshold,
-    };
-    let pool = local_pool(threads)?;
-    let run_chunk = |range: std::ops::Range<usize>| -> Vec<Result<SampleEval, StaticError>> {
-        let one = |s: &mut Scratch, i: usize| {
-            sampler.point(i, &mut s.u);
-            let u = std::mem::take(&mut s.u);
-            map_joint(vehicle, &u, &mut s.q);
-            s.u = u;
-            eval.at(s, i)
-        };
-        match &pool {
-            None => {
-                let mut s = Scratch::new(vehicle);
-                range.map(|i| one(&mut s, i)).collect()
-            }
-            Some(pool) => pool.install(|| {
-                range
-                    .into_par_iter()
-                    .map_init(|| Scratch::new(vehicle), |s, i| one(s, i))
-                    .collect()
-            }),
-        }
+    let mut scratch = Scratch::new(vehicle);
+    let eval = evaluator(vehicle, spec, l, &mut scratch)?;
+    scratch.q.fill(0.0);
+    let straight = SampleEval {
+        index: 0,
+        q: scratch.q.clone(),
+        metrics: eval.at(&mut scratch),
     };
     let mut tally = Tally::new(spec);
-    let mut start = 0;
-    while start < spec.samples {
-        let end = (start + CHUNK).min(spec.samples);
-        for r in run_chunk(start..end) {
-            tally.add(r?, sink)?;
+    match pool(threads)? {
+        None => {
+            let s = &mut scratch;
+            for i in 0..spec.samples {
+                sampler.point(i, &mut s.u);
+                map_joint(vehicle, &s.u, &mut s.q);
+                let m = eval.at(s);
+                tally.add(i, &s.q, m, sink)?;
+                if (i + 1) % CHUNK == 0 || i + 1 == spec.samples {
+                    progress(i + 1);
+                }
+            }
         }
-        start = end;
-        progress(start);
+        Some(pool) => {
+            let n = vehicle.n_joints();
+            let mut qs = vec![0.0; CHUNK * n];
+            let mut ms = vec![eval.at(&mut scratch); CHUNK];
+            let mut start = 0;
+            while start < spec.samples {
+                let len = CHUNK.min(spec.samples - start);
+                pool.install(|| {
+                    qs[..len * n]
+                        .par_chunks_mut((BATCH * n).max(1))
+                        .zip(ms[..len].par_chunks_mut(BATCH))
+                        .enumerate()
+                        .for_each_init(
+                            || Scratch::new(vehicle),
+                            |s, (b, (qb, mb))| {
+                                for (j, m) in mb.iter_mut().enumerate() {
+                                    sampler.point(start + b * BATCH + j, &mut s.u);
+                                    map_joint(vehicle, &s.u, &mut s.q);
+                                    *m = eval.at(s);
+                                    qb[j * n..(j + 1) * n].copy_from_slice(&s.q);
+                                }
+                            },
+                        )
+                });
+                for (j, m) in ms[..len].iter().enumerate() {
+                    tally.add(start + j, &qs[j * n..(j + 1) * n], *m, sink)?;
+                }
+                start += len;
+                progress(start);
+            }
+        }
     }
-    let straight = eval.at(&mut Scratch::new(vehicle), 0)?;
     Ok(tally.summary(vehicle, spec, l, straight))
 }
 
 /// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
-fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, StaticError> {
-    if threads == 1 {
-        return Ok(None);
+pub(super) fn pool(threads: usize) -> Result<Option<rayon::ThreadPool>, StaticError> {
+    local_pool(threads).map_err(StaticError::Threads)
+}
+
+/// The evaluator of `spec` on `v` with characteristic length `l` [m], its design checked.
+pub(super) fn evaluator<'a>(
+    v: &'a Vehicle,
+    spec: &StaticSpec,
+    l: f64,
+    scratch: &mut Scratch,
+) -> Result<Eval<'a>, StaticError> {
+    let eval = Eval::new(v, l, spec.rank_rel_tol, spec.threshold, spec.commanded);
+    eval.check(scratch).map_err(|source| StaticError::Metrics {
+        design: v.name.clone(),
+        source,
+    })?;
+    Ok(eval)
+}
+
+/// Sorted-later samples of one per-sample quantity, full and over the commanded rows.
+#[derive(Default)]
+struct Pair {
+    full: Vec<f64>,
+    commanded: Vec<f64>,
+}
+
+impl Pair {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            full: Vec::with_capacity(n),
+            commanded: Vec::with_capacity(n),
+        }
     }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map(Some)
-        .map_err(|e| StaticError::Threads(e.to_string()))
 }
 
 /// The running aggregates of [`analyse`], fed in sample-index order.
 struct Tally {
     threshold: f64,
     keep: usize,
-    sigmas: Vec<f64>,
-    kappas: Vec<f64>,
+    sigmas: Pair,
+    kappas: Pair,
     worst: Vec<SampleEval>,
     counts: [usize; 6],
     below: usize,
+    below_commanded: usize,
     deficient: usize,
+    deficient_commanded: usize,
+    k_commanded: usize,
+}
+
+/// Whether σ_min counts as singular under `threshold` (NaN does).
+fn singular(sigma_min: f64, threshold: f64) -> bool {
+    sigma_min.is_nan() || sigma_min < threshold
 }
 
 impl Tally {
@@ -466,37 +482,41 @@ impl Tally {
         Self {
             threshold: spec.threshold,
             keep: spec.worst,
-            sigmas: Vec::with_capacity(spec.samples),
-            kappas: Vec::with_capacity(spec.samples),
+            sigmas: Pair::with_capacity(spec.samples),
+            kappas: Pair::with_capacity(spec.samples),
             worst: Vec::new(),
             counts: [0; 6],
             below: 0,
+            below_commanded: 0,
             deficient: 0,
+            deficient_commanded: 0,
+            k_commanded: spec.commanded.len(),
         }
     }
 
-    /// Count sample `e` and hand it to `sink`.
+    /// Count sample `index` at joint angles `q` with metrics `m` and hand it to `sink`.
     fn add(
         &mut self,
-        e: SampleEval,
-        sink: &mut dyn FnMut(&SampleEval) -> Result<(), String>,
+        index: usize,
+        q: &[f64],
+        m: SampleMetrics,
+        sink: &mut RowSink,
     ) -> Result<(), StaticError> {
-        self.sigmas.push(e.sigma_min);
-        self.kappas.push(e.kappa);
-        // NaN counts as singular.
-        if e.sigma_min.is_nan() || e.sigma_min < self.threshold {
-            self.below += 1;
-        }
-        if e.rank < 6 {
-            self.deficient += 1;
-        }
-        if let Some(a) = e.lost_axis {
+        self.sigmas.full.push(m.sigma_min);
+        self.kappas.full.push(m.kappa);
+        self.sigmas.commanded.push(m.sigma_min_commanded);
+        self.kappas.commanded.push(m.kappa_commanded);
+        self.below += usize::from(singular(m.sigma_min, self.threshold));
+        self.below_commanded += usize::from(singular(m.sigma_min_commanded, self.threshold));
+        self.deficient += usize::from(m.rank < 6);
+        self.deficient_commanded += usize::from(m.rank_commanded < self.k_commanded);
+        if let Some(a) = m.lost_axis {
             if let Some(k) = AXIS_NAMES.iter().position(|n| *n == a) {
                 self.counts[k] += 1;
             }
         }
-        sink(&e).map_err(StaticError::Sink)?;
-        keep_worst(&mut self.worst, e, self.keep);
+        sink(index, q, &m).map_err(StaticError::Sink)?;
+        keep_worst(&mut self.worst, index, q, m, self.keep);
         Ok(())
     }
 
@@ -516,12 +536,18 @@ impl Tally {
             seed: spec.seed,
             sampling: spec.sampling.to_string(),
             threshold: spec.threshold,
+            mode: spec.mode.to_string(),
+            commanded_axes: spec.commanded.label(),
             char_length: l,
             rank_rel_tol: spec.rank_rel_tol,
             singular_fraction: self.below as f64 / n,
             rank_deficient_fraction: self.deficient as f64 / n,
-            sigma_min: distribution(self.sigmas),
-            kappa: distribution(self.kappas),
+            sigma_min: distribution(self.sigmas.full),
+            kappa: distribution(self.kappas.full),
+            singular_fraction_commanded: self.below_commanded as f64 / n,
+            rank_deficient_fraction_commanded: self.deficient_commanded as f64 / n,
+            sigma_min_commanded: distribution(self.sigmas.commanded),
+            kappa_commanded: distribution(self.kappas.commanded),
             worst: self.worst,
             lost_axes: AXIS_NAMES
                 .iter()
@@ -537,153 +563,28 @@ impl Tally {
     }
 }
 
-/// Keep the `k` lowest-σ_min samples, ascending, ties by index (NaN counts as lowest).
-fn keep_worst(worst: &mut Vec<SampleEval>, e: SampleEval, k: usize) {
+/// Keep the `k` lowest-σ_min samples, ascending, ties by index (NaN counts as lowest); a
+/// sample is copied only when it enters the list.
+fn keep_worst(worst: &mut Vec<SampleEval>, index: usize, q: &[f64], m: SampleMetrics, k: usize) {
     if k == 0 {
         return;
     }
-    let key = |s: &SampleEval| {
-        if s.sigma_min.is_nan() {
-            f64::NEG_INFINITY
-        } else {
-            s.sigma_min
-        }
-    };
+    let key = |s: f64| if s.is_nan() { f64::NEG_INFINITY } else { s };
     let pos = worst.partition_point(|w| {
-        key(w)
-            .total_cmp(&key(&e))
-            .then(w.index.cmp(&e.index))
+        key(w.metrics.sigma_min)
+            .total_cmp(&key(m.sigma_min))
+            .then(w.index.cmp(&index))
             .is_lt()
     });
     if pos < k {
+        let e = SampleEval {
+            index,
+            q: q.to_vec(),
+            metrics: m,
+        };
         worst.insert(pos, e);
         worst.truncate(k);
     }
-}
-
-/// σ_min over a 2-D slice of joint space: joints `i` and `j` on a `resolution × resolution`
-/// grid within their limits, every other joint at 0.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SliceGrid {
-    /// Index of the joint along x.
-    pub joint_x: usize,
-    /// Index of the joint along y.
-    pub joint_y: usize,
-    /// Grid angles of joint x [rad].
-    pub x: Vec<f64>,
-    /// Grid angles of joint y [rad].
-    pub y: Vec<f64>,
-    /// σ_min, row-major by y: `sigma_min[b * x.len() + a]` at `(x[a], y[b])`.
-    pub sigma_min: Vec<f64>,
-}
-
-fn linspace(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    if n <= 1 {
-        return vec![0.5 * (lo + hi)];
-    }
-    (0..n)
-        .map(|k| lo + (hi - lo) * k as f64 / (n - 1) as f64)
-        .collect()
-}
-
-/// σ_min on a grid over joints `i` and `j` (others 0); see [`SliceGrid`]. Errors if a joint
-/// index is out of range or equal.
-pub fn slice_grid(
-    vehicle: &Vehicle,
-    spec: &StaticSpec,
-    i: usize,
-    j: usize,
-    resolution: usize,
-    threads: usize,
-) -> Result<SliceGrid, StaticError> {
-    let n = vehicle.n_joints();
-    if i >= n || j >= n || i == j {
-        return Err(StaticError::Setting {
-            key: "slice",
-            message: format!("needs two different joint indices in 0..{n}, got {i},{j}"),
-        });
-    }
-    let eval = Eval {
-        v: vehicle,
-        l: spec.char_length_for(vehicle),
-        tol: spec.rank_rel_tol,
-        threshold: spec.threshold,
-    };
-    let res = resolution.clamp(2, 1000);
-    let (ji, jj) = (&vehicle.joints[i], &vehicle.joints[j]);
-    let x = linspace(ji.min, ji.max, res);
-    let y = linspace(jj.min, jj.max, res);
-    let cell = |s: &mut Scratch, k: usize| {
-        s.q.iter_mut().for_each(|q| *q = 0.0);
-        s.q[i] = x[k % res];
-        s.q[j] = y[k / res];
-        eval.at(s, k).map(|e| e.sigma_min)
-    };
-    let compute = || -> Result<Vec<f64>, StaticError> {
-        if threads == 1 {
-            let mut s = Scratch::new(vehicle);
-            (0..res * res).map(|k| cell(&mut s, k)).collect()
-        } else {
-            (0..res * res)
-                .into_par_iter()
-                .map_init(|| Scratch::new(vehicle), |s, k| cell(s, k))
-                .collect()
-        }
-    };
-    let sigma_min = match local_pool(threads)? {
-        None => compute()?,
-        Some(pool) => pool.install(compute)?,
-    };
-    Ok(SliceGrid {
-        joint_x: i,
-        joint_y: j,
-        x,
-        y,
-        sigma_min,
-    })
-}
-
-/// The two joints whose bending most restores the TCM: among the yaw joints (axis along z;
-/// all joints when fewer than two are yaw), the two with the largest mean σ_min when swept
-/// alone over their range (others 0). Ties go to the lower index. `None` with fewer than two
-/// joints.
-pub fn influential_joints(
-    vehicle: &Vehicle,
-    spec: &StaticSpec,
-) -> Result<Option<(usize, usize)>, StaticError> {
-    let n = vehicle.n_joints();
-    if n < 2 {
-        return Ok(None);
-    }
-    let yaw: Vec<usize> = (0..n)
-        .filter(|&k| vehicle.joints[k].axis.z.abs() > 0.9)
-        .collect();
-    let cands: Vec<usize> = if yaw.len() >= 2 {
-        yaw
-    } else {
-        (0..n).collect()
-    };
-    let eval = Eval {
-        v: vehicle,
-        l: spec.char_length_for(vehicle),
-        tol: spec.rank_rel_tol,
-        threshold: spec.threshold,
-    };
-    let mut s = Scratch::new(vehicle);
-    let mut scores = Vec::new();
-    for &k in &cands {
-        let j = &vehicle.joints[k];
-        let mut sum = 0.0;
-        for a in linspace(j.min, j.max, 21) {
-            s.q.iter_mut().for_each(|q| *q = 0.0);
-            s.q[k] = a;
-            sum += eval.at(&mut s, 0)?.sigma_min;
-        }
-        scores.push((k, sum));
-    }
-    scores.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    let (a, b) = (scores[0].0, scores[1].0);
-    Ok(Some((a.min(b), a.max(b))))
 }
 
 #[cfg(test)]

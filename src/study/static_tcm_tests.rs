@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::model::presets::usm_paper;
+use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
     let v = usm_paper();
@@ -17,8 +18,12 @@ fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Ve
         &v,
         &spec,
         threads,
-        &mut |e| {
-            rows.push(e.clone());
+        &mut |index, q, m| {
+            rows.push(SampleEval {
+                index,
+                q: q.to_vec(),
+                metrics: *m,
+            });
             Ok(())
         },
         &|_| {},
@@ -41,10 +46,18 @@ fn deterministic_across_threads() {
 #[test]
 fn paper_straight_is_singular_in_roll() {
     let (s, _) = run(1, 300, Sampling::Sobol);
-    assert_eq!(s.straight.rank, 5);
-    assert_eq!(s.straight.lost_axis, Some("roll"));
+    assert_eq!(s.straight.metrics.rank, 5);
+    assert_eq!(s.straight.metrics.lost_axis, Some("roll"));
+    // Transport does not command roll: the straight body has full commanded authority.
+    assert_eq!(s.commanded_axes, "surge+sway+heave+pitch+yaw");
+    assert_eq!(s.straight.metrics.rank_commanded, 5);
+    assert!(s.straight.metrics.sigma_min_commanded > s.threshold);
+    assert!(s.singular_fraction_commanded <= s.singular_fraction);
     assert!((0.0..=1.0).contains(&s.singular_fraction));
-    assert!(s.worst.windows(2).all(|w| w[0].sigma_min <= w[1].sigma_min));
+    assert!(s
+        .worst
+        .windows(2)
+        .all(|w| w[0].metrics.sigma_min <= w[1].metrics.sigma_min));
     assert_eq!(s.worst.len(), 10);
     let total: usize = s.lost_axes.iter().map(|a| a.count).sum();
     assert!(total >= (s.singular_fraction * 300.0).round() as usize);

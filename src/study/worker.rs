@@ -14,7 +14,7 @@ use super::records::{pack_metrics, CaseStatus, Row, DESIGN_COLUMNS, TCM_COLUMNS}
 use super::runner;
 use super::schema::Study;
 use super::static_table::{static_spec, STATIC_TABLE};
-use super::static_tcm::{analyse, StaticError, StaticSummary};
+use super::static_tcm::{analyse, Distribution, StaticError, StaticSummary};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
@@ -130,7 +130,7 @@ fn static_phase(v: &Vehicle, r: &Resolved, deadline: Option<Instant>, row: &mut 
             return None;
         }
     };
-    let mut on_time = |_: &_| match deadline {
+    let mut on_time = |_: usize, _: &[f64], _: &_| match deadline {
         Some(d) if Instant::now() >= d => Err(runner::TIMEOUT.to_string()),
         _ => Ok(()),
     };
@@ -156,31 +156,30 @@ fn static_phase(v: &Vehicle, r: &Resolved, deadline: Option<Instant>, row: &mut 
 
 /// The [`TCM_COLUMNS`] of a static summary.
 pub fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
-    let q = |p| s.sigma_min_quantile(p).unwrap_or(f64::NAN);
-    let kq = |p: f64| {
-        s.kappa
-            .quantiles
-            .iter()
-            .find(|(l, _)| *l == p)
-            .map_or(f64::NAN, |x| x.1)
-    };
+    let q = |d: &Distribution, p: f64| d.quantile(p).unwrap_or(f64::NAN);
     let lost = |k: usize| s.lost_axes[k].fraction;
     [
         s.singular_fraction,
         s.rank_deficient_fraction,
         s.sigma_min.min,
-        q(0.05),
-        q(0.5),
+        q(&s.sigma_min, 0.05),
+        q(&s.sigma_min, 0.5),
         s.sigma_min.mean,
-        kq(0.5),
-        kq(0.95),
-        s.straight.sigma_min,
+        q(&s.kappa, 0.5),
+        q(&s.kappa, 0.95),
+        s.straight.metrics.sigma_min,
         lost(0),
         lost(1),
         lost(2),
         lost(3),
         lost(4),
         lost(5),
+        s.singular_fraction_commanded,
+        s.sigma_min_commanded.min,
+        q(&s.sigma_min_commanded, 0.05),
+        q(&s.sigma_min_commanded, 0.5),
+        q(&s.kappa_commanded, 0.5),
+        s.straight.metrics.sigma_min_commanded,
     ]
 }
 

@@ -1,0 +1,264 @@
+//! Singular values of small matrices (at most 6 rows) without heap allocation, for the
+//! commanded-subspace singularity metrics (SPEC §6): the eigenvalues of a symmetric `k×k`
+//! (Gram) matrix by Householder tridiagonalisation and implicit QL; a row-by-row Givens QR into
+//! a `k×k` triangle and one-sided (Hestenes) Jacobi on it; and shifted inverse iteration for an
+//! eigenvector. Fixed 6×6 arrays on the stack; only the leading `k×k` block is used.
+
+// Dense k×k kernels read clearest with index loops over rows and columns.
+#![allow(clippy::needless_range_loop)]
+
+/// `√(a² + b²)` without `hypot`'s care for extreme exponents (several times slower in glibc):
+/// exact enough and safe for |a|, |b| < 1e150; beyond, the larger magnitude (the other term is
+/// then below its rounding).
+#[inline]
+fn pythag(a: f64, b: f64) -> f64 {
+    let (x, y) = (a.abs(), b.abs());
+    let big = x.max(y);
+    if big > 1e150 {
+        big
+    } else {
+        (x * x + y * y).sqrt()
+    }
+}
+
+/// Rotate columns `p` and `q` of the leading `k` rows of `m`:
+/// `(m_p, m_q) ← (c m_p − s m_q, s m_p + c m_q)`.
+#[inline]
+fn rotate_columns(m: &mut [[f64; 6]; 6], k: usize, p: usize, q: usize, c: f64, s: f64) {
+    for row in m.iter_mut().take(k) {
+        let (a, b) = (row[p], row[q]);
+        row[p] = c * a - s * b;
+        row[q] = s * a + c * b;
+    }
+}
+
+/// Largest number of Jacobi sweeps (quadratic convergence needs 4–6 for 6×6).
+const MAX_SWEEPS: usize = 30;
+
+/// Rotation `(c, s)` annihilating the off-diagonal entry `apq` of the symmetric 2×2 block
+/// `[[app, apq], [apq, aqq]]` (the smaller-angle root, Golub & Van Loan §8.5.2).
+#[inline]
+fn jacobi_rotation(app: f64, aqq: f64, apq: f64) -> (f64, f64, f64) {
+    let theta = (aqq - app) / (2.0 * apq);
+    let t = if theta.abs() > 1e150 {
+        0.5 / theta
+    } else {
+        theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+    };
+    let c = 1.0 / (t * t + 1.0).sqrt();
+    (c, t * c, t)
+}
+
+/// Fold the row `x` (k entries) into the upper-triangular `r` by Givens rotations, so that
+/// `rᵀr` gains `x xᵀ` (QR of a matrix given one row at a time).
+#[inline]
+pub(crate) fn givens_add_row(r: &mut [[f64; 6]; 6], mut x: [f64; 6], k: usize) {
+    for i in 0..k {
+        if x[i] == 0.0 {
+            continue;
+        }
+        let h = pythag(r[i][i], x[i]);
+        let (c, s) = (r[i][i] / h, x[i] / h);
+        r[i][i] = h;
+        for l in i + 1..k {
+            let (ril, xl) = (r[i][l], x[l]);
+            r[i][l] = c * ril + s * xl;
+            x[l] = c * xl - s * ril;
+        }
+    }
+}
+
+/// Squared singular values of the `k×k` leading block of `w` (destroyed) by one-sided
+/// (Hestenes) Jacobi on its columns: rotate column pairs until all are orthogonal to working
+/// precision (`|w_p·w_q| ≤ ε‖w_p‖‖w_q‖`, or `ε²‖w‖²_F` in absolute terms); the squared column
+/// norms are then the squared singular values.
+pub(crate) fn one_sided_jacobi_sq(w: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
+    let norm2: f64 = w.iter().take(k).flat_map(|r| &r[..k]).map(|x| x * x).sum();
+    let tiny = f64::EPSILON * f64::EPSILON * norm2;
+    for _ in 0..MAX_SWEEPS {
+        let mut rotated = false;
+        for p in 0..k {
+            for q in p + 1..k {
+                let (mut alpha, mut beta, mut gamma) = (0.0, 0.0, 0.0);
+                for row in w.iter().take(k) {
+                    alpha += row[p] * row[p];
+                    beta += row[q] * row[q];
+                    gamma += row[p] * row[q];
+                }
+                if gamma.abs() <= tiny || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt() {
+                    continue;
+                }
+                rotated = true;
+                let (c, s, _) = jacobi_rotation(alpha, beta, gamma);
+                rotate_columns(w, k, p, q, c, s);
+            }
+        }
+        if !rotated {
+            break;
+        }
+    }
+    std::array::from_fn(|j| w.iter().take(k).map(|row| row[j] * row[j]).sum())
+}
+
+/// Eigenvalues of the symmetric `k×k` leading block of `a` (destroyed), in the first `k`
+/// entries (unordered): Householder reduction to tridiagonal form, then the implicit QL
+/// algorithm with Wilkinson-like shifts (Numerical Recipes `tred2`/`tqli`, eigenvalues only).
+/// Backward stable like Jacobi (absolute error about `ε‖a‖`) at a third of its cost.
+pub(crate) fn tridiagonal_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> [f64; 6] {
+    let mut d = [0.0; 6];
+    let mut e = [0.0; 6];
+    householder_tridiagonal(a, k, &mut d, &mut e);
+    implicit_ql(&mut d, &mut e, k);
+    d
+}
+
+/// Reduce the symmetric `k×k` block of `a` to tridiagonal form by Householder reflections
+/// `H = I − 2vvᵀ` from the left and right: diagonal into `d`, subdiagonal (`e[i]` between
+/// rows `i` and `i + 1`) into `e`, `e[k − 1] = 0`.
+fn householder_tridiagonal(a: &mut [[f64; 6]; 6], k: usize, d: &mut [f64; 6], e: &mut [f64; 6]) {
+    for j in 0..k.saturating_sub(2) {
+        let lo = j + 1;
+        let norm = (lo..k).map(|i| a[i][j] * a[i][j]).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            e[j] = 0.0;
+            continue;
+        }
+        let alpha = if a[lo][j] > 0.0 { -norm } else { norm };
+        let mut v = [0.0; 6];
+        for i in lo..k {
+            v[i] = a[i][j];
+        }
+        v[lo] -= alpha;
+        let vn = (lo..k).map(|i| v[i] * v[i]).sum::<f64>().sqrt();
+        for x in v[lo..k].iter_mut() {
+            *x /= vn;
+        }
+        // A ← H A H on the trailing block: p = A v, q = p − (vᵀp) v, A ← A − 2(v qᵀ + q vᵀ).
+        let mut p = [0.0; 6];
+        for i in lo..k {
+            p[i] = (lo..k).map(|l| a[i][l] * v[l]).sum();
+        }
+        let kk: f64 = (lo..k).map(|i| v[i] * p[i]).sum();
+        for i in lo..k {
+            p[i] -= kk * v[i];
+        }
+        for i in lo..k {
+            for l in lo..k {
+                a[i][l] -= 2.0 * (v[i] * p[l] + p[i] * v[l]);
+            }
+        }
+        e[j] = alpha;
+    }
+    for i in 0..k {
+        d[i] = a[i][i];
+    }
+    if k >= 2 {
+        e[k - 2] = a[k - 1][k - 2];
+    }
+    if k >= 1 {
+        e[k - 1] = 0.0;
+    }
+}
+
+/// Eigenvalues of the symmetric tridiagonal matrix `(d, e)` (`k` entries, `e[k − 1] = 0`)
+/// into `d`, by the implicit QL algorithm with shifts; `e` is destroyed.
+fn implicit_ql(d: &mut [f64; 6], e: &mut [f64; 6], k: usize) {
+    for l in 0..k {
+        for _ in 0..60 {
+            let mut m = l;
+            while m + 1 < k {
+                let dd = d[m].abs() + d[m + 1].abs();
+                if e[m].abs() <= f64::EPSILON * dd {
+                    break;
+                }
+                m += 1;
+            }
+            if m == l {
+                break;
+            }
+            let mut g = (d[l + 1] - d[l]) / (2.0 * e[l]);
+            let mut r = pythag(g, 1.0);
+            g = d[m] - d[l] + e[l] / (g + r.copysign(g));
+            let (mut s, mut c, mut p) = (1.0, 1.0, 0.0);
+            let mut underflow = false;
+            for i in (l..m).rev() {
+                let f = s * e[i];
+                let b = c * e[i];
+                r = pythag(f, g);
+                e[i + 1] = r;
+                if r == 0.0 {
+                    d[i + 1] -= p;
+                    e[m] = 0.0;
+                    underflow = true;
+                    break;
+                }
+                s = f / r;
+                c = g / r;
+                g = d[i + 1] - p;
+                r = (d[i] - g) * s + 2.0 * c * b;
+                p = s * r;
+                d[i + 1] = g + p;
+                g = c * r - b;
+            }
+            if underflow {
+                continue;
+            }
+            d[l] -= p;
+            e[l] = g;
+            e[m] = 0.0;
+        }
+    }
+}
+
+/// The eigenvector of the symmetric `k×k` block of `a` whose eigenvalue lies just above
+/// `shift`: two steps of inverse iteration `(a − shift·I) y ← x` by an `LDLᵀ` factorisation
+/// without pivoting (pivots of magnitude below `ε²·trace` are raised to it, so a singular
+/// shifted matrix amplifies its null direction instead of dividing by zero), from a start with
+/// every component non-zero. Unit length, first `k` entries.
+pub(crate) fn shifted_inverse_iteration(mut a: [[f64; 6]; 6], k: usize, shift: f64) -> [f64; 6] {
+    let trace: f64 = (0..k).map(|i| a[i][i].abs()).sum();
+    let tiny = f64::EPSILON * f64::EPSILON * trace.max(f64::MIN_POSITIVE);
+    for (i, row) in a.iter_mut().enumerate().take(k) {
+        row[i] -= shift;
+    }
+    // LDLᵀ in place: a[i][j] (i > j) holds L, a[i][i] holds D.
+    for j in 0..k {
+        let mut dj = a[j][j];
+        for m in 0..j {
+            dj -= a[j][m] * a[j][m] * a[m][m];
+        }
+        if dj.abs() < tiny {
+            dj = tiny.copysign(if dj == 0.0 { 1.0 } else { dj });
+        }
+        a[j][j] = dj;
+        for i in j + 1..k {
+            let mut x = a[i][j];
+            for m in 0..j {
+                x -= a[i][m] * a[j][m] * a[m][m];
+            }
+            a[i][j] = x / dj;
+        }
+    }
+    let mut y: [f64; 6] = std::array::from_fn(|i| 1.0 + 0.1 * i as f64);
+    for _ in 0..2 {
+        for i in 0..k {
+            for m in 0..i {
+                y[i] -= a[i][m] * y[m];
+            }
+        }
+        for i in 0..k {
+            y[i] /= a[i][i];
+        }
+        for i in (0..k).rev() {
+            for m in i + 1..k {
+                y[i] -= a[m][i] * y[m];
+            }
+        }
+        let norm = y[..k].iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !(norm.is_finite() && norm > 0.0) {
+            break;
+        }
+        y[..k].iter_mut().for_each(|x| *x /= norm);
+    }
+    y
+}
