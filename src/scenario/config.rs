@@ -51,8 +51,8 @@ use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
 use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
-pub use physics::{PhysicsSpec, ServoSpec, ThrusterSpec};
 use crate::model::Vehicle;
+pub use physics::{PhysicsSpec, ServoSpec, ThrusterSpec};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
