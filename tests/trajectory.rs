@@ -49,7 +49,11 @@ fn spline_passes_its_via_points_at_their_times_and_arrives_at_the_duration() {
         // Continuous velocity (and acceleration) through the knot.
         let (l, rr) = (r.sample(v.time - 1e-9), r.sample(v.time + 1e-9));
         for j in 0..6 {
-            assert!((l.rate[j] - rr.rate[j]).abs() < 1e-6, "rate {j} at {}", v.time);
+            assert!(
+                (l.rate[j] - rr.rate[j]).abs() < 1e-6,
+                "rate {j} at {}",
+                v.time
+            );
             assert!((l.accel[j] - rr.accel[j]).abs() < 1e-6, "accel {j}");
         }
     }
@@ -66,7 +70,10 @@ fn spline_passes_its_via_points_at_their_times_and_arrives_at_the_duration() {
     for k in 1..=30_000 {
         let x = r.sample(k as f64 * 1e-3);
         for j in 0..6 {
-            assert!((x.rate[j] - prev.rate[j]).abs() < 1e-3, "t = {k} ms, axis {j}");
+            assert!(
+                (x.rate[j] - prev.rate[j]).abs() < 1e-3,
+                "t = {k} ms, axis {j}"
+            );
         }
         prev = x;
     }
@@ -95,7 +102,10 @@ fn a_via_point_on_the_straight_line_at_the_midpoint_time_is_the_quintic() {
 /// The `work-setpoint` preset for 60 s with `reference` appended.
 fn work_with(reference: &str) -> String {
     let base = usm_study::scenario::preset_text("work-setpoint").unwrap();
-    format!("{}\n{reference}", base.replace("duration = 80.0", "duration = 60.0"))
+    format!(
+        "{}\n{reference}",
+        base.replace("duration = 80.0", "duration = 60.0")
+    )
 }
 
 #[test]
@@ -157,8 +167,14 @@ fn bad_via_points_exit_2_naming_file_line_and_key() {
         let out = run(&["simulate", arg(&p), "--out", arg(&dir.path().join("o"))]);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{err}");
-        assert!(err.contains(&format!("{name}:")) && err.contains(key), "{err}");
-        assert!(err.contains(&format!("{name}:{line}:")), "line {line}: {err}");
+        assert!(
+            err.contains(&format!("{name}:")) && err.contains(key),
+            "{err}"
+        );
+        assert!(
+            err.contains(&format!("{name}:{line}:")),
+            "line {line}: {err}"
+        );
     }
     // The same in an optimisation problem, before any evaluation.
     let study = std::fs::read_to_string("studies/trajectory.toml").unwrap();
@@ -167,7 +183,10 @@ fn bad_via_points_exit_2_naming_file_line_and_key() {
     let out = run(&["optimise", arg(&p), "--out", arg(&dir.path().join("p"))]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("problem.toml:") && err.contains("reference.via[0].time"), "{err}");
+    assert!(
+        err.contains("problem.toml:") && err.contains("reference.via[0].time"),
+        "{err}"
+    );
     assert!(!dir.path().join("p").join("history.csv").exists());
 }
 
@@ -176,7 +195,7 @@ fn quiet(_: &Record) {}
 #[test]
 fn trajectory_study_lowers_energy_below_the_straight_line_at_equal_authority() {
     let mut p = load_problem(Path::new("studies/trajectory.toml")).unwrap();
-    // The full budget (200) reaches −56 %; by evaluation 25 the history is below −20 %.
+    // The full budget (200) reaches −57 %; by evaluation 25 the history is below −20 %.
     p.spec.solver.max_evals = 25;
     let opts = Options {
         jobs: 2,
@@ -185,7 +204,10 @@ fn trajectory_study_lowers_energy_below_the_straight_line_at_equal_authority() {
         on_record: &quiet,
     };
     let o = optimise(&p, &opts).unwrap();
-    assert!(o.start().score.feasible, "the straight line meets the constraints");
+    assert!(
+        o.start().score.feasible,
+        "the straight line meets the constraints"
+    );
     let b = o.best();
     assert!(b.score.feasible);
     for k in 0..p.spec.constraints.len() {

@@ -26,8 +26,8 @@ pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
-pub mod spline;
 pub mod sliding;
+pub mod spline;
 pub mod transport;
 pub mod work;
 

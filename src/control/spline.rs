@@ -52,7 +52,10 @@ impl NaturalSpline {
         if n < 2 || y.len() != n {
             return Err(ControlError::new(
                 "spline",
-                format!("needs >= 2 knots with one value each, got {n} and {}", y.len()),
+                format!(
+                    "needs >= 2 knots with one value each, got {n} and {}",
+                    y.len()
+                ),
             ));
         }
         for (i, (s, v)) in sigma.iter().zip(y).enumerate() {
@@ -192,9 +195,8 @@ impl PoseReference {
         rows.push(end);
         let axis = |j: usize| {
             let y: Vec<f64> = rows.iter().map(|r| r[j]).collect();
-            NaturalSpline::new(&sigma, &y).map_err(|e| {
-                ControlError::new(format!("reference.via (axis {j})"), e.message)
-            })
+            NaturalSpline::new(&sigma, &y)
+                .map_err(|e| ControlError::new(format!("reference.via (axis {j})"), e.message))
         };
         Ok(Self {
             timing,

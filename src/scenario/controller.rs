@@ -62,7 +62,7 @@ pub(crate) enum ModeController {
     Work {
         law: Box<WorkController>,
         target: WorkTarget,
-        reference: Option<PoseReference>,
+        reference: Option<Box<PoseReference>>,
         signals: WorkSignals,
     },
 }
@@ -176,10 +176,10 @@ impl ModeController {
                         let [x, y, z] = sp.position;
                         let end = [x, y, z, r[0], r[1], r[2]];
                         let via = spec.via_points();
-                        Some(
+                        Some(Box::new(
                             PoseReference::new(start, end, spec.duration, &via)
                                 .map_err(|e| invalid(e.to_string()))?,
-                        )
+                        ))
                     }
                     None => None,
                 };

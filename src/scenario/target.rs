@@ -73,7 +73,10 @@ impl ReferenceSpec {
     /// name the file key (`reference.via[1].time`).
     pub fn validate(&self, work: bool, run_duration: f64) -> Result<(), KeyError> {
         if !work {
-            return Err(KeyError::new("reference", "only work mode takes a [reference]"));
+            return Err(KeyError::new(
+                "reference",
+                "only work mode takes a [reference]",
+            ));
         }
         let t = self.duration;
         if !t.is_finite() || t <= 0.0 || t > run_duration {
@@ -103,10 +106,16 @@ impl ReferenceSpec {
             }
             prev = v.time;
             if let Some(x) = v.position.iter().find(|x| !x.is_finite()) {
-                return Err(KeyError::new(key("position"), format!("must be finite, got {x}")));
+                return Err(KeyError::new(
+                    key("position"),
+                    format!("must be finite, got {x}"),
+                ));
             }
             if let Some(x) = v.rpy_deg.iter().flatten().find(|x| !x.is_finite()) {
-                return Err(KeyError::new(key("rpy_deg"), format!("must be finite, got {x}")));
+                return Err(KeyError::new(
+                    key("rpy_deg"),
+                    format!("must be finite, got {x}"),
+                ));
             }
         }
         Ok(())
@@ -138,7 +147,9 @@ pub fn check_reference(scenario: &toml::Table) -> Result<(), KeyError> {
     let section = scenario.get("scenario");
     let get = |k: &str| section.and_then(|s| s.get(k));
     let work = get("mode").and_then(|m| m.as_str()) == Some("work");
-    let duration = get("duration").and_then(|d| d.as_float()).unwrap_or(f64::INFINITY);
+    let duration = get("duration")
+        .and_then(|d| d.as_float())
+        .unwrap_or(f64::INFINITY);
     spec.validate(work, duration)
 }
 
@@ -171,7 +182,11 @@ mod tests {
             ),
         ];
         for (text, key) in cases {
-            assert_eq!(spec(text).validate(true, 80.0).unwrap_err().key, key, "{text}");
+            assert_eq!(
+                spec(text).validate(true, 80.0).unwrap_err().key,
+                key,
+                "{text}"
+            );
         }
     }
 }
