@@ -155,7 +155,7 @@ pub fn check_reference(scenario: &toml::Table) -> Result<(), KeyError> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::scenario::target::ReferenceSpec;
 
     fn spec(text: &str) -> ReferenceSpec {
         toml::from_str(text).unwrap()
