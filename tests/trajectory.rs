@@ -195,8 +195,10 @@ fn quiet(_: &Record) {}
 #[test]
 fn trajectory_study_lowers_energy_below_the_straight_line_at_equal_authority() {
     let mut p = load_problem(Path::new("studies/trajectory.toml")).unwrap();
-    // The full budget (200) reaches −57 %; by evaluation 25 the history is below −20 %.
-    p.spec.solver.max_evals = 25;
+    // The full budget (200) reaches −57 % (−29 % once the commanded-subspace exposure of the
+    // authority branch is merged); by evaluation 60 either history is below −15 % (evaluations
+    // 22 and 52).
+    p.spec.solver.max_evals = 60;
     let opts = Options {
         jobs: 2,
         journal: None,
@@ -215,5 +217,5 @@ fn trajectory_study_lowers_energy_below_the_straight_line_at_equal_authority() {
     }
     // Objective = thruster energy / its straight-line value.
     assert!((o.start().score.objective - 1.0).abs() < 1e-12);
-    assert!(b.score.objective < 0.8, "{}", b.score.objective);
+    assert!(b.score.objective < 0.85, "{}", b.score.objective);
 }
