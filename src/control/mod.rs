@@ -6,6 +6,7 @@
 //! | [`guidance`] | line-of-sight guidance along straight segments | USM-39 |
 //! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors, inertial-frame task variables | USM-28…32, AC-7…13 |
 //! | [`quintic`] | quintic point-to-point references (zero end rates and accelerations) | AC §5 |
+//! | [`spline`] | timed end-effector paths: natural spline through via-points, quintic timing | AC §5, USM-42 |
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
 //! | [`work`] | work mode: end-effector pose + base position by SRMTP | USM-42 |
 //! | [`dynamic`] | feedback-linearising base control | USM-33/34 |
@@ -26,6 +27,7 @@ pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
 pub mod sliding;
+pub mod spline;
 pub mod transport;
 pub mod work;
 

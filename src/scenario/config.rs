@@ -21,6 +21,7 @@
 //! [setpoint]                  # work: end-effector pose in the inertial frame
 //! position = [3.5, 0.5, -0.3]
 //! rpy_deg = [0.0, 0.0, 20.0]
+//! [reference]                 # work, optional: timed path to the setpoint (scenario::target)
 //!
 //! [control]                   # transport: TransportGains keys; work: WorkGains keys
 //! [base_control]              # USM-33/34 gains (DynamicGains)
@@ -39,6 +40,7 @@
 mod physics;
 
 use super::success::SuccessSpec;
+pub use super::target::{ReferenceSpec, SetpointSpec, ViaSpec};
 use crate::allocation::{AllocSettings, Method, RateSettings};
 use crate::control::dynamic::DynamicGains;
 use crate::control::guidance::PathSpec;
@@ -173,20 +175,6 @@ impl Default for InitialSpec {
             joint_angles_deg: Vec::new(),
         }
     }
-}
-
-/// `[setpoint]`: a time-invariant end-effector pose (work mode), inertial frame.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SetpointSpec {
-    /// End-effector position [m].
-    pub position: [f64; 3],
-    /// End-effector orientation as roll, pitch, yaw (ZYX) [deg].
-    #[serde(default)]
-    pub rpy_deg: [f64; 3],
-    /// Base position target of the secondary task [m]; default: the initial base position.
-    #[serde(default)]
-    pub base_position: Option<[f64; 3]>,
 }
 
 /// `[allocation]`: the thrust allocation method and its settings (SPEC §5, USM-37).
@@ -334,6 +322,9 @@ pub struct ScenarioFile {
     /// Work setpoint.
     #[serde(default)]
     pub setpoint: Option<SetpointSpec>,
+    /// Work: timed end-effector path to the setpoint; `None` = a step at `t = 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<ReferenceSpec>,
     /// Mode gains (TransportGains or WorkGains keys).
     #[serde(default)]
     pub control: toml::Table,
@@ -534,6 +525,9 @@ impl ScenarioFile {
         if let Some(sp) = &self.setpoint {
             finite("setpoint.position", &sp.position)?;
             finite("setpoint.rpy_deg", &sp.rpy_deg)?;
+        }
+        if let Some(r) = &self.reference {
+            r.validate(self.scenario.mode == Mode::Work, self.scenario.duration)?;
         }
         self.validate_metrics()?;
         self.success.validate()?;

@@ -1,6 +1,8 @@
 //! The mode controller of the closed loop: guidance and kinematic control for the scenario's
 //! mode (transport: LOS path following, USM-38…41; work: end-effector setpoint, USM-42)
-//! followed by the base's dynamic control (USM-33). One enum holds the mode's law; the
+//! followed by the base's dynamic control (USM-33). Work mode with a `[reference]` moves the
+//! setpoint along the timed path of [`crate::control::spline`] and feeds its twist forward.
+//! One enum holds the mode's law; the
 //! command it produces (joint references, base wrench τ_c) and the signals it logs are
 //! overwritten in place every control period.
 
@@ -8,10 +10,11 @@ use super::config::{ModeGains, ScenarioFile};
 use super::error::ScenarioError;
 use crate::control::dynamic::DynamicController;
 use crate::control::guidance::PathSpec;
-use crate::control::kinematic::SecondaryTasks;
+use crate::control::kinematic::{ee_pose, SecondaryTasks};
+use crate::control::spline::{pose_and_twist, PoseReference};
 use crate::control::transport::{measure_transport, TransportController};
 use crate::control::work::{WorkController, WorkTarget};
-use crate::kinematics::{BasePose, KinWorkspace};
+use crate::kinematics::{forward_kinematics, BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{euler_zyx, Vec3, Vec6};
 use nalgebra::{Matrix6, UnitQuaternion};
@@ -54,10 +57,12 @@ pub(crate) enum ModeController {
         path: PathSpec,
         signals: TransportSignals,
     },
-    /// End-effector setpoint regulation (boxed: the work law's workspace is large).
+    /// End-effector setpoint regulation (boxed: the work law's workspace is large); with a
+    /// reference, `target` follows it (pose and twist) every control period.
     Work {
         law: Box<WorkController>,
         target: WorkTarget,
+        reference: Option<Box<PoseReference>>,
         signals: WorkSignals,
     },
 }
@@ -115,12 +120,14 @@ fn secondary_tasks(v: &Vehicle, file: &ScenarioFile) -> Result<SecondaryTasks, S
 
 impl ModeController {
     /// The mode's controller from the file and its parsed `gains`; `q0` are the initial joint
-    /// angles [rad].
+    /// angles [rad] and `base0` the initial base pose (a work reference starts at the end
+    /// effector's pose there).
     pub fn new(
         v: &Vehicle,
         file: &ScenarioFile,
         gains: ModeGains,
         q0: &[f64],
+        base0: &BasePose,
     ) -> Result<Self, ScenarioError> {
         let invalid = ScenarioError::Invalid;
         Ok(match gains {
@@ -159,9 +166,27 @@ impl ModeController {
                     ee_twist: Vec6::zeros(),
                     base_position: Vec3::from(sp.base_position.unwrap_or(file.initial.position)),
                 };
+                let reference = match &file.reference {
+                    Some(spec) => {
+                        let mut ws = KinWorkspace::new(v);
+                        forward_kinematics(v, q0, &mut ws);
+                        let g = ee_pose(base0, &ws.g_be);
+                        let a = euler_zyx(&g.r);
+                        let start = [g.p.x, g.p.y, g.p.z, a.x, a.y, a.z];
+                        let [x, y, z] = sp.position;
+                        let end = [x, y, z, r[0], r[1], r[2]];
+                        let via = spec.via_points();
+                        Some(Box::new(
+                            PoseReference::new(start, end, spec.duration, &via)
+                                .map_err(|e| invalid(e.to_string()))?,
+                        ))
+                    }
+                    None => None,
+                };
                 ModeController::Work {
                     law: Box::new(law),
                     target,
+                    reference,
                     signals: WorkSignals::default(),
                 }
             }
@@ -215,14 +240,19 @@ impl ModeController {
             ModeController::Work {
                 law,
                 target,
+                reference,
                 signals,
             } => {
+                let g_ie = meas.base.to_se3().compose(&meas.ws.g_be);
+                if let Some(r) = reference {
+                    (target.ee_position, target.ee_orientation, target.ee_twist) =
+                        pose_and_twist(&r.sample(t), &g_ie.r);
+                }
                 let out = law.step(meas.base, meas.ws, target, dt);
                 cmd.q_ref.copy_from_slice(law.q_ref());
                 cmd.qd_ref.copy_from_slice(law.qd_ref());
                 let d = base_ctl.velocity_control(meas.m11, meas.nvec, meas.v_b, &out.v_r, dt);
                 cmd.tau_c = d.tau_c;
-                let g_ie = meas.base.to_se3().compose(&meas.ws.g_be);
                 // Orientation error with roll excluded: the angle between the desired and the
                 // actual end-effector x axes (the pointing direction).
                 let x_d = target.ee_orientation * Vec3::x();

@@ -40,6 +40,7 @@ pub(crate) mod recorder;
 pub mod run;
 mod setup;
 pub mod success;
+pub mod target;
 
 pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};

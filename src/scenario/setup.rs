@@ -115,7 +115,7 @@ impl<'f> ClosedLoop<'f> {
         let base_ctl = DynamicController::new(file.base_gains())
             .map_err(|e| ScenarioError::Invalid(format!("base_control.{e}")))?;
         let q0 = sim.state().joint_angles.clone();
-        let mode = ModeController::new(v, file, gains, &q0)?;
+        let mode = ModeController::new(v, file, gains, &q0, &sim.state().pose)?;
         let allocator = allocator(v, file)?;
         let cmd = Command {
             qd_ref: vec![0.0; q0.len()],

@@ -37,6 +37,7 @@ struct StudyFile {
     initial: Option<toml::Table>,
     path: Option<toml::Table>,
     setpoint: Option<toml::Table>,
+    reference: Option<toml::Table>,
     servo: Option<toml::Table>,
     thrusters: Option<toml::Table>,
     success: Option<toml::Table>,
@@ -312,6 +313,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("initial", &file.initial),
         ("path", &file.path),
         ("setpoint", &file.setpoint),
+        ("reference", &file.reference),
         ("servo", &file.servo),
         ("thrusters", &file.thrusters),
         ("success", &file.success),
@@ -331,6 +333,11 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     }
     let (mut sc_names, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&defaults, "", &mut sc_names, &mut sc_arrays);
+    // `[reference]` (work mode) has no default; its keys are checked by parsing it below.
+    if mode == StudyMode::Work {
+        sc_names.insert("reference".into());
+        sc_arrays.insert("reference".into());
+    }
     // Reject unknown keys of the study's own scenario-side tables.
     let (mut own_names, mut own_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&own, "", &mut own_names, &mut own_arrays);
@@ -345,6 +352,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     // The success criteria of the base must parse and hold (dynamic modes).
     if mode.is_dynamic() {
         runner::check_success(&reference).map_err(|e| doc.place(e))?;
+        crate::scenario::target::check_reference(&reference).map_err(|e| doc.place(e))?;
     }
     // Static settings of the base must parse.
     if static_enabled {

@@ -46,7 +46,7 @@ pub struct CaseOutcome {
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
 /// `[static]`); must cover the top-level keys of [`default_table`].
-pub const SCENARIO_TABLES: [&str; 12] = [
+pub const SCENARIO_TABLES: [&str; 13] = [
     "scenario",
     "control",
     "base_control",
@@ -56,6 +56,7 @@ pub const SCENARIO_TABLES: [&str; 12] = [
     "initial",
     "path",
     "setpoint",
+    "reference",
     "servo",
     "thrusters",
     "success",
