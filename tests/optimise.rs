@@ -186,6 +186,34 @@ fn the_evaluation_budget_is_exact() {
     );
 }
 
+#[test]
+fn a_budget_smaller_than_the_simplex_stops_nelder_mead_without_a_panic() {
+    // Three parameters need a simplex of four points; the start point and one more are all
+    // the budget allows, for the first run and for a restart.
+    for (max_evals, restarts) in [(2, 0), (5, 1)] {
+        let mut s = solver(Method::NelderMead, 100, max_evals, 1e-12);
+        s.restarts = restarts;
+        let o = solve(
+            rosenbrock,
+            &spec(
+                vec![
+                    param("a.x", -2.0, 2.0, 0.0),
+                    param("a.y", -2.0, 2.0, 0.0),
+                    param("a.z", -2.0, 2.0, 0.0),
+                ],
+                s,
+            ),
+            1,
+        );
+        assert!(o.fresh_evaluations() <= max_evals);
+        assert!(
+            o.stops.iter().any(|s| s.contains("budget")),
+            "{:?}",
+            o.stops
+        );
+    }
+}
+
 fn table(o: &Outcome, spec: &Spec) -> usm_study::report::Table {
     let params: Vec<String> = spec.space.params.iter().map(|p| p.name.clone()).collect();
     history_table(&o.records, &params, &o.metrics, &[String::new()]).unwrap()

@@ -166,6 +166,15 @@ impl<'a, E: Evaluator> Search<'a, E> {
         (plan, false)
     }
 
+    /// Whether evaluating `us` would need more fresh points than the budget has left (or the
+    /// budget is already spent); if so the search counts as exhausted from now on.
+    fn would_exceed(&self, us: &[Vec<f64>]) -> bool {
+        let mut st = self.lock();
+        let cut = st.exhausted || self.plan(&st, us).1;
+        st.exhausted |= cut;
+        cut
+    }
+
     /// Evaluate a batch in order (see the module docs); the costs, or the budget error.
     fn batch<P: std::borrow::Borrow<Vec<f64>>>(&self, us: &[P]) -> Result<Vec<f64>, Error> {
         let (plan, cut) = {
@@ -354,6 +363,11 @@ fn nelder_mead<E: Evaluator>(
             v[i] - s.step
         };
         simplex.push(v);
+    }
+    // argmin's Nelder–Mead unwraps the costs of its initial simplex (it would panic on the
+    // budget error): a budget that cannot cover the whole simplex stops the search here.
+    if search.would_exceed(&simplex) {
+        return Err(Error::msg("evaluation budget reached"));
     }
     let solver = NelderMead::new(simplex).with_sd_tolerance(s.tolerance)?;
     let res = Executor::new(Handle(search), solver)
