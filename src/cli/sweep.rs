@@ -11,12 +11,12 @@ use anyhow::{anyhow, bail, Context};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Duration;
 use usm_study::pipeline::review::write_review;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
-use std::time::Duration;
 use usm_study::study::shards::{slurm_script, SlurmPlan};
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
