@@ -172,7 +172,7 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         doc,
     )?;
     if side.mode.is_dynamic() {
-        check_base_scenario(&design, &names.scenario_ref, &axes, &doc)?;
+        check_base_scenario(&design, &names.scenario_ref, &axes, doc)?;
     }
     let output = meta
         .output

@@ -212,10 +212,13 @@ fn tune_section(c: &Ctx, md: &mut String) {
         "## Per-design tuning
 "
     );
-    let _ = writeln!(
+    let _ =
+        writeln!(
         md,
-        "Every case was tuned before it was scored (`[tune]`: its own design and axis values),          then scored at its tuned values: {} cases tuned, {} of them to a point meeting every          tuning constraint, {:.0} evaluations per case on average; **{} of {} cases are not          successful at their tuned values** ({}).
-",
+        "Every case was tuned before it was scored (`[tune]`: its own design and axis values), \
+         then scored at its tuned values: {} cases tuned, {} of them to a point meeting every \
+         tuning constraint, {:.0} evaluations per case on average; **{} of {} cases are not \
+         successful at their tuned values** ({}).\n",
         tuned.len(),
         met,
         if tuned.is_empty() { 0.0 } else { total / tuned.len() as f64 },
