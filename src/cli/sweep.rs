@@ -18,6 +18,7 @@ use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::study::shards::{slurm_script, SlurmPlan};
+use usm_study::study::tune::Tuner;
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -162,6 +163,8 @@ fn study_err(e: StudyError) -> anyhow::Error {
 /// Run `usm-study sweep`.
 pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     let study = load_study(&a.study).map_err(|e| anyhow!(e.to_string()))?;
+    // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
+    Tuner::new(&study).map_err(|e| anyhow!(e.to_string()))?;
     let shard = match &a.shard {
         None => None,
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),

@@ -4,9 +4,12 @@
 //! dynamic mode — the metrics a sweep row holds, by name. A panic or an invalid design is
 //! the evaluation's failure (its metrics NaN), never the optimiser's.
 //!
-//! Every evaluation uses case id 0 and so the same seed (`derive_seed(study.seed, 0)`): the
+//! Every evaluation uses one case id (0; a sweep's own id for a case tuned in place,
+//! [`CaseEvaluator::for_case`]) and so the same seed (`derive_seed(study.seed, id)`): the
 //! static analysis samples the same joint configurations at every point, and the objective
 //! is a deterministic function of the parameters.
+
+use std::time::Instant;
 
 use super::history::Evaluation;
 use super::problem::Problem;
@@ -43,6 +46,10 @@ pub struct CaseEvaluator<'a> {
     /// Per scenario, the values of the scenario-key axes.
     variant_values: Vec<Vec<toml::Value>>,
     metrics: Vec<String>,
+    /// The case id every evaluation runs as (its seed `derive_seed(study.seed, id)`).
+    case_id: usize,
+    /// Wall-clock deadline of every run (`None`: unlimited).
+    deadline: Option<Instant>,
 }
 
 impl<'a> CaseEvaluator<'a> {
@@ -101,6 +108,18 @@ impl<'a> CaseEvaluator<'a> {
             study,
             variant_values,
             metrics: spec.metrics(),
+            case_id: 0,
+            deadline: None,
+        }
+    }
+
+    /// The same evaluator running every point as case `id` of its study (a sweep's case
+    /// tuned in place: the case's seed) within `deadline` (a run past it fails `timeout`).
+    pub fn for_case(self, id: usize, deadline: Option<Instant>) -> Self {
+        CaseEvaluator {
+            case_id: id,
+            deadline,
+            ..self
         }
     }
 
@@ -108,14 +127,21 @@ impl<'a> CaseEvaluator<'a> {
     pub fn resolve(&self, x: &[f64], variant: usize) -> Result<Resolved, String> {
         let mut values: Vec<toml::Value> = x.iter().map(|v| toml::Value::Float(*v)).collect();
         values.extend(self.variant_values[variant].iter().cloned());
-        resolve_case(&self.study, &Case { id: 0, values })
+        resolve_case(
+            &self.study,
+            &Case {
+                id: self.case_id,
+                values,
+            },
+        )
     }
 
     /// Run one resolved case (with its trajectory when `log`).
     pub fn run_case(&self, r: &Resolved, log: bool) -> CaseMetrics {
         let study = &self.problem.study;
-        let outcome =
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| case_metrics(study, r, log)));
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            case_metrics(study, r, log, self.deadline)
+        }));
         outcome.unwrap_or_else(|p| {
             let msg = p
                 .downcast_ref::<&str>()
@@ -176,7 +202,7 @@ pub fn pick(named: &[(String, f64)], names: &[String]) -> Vec<f64> {
 }
 
 /// The named metrics of a resolved case (see the module docs).
-fn case_metrics(study: &Study, r: &Resolved, log: bool) -> CaseMetrics {
+fn case_metrics(study: &Study, r: &Resolved, log: bool, deadline: Option<Instant>) -> CaseMetrics {
     let mut out = CaseMetrics::default();
     let v = match parse_design_table(&r.design, "optimised design") {
         Ok(v) => v,
@@ -210,7 +236,7 @@ fn case_metrics(study: &Study, r: &Resolved, log: bool) -> CaseMetrics {
     if study.mode.is_dynamic() {
         let mut sc = r.scenario.clone();
         sc.remove(STATIC_TABLE);
-        match runner::run_case(&v, &sc, r.seed, log) {
+        match runner::run_case_until(&v, &sc, r.seed, log, deadline) {
             Ok(run) => {
                 out.named.extend(run.metrics);
                 out.failure = run.failure;

@@ -288,6 +288,12 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<Problem, InputError> {
             spec_table.insert(k.to_string(), v);
         }
     }
+    if table.contains_key("tune") {
+        return Err(doc.err(
+            "tune",
+            "[tune] tunes each case of a sweep; a problem file optimises its own [[param]]",
+        ));
+    }
     let study = parse_study_table(&doc, &table, path)?;
     let spec = parse_spec(&doc, &spec_table, "", &study)?;
     Ok(Problem { study, spec })

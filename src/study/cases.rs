@@ -3,6 +3,7 @@
 
 use super::doe::Case;
 use super::hash::{case_hashes, unresolved_case_hash};
+use super::runner::method_control;
 use super::schema::{Study, Target};
 use crate::input::keypath::{set, Seg};
 use crate::model::design::{design_to_toml, parse_design_table};
@@ -55,8 +56,22 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
     for (a, p, v) in thruster_edits {
         set(&mut design, &p.0, v.clone(), &a.name)?;
     }
+    if let Some(c) = method_axis_control(study, case)? {
+        scenario.insert("control".into(), toml::Value::Table(c));
+    }
     let seed = derive_seed(study.seed, case.id as u64);
-    let (hash, design_hash) = case_hashes(&design, &scenario, seed);
+    let (hash, design_hash) = match &study.tune {
+        None => case_hashes(&design, &scenario, seed),
+        Some(t) => {
+            // A case is tuned by the study's `[tune]`: its row depends on it.
+            let mut hashed = scenario.clone();
+            hashed.insert("tune".into(), toml::Value::Table(t.clone()));
+            (
+                case_hashes(&design, &hashed, seed).0,
+                case_hashes(&design, &scenario, seed).1,
+            )
+        }
+    };
     Ok(Resolved {
         design,
         scenario,
@@ -64,6 +79,38 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
         hash,
         design_hash,
     })
+}
+
+/// With an axis over `control.method` (transport): the case's `[control]` written out from
+/// its method's Table III row, with the study's own `[control]` keys and the case's other
+/// `control.…` values on top ([`method_control`]); `None` without such an axis (the study's
+/// own method was resolved when the file was parsed).
+fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>, String> {
+    let on_control = |t: &Target| match t {
+        Target::Scenario(p) => matches!(p.0.first(), Some(Seg::Key(k)) if k == "control"),
+        Target::Design(_) => false,
+    };
+    let method_axis = study.axes.iter().any(|a| {
+        on_control(&a.target) && matches!(&a.target, Target::Scenario(p) if p.0.len() == 2 && matches!(&p.0[1], Seg::Key(k) if k == "method"))
+    });
+    if !method_axis {
+        return Ok(None);
+    }
+    let mut own = toml::Table::new();
+    own.insert(
+        "control".into(),
+        study
+            .scenario
+            .get("control")
+            .cloned()
+            .unwrap_or_else(|| toml::Value::Table(toml::Table::new())),
+    );
+    for (a, v) in study.axes.iter().zip(&case.values) {
+        if let (true, Target::Scenario(p)) = (on_control(&a.target), &a.target) {
+            set(&mut own, &p.0, v.clone(), &a.name)?;
+        }
+    }
+    method_control(study.mode, own.get("control")).transpose()
 }
 
 /// The hash of a case: its resolved hash, or for a case whose overrides do not apply a hash

@@ -16,6 +16,9 @@
 //! - `study.toml`: a copy of the study file.
 //! - `.usm-study.lock`: held while the sweep runs ([`super::outdir`]): one run per directory.
 //!
+//! With `[tune]`, every case is first tuned, then scored at its tuned values
+//! ([`super::tune`]).
+//!
 //! Every case has a wall-clock budget (`case_timeout`), checked cooperatively inside the
 //! simulation loop (see [`super::worker`]): a case past it is recorded `failed` with a reason
 //! starting `timeout`, and the batch goes on. Timed-out rows depend on the machine's speed;
@@ -48,6 +51,7 @@ use super::records::{
 };
 use super::runner::TIMEOUT;
 use super::schema::Study;
+use super::tune::Tuner;
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 
@@ -147,6 +151,7 @@ pub fn run_sweep(
             )));
         }
     }
+    let tuner = Tuner::new(study)?;
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
     let out = output_dir(study, opts);
     let _lock = outdir::lock(&out)?;
@@ -177,6 +182,7 @@ pub fn run_sweep(
         done: &done,
         max: opts.max_cases.unwrap_or(usize::MAX),
         budget: opts.case_timeout,
+        tuner: tuner.as_ref(),
     };
     let streamed = stream_cases(&run, &cases, &pool, &mut appender, progress)?;
     let _ = appender.sync();
@@ -310,12 +316,13 @@ struct Streamed {
 }
 
 /// What every case of one run shares: the study, the hashes already done, the cap on cases
-/// run (`max_cases`) and the per-case time budget.
+/// run (`max_cases`), the per-case time budget and the per-case tuning (`[tune]`).
 struct RunSpec<'a> {
     study: &'a Study,
     done: &'a HashSet<String>,
     max: usize,
     budget: Option<Duration>,
+    tuner: Option<&'a Tuner>,
 }
 
 /// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs, each within the
@@ -414,7 +421,13 @@ fn process(
         return Msg::NotRun;
     }
     let row = match resolved {
-        Ok(r) => w.evaluate(study, case, &r, false).0,
+        Ok(r) => match run.tuner {
+            None => w.evaluate(study, case, &r, false).0,
+            Some(t) => {
+                let deadline = w.budget.map(|b| Instant::now() + b);
+                t.evaluate(w, study, case, &r, deadline)
+            }
+        },
         Err(reason) => {
             let mut row = Row::new(study, case.id, hash, case.values.clone());
             row.end(CaseStatus::Skipped, &reason);

@@ -11,6 +11,7 @@ use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE}
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
+use super::tune::Tuner;
 use super::worker::Worker;
 use crate::report::{read_csv_typed, write_csv, Table};
 
@@ -48,11 +49,23 @@ fn rerun_extremes(
     };
     let ids = table.i64(CASE_ID).map_err(|e| e.to_string())?;
     let all = expand(study, None)?;
+    let tuner = Tuner::new(study).map_err(|e| e.to_string())?;
+    let params = study.tune_columns();
+    let tuned = params[..params.len().saturating_sub(2)]
+        .iter()
+        .map(|c| table.f64(c))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
     // The two reruns are independent: run them side by side.
     let rerun = |which: Extreme, row: usize| -> Result<(), String> {
         let id = ids[row] as usize;
         let case = all.get(id).ok_or("case id out of range")?;
-        let r = resolve_case(study, case)?;
+        let mut r = resolve_case(study, case)?;
+        if let Some(t) = &tuner {
+            // Rerun at the case's tuned values, as scored.
+            let x: Vec<f64> = tuned.iter().map(|c| c[row]).collect();
+            r = t.at(study, case, &r, &x)?;
+        }
         let (_, traj) = Worker::new().evaluate(study, case, &r, true);
         if let Some(t) = traj {
             write_csv(&t, &out.join(which.trajectory_file())).map_err(|e| e.to_string())?;

@@ -17,6 +17,7 @@
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
 //! - [`records`]: case status, row, columns of the raw and final tables.
 //! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
+//! - [`tune`]: per-case tuning (`[tune]`): tune a case with the optimiser, score it there.
 //! - [`manifest`]: the `manifest.json` of an output directory.
 //! - [`outdir`]: the output directory's lock, its ownership by one study, stale temporaries.
 //! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.
@@ -47,6 +48,7 @@ pub mod static_tcm;
 mod static_tcm_eval;
 pub mod static_tcm_slice;
 pub mod summary;
+pub mod tune;
 pub mod worker;
 
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};

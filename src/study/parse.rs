@@ -43,6 +43,7 @@ struct StudyFile {
     success: Option<toml::Table>,
     axis: Option<Vec<AxisFile>>,
     doe: Option<DoeFile>,
+    tune: Option<toml::Table>,
 }
 
 #[derive(Deserialize)]
@@ -201,6 +202,7 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
             maximise: meta.maximise.clone().unwrap_or_default(),
         },
         hash,
+        tune: file.tune.clone(),
     })
 }
 
@@ -349,6 +351,11 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     }
     let mut reference = defaults;
     merge_into(&mut reference, &own);
+    // `control.method` picks its own Table III row: the defaults above are Method 2's.
+    if let Some(c) = runner::method_control(mode, own.get("control")) {
+        let c = c.map_err(|m| doc.err("control", m))?;
+        reference.insert("control".into(), toml::Value::Table(c));
+    }
     // The success criteria of the base must parse and hold (dynamic modes).
     if mode.is_dynamic() {
         runner::check_success(&reference).map_err(|e| doc.place(e))?;

@@ -237,6 +237,12 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
     if study.static_enabled {
         s.extend(TCM_COLUMNS.iter().map(|c| (c.to_string(), ColumnKind::F64)));
     }
+    s.extend(
+        study
+            .tune_columns()
+            .into_iter()
+            .map(|c| (c, ColumnKind::F64)),
+    );
     if study.mode.is_dynamic() {
         s.push((SCENARIO_METRICS_COLUMN.into(), ColumnKind::Str));
     }
@@ -251,6 +257,7 @@ pub fn metric_count(study: &Study) -> usize {
         } else {
             0
         }
+        + study.tune_columns().len()
 }
 
 /// Text of a non-numeric axis value.
@@ -312,7 +319,7 @@ pub struct Row {
     pub reason: String,
     /// Axis values.
     pub axes: Vec<toml::Value>,
-    /// Design and TCM metrics, in raw-schema order (NaN when not computed).
+    /// Design, TCM and tuning columns, in raw-schema order (NaN when not computed).
     pub metrics: Vec<f64>,
     /// Packed scenario metrics (see [`pack_metrics`]).
     pub scenario: String,

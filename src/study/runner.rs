@@ -176,6 +176,27 @@ pub fn run_case_until(
     })
 }
 
+/// The full `[control]` table of a transport case whose own `control` table (the study's,
+/// with the case's overrides) names a `method`: that method's USM Table III row with every
+/// key the table gives on top, written out in full — so `method = "method1"` brings Method
+/// 1's Δ, k_6p, k_6d and end-effector surge unless the file sets them. `None` when the mode
+/// is not transport or no method is named (the defaults, Method 2, stand); `Some(Err)` for
+/// gains that do not parse or validate.
+pub fn method_control(
+    mode: StudyMode,
+    control: Option<&toml::Value>,
+) -> Option<Result<toml::Table, String>> {
+    let control = control?.as_table()?;
+    if mode != StudyMode::Transport || !control.contains_key("method") {
+        return None;
+    }
+    Some(
+        deserialize_table::<crate::control::TransportGains>(control, "control")
+            .map_err(|e| e.to_string())
+            .and_then(|g| toml::Table::try_from(&g).map_err(|e| e.to_string())),
+    )
+}
+
 /// Check the `[success]` table of a resolved scenario-side table (absent: the defaults), so
 /// that a bad success definition is reported with its key before any case runs.
 pub fn check_success(scenario: &toml::Table) -> Result<(), KeyError> {

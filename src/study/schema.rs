@@ -212,6 +212,37 @@ pub struct Study {
     pub report: ReportSettings,
     /// SHA-256 of the study text, the base design and the tool version (hex).
     pub hash: String,
+    /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`); validated
+    /// by [`crate::study::tune::Tuner::new`] before any case runs.
+    pub tune: Option<toml::Table>,
+}
+
+/// Column of a tuned study's rows: fresh evaluations the case's tuning used.
+pub const TUNE_EVALUATIONS: &str = "tune_evaluations";
+/// Column of a tuned study's rows: 1 when the tuned point met every `[[tune.constraint]]`.
+pub const TUNE_FEASIBLE: &str = "tune_feasible";
+/// Prefix of the tuned-value columns (`tuned.control.k_psi`).
+pub const TUNED_PREFIX: &str = "tuned.";
+
+impl Study {
+    /// The columns per-case tuning adds to every row: `tuned.<param>` for each
+    /// `[[tune.param]]` in file order, then [`TUNE_EVALUATIONS`] and [`TUNE_FEASIBLE`]
+    /// (none without `[tune]`).
+    pub fn tune_columns(&self) -> Vec<String> {
+        let Some(t) = &self.tune else {
+            return Vec::new();
+        };
+        let params = t.get("param").and_then(|p| p.as_array());
+        let mut cols: Vec<String> = params
+            .into_iter()
+            .flatten()
+            .filter_map(|p| p.get("name").and_then(|n| n.as_str()))
+            .map(|n| format!("{TUNED_PREFIX}{n}"))
+            .collect();
+        cols.push(TUNE_EVALUATIONS.into());
+        cols.push(TUNE_FEASIBLE.into());
+        cols
+    }
 }
 
 /// Keys of the design generator table (design-file schema); `design.<key>` is an alias of

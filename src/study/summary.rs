@@ -17,7 +17,7 @@ use std::path::Path;
 use super::manifest::Manifest;
 use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
-use super::schema::DoeKind;
+use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
 use crate::report::{fmt_short, MarkdownTable, Table};
 
@@ -71,6 +71,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         key,
     };
     let mut md = header_section(&c, m);
+    tune_section(&c, &mut md);
     best_section(&c, &mut md);
     effects_section(&c, &mut md);
     if let Some(f) = c.sel.front(table, &c.ok_rows) {
@@ -194,6 +195,68 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
     md
 }
 
+/// With per-case tuning (`[tune]`): how many cases tuning made feasible and successful, and
+/// the winner at tuned values (the best successful case by the objective) with its values.
+fn tune_section(c: &Ctx, md: &mut String) {
+    let (Ok(feasible), Ok(evals)) = (c.table.f64(TUNE_FEASIBLE), c.table.f64(TUNE_EVALUATIONS))
+    else {
+        return;
+    };
+    let tuned: Vec<usize> = (0..c.table.n_rows())
+        .filter(|&r| feasible[r].is_finite())
+        .collect();
+    let met = tuned.iter().filter(|&&r| feasible[r] == 1.0).count();
+    let total: f64 = tuned.iter().map(|&r| evals[r]).sum();
+    let _ = writeln!(
+        md,
+        "## Per-design tuning
+"
+    );
+    let _ =
+        writeln!(
+        md,
+        "Every case was tuned before it was scored (`[tune]`: its own design and axis values), \
+         then scored at its tuned values: {} cases tuned, {} of them to a point meeting every \
+         tuning constraint, {:.0} evaluations per case on average; **{} of {} cases are not \
+         successful at their tuned values** ({}).\n",
+        tuned.len(),
+        met,
+        if tuned.is_empty() { 0.0 } else { total / tuned.len() as f64 },
+        c.table.n_rows() - c.ok_rows.len(),
+        c.table.n_rows(),
+        left_out_text(c)
+    );
+    let (Some(o), Some((best, _))) = (&c.sel.objective, c.sel.extremes(c.table)) else {
+        return;
+    };
+    let values: Vec<String> = c
+        .table
+        .columns
+        .iter()
+        .filter(|col| col.name.starts_with(TUNED_PREFIX))
+        .map(|col| {
+            format!(
+                "`{}` = {}",
+                &col.name[TUNED_PREFIX.len()..],
+                cell_text(c.table, &col.name, best)
+            )
+        })
+        .collect();
+    let axes: Vec<String> = c
+        .axes
+        .iter()
+        .map(|a| format!("`{a}` = {}", cell_text(c.table, a, best)))
+        .collect();
+    let _ = writeln!(
+        md,
+        "**Winner at tuned values** by `{o}`: case #{} ({}), `{o}` = {}, tuned {}.\n",
+        c.ids[best],
+        axes.join(", "),
+        cell_text(c.table, o, best),
+        values.join(", ")
+    );
+}
+
 /// The best case by each metric (design columns aside).
 fn best_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "## Best case by each metric\n");
@@ -204,11 +267,13 @@ fn best_section(c: &Ctx, md: &mut String) {
         left_out_text(c)
     );
     let mut t = c.table(&["metric", "goal", "case", "value"]);
-    let shown = c
-        .sel
-        .metrics
-        .iter()
-        .filter(|m| !m.starts_with("design_") && *m != SUCCESS);
+    let shown = c.sel.metrics.iter().filter(|m| {
+        !m.starts_with("design_")
+            && *m != SUCCESS
+            && !m.starts_with(TUNED_PREFIX)
+            && *m != TUNE_EVALUATIONS
+            && *m != TUNE_FEASIBLE
+    });
     for metric in shown {
         let goal = c.sel.goal(metric);
         let best = c.sel.best_row(c.table, metric, false);

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 pub struct Worker {
     cache: Option<(String, Vehicle)>,
     /// Wall-clock budget of one case (`None`: unlimited).
-    budget: Option<Duration>,
+    pub budget: Option<Duration>,
 }
 
 impl Worker {
@@ -53,8 +53,21 @@ impl Worker {
         r: &Resolved,
         log: bool,
     ) -> (Row, Option<Table>) {
-        let mut row = Row::new(study, case.id, r.hash.clone(), case.values.clone());
         let deadline = self.budget.map(|b| Instant::now() + b);
+        self.evaluate_until(study, case, r, log, deadline)
+    }
+
+    /// [`Worker::evaluate`] within a deadline set by the caller (per-case tuning spends part
+    /// of the case's budget before the case is scored).
+    pub fn evaluate_until(
+        &mut self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        log: bool,
+        deadline: Option<Instant>,
+    ) -> (Row, Option<Table>) {
+        let mut row = Row::new(study, case.id, r.hash.clone(), case.values.clone());
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             self.evaluate_phases(study, case, r, log, deadline, &mut row)
         }));
@@ -136,7 +149,8 @@ fn static_phase(v: &Vehicle, r: &Resolved, deadline: Option<Instant>, row: &mut 
     };
     match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
         Ok(s) => {
-            row.metrics[DESIGN_COLUMNS.len()..].copy_from_slice(&tcm_metrics(&s));
+            let d = DESIGN_COLUMNS.len();
+            row.metrics[d..d + TCM_COLUMNS.len()].copy_from_slice(&tcm_metrics(&s));
             Some(())
         }
         Err(StaticError::Sink(_)) => {

@@ -1,0 +1,243 @@
+//! Per-case tuning inside sweeps (`[tune]`, issue 12 deliverable 3) and the transport method
+//! of a study's scenario side selecting its own USM Table III gains.
+//!
+//! A tiny tuned sweep (two designs, a 45 s transport run, six evaluations of energy per metre per case): rows
+//! carry the tuned values, the evaluations used and the tuning's feasibility; `cases.csv` is
+//! identical for `--jobs 1` and `--jobs 2` and after an interrupted run resumed; every case
+//! scores at least as well as at its start gains (its row is the tuned run), and the summary
+//! names the winner at tuned values. Bad `[tune]` sections exit 2 naming file, line and key
+//! before any case runs.
+
+mod common;
+
+use std::path::Path;
+
+use common::{arg, run, stderr, write};
+use usm_study::study::cases::resolve_case;
+use usm_study::study::doe::expand;
+use usm_study::study::parse::parse_study;
+
+const BASE: &str = r#"[study]
+name = "tiny_tune"
+seed = 5
+
+[design.generator]
+links = 3
+link_length = 0.6
+thrust_limit = 40.0
+
+[scenario]
+mode = "transport"
+duration = 45.0
+
+[allocation]
+method = "pinv"
+lambda = 0.1
+
+[success]
+# 45 s: the vehicle converges to the path (3 m off at the start), not yet fully settled.
+cross_track_bound = 1.0
+
+[[axis]]
+name = "design.links"
+values = [3, 4]
+"#;
+
+const TUNE: &str = r#"
+[tune]
+[[tune.param]]
+name = "control.k_psi"
+lower = 0.15
+upper = 1.35
+scale = "log"
+
+[[tune.param]]
+name = "control.k_6p"
+lower = 0.002
+upper = 0.5
+scale = "log"
+
+[tune.objective]
+[[tune.objective.term]]
+metric = "energy_per_metre"
+weight = 1.0
+
+[[tune.constraint]]
+metric = "completed"
+op = "=="
+value = 1
+
+[tune.solver]
+method = "nelder-mead"
+max_evals = 6
+step = 0.3
+"#;
+
+/// Rows of a `cases.csv` as (header, rows of cells).
+fn table(dir: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(dir.join("cases.csv")).unwrap();
+    let mut lines = text.lines();
+    let split = |l: &str| l.split(',').map(str::to_string).collect::<Vec<_>>();
+    let head = split(lines.next().unwrap());
+    (head, lines.map(split).collect())
+}
+
+fn column(head: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
+    let c = head
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("{name}: {head:?}"));
+    rows.iter().map(|r| r[c].parse().unwrap()).collect()
+}
+
+fn sweep(study: &Path, out: &Path, extra: &[&str]) {
+    let mut args = vec!["sweep", arg(study), "--out", arg(out)];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+#[test]
+fn tuned_sweep_rows_carry_tuned_values_and_do_not_depend_on_jobs_or_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let tuned = write(dir.path(), "tuned.toml", &format!("{BASE}{TUNE}"));
+    let plain = write(dir.path(), "plain.toml", BASE);
+    let (j1, j2, res, un) = (
+        dir.path().join("j1"),
+        dir.path().join("j2"),
+        dir.path().join("res"),
+        dir.path().join("plain"),
+    );
+    sweep(&tuned, &j1, &["--jobs", "1"]);
+    sweep(&tuned, &j2, &["--jobs", "2"]);
+    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
+    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
+    // Interrupted after one case, then resumed: the uninterrupted table.
+    sweep(&tuned, &res, &["--jobs", "1", "--max-cases", "1"]);
+    sweep(&tuned, &res, &["--jobs", "2", "--resume"]);
+    assert_eq!(a, std::fs::read_to_string(res.join("cases.csv")).unwrap());
+
+    let (head, rows) = table(&j1);
+    assert_eq!(rows.len(), 2);
+    let k_psi = column(&head, &rows, "tuned.control.k_psi");
+    let k_6p = column(&head, &rows, "tuned.control.k_6p");
+    let evals = column(&head, &rows, "tune_evaluations");
+    let feasible = column(&head, &rows, "tune_feasible");
+    for i in 0..2 {
+        assert!((0.15..=1.35).contains(&k_psi[i]), "{k_psi:?}");
+        assert!((0.002..=0.5).contains(&k_6p[i]), "{k_6p:?}");
+        assert!(evals[i] >= 2.0 && evals[i] <= 6.0, "{evals:?}");
+        assert_eq!(feasible[i], 1.0, "every run completes");
+    }
+    // Each row is scored at its tuned gains: never worse than at the start gains (the
+    // defaults, Method 2 of Table III), which the untuned sweep scores.
+    sweep(&plain, &un, &[]);
+    let (ph, pr) = table(&un);
+    let before = column(&ph, &pr, "energy_per_metre");
+    let after = column(&head, &rows, "energy_per_metre");
+    for i in 0..2 {
+        assert!(after[i] <= before[i], "case {i}: {after:?} vs {before:?}");
+    }
+    assert!(
+        after.iter().zip(&before).any(|(a, b)| a < b),
+        "tuning improved nothing"
+    );
+    let md = std::fs::read_to_string(j1.join("summary.md")).unwrap();
+    assert!(md.contains("## Per-design tuning"), "{md}");
+    assert!(md.contains("**Winner at tuned values**"), "{md}");
+    assert!(md.contains("`control.k_psi` = "), "{md}");
+}
+
+#[test]
+fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("{BASE}{TUNE}");
+    let line_of =
+        |s: &str, needle: &str| s.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
+    let bad = [
+        (
+            text.replace("name = \"control.k_6p\"", "name = \"control.k_6q\""),
+            "name = \"control.k_6q\"",
+            "tune.param[1].name",
+            "unknown parameter",
+        ),
+        (
+            text.replace("upper = 1.35", "upper = 0.1"),
+            "upper = 0.1",
+            "tune.param[0].upper",
+            "needs lower < upper",
+        ),
+        (
+            text.replace(
+                "metric = \"energy_per_metre\"",
+                "metric = \"energy_per_meter\"",
+            ),
+            "metric = \"energy_per_meter\"",
+            "tune.objective.term[0].metric",
+            "unknown metric",
+        ),
+        (
+            text.replace("name = \"control.k_6p\"", "name = \"design.links\""),
+            "name = \"design.links\"",
+            "tune.param[1].name",
+            "also a sweep axis",
+        ),
+    ];
+    for (i, (t, needle, key, message)) in bad.iter().enumerate() {
+        let p = write(dir.path(), &format!("bad{i}.toml"), t);
+        let out = dir.path().join(format!("out{i}"));
+        let o = run(&["sweep", arg(&p), "--out", arg(&out)]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        // The line of the offending key (the last match: the axis has the same name).
+        let line = t
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| l.starts_with(needle))
+            .map(|(n, _)| n + 1)
+            .last()
+            .unwrap_or_else(|| line_of(t, needle));
+        assert!(
+            e.contains(&format!("{}:{line}:", p.display())),
+            "case {i}: {e}"
+        );
+        assert!(e.contains(&format!(": {key}: ")), "case {i}: {e}");
+        assert!(e.contains(message), "case {i}: {e}");
+        assert!(!out.exists(), "case {i}: nothing may run");
+    }
+}
+
+#[test]
+fn control_method_selects_its_table_iii_gains_unless_the_file_sets_them() {
+    let control = |text: &str, case: usize| {
+        let study = parse_study(text, Path::new("m.toml")).unwrap();
+        let cases = expand(&study, None).unwrap();
+        let r = resolve_case(&study, &cases[case]).unwrap();
+        r.scenario["control"].as_table().unwrap().clone()
+    };
+    let head = "[study]\nname = \"m\"\n[design]\npreset = \"usm-paper\"\n[scenario]\nmode = \"transport\"\n";
+    // The file names Method 1: its Δ = 3, k_6p = 0.13, k_6d = 0.12, end-effector surge.
+    let c = control(&format!("{head}[control]\nmethod = \"method1\"\n"), 0);
+    assert_eq!(c["look_ahead"].as_float(), Some(3.0));
+    assert_eq!(c["k_6p"].as_float(), Some(0.13));
+    assert_eq!(c["k_6d"].as_float(), Some(0.12));
+    assert_eq!(c["surge_source"].as_str(), Some("end_effector"));
+    // A gain the file sets explicitly wins over the method's row.
+    let c = control(
+        &format!("{head}[control]\nmethod = \"method1\"\nlook_ahead = 2.5\n"),
+        0,
+    );
+    assert_eq!(c["look_ahead"].as_float(), Some(2.5));
+    assert_eq!(c["k_6p"].as_float(), Some(0.13));
+    // An axis over the method: each case gets its own row, explicit keys still win.
+    let swept = format!(
+        "{head}[control]\nk_psi = 0.5\n[[axis]]\nname = \"control.method\"\nvalues = [\"method1\", \"method2\"]\n"
+    );
+    let (m1, m2) = (control(&swept, 0), control(&swept, 1));
+    assert_eq!(m1["surge_source"].as_str(), Some("end_effector"));
+    assert_eq!(m1["look_ahead"].as_float(), Some(3.0));
+    assert_eq!(m2["surge_source"].as_str(), Some("base"));
+    assert_eq!(m2["look_ahead"].as_float(), Some(2.0));
+    assert_eq!(m1["k_psi"].as_float(), Some(0.5));
+    assert_eq!(m2["k_psi"].as_float(), Some(0.5));
+}
