@@ -1,8 +1,8 @@
 //! The shipped tuning studies, on a reduced budget: from the paper's gains (feasible), the
 //! optimiser finds gains that meet every constraint and improve the objective by a margin.
-//! The full budgets (docs/optimise.md) reach 2.000 → 1.260 (transport) and 2.250 → 0.812
-//! (work); these runs stop early, where the history of the full runs had already reached
-//! 1.260 (evaluation 43) and 1.029 (evaluation 40).
+//! The full budgets (docs/optimise.md) reach 2.000 → 1.260 (transport) and 2.250 → 1.579
+//! (work, at the `work-setpoint` pose within reach); these runs stop early (45 and 41
+//! evaluations: 1.260 and 1.761).
 
 use std::path::Path;
 
@@ -49,8 +49,11 @@ fn tuned_transport_gains_beat_table_iii_by_over_a_third() {
 }
 
 #[test]
-fn tuned_work_gains_beat_the_papers_by_over_half() {
+fn tuned_work_gains_beat_the_papers_by_over_a_sixth() {
+    // At the in-reach default pose the paper's gains already keep the base home (drift 8 mm)
+    // and spend 141 J, so there is less to gain than at the far pose (which gave −64 %): the
+    // reduced budget reaches 1.761 (−22 %), the full one 1.579 (−30 %).
     let (start, best) = tuned("studies/tune_work.toml", 41);
     assert!((start - 2.25).abs() < 1e-12, "{start}");
-    assert!(best < 0.5 * start, "{best}");
+    assert!(best < 0.83 * start, "{best}");
 }
