@@ -65,7 +65,7 @@ impl Selection {
         for m in &metrics {
             // Larger is better for conditioning (σ_min) and for run outcomes.
             if m.starts_with("tcm_sigma_min")
-                || m == TCM_STRAIGHT_SIGMA_MIN
+                || m.starts_with(TCM_STRAIGHT_SIGMA_MIN)
                 || m.starts_with("sigma_min")
                 || matches!(
                     m.as_str(),
