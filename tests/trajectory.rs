@@ -42,8 +42,8 @@ fn spline_passes_its_via_points_at_their_times_and_arrives_at_the_duration() {
             assert!((x.pose[j] - v.position[j]).abs() < 1e-12, "{v:?} {j}");
         }
         if let Some(a) = v.rpy {
-            for j in 0..3 {
-                assert!((x.pose[3 + j] - a[j]).abs() < 1e-12);
+            for (j, aj) in a.iter().enumerate() {
+                assert!((x.pose[3 + j] - aj).abs() < 1e-12);
             }
         }
         // Continuous velocity (and acceleration) through the knot.
@@ -60,8 +60,8 @@ fn spline_passes_its_via_points_at_their_times_and_arrives_at_the_duration() {
     // Starts at the start pose at rest, arrives at T at rest and holds.
     for (t, pose) in [(0.0, START), (30.0, END), (45.0, END)] {
         let x = r.sample(t);
-        for j in 0..6 {
-            assert!((x.pose[j] - pose[j]).abs() < 1e-12, "{t} {j}");
+        for (j, pj) in pose.iter().enumerate() {
+            assert!((x.pose[j] - pj).abs() < 1e-12, "{t} {j}");
             assert_eq!(x.rate[j], 0.0);
         }
     }
