@@ -4,9 +4,7 @@
 
 mod common;
 
-use common::{read, run, stderr, write};
-use std::path::Path;
-use std::process::Output;
+use common::{read, run, stderr, sweep, write};
 
 /// Three work-mode cases of 60 s simulated time (about a second of wall time each).
 const SLOW: &str = r#"
@@ -40,17 +38,6 @@ samples = 32
 name = "design.links"
 values = [4, 5, 6, 7]
 "#;
-
-fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut a = vec![
-        "sweep",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    a.extend_from_slice(extra);
-    run(&a)
-}
 
 #[test]
 fn a_case_past_its_budget_fails_with_timeout_and_the_batch_goes_on() {

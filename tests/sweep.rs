@@ -3,10 +3,8 @@
 
 mod common;
 
-use common::{read, run, stderr, write};
+use common::{read, run, stderr, sweep, write};
 use proptest::prelude::*;
-use std::path::Path;
-use std::process::Output;
 
 /// 12 cases: 3 link counts × 2 rules × 2 offsets, all valid.
 const STUDY12: &str = r#"
@@ -33,17 +31,6 @@ values = ["paper", "distributed"]
 name = "design.generator.longitudinal_offset"
 range = { start = 0.1, stop = 0.2, steps = 2 }
 "#;
-
-fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut a = vec![
-        "sweep",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    a.extend_from_slice(extra);
-    run(&a)
-}
 
 #[test]
 fn jobs_do_not_change_results() {

@@ -57,3 +57,15 @@ pub fn metric(s: &serde_json::Value, k: &str) -> f64 {
         .as_f64()
         .unwrap_or_else(|| panic!("metric {k} in {s}"))
 }
+
+/// `usm-study sweep STUDY --out OUT EXTRA…`.
+pub fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut a = vec![
+        "sweep",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend_from_slice(extra);
+    run(&a)
+}

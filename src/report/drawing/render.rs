@@ -4,7 +4,7 @@
 use super::labels::Labeller;
 use super::scene::Scene;
 use super::svg::{Attr, Svg};
-use super::views::{cylinder_outline, View, ViewTransform};
+use super::views::{cylinder_outline, open_view, View, ViewTransform};
 use crate::report::file_stem_safe;
 use crate::spatial::Vec3;
 
@@ -123,35 +123,12 @@ pub(super) fn view(
     frame: [f64; 4],
 ) {
     let (u, v) = view.axis_names();
-    s.open(
-        "g",
-        &[
-            ("class", "view".into()),
-            ("id", format!("view-{}", view.id()).into()),
-            ("data-u", u.into()),
-            ("data-v", v.into()),
-            ("data-scale", Attr::Text(format!("{:.6}", t.scale))),
-            ("data-x0", Attr::Text(format!("{:.6}", t.x0))),
-            ("data-y0", Attr::Text(format!("{:.6}", t.y0))),
-        ],
-    );
-    s.empty(
-        "rect",
-        &[
-            ("class", "frame".into()),
-            ("x", frame[0].into()),
-            ("y", frame[1].into()),
-            ("width", frame[2].into()),
-            ("height", frame[3].into()),
-        ],
-    );
-    s.text(
-        &[
-            ("class", "title".into()),
-            ("x", frame[0].into()),
-            ("y", (frame[1] - 8.0).into()),
-        ],
-        view.title(),
+    open_view(
+        s,
+        view,
+        t,
+        frame,
+        vec![("data-u", u.into()), ("data-v", v.into())],
     );
     bodies(s, scene, view, t);
     joints(s, scene, view, t);

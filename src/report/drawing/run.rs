@@ -15,7 +15,7 @@ use super::labels::Labeller;
 use super::page::{nice_length, ACCENT};
 use super::scene::Scene;
 use super::svg::{num, Attr, Svg};
-use super::views::{cylinder_outline, Bounds, View, ViewTransform};
+use super::views::{cylinder_outline, open_view, Bounds, View, ViewTransform};
 use crate::spatial::Vec3;
 
 /// The vehicle at one time of a run.
@@ -232,38 +232,6 @@ fn snapshot(
     s.close("g");
 }
 
-/// Opens a view group with its frame and title.
-fn open_view(s: &mut Svg, view: View, t: &ViewTransform, frame: [f64; 4]) {
-    s.open(
-        "g",
-        &[
-            ("class", "view".into()),
-            ("id", format!("view-{}", view.id()).into()),
-            ("data-scale", Attr::Text(format!("{:.6}", t.scale))),
-            ("data-x0", Attr::Text(format!("{:.6}", t.x0))),
-            ("data-y0", Attr::Text(format!("{:.6}", t.y0))),
-        ],
-    );
-    s.empty(
-        "rect",
-        &[
-            ("class", "frame".into()),
-            ("x", frame[0].into()),
-            ("y", frame[1].into()),
-            ("width", frame[2].into()),
-            ("height", frame[3].into()),
-        ],
-    );
-    s.text(
-        &[
-            ("class", "title".into()),
-            ("x", frame[0].into()),
-            ("y", (frame[1] - 8.0).into()),
-        ],
-        view.title(),
-    );
-}
-
 /// Caption (left) and legend (right): time colours, traces, thrusters, scale bar.
 fn caption_and_legend(s: &mut Svg, d: &RunDrawing, scale: f64, top: f64) {
     let y = |i: usize| top + LINE * (i as f64 + 0.8);
@@ -385,7 +353,7 @@ pub fn render_shapes_svg(d: &RunDrawing) -> String {
     let n = d.snapshots.len().max(2) - 1;
     let mut labels = Labeller::new(WIDTH);
     for (k, view) in VIEWS.into_iter().enumerate() {
-        open_view(&mut s, view, &ts[k], boxes[k]);
+        open_view(&mut s, view, &ts[k], boxes[k], Vec::new());
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
         for (i, snap) in d.snapshots.iter().enumerate() {
@@ -432,7 +400,7 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
     let n = d.snapshots.len().max(1);
     let dur = format!("{}s", num(duration));
     for (k, view) in VIEWS.into_iter().enumerate() {
-        open_view(&mut s, view, &ts[k], boxes[k]);
+        open_view(&mut s, view, &ts[k], boxes[k], Vec::new());
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
         for (i, snap) in d.snapshots.iter().enumerate() {

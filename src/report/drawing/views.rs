@@ -4,6 +4,7 @@
 //! seen from −y (x right, z up), **front** `y–z` seen from +x, the head end (y right, z up).
 //! Each is right-handed: the screen's out-of-page direction is [`View::normal`].
 
+use super::svg::{Attr, Svg};
 use crate::spatial::{Se3, Vec3};
 
 /// One orthographic view.
@@ -211,4 +212,45 @@ mod tests {
             assert_eq!(eu.cross(&ev), v.normal(), "{v:?}");
         }
     }
+}
+
+/// Opens the group of `view` — id `view-<id>`, `extra` attributes, then its transform `t` as
+/// `data-scale`/`data-x0`/`data-y0` — and draws its frame (`[x, y, w, h]` px) and title; the
+/// caller closes the group.
+pub(super) fn open_view(
+    s: &mut Svg,
+    view: View,
+    t: &ViewTransform,
+    frame: [f64; 4],
+    extra: Vec<(&str, Attr)>,
+) {
+    let mut attrs: Vec<(&str, Attr)> = vec![
+        ("class", "view".into()),
+        ("id", format!("view-{}", view.id()).into()),
+    ];
+    attrs.extend(extra);
+    attrs.extend([
+        ("data-scale", Attr::Text(format!("{:.6}", t.scale))),
+        ("data-x0", Attr::Text(format!("{:.6}", t.x0))),
+        ("data-y0", Attr::Text(format!("{:.6}", t.y0))),
+    ]);
+    s.open("g", &attrs);
+    s.empty(
+        "rect",
+        &[
+            ("class", "frame".into()),
+            ("x", frame[0].into()),
+            ("y", frame[1].into()),
+            ("width", frame[2].into()),
+            ("height", frame[3].into()),
+        ],
+    );
+    s.text(
+        &[
+            ("class", "title".into()),
+            ("x", frame[0].into()),
+            ("y", (frame[1] - 8.0).into()),
+        ],
+        view.title(),
+    );
 }
