@@ -181,39 +181,6 @@ fn convex_hull(mut pts: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
     hull
 }
 
-#[cfg(test)]
-mod tests {
-    use crate::report::drawing::views::*;
-
-    #[test]
-    fn a_straight_cylinder_is_a_rectangle_from_the_side_and_a_disc_from_the_front() {
-        let pose = Se3::from_translation(Vec3::new(1.0, 0.0, 0.0));
-        let side = cylinder_outline(View::Side, &pose, 2.0, 0.5);
-        let mut b = Bounds::empty();
-        side.iter().for_each(|p| b.extend(*p));
-        assert_eq!(side.len(), 4, "{side:?}");
-        assert!((b.min[0] - 1.0).abs() < 1e-12 && (b.max[0] - 3.0).abs() < 1e-12);
-        assert!((b.max[1] - 0.5).abs() < 1e-12 && (b.min[1] + 0.5).abs() < 1e-12);
-        let front = cylinder_outline(View::Front, &pose, 2.0, 0.5);
-        assert_eq!(front.len(), RIM_POINTS);
-        assert!(front
-            .iter()
-            .all(|p| ((p[0].hypot(p[1])) - 0.5).abs() < 1e-12));
-    }
-
-    #[test]
-    fn views_are_right_handed() {
-        for v in View::ALL {
-            let (u, w) = v.axes();
-            let mut eu = Vec3::zeros();
-            let mut ev = Vec3::zeros();
-            eu[u] = 1.0;
-            ev[w] = 1.0;
-            assert_eq!(eu.cross(&ev), v.normal(), "{v:?}");
-        }
-    }
-}
-
 /// Opens the group of `view` — id `view-<id>`, `extra` attributes, then its transform `t` as
 /// `data-scale`/`data-x0`/`data-y0` — and draws its frame (`[x, y, w, h]` px) and title; the
 /// caller closes the group.
@@ -253,4 +220,37 @@ pub(super) fn open_view(
         ],
         view.title(),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::report::drawing::views::*;
+
+    #[test]
+    fn a_straight_cylinder_is_a_rectangle_from_the_side_and_a_disc_from_the_front() {
+        let pose = Se3::from_translation(Vec3::new(1.0, 0.0, 0.0));
+        let side = cylinder_outline(View::Side, &pose, 2.0, 0.5);
+        let mut b = Bounds::empty();
+        side.iter().for_each(|p| b.extend(*p));
+        assert_eq!(side.len(), 4, "{side:?}");
+        assert!((b.min[0] - 1.0).abs() < 1e-12 && (b.max[0] - 3.0).abs() < 1e-12);
+        assert!((b.max[1] - 0.5).abs() < 1e-12 && (b.min[1] + 0.5).abs() < 1e-12);
+        let front = cylinder_outline(View::Front, &pose, 2.0, 0.5);
+        assert_eq!(front.len(), RIM_POINTS);
+        assert!(front
+            .iter()
+            .all(|p| ((p[0].hypot(p[1])) - 0.5).abs() < 1e-12));
+    }
+
+    #[test]
+    fn views_are_right_handed() {
+        for v in View::ALL {
+            let (u, w) = v.axes();
+            let mut eu = Vec3::zeros();
+            let mut ev = Vec3::zeros();
+            eu[u] = 1.0;
+            ev[w] = 1.0;
+            assert_eq!(eu.cross(&ev), v.normal(), "{v:?}");
+        }
+    }
 }
