@@ -155,6 +155,7 @@ fn a_tiny_problem_writes_every_output_and_best_toml_reproduces_the_best_objectiv
         "parameters.svg",
         "runs.svg",
         "journal.jsonl",
+        "report.html",
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }

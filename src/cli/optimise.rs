@@ -125,6 +125,7 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
         out.display(),
         out.join(BEST_FILE).display()
     );
+    super::sweep::review("optimise", &out)?;
     Ok(if b.score.feasible {
         ExitCode::SUCCESS
     } else {

@@ -307,7 +307,7 @@ pub struct ReportArgs {
 }
 
 /// Writes `report.html` into `dir`, printing what it holds; an unwritable page is an error.
-fn review(verb: &str, dir: &Path) -> anyhow::Result<()> {
+pub(crate) fn review(verb: &str, dir: &Path) -> anyhow::Result<()> {
     let r = write_review(dir)
         .with_context(|| format!("writing the design review of {}", dir.display()))?;
     for w in &r.warnings {
