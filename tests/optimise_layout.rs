@@ -5,24 +5,13 @@
 //! meets its success criteria. The full budget (240 evaluations) finds its best at evaluation 9
 //! (fraction 0.0703 → 0.0508, p05 σ_min 0.0435 → 0.0506; docs/optimise.md), inside this budget.
 
-use std::path::Path;
+mod common;
 
-use usm_study::optimise::history::Record;
-use usm_study::optimise::{load_problem, run, Options};
-
-fn quiet(_: &Record) {}
+use common::optimise_study;
 
 #[test]
 fn optimised_layout_beats_the_paper_layout_on_both_static_figures() {
-    let mut p = load_problem(Path::new("studies/layout.toml")).unwrap();
-    p.spec.solver.max_evals = 60;
-    let opts = Options {
-        jobs: 2,
-        journal: None,
-        resume: false,
-        on_record: &quiet,
-    };
-    let o = run(&p, &opts).unwrap();
+    let (p, o) = optimise_study("studies/layout.toml", 60);
     let names = p.spec.metrics();
     let at = |n: &str| names.iter().position(|m| m == n).unwrap();
     let (frac, p05) = (

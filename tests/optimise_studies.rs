@@ -4,24 +4,13 @@
 //! (work, at the `work-setpoint` pose within reach); these runs stop early (45 and 41
 //! evaluations: 1.260 and 1.761).
 
-use std::path::Path;
+mod common;
 
-use usm_study::optimise::history::Record;
-use usm_study::optimise::{load_problem, run, Options};
-
-fn quiet(_: &Record) {}
+use common::optimise_study;
 
 /// Run `file` with `max_evals` evaluations; returns (start objective, best objective).
 fn tuned(file: &str, max_evals: usize) -> (f64, f64) {
-    let mut p = load_problem(Path::new(file)).unwrap();
-    p.spec.solver.max_evals = max_evals;
-    let opts = Options {
-        jobs: 2,
-        journal: None,
-        resume: false,
-        on_record: &quiet,
-    };
-    let o = run(&p, &opts).unwrap();
+    let (p, o) = optimise_study(file, max_evals);
     assert!(
         o.start().score.feasible,
         "{file}: the paper's gains meet the constraints"

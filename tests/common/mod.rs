@@ -69,3 +69,24 @@ pub fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
     a.extend_from_slice(extra);
     run(&a)
 }
+
+fn quiet_record(_: &usm_study::optimise::history::Record) {}
+
+/// Load the shipped optimisation study `file` (relative to the repository root), cut its budget
+/// to `max_evals` evaluations and run it on two threads, quietly; returns the problem and the
+/// outcome.
+pub fn optimise_study(
+    file: &str,
+    max_evals: usize,
+) -> (usm_study::optimise::Problem, usm_study::optimise::Outcome) {
+    let mut p = usm_study::optimise::load_problem(Path::new(file)).unwrap();
+    p.spec.solver.max_evals = max_evals;
+    let opts = usm_study::optimise::Options {
+        jobs: 2,
+        journal: None,
+        resume: false,
+        on_record: &quiet_record,
+    };
+    let o = usm_study::optimise::run(&p, &opts).unwrap();
+    (p, o)
+}
