@@ -15,62 +15,78 @@ pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Optio
             .find(|(n, _)| n == k)
             .map_or(f64::NAN, |x| x.1)
     };
-    let missed = |criterion, detail: String| Some(Missed { criterion, detail });
-    // NaN misses.
-    let above = |x: f64, bound: f64| x.is_nan() || x > bound;
     if get("completed") != 1.0 {
-        return missed(Criterion::NoFailure, "the run stopped early".into());
+        return Some(Missed {
+            criterion: Criterion::NoFailure,
+            detail: "the run stopped early".into(),
+        });
     }
-    let peak = get("peak_thrust");
-    if spec.max_peak_thrust > 0.0 && above(peak, spec.max_peak_thrust) {
-        let d = format!("peak_thrust = {peak:.4} N > {} N", spec.max_peak_thrust);
-        return missed(Criterion::MaxPeakThrust, d);
-    }
-    let sat = get("saturation_fraction");
-    if above(sat, spec.max_saturation_fraction) {
-        let d = format!(
-            "saturation_fraction = {sat:.4} > {}",
-            spec.max_saturation_fraction
+    // The metric `name` against its upper `limit` (NaN misses).
+    let check = |c, name, limit, unit| exceeds(c, name, get(name), limit, unit);
+    if spec.max_peak_thrust > 0.0 {
+        let m = check(
+            Criterion::MaxPeakThrust,
+            "peak_thrust",
+            spec.max_peak_thrust,
+            " N",
         );
-        return missed(Criterion::MaxSaturationFraction, d);
+        if m.is_some() {
+            return m;
+        }
+    }
+    let sat = spec.max_saturation_fraction;
+    let m = check(
+        Criterion::MaxSaturationFraction,
+        "saturation_fraction",
+        sat,
+        "",
+    );
+    if m.is_some() {
+        return m;
     }
     match mode {
         Mode::Transport => judge_transport(spec, &get),
         Mode::Work => {
-            let p = get("final_position_error");
-            if above(p, spec.position_tolerance) {
-                let d = format!(
-                    "final_position_error = {p:.4} m > {} m",
-                    spec.position_tolerance
-                );
-                return missed(Criterion::PositionTolerance, d);
-            }
-            let a = get("final_orientation_error_deg");
-            if above(a, spec.orientation_tolerance_deg) {
-                let d = format!(
-                    "final_orientation_error_deg = {a:.4} > {}",
-                    spec.orientation_tolerance_deg
-                );
-                return missed(Criterion::OrientationTolerance, d);
-            }
-            None
+            let (p, a) = (spec.position_tolerance, spec.orientation_tolerance_deg);
+            check(
+                Criterion::PositionTolerance,
+                "final_position_error",
+                p,
+                " m",
+            )
+            .or_else(|| {
+                check(
+                    Criterion::OrientationTolerance,
+                    "final_orientation_error_deg",
+                    a,
+                    "",
+                )
+            })
         }
     }
+}
+
+/// `criterion` missed when `x` (the value of `label`, in `unit`) is NaN or above `limit`.
+fn exceeds(criterion: Criterion, label: &str, x: f64, limit: f64, unit: &str) -> Option<Missed> {
+    (x.is_nan() || x > limit).then(|| Missed {
+        criterion,
+        detail: format!("{label} = {x:.4}{unit} > {limit}{unit}"),
+    })
 }
 
 /// The transport criteria: the final cross-track bound, then each reached segment's
 /// convergence window in the order the segments became active.
 fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
-    let e = get("final_cross_track");
-    if e.is_nan() || e.abs() > spec.cross_track_bound {
-        return Some(Missed {
-            criterion: Criterion::CrossTrackBound,
-            detail: format!(
-                "|final_cross_track| = {:.4} m > {} m",
-                e.abs(),
-                spec.cross_track_bound
-            ),
-        });
+    let e = get("final_cross_track").abs();
+    let bound = spec.cross_track_bound;
+    if let Some(m) = exceeds(
+        Criterion::CrossTrackBound,
+        "|final_cross_track|",
+        e,
+        bound,
+        " m",
+    ) {
+        return Some(m);
     }
     let reached = get("segments_reached");
     let n = if reached.is_finite() && reached > 0.0 {
