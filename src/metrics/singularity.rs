@@ -283,6 +283,59 @@ pub fn commanded_sigma(
     char_length: f64,
     dofs: CommandedDofs,
 ) -> CommandedSigma {
+    commanded_sigma_with(&ScaledGram::new(t, char_length), t, dofs)
+}
+
+/// The scaled Gram matrix `T_L T_Lᵀ` of all six rows of one `T` (moments divided by
+/// `char_length` L [m]), built in one pass over its columns. The Gram matrix of any axis
+/// selection `S` is a principal submatrix of it (entry for entry the same sums), so
+/// [`commanded_sigma_with`] and [`weakest_direction_with`] score several selections of one
+/// configuration — the static analysis does all six axes and the commanded ones — without
+/// reading `T` again.
+#[derive(Clone, Copy, Debug)]
+pub struct ScaledGram {
+    gram: [[f64; 6]; 6],
+    char_length: f64,
+    /// L finite and > 0 and every entry of `T` finite.
+    valid: bool,
+}
+
+impl ScaledGram {
+    /// The Gram matrix of `t` scaled by `char_length` (zero, and invalid, for a bad L or a
+    /// non-finite `t`).
+    pub fn new(t: &Matrix6xX<f64>, char_length: f64) -> Self {
+        let valid = char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite());
+        let all = selected_rows(CommandedDofs::ALL);
+        Self {
+            gram: if valid {
+                commanded_gram(t, char_length, &all, 6)
+            } else {
+                [[0.0; 6]; 6]
+            },
+            char_length,
+            valid,
+        }
+    }
+
+    /// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]`.
+    fn select(&self, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
+        let mut g = [[0.0; 6]; 6];
+        for (ga, &ra) in g.iter_mut().zip(rows).take(k) {
+            for (gab, &rb) in ga.iter_mut().zip(rows).take(k) {
+                *gab = self.gram[ra][rb];
+            }
+        }
+        g
+    }
+}
+
+/// [`commanded_sigma`] of the `T` whose [`ScaledGram`] is `g` (`t` is read again only on the
+/// ill-conditioned route).
+pub fn commanded_sigma_with(
+    g: &ScaledGram,
+    t: &Matrix6xX<f64>,
+    dofs: CommandedDofs,
+) -> CommandedSigma {
     let k = dofs.len();
     let mut out = CommandedSigma {
         singular_values: [0.0; 6],
@@ -291,7 +344,7 @@ pub fn commanded_sigma(
         sigma_max: 0.0,
         condition_number: f64::INFINITY,
     };
-    if !(char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite())) {
+    if !g.valid {
         out.sigma_min = f64::NAN;
         out.sigma_max = f64::NAN;
         out.condition_number = f64::NAN;
@@ -301,13 +354,13 @@ pub fn commanded_sigma(
         return out;
     }
     let rows = selected_rows(dofs);
-    let mut gram = commanded_gram(t, char_length, &rows, k);
+    let mut gram = g.select(&rows, k);
     let mut ev = tridiagonal_eigenvalues(&mut gram, k);
     let (lo, hi) = min_max(&ev[..k]);
     if lo < GRAM_MIN_RATIO * hi {
         let mut r = [[0.0; 6]; 6];
         for col in t.column_iter() {
-            let x = select_scaled(col.as_slice(), &rows, k, char_length);
+            let x = select_scaled(col.as_slice(), &rows, k, g.char_length);
             givens_add_row(&mut r, x, k);
         }
         ev = one_sided_jacobi_sq(&mut r, k);
@@ -342,13 +395,18 @@ pub fn weakest_direction(
     dofs: CommandedDofs,
     sigma_min: f64,
 ) -> [f64; 6] {
+    weakest_direction_with(&ScaledGram::new(t, char_length), dofs, sigma_min)
+}
+
+/// [`weakest_direction`] of the `T` whose [`ScaledGram`] is `g`.
+pub fn weakest_direction_with(g: &ScaledGram, dofs: CommandedDofs, sigma_min: f64) -> [f64; 6] {
     let k = dofs.len();
     let mut dir = [0.0; 6];
-    if k == 0 || !sigma_min.is_finite() || !(char_length.is_finite() && char_length > 0.0) {
+    if k == 0 || !sigma_min.is_finite() || !g.valid {
         return dir;
     }
     let rows = selected_rows(dofs);
-    let gram = commanded_gram(t, char_length, &rows, k);
+    let gram = g.select(&rows, k);
     let y = shifted_inverse_iteration(gram, k, sigma_min * sigma_min * (1.0 - 1e-6));
     for (a, &r) in rows.iter().take(k).enumerate() {
         dir[r] = y[a];

@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{
-    commanded_sigma, tcm_svd_metrics, weakest_direction, CommandedDofs, SingularityError,
-    AXIS_NAMES,
+    commanded_sigma_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs, ScaledGram,
+    SingularityError, AXIS_NAMES,
 };
 use crate::model::Vehicle;
 
@@ -90,15 +90,16 @@ impl<'a> Eval<'a> {
     pub fn at(&self, s: &mut Scratch) -> SampleMetrics {
         forward_kinematics(self.v, &s.q, &mut s.ws);
         thruster_matrix(self.v, &s.ws, &mut s.t);
-        let full = commanded_sigma(&s.t, self.l, CommandedDofs::ALL);
+        let g = ScaledGram::new(&s.t, self.l);
+        let full = commanded_sigma_with(&g, &s.t, CommandedDofs::ALL);
         let rank = full.rank(self.tol);
         let flagged = rank < 6 || full.sigma_min < self.threshold;
         let lost_axis = (flagged && full.sigma_min.is_finite()).then(|| {
-            let d = weakest_direction(&s.t, self.l, CommandedDofs::ALL, full.sigma_min);
+            let d = weakest_direction_with(&g, CommandedDofs::ALL, full.sigma_min);
             let imax = (0..6).fold(0, |m, i| if d[i].abs() > d[m].abs() { i } else { m });
             AXIS_NAMES[imax]
         });
-        let cmd = commanded_sigma(&s.t, self.l, self.commanded);
+        let cmd = commanded_sigma_with(&g, &s.t, self.commanded);
         let rank_commanded = cmd.rank(self.tol);
         SampleMetrics {
             sigma_min: full.sigma_min,
