@@ -12,7 +12,9 @@ use super::setup::ClosedLoop;
 use crate::allocation::{AllocPath, AllocStatus, Allocation};
 use crate::dynamics::SimState;
 use crate::kinematics::KinWorkspace;
-use crate::metrics::singularity::{commanded_sigma, residual_exceeds, CommandedDofs};
+use crate::metrics::singularity::{
+    commanded_sigma_with, residual_exceeds, CommandedDofs, ScaledGram,
+};
 use crate::metrics::trajectory::{
     EnergyIntegrator, EnergyMetrics, PowerModel, PowerSample, ThrusterSample,
 };
@@ -396,15 +398,10 @@ impl Recorder {
             held.enumerate()
                 .map(|(j, (_, v_a))| (Channel::Inflow(j), *v_a)),
         );
-        let l = self.char_length;
-        w.put(
-            Channel::SigmaMin,
-            commanded_sigma(&lp.t_mat, l, CommandedDofs::ALL).sigma_min,
-        );
-        w.put(
-            Channel::SigmaMinCommanded,
-            commanded_sigma(&lp.t_mat, l, self.commanded).sigma_min,
-        );
+        let g = ScaledGram::new(&lp.t_mat, self.char_length);
+        let sigma = |dofs| commanded_sigma_with(&g, &lp.t_mat, dofs).sigma_min;
+        w.put(Channel::SigmaMin, sigma(CommandedDofs::ALL));
+        w.put(Channel::SigmaMinCommanded, sigma(self.commanded));
         w.put(Channel::SlackNorm, lp.alloc.s.norm());
         w.put(Channel::AllocStatus, status_code(&lp.alloc.status));
         self.traj.push_row(&self.row);
