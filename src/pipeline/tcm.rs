@@ -86,7 +86,7 @@ pub fn run_tcm(
     create_dir(out)?;
     let schema = sample_schema(vehicle.n_joints());
     let csv_path = out.join("samples.csv");
-    let mut app = CsvAppender::create(&csv_path, &schema)?;
+    let mut app = CsvAppender::create(&csv_path, &schema)?.batched();
     let mut sigmas: Vec<f64> = Vec::with_capacity(spec.samples);
     let mut commanded: Vec<f64> = Vec::with_capacity(spec.samples);
     let mut row: Vec<Value> = Vec::with_capacity(schema.len());

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::error::{ReportError, Result};
-use super::number::format_f64;
+use super::number::push_f64;
 use super::table::{check_same_schema, check_schema_names, ColumnKind, Table, Value};
 
 /// Appends `s` to `buf` quoted the way polars does with its default (`Necessary`) quote style.
@@ -24,8 +24,11 @@ fn push_csv_str(buf: &mut String, s: &str) {
 
 fn push_csv_value(buf: &mut String, v: &Value<'_>) {
     match v {
-        Value::F64(x) => buf.push_str(&format_f64(*x)),
-        Value::I64(x) => buf.push_str(&x.to_string()),
+        Value::F64(x) => push_f64(buf, *x),
+        Value::I64(x) => {
+            use std::fmt::Write as _;
+            let _ = write!(buf, "{x}");
+        }
         Value::Str(s) => push_csv_str(buf, s),
         Value::Bool(b) => buf.push_str(if *b { "true" } else { "false" }),
     }
@@ -49,7 +52,7 @@ fn csv_header_line(schema: &[(String, ColumnKind)]) -> String {
 /// Plain std I/O: each row is formatted into one line and written with a single `write_all`
 /// on the unbuffered file (no data sits in a user-space buffer after [`CsvAppender::append`]
 /// returns). The bytes are identical to [`write_csv`] of the same table (same header quoting,
-/// float format [`format_f64`], `true`/`false`, integers in decimal), so reading the file back
+/// float format [`super::number::format_f64`], `true`/`false`, integers in decimal), so reading the file back
 /// and writing it with polars reproduces it exactly.
 #[derive(Debug)]
 pub struct CsvAppender {
@@ -58,6 +61,8 @@ pub struct CsvAppender {
     schema: Vec<(String, ColumnKind)>,
     rows: usize,
     line: String,
+    /// Pending bytes at which `line` is written: 0 writes every row ([`CsvAppender::batched`]).
+    batch: usize,
 }
 
 impl CsvAppender {
@@ -81,6 +86,7 @@ impl CsvAppender {
             schema: schema.to_vec(),
             rows: 0,
             line: String::new(),
+            batch: 0,
         })
     }
 
@@ -144,6 +150,7 @@ impl CsvAppender {
             schema: schema.to_vec(),
             rows,
             line: String::new(),
+            batch: 0,
         })
     }
 
@@ -163,7 +170,6 @@ impl CsvAppender {
                 });
             }
         }
-        self.line.clear();
         for (i, v) in row.iter().enumerate() {
             if i > 0 {
                 self.line.push(',');
@@ -171,6 +177,23 @@ impl CsvAppender {
             push_csv_value(&mut self.line, v);
         }
         self.line.push('\n');
+        self.rows += 1;
+        if self.line.len() >= self.batch {
+            self.write_pending()?;
+        }
+        Ok(())
+    }
+
+    /// The same appender writing rows in batches of about 64 KiB instead of one `write_all`
+    /// per row: for large outputs that are not a journal (a crash may lose the last batch);
+    /// [`CsvAppender::sync`] writes what is pending. Dropping it without `sync` loses the
+    /// pending rows.
+    pub fn batched(mut self) -> Self {
+        self.batch = 1 << 16;
+        self
+    }
+
+    fn write_pending(&mut self) -> Result<()> {
         self.file
             .write_all(self.line.as_bytes())
             .map_err(|source| ReportError::Io {
@@ -178,7 +201,7 @@ impl CsvAppender {
                 action: "appending to",
                 source,
             })?;
-        self.rows += 1;
+        self.line.clear();
         Ok(())
     }
 
@@ -193,8 +216,10 @@ impl CsvAppender {
     }
 
     /// Forces the written rows to stable storage (`fsync`); rows are already handed to the
-    /// operating system by [`CsvAppender::append`].
-    pub fn sync(&self) -> Result<()> {
+    /// operating system by [`CsvAppender::append`] (in batches after
+    /// [`CsvAppender::batched`], whose pending rows are written first).
+    pub fn sync(&mut self) -> Result<()> {
+        self.write_pending()?;
         self.file.sync_all().map_err(|source| ReportError::Io {
             path: self.path.clone(),
             action: "syncing",
