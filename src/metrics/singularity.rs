@@ -13,7 +13,8 @@ use nalgebra::{Matrix6xX, Vector6};
 use serde::Serialize;
 
 use super::small_svd::{
-    givens_add_row, one_sided_jacobi_sq, shifted_inverse_iteration, tridiagonal_eigenvalues,
+    extreme_eigenvalues, givens_add_row, one_sided_jacobi_sq, shifted_inverse_iteration,
+    tridiagonal_eigenvalues,
 };
 use crate::allocation::{attainable_wrench, AllocError, AttainableWrench};
 
@@ -358,27 +359,111 @@ pub fn commanded_sigma_with(
     let mut ev = tridiagonal_eigenvalues(&mut gram, k);
     let (lo, hi) = min_max(&ev[..k]);
     if lo < GRAM_MIN_RATIO * hi {
-        let mut r = [[0.0; 6]; 6];
-        for col in t.column_iter() {
-            let x = select_scaled(col.as_slice(), &rows, k, g.char_length);
-            givens_add_row(&mut r, x, k);
-        }
-        ev = one_sided_jacobi_sq(&mut r, k);
+        ev = triangle_sigma_sq(g, t, &rows, k);
     }
+    from_squares(&ev, k)
+}
+
+/// The [`CommandedSigma`] of `k` squared singular values `ev[..k]` (any order; negative
+/// rounding clipped to 0).
+fn from_squares(ev: &[f64; 6], k: usize) -> CommandedSigma {
     let mut sv = [0.0; 6];
     for (s, e) in sv.iter_mut().zip(&ev[..k]) {
         *s = e.max(0.0).sqrt();
     }
     sv[..k].sort_by(|a, b| b.total_cmp(a));
-    out.singular_values = sv;
-    out.sigma_max = sv[0];
-    out.sigma_min = sv[k - 1];
-    out.condition_number = if out.sigma_min > 0.0 {
-        out.sigma_max / out.sigma_min
-    } else {
-        f64::INFINITY
-    };
-    out
+    CommandedSigma {
+        singular_values: sv,
+        k,
+        sigma_max: sv[0],
+        sigma_min: sv[k - 1],
+        condition_number: if sv[k - 1] > 0.0 {
+            sv[0] / sv[k - 1]
+        } else {
+            f64::INFINITY
+        },
+    }
+}
+
+/// The extreme singular values of the commanded rows `S·T_L` and the rank (SPEC §6): what
+/// the static analysis reports per configuration, at a third of [`commanded_sigma_with`]'s
+/// cost.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SigmaExtremes {
+    /// Number of commanded rows.
+    pub k: usize,
+    /// σ_min of `S·T_L` (N per N), as [`CommandedSigma::sigma_min`].
+    pub sigma_min: f64,
+    /// σ_max of `S·T_L` (N per N).
+    pub sigma_max: f64,
+    /// σ_max/σ_min; `+inf` when σ_min = 0.
+    pub condition_number: f64,
+    /// Number of singular values above `rank_rel_tol · σ_max`.
+    pub rank: usize,
+}
+
+/// [`commanded_sigma_with`] reduced to σ_min, σ_max, κ and the rank under `rank_rel_tol`,
+/// equal to it to rounding: on the well-conditioned (Gram) route only the two extreme
+/// eigenvalues of the Gram matrix are sought (Laguerre's iteration on its tridiagonal form,
+/// no QL sweeps), and every singular value then exceeds `rank_rel_tol · σ_max` (rank `k`)
+/// as long as `rank_rel_tol² < GRAM_MIN_RATIO`; otherwise, and on the ill-conditioned route,
+/// all singular values as [`commanded_sigma_with`] computes them. Allocation-free.
+pub fn commanded_extremes_with(
+    g: &ScaledGram,
+    t: &Matrix6xX<f64>,
+    dofs: CommandedDofs,
+    rank_rel_tol: f64,
+) -> SigmaExtremes {
+    let k = dofs.len();
+    if g.valid && k > 0 && rank_rel_tol * rank_rel_tol < GRAM_MIN_RATIO {
+        let rows = selected_rows(dofs);
+        let mut gram = g.select(&rows, k);
+        let (lo, hi) = extreme_eigenvalues(&mut gram, k);
+        if lo < GRAM_MIN_RATIO * hi {
+            let c = from_squares(&triangle_sigma_sq(g, t, &rows, k), k);
+            return SigmaExtremes {
+                k,
+                sigma_min: c.sigma_min,
+                sigma_max: c.sigma_max,
+                condition_number: c.condition_number,
+                rank: c.rank(rank_rel_tol),
+            };
+        } else {
+            let (sigma_min, sigma_max) = (lo.max(0.0).sqrt(), hi.max(0.0).sqrt());
+            return SigmaExtremes {
+                k,
+                sigma_min,
+                sigma_max,
+                condition_number: if sigma_min > 0.0 {
+                    sigma_max / sigma_min
+                } else {
+                    f64::INFINITY
+                },
+                rank: k,
+            };
+        }
+    }
+    // Invalid input, nothing commanded, or a rank tolerance the Gram route cannot certify.
+    let c = commanded_sigma_with(g, t, dofs);
+    SigmaExtremes {
+        k,
+        sigma_min: c.sigma_min,
+        sigma_max: c.sigma_max,
+        condition_number: c.condition_number,
+        rank: c.rank(rank_rel_tol),
+    }
+}
+
+/// The squared singular values of `S·T_L` (the rows `rows[..k]` of the `T` whose Gram matrix
+/// is `g`) by the route that keeps small ones accurate: the triangular factor of `(S T_L)ᵀ`
+/// (Givens QR, one thruster column at a time), then one-sided Jacobi on it.
+fn triangle_sigma_sq(g: &ScaledGram, t: &Matrix6xX<f64>, rows: &[usize; 6], k: usize) -> [f64; 6] {
+    let mut r = [[0.0; 6]; 6];
+    for col in t.column_iter() {
+        let x = select_scaled(col.as_slice(), rows, k, g.char_length);
+        givens_add_row(&mut r, x, k);
+    }
+    one_sided_jacobi_sq(&mut r, k)
 }
 
 /// The weakest commanded wrench direction of `S·T_L` whose smallest singular value

@@ -264,6 +264,67 @@ fn commanded_sigma_matches_svd_over_random_configurations() {
                 agrees(r.sigma_max, smax, smax),
                 "{n} {dofs:?}: {r:?} vs {smax}"
             );
+            // The static analysis' extremes-only route (Laguerre on the Gram matrix) agrees
+            // just as well, and its rank is the full route's.
+            let x = commanded_extremes_with(&ScaledGram::new(&t, l), &t, dofs, 1e-6);
+            assert!(agrees(x.sigma_min, want, smax), "{n} {dofs:?}: {x:?}");
+            assert!(agrees(x.sigma_max, smax, smax), "{n} {dofs:?}: {x:?}");
+            assert_eq!(x.rank, r.rank(1e-6), "{n} {dofs:?}");
+        }
+    }
+}
+
+#[test]
+fn extremes_agree_with_the_svd_on_random_gram_spectra() {
+    // Random T = U diag(σ) Vᵀ with prescribed singular values spanning κ from 1 to 1e12,
+    // repeated values and exact zeros: σ_min, σ_max and the rank of the extremes-only route
+    // against nalgebra's SVD (1e-10 relative, or 1e-14·σ_max absolute when tiny).
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for n in 0..600 {
+        let m = 6 + n % 4;
+        let a = nalgebra::DMatrix::from_fn(6, 6, |_, _| unit() - 0.5);
+        let b = nalgebra::DMatrix::from_fn(m, m, |_, _| unit() - 0.5);
+        let (u, w) = (a.qr().q(), b.qr().q());
+        let mut sig = [0.0; 6];
+        for (i, s) in sig.iter_mut().enumerate() {
+            *s = match n % 5 {
+                0 => 10f64.powf(-12.0 * unit()),
+                1 => 1.0 + 1e-3 * i as f64,
+                2 => {
+                    if i < 3 {
+                        0.5
+                    } else {
+                        2.0
+                    }
+                }
+                3 => {
+                    if i == 5 {
+                        0.0
+                    } else {
+                        unit() + 0.1
+                    }
+                }
+                _ => unit() + 1e-3,
+            };
+        }
+        let mut d = nalgebra::DMatrix::zeros(6, m);
+        for i in 0..6 {
+            d[(i, i)] = sig[i];
+        }
+        let t: Matrix6xX<f64> = Matrix6xX::from_column_slice((u * d * w.transpose()).as_slice());
+        for dofs in [CommandedDofs::ALL, transport_dofs()] {
+            let x = commanded_extremes_with(&ScaledGram::new(&t, 1.0), &t, dofs, 1e-6);
+            let (want, smax) = svd_reference(&t, 1.0, dofs);
+            assert!(agrees(x.sigma_min, want, smax), "{n} {dofs:?}: {x:?} vs {want}");
+            assert!(agrees(x.sigma_max, smax, smax), "{n} {dofs:?}: {x:?} vs {smax}");
+            let full = commanded_sigma(&t, 1.0, dofs);
+            assert_eq!(x.rank, full.rank(1e-6), "{n} {dofs:?}");
         }
     }
 }

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{
-    commanded_sigma_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs, ScaledGram,
+    commanded_extremes_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs, ScaledGram,
     SingularityError, AXIS_NAMES,
 };
 use crate::model::Vehicle;
@@ -91,16 +91,16 @@ impl<'a> Eval<'a> {
         forward_kinematics(self.v, &s.q, &mut s.ws);
         thruster_matrix(self.v, &s.ws, &mut s.t);
         let g = ScaledGram::new(&s.t, self.l);
-        let full = commanded_sigma_with(&g, &s.t, CommandedDofs::ALL);
-        let rank = full.rank(self.tol);
+        let full = commanded_extremes_with(&g, &s.t, CommandedDofs::ALL, self.tol);
+        let rank = full.rank;
         let flagged = rank < 6 || full.sigma_min < self.threshold;
         let lost_axis = (flagged && full.sigma_min.is_finite()).then(|| {
             let d = weakest_direction_with(&g, CommandedDofs::ALL, full.sigma_min);
             let imax = (0..6).fold(0, |m, i| if d[i].abs() > d[m].abs() { i } else { m });
             AXIS_NAMES[imax]
         });
-        let cmd = commanded_sigma_with(&g, &s.t, self.commanded);
-        let rank_commanded = cmd.rank(self.tol);
+        let cmd = commanded_extremes_with(&g, &s.t, self.commanded, self.tol);
+        let rank_commanded = cmd.rank;
         SampleMetrics {
             sigma_min: full.sigma_min,
             kappa: if rank < 6 {
