@@ -321,8 +321,14 @@ fn extremes_agree_with_the_svd_on_random_gram_spectra() {
         for dofs in [CommandedDofs::ALL, transport_dofs()] {
             let x = commanded_extremes_with(&ScaledGram::new(&t, 1.0), &t, dofs, 1e-6);
             let (want, smax) = svd_reference(&t, 1.0, dofs);
-            assert!(agrees(x.sigma_min, want, smax), "{n} {dofs:?}: {x:?} vs {want}");
-            assert!(agrees(x.sigma_max, smax, smax), "{n} {dofs:?}: {x:?} vs {smax}");
+            assert!(
+                agrees(x.sigma_min, want, smax),
+                "{n} {dofs:?}: {x:?} vs {want}"
+            );
+            assert!(
+                agrees(x.sigma_max, smax, smax),
+                "{n} {dofs:?}: {x:?} vs {smax}"
+            );
             let full = commanded_sigma(&t, 1.0, dofs);
             assert_eq!(x.rank, full.rank(1e-6), "{n} {dofs:?}");
         }

@@ -365,4 +365,3 @@ pub(crate) fn shifted_inverse_iteration(mut a: [[f64; 6]; 6], k: usize, shift: f
     }
     y
 }
-

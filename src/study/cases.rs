@@ -6,7 +6,7 @@ use super::hash::{case_hashes, unresolved_case_hash};
 use super::runner::method_control;
 use super::schema::{Study, Target};
 use crate::input::keypath::{set, Seg};
-use crate::model::design::{design_to_toml, parse_design_table};
+use crate::model::design::{parse_design_table, thrusters_to_toml};
 use crate::sampling::derive_seed;
 
 /// A case with every override applied.
@@ -45,13 +45,7 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
     if !thruster_edits.is_empty() && study.generator && !design.contains_key("thruster") {
         // Write the generated thrusters out so that they can be edited one by one.
         let v = parse_design_table(&design, "generated design").map_err(|e| e.to_string())?;
-        let explicit: toml::Table =
-            toml::from_str(&design_to_toml(&v)).map_err(|e| e.to_string())?;
-        if let Some(t) = explicit.get("thruster") {
-            design.insert("thruster".into(), t.clone());
-        } else {
-            design.insert("thruster".into(), toml::Value::Array(Vec::new()));
-        }
+        design.insert("thruster".into(), thrusters_to_toml(&v));
     }
     for (a, p, v) in thruster_edits {
         set(&mut design, &p.0, v.clone(), &a.name)?;

@@ -62,7 +62,7 @@ mod tests;
 mod write;
 
 pub use error::{DesignError, DesignErrorKind, DesignFault};
-pub use write::design_to_toml;
+pub use write::{design_to_toml, thrusters_to_toml};
 
 use super::presets::{self, PRESETS};
 use super::Vehicle;

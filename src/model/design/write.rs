@@ -204,3 +204,42 @@ pub fn design_to_toml(v: &Vehicle) -> String {
     }
     o
 }
+
+/// The `[[thruster]]` array of [`design_to_toml`]`(v)` as a TOML value, equal to what parsing
+/// that text gives (same keys, the same floats bit for bit), without writing and parsing the
+/// whole design: a sweep that edits one generated thruster per case writes the generated ones
+/// out with it.
+pub fn thrusters_to_toml(v: &Vehicle) -> toml::Value {
+    use toml::Value;
+    let unique_names = v
+        .bodies
+        .iter()
+        .enumerate()
+        .all(|(i, b)| v.bodies[..i].iter().all(|o| o.name != b.name));
+    let floats = |x: &[f64]| Value::Array(x.iter().map(|&c| Value::Float(c)).collect());
+    let tables = v
+        .thrusters
+        .iter()
+        .map(|t| {
+            let mut m = toml::Table::new();
+            m.insert("name".into(), Value::String(t.name.clone()));
+            let body = match v.bodies.get(t.body) {
+                Some(b) if unique_names => Value::String(b.name.clone()),
+                _ => Value::Integer(t.body as i64),
+            };
+            m.insert("body".into(), body);
+            m.insert("position".into(), floats(t.position.as_slice()));
+            m.insert("direction".into(), floats(t.direction.as_slice()));
+            m.insert("u_min".into(), Value::Float(t.u_min));
+            m.insert("u_max".into(), Value::Float(t.u_max));
+            if let Some(tc) = t.time_constant {
+                m.insert("time_constant".into(), Value::Float(tc));
+            }
+            if let Some(r) = t.rate_limit {
+                m.insert("rate_limit".into(), Value::Float(r));
+            }
+            Value::Table(m)
+        })
+        .collect();
+    Value::Array(tables)
+}

@@ -185,6 +185,11 @@ proptest! {
     #[test]
     fn generated_designs_round_trip(spec in arb_spec()) {
         let v = spec.build("gen").unwrap();
+        // The thruster array written directly is the one the explicit text parses to (none
+        // written: empty).
+        let text: toml::Table = toml::from_str(&design_to_toml(&v)).unwrap();
+        let parsed = text.get("thruster").cloned();
+        prop_assert_eq!(thrusters_to_toml(&v), parsed.unwrap_or(toml::Value::Array(Vec::new())));
         let back = round_trip(&v).map_err(TestCaseError::fail)?;
         prop_assert!(close(&v, &back, 1e-12).is_ok(), "{:?}", close(&v, &back, 1e-12));
         // The [generator] form builds the same vehicle.
