@@ -2,7 +2,12 @@
 //! forces (RNEA), forward and hybrid dynamics, one RK4 step with full hydrodynamics, and one
 //! 50 ms control period advanced by the adaptive Dormand–Prince integrator.
 //!
-//! Run with `cargo bench --bench dynamics -- --warm-up-time 1 --measurement-time 3`.
+//! Group `whole_run`: a whole closed-loop run of the presets `transport-method1` (140 s,
+//! qp allocation) and `work-setpoint` (80 s), as `usm-study simulate` runs them without
+//! writing files (scenario parsed and design built once, outside the measurement).
+//!
+//! Run with `cargo bench --bench dynamics -- --warm-up-time 1 --measurement-time 3`
+//! (`-- whole_run` for the whole runs alone; issue 11 target: ≤ 70 ms for the 140 s run).
 //! Before measuring, a counting allocator checks that neither a simulator RK4 step nor an
 //! adaptive span allocates.
 
@@ -17,6 +22,7 @@ use usm_study::dynamics::{
 };
 use usm_study::kinematics::BasePose;
 use usm_study::model::presets::usm_paper;
+use usm_study::scenario;
 use usm_study::spatial::Vec3;
 
 /// A bent, moving state of the paper's USM in a current.
@@ -121,5 +127,23 @@ fn bench_dynamics(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench_dynamics);
+fn bench_whole_run(c: &mut Criterion) {
+    let mut g = c.benchmark_group("whole_run");
+    g.sample_size(10);
+    for preset in ["transport-method1", "work-setpoint"] {
+        let (table, src) = scenario::load_table(preset).unwrap();
+        let file = scenario::parse_table(&table, &src).unwrap();
+        let v = scenario::resolve_design(&file, &src).unwrap();
+        g.bench_function(preset, |b| {
+            b.iter(|| {
+                let r = scenario::run_scenario(&v, black_box(&file)).unwrap();
+                assert!(r.failure.is_none(), "{preset}: {:?}", r.failure);
+                black_box(r)
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_dynamics, bench_whole_run);
 criterion_main!(benches);

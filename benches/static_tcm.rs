@@ -5,7 +5,9 @@
 //! - `static_config`: `kinematics` (forward kinematics and `T(q)`), `svd` (σ of `T_L` by a
 //!   general SVD, [`tcm_svd_metrics`], the route before issue 11), `sigma_full` and
 //!   `sigma_transport` ([`commanded_sigma`] for all six rows and for transport's five);
-//!   each iteration takes the next of 64 seeded configurations;
+//!   `extremes_full` and `extremes_transport` ([`commanded_extremes_with`] from the scaled Gram
+//!   matrix: σ_min, σ_max and rank only, the static analysis' route); each iteration takes the
+//!   next of 64 seeded configurations;
 //! - `static_analyse`: [`analyse`] of 20 000 Sobol configurations on one thread (throughput
 //!   in configurations/s), with and without a row sink.
 //!
@@ -23,7 +25,8 @@ use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
 use usm_study::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use usm_study::metrics::singularity::{
-    commanded_sigma, tcm_svd_metrics, CommandedDofs, DEFAULT_RANK_REL_TOL,
+    commanded_extremes_with, commanded_sigma, tcm_svd_metrics, CommandedDofs, ScaledGram,
+    DEFAULT_RANK_REL_TOL,
 };
 use usm_study::model::presets::usm_paper;
 use usm_study::study::static_tcm::{analyse, StaticSpec};
@@ -55,6 +58,13 @@ fn bench_static(c: &mut Criterion) {
     for t in &ts {
         black_box(commanded_sigma(t, l, CommandedDofs::ALL));
         black_box(commanded_sigma(t, l, transport));
+        let gram = ScaledGram::new(t, l);
+        black_box(commanded_extremes_with(
+            &gram,
+            t,
+            transport,
+            DEFAULT_RANK_REL_TOL,
+        ));
     }
     let n = ALLOCS.load(Ordering::Relaxed) - before;
     assert_eq!(n, 0, "commanded_sigma allocated {n} times");
@@ -88,6 +98,20 @@ fn bench_static(c: &mut Criterion) {
             b.iter(|| {
                 k = (k + 1) % ts.len();
                 black_box(commanded_sigma(&ts[k], l, dofs).sigma_min)
+            })
+        });
+    }
+    for (name, dofs) in [
+        ("extremes_full", CommandedDofs::ALL),
+        ("extremes_transport", transport),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                k = (k + 1) % ts.len();
+                let gram = ScaledGram::new(&ts[k], l);
+                black_box(
+                    commanded_extremes_with(&gram, &ts[k], dofs, DEFAULT_RANK_REL_TOL).sigma_min,
+                )
             })
         });
     }
