@@ -7,7 +7,8 @@
 //!   `sigma_transport` ([`commanded_sigma`] for all six rows and for transport's five);
 //!   `extremes_full` and `extremes_transport` ([`commanded_extremes_with`] from the scaled Gram
 //!   matrix: σ_min, σ_max and rank only, the static analysis' route); each iteration takes the
-//!   next of 64 seeded configurations;
+//!   next of 64 seeded configurations; `kinematics_and_sigma_min` is the whole per-configuration
+//!   work of σ_min alone (T(q) and the extremes of all six rows);
 //! - `static_analyse`: [`analyse`] of 20 000 Sobol configurations on one thread (throughput
 //!   in configurations/s), with and without a row sink.
 //!
@@ -115,6 +116,20 @@ fn bench_static(c: &mut Criterion) {
             })
         });
     }
+    // The baseline's workload (issue 11's 80 k configurations/s): T(q) and its σ_min, one
+    // configuration after the other, nothing else.
+    g.bench_function("kinematics_and_sigma_min", |b| {
+        b.iter(|| {
+            k = (k + 1) % qs.len();
+            forward_kinematics(&v, &qs[k], &mut ws);
+            thruster_matrix(&v, &ws, &mut t);
+            let gram = ScaledGram::new(&t, l);
+            black_box(
+                commanded_extremes_with(&gram, &t, CommandedDofs::ALL, DEFAULT_RANK_REL_TOL)
+                    .sigma_min,
+            )
+        })
+    });
     g.finish();
 
     let mut g = c.benchmark_group("static_analyse");

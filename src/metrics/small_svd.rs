@@ -144,10 +144,14 @@ pub(crate) fn extreme_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> (f64, f64)
     let slack = 4.0 * f64::EPSILON * scale;
     lo_bound = lo_bound.max(-slack);
     hi_bound = hi_bound.min(d[..k].iter().sum::<f64>() + slack);
-    match (
-        laguerre_extreme(&d, &e2, k, lo_bound, true, scale),
-        laguerre_extreme(&d, &e2, k, hi_bound, false, scale),
-    ) {
+    let extreme = |start, from_below| match k {
+        6 => laguerre_extreme::<6>(&d, &e2, start, from_below, scale),
+        5 => laguerre_extreme::<5>(&d, &e2, start, from_below, scale),
+        4 => laguerre_extreme::<4>(&d, &e2, start, from_below, scale),
+        3 => laguerre_extreme::<3>(&d, &e2, start, from_below, scale),
+        _ => laguerre_extreme::<2>(&d, &e2, start, from_below, scale),
+    };
+    match (extreme(lo_bound, true), extreme(hi_bound, false)) {
         (Some(lo), Some(hi)) => (lo, hi),
         _ => {
             implicit_ql(&mut d, &mut e, k);
@@ -158,23 +162,22 @@ pub(crate) fn extreme_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> (f64, f64)
     }
 }
 
-/// The eigenvalue of the symmetric tridiagonal matrix `(d, e)` (`e2[i] = e[i]²`, `k`
-/// entries) nearest to `start`, a bound below (`from_below`) or above the spectrum
+/// The eigenvalue of the symmetric tridiagonal matrix `(d, e)` (`e2[i] = e[i]²`, `K`
+/// entries, `K ≥ 2`) nearest to `start`, a bound below (`from_below`) or above the spectrum
 /// (Gershgorin): Laguerre's
 /// iteration on `p(λ) = det(T − λI)` (three-term recurrences for `p`, `p'`, `p''`). With all
 /// roots real it moves monotonically from an outer bound to the extreme root and converges
 /// cubically to a simple one (Wilkinson, *The Algebraic Eigenvalue Problem*, §7.6). Stops
 /// when the step falls below `4ε·scale` (`scale` ≥ ‖T‖) or stops moving outward-in; `None`
 /// after 40 iterations (a multiple root converges only linearly).
-fn laguerre_extreme(
+fn laguerre_extreme<const K: usize>(
     d: &[f64; 6],
     e2: &[f64; 6],
-    k: usize,
     start: f64,
     from_below: bool,
     scale: f64,
 ) -> Option<f64> {
-    let n = k as f64;
+    let n = K as f64;
     let tiny = 4.0 * f64::EPSILON * scale.max(f64::MIN_POSITIVE);
     let mut x = start;
     for _ in 0..40 {
@@ -182,7 +185,7 @@ fn laguerre_extreme(
         let (mut p0, mut p1) = (1.0, d[0] - x);
         let (mut dp0, mut dp1) = (0.0, -1.0);
         let (mut ddp0, mut ddp1) = (0.0, 0.0);
-        for j in 1..k {
+        for j in 1..K {
             let (a, b) = (d[j] - x, e2[j - 1]);
             let p2 = a * p1 - b * p0;
             let dp2 = a * dp1 - b * dp0 - p1;
@@ -219,47 +222,72 @@ fn laguerre_extreme(
 /// `H = I − 2vvᵀ` from the left and right: diagonal into `d`, subdiagonal (`e[i]` between
 /// rows `i` and `i + 1`) into `e`, `e[k − 1] = 0`.
 fn householder_tridiagonal(a: &mut [[f64; 6]; 6], k: usize, d: &mut [f64; 6], e: &mut [f64; 6]) {
-    for j in 0..k.saturating_sub(2) {
+    // One copy per size, so that every loop bound is a constant (unrolled, no bounds checks).
+    match k {
+        6 => householder_k::<6>(a, d, e),
+        5 => householder_k::<5>(a, d, e),
+        4 => householder_k::<4>(a, d, e),
+        3 => householder_k::<3>(a, d, e),
+        2 => householder_k::<2>(a, d, e),
+        1 => householder_k::<1>(a, d, e),
+        _ => {}
+    }
+}
+
+/// [`householder_tridiagonal`] of the `K×K` block. Each reflection is `H = I − β v vᵀ` with
+/// `v = x − α e_1` unnormalised and `β = 2/(vᵀv) = 1/(‖x‖(‖x‖ + |x_1|))`.
+fn householder_k<const K: usize>(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6]) {
+    for j in 0..K.saturating_sub(2) {
         let lo = j + 1;
-        let norm = (lo..k).map(|i| a[i][j] * a[i][j]).sum::<f64>().sqrt();
-        if norm == 0.0 {
+        let mut norm2 = 0.0;
+        for i in lo..K {
+            norm2 += a[i][j] * a[i][j];
+        }
+        if norm2 == 0.0 {
             e[j] = 0.0;
             continue;
         }
+        let norm = norm2.sqrt();
         let alpha = if a[lo][j] > 0.0 { -norm } else { norm };
         let mut v = [0.0; 6];
-        for i in lo..k {
+        for i in lo..K {
             v[i] = a[i][j];
         }
         v[lo] -= alpha;
-        let vn = (lo..k).map(|i| v[i] * v[i]).sum::<f64>().sqrt();
-        for x in v[lo..k].iter_mut() {
-            *x /= vn;
-        }
-        // A ← H A H on the trailing block: p = A v, q = p − (vᵀp) v, A ← A − 2(v qᵀ + q vᵀ).
+        let beta = 1.0 / (norm * (norm + a[lo][j].abs()));
+        // A ← H A H on the trailing block: p = β A v, q = p − (β vᵀp / 2) v,
+        // A ← A − v qᵀ − q vᵀ.
         let mut p = [0.0; 6];
-        for i in lo..k {
-            p[i] = (lo..k).map(|l| a[i][l] * v[l]).sum();
+        for i in lo..K {
+            let mut acc = 0.0;
+            for l in lo..K {
+                acc += a[i][l] * v[l];
+            }
+            p[i] = beta * acc;
         }
-        let kk: f64 = (lo..k).map(|i| v[i] * p[i]).sum();
-        for i in lo..k {
-            p[i] -= kk * v[i];
+        let mut vp = 0.0;
+        for i in lo..K {
+            vp += v[i] * p[i];
         }
-        for i in lo..k {
-            for l in lo..k {
-                a[i][l] -= 2.0 * (v[i] * p[l] + p[i] * v[l]);
+        let half = 0.5 * beta * vp;
+        for i in lo..K {
+            p[i] -= half * v[i];
+        }
+        for i in lo..K {
+            for l in lo..K {
+                a[i][l] -= v[i] * p[l] + p[i] * v[l];
             }
         }
         e[j] = alpha;
     }
-    for i in 0..k {
+    for i in 0..K {
         d[i] = a[i][i];
     }
-    if k >= 2 {
-        e[k - 2] = a[k - 1][k - 2];
+    if K >= 2 {
+        e[K - 2] = a[K - 1][K - 2];
     }
-    if k >= 1 {
-        e[k - 1] = 0.0;
+    if K >= 1 {
+        e[K - 1] = 0.0;
     }
 }
 
