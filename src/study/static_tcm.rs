@@ -39,7 +39,7 @@ pub use super::static_tcm_eval::SampleMetrics;
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
 /// for streaming rows).
-pub const CHUNK: usize = 4096;
+pub const CHUNK: usize = 16384;
 
 /// Samples per worker batch within a chunk (one scratch per batch).
 const BATCH: usize = 256;
@@ -322,7 +322,7 @@ pub fn distribution(mut values: Vec<f64>) -> Distribution {
         }
     }
     let non_finite = values.len() - n;
-    values.sort_by(f64::total_cmp);
+    values.sort_unstable_by(f64::total_cmp);
     Distribution {
         min: values.first().copied().unwrap_or(f64::NAN),
         max: values.last().copied().unwrap_or(f64::NAN),
@@ -387,16 +387,14 @@ pub fn analyse(
             }
         }
         Some(pool) => {
+            // Two chunk buffers: the workers fill one while this thread hands the other's
+            // rows (in sample order) to the tally and the sink, so the serial row output
+            // overlaps the parallel evaluation.
             let n = vehicle.n_joints();
-            let mut qs = vec![0.0; CHUNK * n];
-            let mut ms = vec![eval.at(&mut scratch); CHUNK];
-            let mut start = 0;
-            while start < spec.samples {
-                let len = CHUNK.min(spec.samples - start);
+            let fill = |start: usize, qs: &mut [f64], ms: &mut [SampleMetrics]| {
                 pool.install(|| {
-                    qs[..len * n]
-                        .par_chunks_mut((BATCH * n).max(1))
-                        .zip(ms[..len].par_chunks_mut(BATCH))
+                    qs.par_chunks_mut((BATCH * n).max(1))
+                        .zip(ms.par_chunks_mut(BATCH))
                         .enumerate()
                         .for_each_init(
                             || Scratch::new(vehicle),
@@ -409,12 +407,37 @@ pub fn analyse(
                                 }
                             },
                         )
+                })
+            };
+            let blank = eval.at(&mut scratch);
+            let mut cur = (vec![0.0; CHUNK * n], vec![blank; CHUNK]);
+            let mut next = cur.clone();
+            let mut start = 0;
+            let mut len = CHUNK.min(spec.samples);
+            fill(0, &mut cur.0[..len * n], &mut cur.1[..len]);
+            while len > 0 {
+                let after = start + len;
+                let next_len = CHUNK.min(spec.samples - after);
+                let (qs, ms) = (&mut next.0[..next_len * n], &mut next.1[..next_len]);
+                let handed = std::thread::scope(|scope| {
+                    let worker = scope.spawn(|| fill(after, qs, ms));
+                    let mut handed = Ok(());
+                    for (j, m) in cur.1[..len].iter().enumerate() {
+                        handed = tally.add(start + j, &cur.0[j * n..(j + 1) * n], *m, sink);
+                        if handed.is_err() {
+                            break;
+                        }
+                    }
+                    // A worker panic is a bug: pass it on.
+                    if let Err(p) = worker.join() {
+                        std::panic::resume_unwind(p);
+                    }
+                    handed
                 });
-                for (j, m) in ms[..len].iter().enumerate() {
-                    tally.add(start + j, &qs[j * n..(j + 1) * n], *m, sink)?;
-                }
-                start += len;
-                progress(start);
+                handed?;
+                progress(after);
+                std::mem::swap(&mut cur, &mut next);
+                (start, len) = (after, next_len);
             }
         }
     }
