@@ -306,8 +306,21 @@ pub struct ReportArgs {
     pub dir: PathBuf,
 }
 
+/// Hands the heap memory freed by the phases before (the case table, its polars frame, the
+/// Parquet buffers) back to the operating system, so that the page built next does not add
+/// its own peak on top of theirs in the resident set (glibc keeps freed memory otherwise:
+/// the 100 000-case static study peaked at 199 MB, 8 MB of it below the review's own).
+fn release_free_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only releases unused heap pages; it has no preconditions.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 /// Writes `report.html` into `dir`, printing what it holds; an unwritable page is an error.
 pub(crate) fn review(verb: &str, dir: &Path) -> anyhow::Result<()> {
+    release_free_memory();
     let r = write_review(dir)
         .with_context(|| format!("writing the design review of {}", dir.display()))?;
     for w in &r.warnings {

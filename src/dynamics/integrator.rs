@@ -116,7 +116,7 @@ impl Dopri5 {
     }
 
     /// Integrate `x` over `[0, span]` with `ẋ = f(s, x)`, adapting the step to `tol`.
-    /// `quat` is the offset of the unit quaternion in `x`, projected after every step.
+    /// `quad.quat` is the offset of the unit quaternion in `x`, projected after every step.
     /// The components from `quad.start` on are quadrature states (integrals of the state,
     /// never read by `f`): they stay out of the error norm, and `quad.abs` gains
     /// `∫ |ẋ_i| dt` of each of them over every accepted step ([`abs_increment`]).
@@ -128,7 +128,6 @@ impl Dopri5 {
         x: &mut [f64],
         span: f64,
         tol: Tolerance,
-        quat: usize,
         quad: Quadrature<'_>,
         stats: &mut StepStats,
         mut f: F,
@@ -163,11 +162,12 @@ impl Dopri5 {
             let err = self.try_step(x, s, h, tol, quad.start, &mut f)?;
             if err <= 1.0 {
                 s = if h == span - s { span } else { s + h };
-                for i in quad.start..x.len() {
-                    *quad.abs += abs_increment(x[i], self.x_new[i], self.k[0][i], self.k[6][i], h);
+                let (k0, k6) = (&self.k[0], &self.k[6]);
+                for (i, (x0, x1)) in x.iter().zip(&self.x_new).enumerate().skip(quad.start) {
+                    *quad.abs += abs_increment(*x0, *x1, k0[i], k6[i], h);
                 }
                 x.copy_from_slice(&self.x_new);
-                project_quaternion(&mut x[quat..quat + 4]);
+                project_quaternion(&mut x[quad.quat..quad.quat + 4]);
                 self.k.swap(0, 6);
                 stats.steps += 1;
                 let fac = if err == 0.0 {
@@ -242,9 +242,11 @@ impl Dopri5 {
     }
 }
 
-/// The quadrature states of an integration: components `start..` of the flat state, and the
-/// accumulator of `Σ_i ∫ |ẋ_i| dt` over them.
+/// The special components of the flat state: the unit quaternion at `quat..quat + 4`, the
+/// quadrature states from `start` on, and the accumulator of `Σ_i ∫ |ẋ_i| dt` over the latter.
 pub(super) struct Quadrature<'a> {
+    /// Offset of the unit quaternion `[w, i, j, k]`.
+    pub quat: usize,
     /// First quadrature component.
     pub start: usize,
     /// Accumulated `Σ_i ∫ |ẋ_i| dt`.
@@ -314,7 +316,7 @@ fn project_quaternion(q: &mut [f64]) {
 }
 
 /// One classical RK4 step of size `h` from `(s, x)` into `x` (stage derivatives in `k`,
-/// stage state in `xs`), then the quaternion block at `quat` projected onto the unit sphere
+/// stage state in `xs`), then the quaternion block at `quad.quat` projected onto the unit sphere
 /// (a change of `O(h⁵)`). `f(s, x, dx, boundary)` is told which stage starts the step.
 /// `quad.abs` gains `∫ |ẋ_i| dt` of the quadrature states `i ≥ quad.start` over the step
 /// ([`abs_increment`], with the last stage's derivative standing for the end's).
@@ -324,7 +326,6 @@ pub(super) fn rk4_step<F>(
     h: f64,
     k: &mut [Vec<f64>; 4],
     xs: &mut [f64],
-    quat: usize,
     quad: Quadrature<'_>,
     f: &mut F,
 ) -> Result<(), (f64, DynError)>
@@ -351,6 +352,6 @@ where
         }
         x[i] = x1;
     }
-    project_quaternion(&mut x[quat..quat + 4]);
+    project_quaternion(&mut x[quad.quat..quad.quat + 4]);
     Ok(())
 }

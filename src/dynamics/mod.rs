@@ -22,10 +22,11 @@
 //! - `cholesky`: the one dense Cholesky factorisation of the crate (forward dynamics and the
 //!   kinematic-control pseudoinverse);
 //! - [`config`]: the servo and thruster models and the [`SimConfig`] (defaults, `validate()`);
-//! - [`sim`]: the actuator dynamics (thruster lag and rate limit, servo laws), the flat
-//!   Lie-group state and the [`Simulator`];
+//! - [`sim`]: the servo laws, the flat Lie-group state and the [`Simulator`];
+//!   `thruster_lag`: the thruster lag and rate limit in closed form;
 //! - `integrator`: the fixed-step RK4 step and the adaptive Dormand–Prince 5(4) span
-//!   integrator with error control ([`Integrator`] chooses);
+//!   integrator with error control ([`Integrator`] chooses), and the folding of the joint
+//!   work's quadrature states at the sign changes of the joint power;
 //! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`.
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
@@ -39,6 +40,7 @@ mod integrator;
 pub mod manoeuvring;
 mod passes;
 pub mod sim;
+mod thruster_lag;
 pub mod workspace;
 
 #[cfg(test)]

@@ -41,6 +41,7 @@ use super::algorithms::{
 };
 use super::config::{config_err, Integrator, ServoModel, SimConfig, ThrusterModel};
 use super::integrator::{rk4_step, Dopri5, Quadrature, StepStats, Tolerance};
+use super::thruster_lag::ThrusterDyn;
 use super::{check_finite, DynError, DynWorkspace, SimError};
 use crate::kinematics::{generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
@@ -104,52 +105,6 @@ pub struct ActuatorCommand<'a> {
     pub joint_ref: &'a [f64],
     /// Joint rate references `q̇_r` [rad/s] (n); used by the PD servo.
     pub joint_rate_ref: &'a [f64],
-}
-
-/// Lag and rate limit of one thruster, resolved from the model and the config.
-#[derive(Clone, Copy, Debug)]
-struct ThrusterDyn {
-    time_constant: Option<f64>,
-    rate_limit: Option<f64>,
-    u_min: f64,
-    u_max: f64,
-}
-
-impl ThrusterDyn {
-    /// Exact solution after `s` seconds of `u̇ = clamp((u_c − u)/T, −r, r)` from `u0`
-    /// towards the (saturated) command `u_c`.
-    fn evolve(&self, u0: f64, u_c: f64, s: f64) -> f64 {
-        let e0 = u_c - u0;
-        match (self.time_constant, self.rate_limit) {
-            (None, None) => u_c,
-            (Some(t), None) => u_c - e0 * (-s / t).exp(),
-            (None, Some(r)) => {
-                if e0.abs() <= r * s {
-                    u_c
-                } else {
-                    u0 + r * s * e0.signum()
-                }
-            }
-            (Some(t), Some(r)) => {
-                // Rate-limited while |e| > r T, then the exponential lag.
-                let e_lin = r * t;
-                if e0.abs() <= e_lin {
-                    u_c - e0 * (-s / t).exp()
-                } else {
-                    let t1 = (e0.abs() - e_lin) / r;
-                    if s <= t1 {
-                        u0 + r * s * e0.signum()
-                    } else {
-                        u_c - e_lin * e0.signum() * (-(s - t1) / t).exp()
-                    }
-                }
-            }
-        }
-    }
-
-    fn saturate(&self, u: f64) -> f64 {
-        u.clamp(self.u_min, self.u_max)
-    }
 }
 
 /// Offsets in the flat integration vector
@@ -524,10 +479,11 @@ impl Simulator {
                 let h = span / steps as f64;
                 for i in 0..steps {
                     let quad = Quadrature {
+                        quat: QUAT,
                         start,
                         abs: &mut work,
                     };
-                    rk4_step(x0, i as f64 * h, h, k, xs, QUAT, quad, &mut f).map_err(fail)?;
+                    rk4_step(x0, i as f64 * h, h, k, xs, quad, &mut f).map_err(fail)?;
                 }
                 stats.steps += steps as u64;
                 *terms_fresh = false;
@@ -536,11 +492,12 @@ impl Simulator {
                 let mut counts = StepStats::default();
                 let tol = Tolerance { rtol, atol };
                 let quad = Quadrature {
+                    quat: QUAT,
                     start,
                     abs: &mut work,
                 };
                 dopri
-                    .span(x0, span, tol, QUAT, quad, &mut counts, &mut f)
+                    .span(x0, span, tol, quad, &mut counts, &mut f)
                     .map_err(fail)?;
                 stats.steps += counts.steps;
                 stats.rejected += counts.rejected;

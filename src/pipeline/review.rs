@@ -57,8 +57,13 @@ struct CaseInfo {
     name: String,
 }
 
-/// Every case of `table` by id: outcome, reason and design name (from the `axes`).
-fn case_infos(table: &Table, axes: &[&str]) -> BTreeMap<i64, CaseInfo> {
+/// The cases of `table` whose id is `wanted`, by id: outcome, reason and design name (from
+/// the `axes`).
+fn case_infos(
+    table: &Table,
+    axes: &[&str],
+    wanted: impl Fn(i64) -> bool,
+) -> BTreeMap<i64, CaseInfo> {
     let Ok(ids) = table.i64(CASE_ID) else {
         return BTreeMap::new();
     };
@@ -72,6 +77,7 @@ fn case_infos(table: &Table, axes: &[&str]) -> BTreeMap<i64, CaseInfo> {
         .filter_map(|c| table.str(&c.name).ok())
         .collect();
     (0..table.n_rows())
+        .filter(|&r| wanted(ids[r]))
         .map(|r| {
             let why: Vec<&str> = why_cols
                 .iter()
@@ -218,13 +224,25 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
                 .collect()
         })
         .unwrap_or_default();
-    let table = read_cases(dir);
-    let infos = table
-        .as_ref()
-        .map(|t| case_infos(t, &axes.iter().map(String::as_str).collect::<Vec<_>>()))
-        .unwrap_or_default();
     let summary = std::fs::read_to_string(dir.join("summary.md")).ok();
     let named = summary.as_deref().map(referenced_cases).unwrap_or_default();
+    // What the page needs of the case table: the named cases' details, the counts and whether
+    // success was judged; the table itself is dropped before the page is built (a 100 000-case
+    // table is tens of MB).
+    let (infos, counts, has_success) = match read_cases(dir) {
+        Some(t) => {
+            let wanted: BTreeSet<i64> = named.iter().copied().collect();
+            let axes: Vec<&str> = axes.iter().map(String::as_str).collect();
+            let infos = case_infos(&t, &axes, |id| wanted.contains(&id));
+            let bad = unsuccessful_rows(&t).iter().filter(|b| **b).count();
+            (
+                infos,
+                Some((t.n_rows(), bad)),
+                t.column("success").is_some(),
+            )
+        }
+        None => (BTreeMap::new(), None, false),
+    };
     let study_file = m.and_then(|m| m["study_file"].as_str());
     let drawn = if named.is_empty() {
         Vec::new()
@@ -239,7 +257,8 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
         dir,
         manifest: m,
         axes: &axes,
-        table: table.as_ref(),
+        counts,
+        has_success,
         infos: &infos,
         summary: summary.as_deref(),
         drawings: &drawn,
@@ -260,7 +279,10 @@ struct Page<'a> {
     dir: &'a Path,
     manifest: Option<&'a serde_json::Value>,
     axes: &'a [String],
-    table: Option<&'a Table>,
+    /// Cases in the table and how many of them are unsuccessful (no table: `None`).
+    counts: Option<(usize, usize)>,
+    /// The table has a `success` column.
+    has_success: bool,
     infos: &'a BTreeMap<i64, CaseInfo>,
     summary: Option<&'a str>,
     drawings: &'a [Drawing],
@@ -297,7 +319,13 @@ impl Page<'_> {
                     .file_name()
                     .map_or("study".into(), |n| n.to_string_lossy().into_owned())
             });
-        let mut h = String::new();
+        // The page is mostly the inlined figures: reserve for them at once instead of
+        // doubling a large string (and holding two copies) while it grows.
+        let figure_bytes: u64 = figures
+            .iter()
+            .filter_map(|f| std::fs::metadata(f).ok().map(|m| m.len()))
+            .sum();
+        let mut h = String::with_capacity(figure_bytes as usize + (1 << 20));
         let _ = writeln!(
             h,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -380,7 +408,7 @@ impl Page<'_> {
     /// What success means here, and how many cases met it.
     fn success_section(&self, h: &mut String) {
         h.push_str("<section id=\"success\">\n<h2>What success means</h2>\n");
-        let has_success = self.table.is_some_and(|t| t.column("success").is_some());
+        let has_success = self.has_success;
         let rule = if has_success {
             "A case is <span class=\"r-ok\">successful</span> when its run finished \
              (<code>status</code> = <code>ok</code>) and it met its scenario's success criteria \
@@ -392,14 +420,12 @@ impl Page<'_> {
              columns (e.g. <code>converged</code>) before trusting a ranking."
         };
         let _ = writeln!(h, "<p>{rule}</p>");
-        let bad = self.infos.values().filter(|i| i.unsuccessful).count();
-        if !self.infos.is_empty() {
+        if let Some((n, bad)) = self.counts.filter(|(n, _)| *n > 0) {
             let _ = writeln!(
                 h,
-                "<p>{} of {} cases successful, <span class=\"r-badword\">{bad} unsuccessful</span>. \
+                "<p>{} of {n} cases successful, <span class=\"r-badword\">{bad} unsuccessful</span>. \
                  Unsuccessful cases are shaded red in the tables and framed red in the drawings.</p>",
-                self.infos.len() - bad,
-                self.infos.len()
+                n - bad,
             );
         }
         h.push_str("</section>\n");
@@ -525,13 +551,13 @@ mod tests {
         t.push("design.links", ColumnData::F64(vec![3.0, 4.0, 5.0]))
             .unwrap();
         let axes = ["design.links"];
-        let i = case_infos(&t, &axes);
+        let i = case_infos(&t, &axes, |_| true);
         assert!(!i[&0].unsuccessful && i[&1].unsuccessful && !i[&2].unsuccessful);
         assert_eq!((i[&1].why.as_str(), i[&1].name.as_str()), ("diverged", "4"));
         // With a `success` column, an ok run that missed its criteria is unsuccessful too.
         t.push("success", ColumnData::Bool(vec![true, false, false]))
             .unwrap();
-        let i = case_infos(&t, &axes);
+        let i = case_infos(&t, &axes, |_| true);
         assert!(!i[&0].unsuccessful && i[&1].unsuccessful && i[&2].unsuccessful);
     }
 

@@ -10,6 +10,15 @@ use super::error::{ReportError, Result};
 /// synced, then renamed into place. A reader never sees a half-written file; an interrupted
 /// write leaves at most a stray `.<name>.tmp-<pid>` file.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
+    atomic_write_with(path, |w| w.write_all(bytes))
+}
+
+/// [`atomic_write`] of what `fill` writes (through a 64 KiB buffer) into the temporary file:
+/// for large files produced piece by piece, without holding them in memory.
+pub fn atomic_write_with(
+    path: &Path,
+    fill: impl FnOnce(&mut std::io::BufWriter<&mut std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
     let io = |action: &'static str, p: &Path| {
         let p = p.to_path_buf();
         move |source| ReportError::Io {
@@ -33,7 +42,10 @@ pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = dir.join(tmp_name);
     let result = (|| {
         let mut file = std::fs::File::create(&tmp).map_err(io("creating", &tmp))?;
-        file.write_all(bytes).map_err(io("writing", &tmp))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, &mut file);
+        fill(&mut w).map_err(io("writing", &tmp))?;
+        w.flush().map_err(io("writing", &tmp))?;
+        drop(w);
         file.sync_all().map_err(io("syncing", &tmp))?;
         drop(file);
         std::fs::rename(&tmp, path).map_err(io("renaming into place", path))

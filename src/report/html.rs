@@ -178,16 +178,41 @@ pub fn inline_svg(svg: &str, prefix: &str) -> String {
         Some(k) => &svg[k..],
         None => svg,
     };
-    let mut s = body
-        .replace(" id=\"", &format!(" id=\"{prefix}"))
-        .replace("href=\"#", &format!("href=\"#{prefix}"));
-    let tag_end = s.find('>').unwrap_or(0);
-    let tag = s[..tag_end].to_string();
-    if attr(&tag, "viewBox").is_none() {
-        if let (Some(w), Some(h)) = (attr(&tag, "width"), attr(&tag, "height")) {
-            let (w, h) = (w.trim_end_matches("px"), h.trim_end_matches("px"));
-            s.insert_str(4, &format!(" viewBox=\"0 0 {w} {h}\""));
-        }
+    let tag = &body[..body.find('>').unwrap_or(0)];
+    let view_box = match (
+        attr(tag, "viewBox"),
+        attr(tag, "width"),
+        attr(tag, "height"),
+    ) {
+        (None, Some(w), Some(h)) => Some(format!(
+            " viewBox=\"0 0 {} {}\"",
+            w.trim_end_matches("px"),
+            h.trim_end_matches("px")
+        )),
+        _ => None,
+    };
+    // One pass, one output string: ` id="` and `href="#` gain the prefix.
+    let mut s = String::with_capacity(body.len() + body.len() / 16 + 64);
+    let mut rest = body;
+    if let Some(vb) = &view_box {
+        s.push_str(&rest[..4.min(rest.len())]);
+        s.push_str(vb);
+        rest = &rest[4.min(rest.len())..];
+    }
+    const ID: &str = " id=\"";
+    const HREF: &str = "href=\"#";
+    loop {
+        let next = [ID, HREF]
+            .iter()
+            .filter_map(|pat| rest.find(pat).map(|k| (k, *pat)))
+            .min_by_key(|(k, _)| *k);
+        let Some((k, pat)) = next else {
+            s.push_str(rest);
+            break;
+        };
+        s.push_str(&rest[..k + pat.len()]);
+        s.push_str(prefix);
+        rest = &rest[k + pat.len()..];
     }
     s
 }

@@ -2,7 +2,8 @@
 
 use super::*;
 use crate::report::{
-    read_csv, read_csv_typed, read_parquet, write_csv, write_parquet, CsvAppender, ReportError,
+    read_csv, read_csv_typed, read_parquet, write_csv, write_csv_streamed, write_parquet,
+    CsvAppender, ReportError,
 };
 use std::io::Write;
 
@@ -184,6 +185,13 @@ fn appender_matches_polars_and_resumes() {
         std::fs::read_to_string(&whole).unwrap()
     );
     assert!(read_csv(&streamed).unwrap().bit_eq(&t));
+    // The whole-table streamed writer too.
+    let direct = dir.path().join("direct.csv");
+    write_csv_streamed(&t, &direct).unwrap();
+    assert_eq!(
+        std::fs::read(&direct).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
 
     // Bad rows are typed errors.
     let mut app = CsvAppender::open_or_create(&streamed, &t.schema()).unwrap();

@@ -13,7 +13,7 @@ use std::str::FromStr;
 use super::error::StudyError;
 use super::schema::Study;
 use crate::report::{
-    format_f64, write_csv, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
+    format_f64, write_csv_streamed, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
 };
 
 /// How a case ended (the `status` column: `ok`, `unsuccessful`, `failed`, `skipped`).
@@ -435,9 +435,9 @@ pub fn final_table(raw: Table) -> Result<Table, StudyError> {
 /// Write compacted raw rows to the partial file of `out` and the final table to
 /// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table (built from `raw`'s columns).
 pub fn write_tables(raw: Table, out: &Path) -> Result<Table, StudyError> {
-    write_csv(&raw, &out.join(PARTIAL_FILE))?;
+    write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
     let table = final_table(raw)?;
-    write_csv(&table, &out.join(CASES_CSV))?;
+    write_csv_streamed(&table, &out.join(CASES_CSV))?;
     write_parquet(&table, &out.join(CASES_PARQUET))?;
     Ok(table)
 }
