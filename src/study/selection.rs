@@ -14,6 +14,10 @@ use super::records::{
 };
 use crate::report::{fmt_short, pareto_front, ColumnData, ColumnKind, Table};
 
+/// Relative difference below which two values of a metric tie in `Selection::best_row`
+/// (far above rounding, far below any difference a design review would act on).
+pub const TIE_REL: f64 = 1e-9;
+
 /// Most points drawn per scatter panel (a deterministic stride through the rows beyond it),
 /// so plots of 100 000-case sweeps stay small.
 pub const MAX_PLOT_POINTS: usize = 4000;
@@ -149,6 +153,8 @@ impl Selection {
     }
 
     /// Row of the best value of `metric` among the successful (`ok`) rows (first on ties).
+    /// Values within [`TIE_REL`] of each other tie: two designs equal by symmetry do not
+    /// swap places on rounding noise (e.g. a change of the eigenvalue kernel's last bits).
     pub(crate) fn best_row(&self, table: &Table, metric: &str, worst: bool) -> Option<usize> {
         let v = table.f64(metric).ok()?;
         let status = table.str(STATUS).ok()?;
@@ -160,7 +166,8 @@ impl Selection {
             let replace = match best {
                 None => true,
                 Some(b) => {
-                    if worst {
+                    let tie = (v[i] - v[b]).abs() <= TIE_REL * v[i].abs().max(v[b].abs());
+                    !tie && if worst {
                         self.better(metric, v[b], v[i])
                     } else {
                         self.better(metric, v[i], v[b])
