@@ -149,6 +149,23 @@ fn agrees_static(a: f64, b: f64, sigma_max: f64) -> bool {
     (a - b).abs() <= 1e-10 * b + 1e-14 * sigma_max
 }
 
+/// [`commanded_extremes_with`] of `t` against nalgebra's SVD (σ_min to the static analysis'
+/// 1e-10, σ_max to 1e-12) and its rank against [`commanded_sigma`]'s.
+fn check_extremes(t: &Matrix6xX<f64>, l: f64, dofs: CommandedDofs, label: &str) {
+    let x = commanded_extremes_with(&ScaledGram::new(t, l), t, dofs, 1e-6);
+    let (want, smax) = svd_reference(t, l, dofs);
+    assert!(
+        agrees_static(x.sigma_min, want, smax),
+        "{label} {dofs:?}: {x:?} vs {want}"
+    );
+    assert!(
+        agrees(x.sigma_max, smax, smax),
+        "{label} {dofs:?}: {x:?} vs {smax}"
+    );
+    let full = commanded_sigma(t, l, dofs);
+    assert_eq!(x.rank, full.rank(1e-6), "{label} {dofs:?}");
+}
+
 /// Transport's commanded axes under the paper's `K_p = diag(1, 1, 1, 0, 1, 1)`.
 fn transport_dofs() -> CommandedDofs {
     CommandedDofs::transport(&[1.0, 1.0, 1.0, 0.0, 1.0, 1.0])
@@ -271,13 +288,7 @@ fn commanded_sigma_matches_svd_over_random_configurations() {
             );
             // The static analysis' extremes-only route (Laguerre on the Gram matrix) agrees
             // just as well, and its rank is the full route's.
-            let x = commanded_extremes_with(&ScaledGram::new(&t, l), &t, dofs, 1e-6);
-            assert!(
-                agrees_static(x.sigma_min, want, smax),
-                "{n} {dofs:?}: {x:?}"
-            );
-            assert!(agrees(x.sigma_max, smax, smax), "{n} {dofs:?}: {x:?}");
-            assert_eq!(x.rank, r.rank(1e-6), "{n} {dofs:?}");
+            check_extremes(&t, l, dofs, &format!("{n}"));
         }
     }
 }
@@ -328,18 +339,7 @@ fn extremes_agree_with_the_svd_on_random_gram_spectra() {
         }
         let t: Matrix6xX<f64> = Matrix6xX::from_column_slice((u * d * w.transpose()).as_slice());
         for dofs in [CommandedDofs::ALL, transport_dofs()] {
-            let x = commanded_extremes_with(&ScaledGram::new(&t, 1.0), &t, dofs, 1e-6);
-            let (want, smax) = svd_reference(&t, 1.0, dofs);
-            assert!(
-                agrees_static(x.sigma_min, want, smax),
-                "{n} {dofs:?}: {x:?} vs {want}"
-            );
-            assert!(
-                agrees(x.sigma_max, smax, smax),
-                "{n} {dofs:?}: {x:?} vs {smax}"
-            );
-            let full = commanded_sigma(&t, 1.0, dofs);
-            assert_eq!(x.rank, full.rank(1e-6), "{n} {dofs:?}");
+            check_extremes(&t, 1.0, dofs, &format!("{n}"));
         }
     }
 }
