@@ -84,10 +84,18 @@ pub fn minimise<E: Evaluator>(
     hash: &str,
     opts: &Options<'_>,
 ) -> Result<Outcome, OptimiseError> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.jobs.max(1))
-        .build()
-        .map_err(|e| OptimiseError::Pool(e.to_string()))?;
+    // One job: evaluate on the calling thread. A pool of one would make a sweep worker that
+    // tunes its case (`[tune]`) wait across pools, and a waiting rayon worker steals its own
+    // pool's next case meanwhile: cases then nest on one thread while the other idles.
+    let pool = match opts.jobs {
+        1 => None,
+        n => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n.max(1))
+                .build()
+                .map_err(|e| OptimiseError::Pool(e.to_string()))?,
+        ),
+    };
     let (memo, journal) = match opts.journal {
         Some(p) if opts.resume && p.is_file() => (
             read_journal(p, hash).map_err(OptimiseError::Journal)?,
@@ -103,7 +111,7 @@ pub fn minimise<E: Evaluator>(
     let search = Search::new(
         &spec.space,
         ev,
-        &pool,
+        pool.as_ref(),
         spec.solver.max_evals,
         memo,
         journal,

@@ -70,7 +70,7 @@ struct SearchState {
 pub struct Search<'a, E: Evaluator> {
     space: &'a Space,
     ev: &'a E,
-    pool: &'a rayon::ThreadPool,
+    pool: Option<&'a rayon::ThreadPool>,
     budget: usize,
     iteration: Arc<AtomicU64>,
     on_record: &'a (dyn Fn(&Record) + Sync),
@@ -87,12 +87,13 @@ struct Planned {
 }
 
 impl<'a, E: Evaluator> Search<'a, E> {
-    /// A search of `space` through `ev` on `pool`, with at most `budget` fresh evaluations;
-    /// `memo` holds the evaluations of an interrupted run, `journal` records new ones.
+    /// A search of `space` through `ev` on `pool` (`None`: on the calling thread), with at
+    /// most `budget` fresh evaluations; `memo` holds the evaluations of an interrupted run,
+    /// `journal` records new ones.
     pub fn new(
         space: &'a Space,
         ev: &'a E,
-        pool: &'a rayon::ThreadPool,
+        pool: Option<&'a rayon::ThreadPool>,
         budget: usize,
         memo: HashMap<Vec<u64>, Evaluation>,
         journal: Option<Journal>,
@@ -195,11 +196,11 @@ impl<'a, E: Evaluator> Search<'a, E> {
                 })
                 .collect()
         };
-        let done: Vec<Evaluation> = self.pool.install(|| {
-            todo.par_iter()
-                .map(|&i| self.ev.evaluate(&plan[i].x))
-                .collect()
-        });
+        let evaluate = |&i: &usize| self.ev.evaluate(&plan[i].x);
+        let done: Vec<Evaluation> = match self.pool {
+            Some(pool) => pool.install(|| todo.par_iter().map(evaluate).collect()),
+            None => todo.iter().map(evaluate).collect(),
+        };
         let mut st = self.lock();
         for (&i, e) in todo.iter().zip(done) {
             if let Some(j) = st.journal.as_mut() {

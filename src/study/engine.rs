@@ -354,8 +354,18 @@ fn stream_cases(
         let (tx, rx) = mpsc::channel::<Msg>();
         let (cancel, started) = (&cancel, &started);
         s.spawn(move || {
+            // A closed-loop case takes seconds and cases differ several-fold (links,
+            // tuning): one case per stealable job, else rayon runs a block of neighbouring
+            // cases on one thread while the other idles (the thrusters study's last 38 s ran on
+            // one core). Static cases take a fraction of a millisecond: default splitting
+            // keeps a worker's design cache across neighbours.
+            let max_len = if run.study.mode.is_dynamic() {
+                1
+            } else {
+                usize::MAX
+            };
             pool.install(|| {
-                cases.par_iter().for_each_init(
+                cases.par_iter().with_max_len(max_len).for_each_init(
                     || (tx.clone(), Worker::with_budget(run.budget)),
                     |(tx, w), case| {
                         let msg = process(run, case, w, cancel, started);
