@@ -20,10 +20,10 @@ use serde::Serialize;
 use super::error::{create_dir, PipelineError};
 use crate::model::Vehicle;
 use crate::report::{
-    atomic_write, heatmap, histogram, read_csv_typed, write_parquet, ColourScale, ColumnKind,
-    CsvAppender, Value,
+    atomic_write, heatmap, histogram, push_csv_value, read_csv_typed, write_parquet, ColourScale,
+    ColumnKind, CsvAppender, Value,
 };
-use crate::study::static_tcm::{analyse, StaticSpec, StaticSummary};
+use crate::study::static_tcm::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
 use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 /// Largest sample count for which `samples.parquet` is written.
@@ -89,26 +89,34 @@ pub fn run_tcm(
     let mut app = CsvAppender::create(&csv_path, &schema)?.batched();
     let mut sigmas: Vec<f64> = Vec::with_capacity(spec.samples);
     let mut commanded: Vec<f64> = Vec::with_capacity(spec.samples);
-    let mut row: Vec<Value> = Vec::with_capacity(schema.len());
-    let summary = analyse(
+    // Each worker formats its samples' rows (the bytes `CsvAppender::append` would write);
+    // this thread keeps the σ_min columns for the histograms and writes the text in order.
+    let format = |index: usize, q: &[f64], m: &SampleMetrics, text: &mut String| {
+        let cells = [
+            Value::F64(m.sigma_min),
+            Value::F64(m.kappa),
+            Value::I64(m.rank as i64),
+            Value::Str(m.lost_axis.unwrap_or("")),
+            Value::F64(m.sigma_min_commanded),
+            Value::F64(m.kappa_commanded),
+        ];
+        push_csv_value(text, &Value::I64(index as i64));
+        for v in q.iter().map(|q| Value::F64(*q)).chain(cells) {
+            text.push(',');
+            push_csv_value(text, &v);
+        }
+        text.push('\n');
+    };
+    let summary = analyse_text(
         vehicle,
         spec,
         config.jobs,
-        &mut |index, q, m| {
+        &format,
+        &mut |text| app.append_lines(text).map_err(|e| e.to_string()),
+        &mut |_, _, m| {
             sigmas.push(m.sigma_min);
             commanded.push(m.sigma_min_commanded);
-            row.clear();
-            row.push(Value::I64(index as i64));
-            row.extend(q.iter().map(|q| Value::F64(*q)));
-            row.extend([
-                Value::F64(m.sigma_min),
-                Value::F64(m.kappa),
-                Value::I64(m.rank as i64),
-                Value::Str(m.lost_axis.unwrap_or("")),
-                Value::F64(m.sigma_min_commanded),
-                Value::F64(m.kappa_commanded),
-            ]);
-            app.append(&row).map_err(|e| e.to_string())
+            Ok(())
         },
         progress,
     )?;

@@ -22,7 +22,9 @@ fn push_csv_str(buf: &mut String, s: &str) {
     }
 }
 
-fn push_csv_value(buf: &mut String, v: &Value<'_>) {
+/// Appends one CSV cell (no separator) exactly as [`CsvAppender::append`] writes it: for
+/// callers that format rows themselves ([`CsvAppender::append_lines`]).
+pub fn push_csv_value(buf: &mut String, v: &Value<'_>) {
     match v {
         Value::F64(x) => push_f64(buf, *x),
         Value::I64(x) => {
@@ -203,6 +205,18 @@ impl CsvAppender {
         }
         self.line.push('\n');
         self.rows += 1;
+        if self.line.len() >= self.batch {
+            self.write_pending()?;
+        }
+        Ok(())
+    }
+
+    /// Appends complete rows already formatted by the caller (cells by [`push_csv_value`],
+    /// `,` between them, each line ending in `\n`) in the appender's schema: the rows of a
+    /// parallel formatter, written in order. Counted by their newlines.
+    pub fn append_lines(&mut self, text: &str) -> Result<()> {
+        self.line.push_str(text);
+        self.rows += text.bytes().filter(|&b| b == b'\n').count();
         if self.line.len() >= self.batch {
             self.write_pending()?;
         }

@@ -7,7 +7,8 @@
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
 //! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
-//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space.
+//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space;
+//!   `static_dist`: the distributions (exact quantiles) of its per-sample quantities.
 //! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
 //! - [`static_tcm_slice`]: σ_min over 2-D slices of joint space, the most influential joints.
 //! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
@@ -43,6 +44,7 @@ pub mod runner;
 pub mod schema;
 pub mod selection;
 pub mod shards;
+mod static_dist;
 pub mod static_table;
 pub mod static_tcm;
 mod static_tcm_eval;

@@ -35,6 +35,7 @@ use crate::model::Vehicle;
 use crate::sampling::{Sampler, Sampling};
 use crate::scenario::config::Mode;
 
+pub use super::static_dist::{distribution, quantile_sorted, Distribution, QUANTILES};
 pub use super::static_tcm_eval::SampleMetrics;
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
@@ -65,9 +66,6 @@ pub const DEFAULT_SAMPLING: Sampling = Sampling::Sobol;
 
 /// Default number of lowest-σ_min configurations kept (`tcm --worst`).
 pub const DEFAULT_WORST: usize = 10;
-
-/// Quantile levels reported for σ_min and κ.
-pub const QUANTILES: [f64; 7] = [0.01, 0.05, 0.10, 0.25, 0.50, 0.75, 0.95];
 
 /// Errors of the static analysis (bad settings or a design the metrics cannot score).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -203,30 +201,20 @@ pub struct SampleEval {
 /// sample's index, joint angles [rad] and metrics; an `Err` stops the analysis.
 pub type RowSink<'a> = dyn FnMut(usize, &[f64], &SampleMetrics) -> Result<(), String> + 'a;
 
-/// Distribution of a per-sample quantity.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Distribution {
-    /// Smallest value.
-    pub min: f64,
-    /// Largest value.
-    pub max: f64,
-    /// Mean of the finite values (summed in index order).
-    pub mean: f64,
-    /// Number of non-finite values (κ of rank-deficient samples).
-    pub non_finite: usize,
-    /// `(level, value)` pairs for [`QUANTILES`] (linear interpolation between order statistics).
-    pub quantiles: Vec<(f64, f64)>,
+/// Formats one sample (index, joint angles [rad], metrics) as text appended to the buffer:
+/// run by the workers of [`analyse_text`], so it must not depend on other samples.
+pub type RowText = dyn Fn(usize, &[f64], &SampleMetrics, &mut String) + Sync;
+
+/// Where the samples of an analysis go: row by row to a sink on the calling thread, or
+/// formatted by the workers and handed over as text, in index order.
+enum Output<'a, 'b> {
+    Rows(&'a mut RowSink<'b>),
+    Text(&'a RowText, &'a mut TextSink<'b>, &'a mut RowSink<'b>),
 }
 
-impl Distribution {
-    /// The value at quantile level `p` if it is one of [`QUANTILES`].
-    pub fn quantile(&self, p: f64) -> Option<f64> {
-        self.quantiles
-            .iter()
-            .find(|(l, _)| *l == p)
-            .map(|(_, v)| *v)
-    }
-}
+/// The consumer of [`analyse_text`]'s formatted rows, in index order; an `Err` stops the
+/// analysis.
+pub type TextSink<'a> = dyn FnMut(&str) -> Result<(), String> + 'a;
 
 /// How often one wrench axis is the lost (weakest) direction.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -289,52 +277,6 @@ pub struct StaticSummary {
     pub straight: SampleEval,
 }
 
-/// Quantile at level `p` of sorted values (linear interpolation, "type 7"); `inf` propagates.
-pub fn quantile_sorted(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let h = p.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
-    let lo = h.floor() as usize;
-    let hi = (lo + 1).min(sorted.len() - 1);
-    let f = h - lo as f64;
-    let (a, b) = (sorted[lo], sorted[hi]);
-    if f == 0.0 || a == b {
-        a
-    } else if !a.is_finite() || !b.is_finite() {
-        if f < 1.0 {
-            b.max(a)
-        } else {
-            b
-        }
-    } else {
-        a + (b - a) * f
-    }
-}
-
-/// The distribution of `values` (consumed: sorted in place).
-pub fn distribution(mut values: Vec<f64>) -> Distribution {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for x in &values {
-        if x.is_finite() {
-            sum += x;
-            n += 1;
-        }
-    }
-    let non_finite = values.len() - n;
-    values.sort_unstable_by(f64::total_cmp);
-    Distribution {
-        min: values.first().copied().unwrap_or(f64::NAN),
-        max: values.last().copied().unwrap_or(f64::NAN),
-        mean: if n > 0 { sum / n as f64 } else { f64::NAN },
-        non_finite,
-        quantiles: QUANTILES
-            .iter()
-            .map(|&p| (p, quantile_sorted(&values, p)))
-            .collect(),
-    }
-}
-
 /// Static TCM analysis of `vehicle` (SPEC §6).
 ///
 /// Samples `spec.samples` joint configurations uniformly within the joint limits, evaluates
@@ -349,6 +291,39 @@ pub fn analyse(
     spec: &StaticSpec,
     threads: usize,
     sink: &mut RowSink,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<StaticSummary, StaticError> {
+    analyse_with(vehicle, spec, threads, Output::Rows(sink), progress)
+}
+
+/// [`analyse`] with the rows also formatted as text by `format` on the workers (a sample's
+/// text does not depend on the others) and handed to `write` in index order, chunk by chunk:
+/// with several threads the formatting is parallel too and the calling thread only writes
+/// (and calls `sink`, which should be cheap). Same result and the same text for any
+/// `threads`.
+pub fn analyse_text(
+    vehicle: &Vehicle,
+    spec: &StaticSpec,
+    threads: usize,
+    format: &RowText,
+    write: &mut TextSink,
+    sink: &mut RowSink,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<StaticSummary, StaticError> {
+    analyse_with(
+        vehicle,
+        spec,
+        threads,
+        Output::Text(format, write, sink),
+        progress,
+    )
+}
+
+fn analyse_with(
+    vehicle: &Vehicle,
+    spec: &StaticSpec,
+    threads: usize,
+    mut out: Output,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<StaticSummary, StaticError> {
     spec.validate()?;
@@ -373,61 +348,82 @@ pub fn analyse(
         metrics: eval.at(&mut scratch),
     };
     let mut tally = Tally::new(spec);
+    let format: Option<&RowText> = match &out {
+        Output::Text(f, _, _) => Some(*f),
+        Output::Rows(_) => None,
+    };
     match pool(threads)? {
         None => {
             let s = &mut scratch;
+            let mut text = String::new();
             for i in 0..spec.samples {
                 sampler.point(i, &mut s.u);
                 map_joint(vehicle, &s.u, &mut s.q);
                 let m = eval.at(s);
-                tally.add(i, &s.q, m, sink)?;
+                tally.add(i, &s.q, m);
+                match &mut out {
+                    Output::Rows(sink) => sink(i, &s.q, &m).map_err(StaticError::Sink)?,
+                    Output::Text(f, _, sink) => {
+                        f(i, &s.q, &m, &mut text);
+                        sink(i, &s.q, &m).map_err(StaticError::Sink)?;
+                    }
+                }
                 if (i + 1) % CHUNK == 0 || i + 1 == spec.samples {
+                    if let Output::Text(_, write, _) = &mut out {
+                        write(&text).map_err(StaticError::Sink)?;
+                        text.clear();
+                    }
                     progress(i + 1);
                 }
             }
         }
         Some(pool) => {
-            // Two chunk buffers: the workers fill one while this thread hands the other's
-            // rows (in sample order) to the tally and the sink, so the serial row output
-            // overlaps the parallel evaluation.
+            // Two chunk buffers: the workers fill one (metrics, and the rows' text with
+            // `analyse_text`) while this thread hands the other's rows, in sample order, to
+            // the tally and the output, so the serial part overlaps the parallel evaluation.
             let n = vehicle.n_joints();
-            let fill = |start: usize, qs: &mut [f64], ms: &mut [SampleMetrics]| {
+            let fill = |start: usize, buf: &mut ChunkView| {
+                let ChunkView { qs, ms, texts } = buf;
                 pool.install(|| {
                     qs.par_chunks_mut((BATCH * n).max(1))
                         .zip(ms.par_chunks_mut(BATCH))
+                        .zip(texts.par_iter_mut())
                         .enumerate()
                         .for_each_init(
                             || Scratch::new(vehicle),
-                            |s, (b, (qb, mb))| {
+                            |s, (b, ((qb, mb), text))| {
+                                text.clear();
                                 for (j, m) in mb.iter_mut().enumerate() {
-                                    sampler.point(start + b * BATCH + j, &mut s.u);
+                                    let index = start + b * BATCH + j;
+                                    sampler.point(index, &mut s.u);
                                     map_joint(vehicle, &s.u, &mut s.q);
                                     *m = eval.at(s);
                                     qb[j * n..(j + 1) * n].copy_from_slice(&s.q);
+                                    if let Some(f) = format {
+                                        f(index, &s.q, m, text);
+                                    }
                                 }
                             },
                         )
                 })
             };
             let blank = eval.at(&mut scratch);
-            let mut cur = (vec![0.0; CHUNK * n], vec![blank; CHUNK]);
+            let mut cur = ChunkBuf {
+                qs: vec![0.0; CHUNK * n],
+                ms: vec![blank; CHUNK],
+                texts: vec![String::new(); CHUNK.div_ceil(BATCH)],
+            };
             let mut next = cur.clone();
             let mut start = 0;
             let mut len = CHUNK.min(spec.samples);
-            fill(0, &mut cur.0[..len * n], &mut cur.1[..len]);
+            fill(0, &mut cur.prefix(len, n));
             while len > 0 {
                 let after = start + len;
                 let next_len = CHUNK.min(spec.samples - after);
-                let (qs, ms) = (&mut next.0[..next_len * n], &mut next.1[..next_len]);
+                let mut next_view = next.prefix(next_len, n);
                 let handed = std::thread::scope(|scope| {
-                    let worker = scope.spawn(|| fill(after, qs, ms));
-                    let mut handed = Ok(());
-                    for (j, m) in cur.1[..len].iter().enumerate() {
-                        handed = tally.add(start + j, &cur.0[j * n..(j + 1) * n], *m, sink);
-                        if handed.is_err() {
-                            break;
-                        }
-                    }
+                    let worker = scope.spawn(|| fill(after, &mut next_view));
+                    let handed = hand_over(&mut tally, &mut out, &cur, start, len, n);
                     // A worker panic is a bug: pass it on.
                     if let Err(p) = worker.join() {
                         std::panic::resume_unwind(p);
@@ -442,6 +438,55 @@ pub fn analyse(
         }
     }
     Ok(tally.summary(vehicle, spec, l, straight))
+}
+
+/// One chunk's buffers in the parallel path: joint angles (`n` per sample), metrics, and
+/// the text of each batch of `BATCH` samples.
+#[derive(Clone)]
+struct ChunkBuf {
+    qs: Vec<f64>,
+    ms: Vec<SampleMetrics>,
+    texts: Vec<String>,
+}
+
+/// Mutable views of the first `len` samples of a [`ChunkBuf`].
+struct ChunkView<'a> {
+    qs: &'a mut [f64],
+    ms: &'a mut [SampleMetrics],
+    texts: &'a mut [String],
+}
+
+impl ChunkBuf {
+    fn prefix(&mut self, len: usize, n: usize) -> ChunkView<'_> {
+        ChunkView {
+            qs: &mut self.qs[..len * n],
+            ms: &mut self.ms[..len],
+            texts: &mut self.texts[..len.div_ceil(BATCH)],
+        }
+    }
+}
+
+/// The samples `start..start + len` of a filled chunk to the tally and the output, in order.
+fn hand_over(
+    tally: &mut Tally,
+    out: &mut Output,
+    buf: &ChunkBuf,
+    start: usize,
+    len: usize,
+    n: usize,
+) -> Result<(), StaticError> {
+    for (j, m) in buf.ms[..len].iter().enumerate() {
+        let q = &buf.qs[j * n..(j + 1) * n];
+        tally.add(start + j, q, *m);
+        let (Output::Rows(sink) | Output::Text(_, _, sink)) = out;
+        sink(start + j, q, m).map_err(StaticError::Sink)?;
+    }
+    if let Output::Text(_, write, _) = out {
+        for t in &buf.texts[..len.div_ceil(BATCH)] {
+            write(t).map_err(StaticError::Sink)?;
+        }
+    }
+    Ok(())
 }
 
 /// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
@@ -518,13 +563,7 @@ impl Tally {
     }
 
     /// Count sample `index` at joint angles `q` with metrics `m` and hand it to `sink`.
-    fn add(
-        &mut self,
-        index: usize,
-        q: &[f64],
-        m: SampleMetrics,
-        sink: &mut RowSink,
-    ) -> Result<(), StaticError> {
+    fn add(&mut self, index: usize, q: &[f64], m: SampleMetrics) {
         self.sigmas.full.push(m.sigma_min);
         self.kappas.full.push(m.kappa);
         self.sigmas.commanded.push(m.sigma_min_commanded);
@@ -538,9 +577,7 @@ impl Tally {
                 self.counts[k] += 1;
             }
         }
-        sink(index, q, &m).map_err(StaticError::Sink)?;
         keep_worst(&mut self.worst, index, q, m, self.keep);
-        Ok(())
     }
 
     fn summary(

@@ -6,17 +6,21 @@ use crate::model::presets::usm_paper;
 use crate::study::static_tcm_slice::{influential_joints, slice_grid};
 
 fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
-    let v = usm_paper();
     let spec = StaticSpec {
         samples,
         seed: 7,
         sampling,
         ..Default::default()
     };
+    run_spec(&usm_paper(), &spec, threads)
+}
+
+/// [`analyse`] of `v` under `spec`: the summary and every row the sink saw.
+fn run_spec(v: &Vehicle, spec: &StaticSpec, threads: usize) -> (StaticSummary, Vec<SampleEval>) {
     let mut rows = Vec::new();
     let s = analyse(
-        &v,
-        &spec,
+        v,
+        spec,
         threads,
         &mut |index, q, m| {
             rows.push(SampleEval {
@@ -40,6 +44,54 @@ fn deterministic_across_threads() {
         assert_eq!(a, b);
         assert_eq!(ra, rb);
         assert!(ra.iter().enumerate().all(|(i, r)| r.index == i));
+    }
+}
+
+#[test]
+fn text_output_is_the_same_for_any_thread_count_and_in_index_order() {
+    // More than one chunk and a partial last batch: formatted on the workers with several
+    // threads, inline with one; the row sink sees the same samples as `analyse`'s.
+    let v = usm_paper();
+    let samples = CHUNK + BATCH + 7;
+    let spec = StaticSpec {
+        samples,
+        seed: 3,
+        ..Default::default()
+    };
+    let format = |i: usize, q: &[f64], m: &SampleMetrics, t: &mut String| {
+        t.push_str(&format!("{i} {:?} {:e}\n", q, m.sigma_min));
+    };
+    let text = |threads| {
+        let (mut out, mut seen) = (String::new(), Vec::new());
+        let s = analyse_text(
+            &v,
+            &spec,
+            threads,
+            &format,
+            &mut |t| {
+                out.push_str(t);
+                Ok(())
+            },
+            &mut |i, _, m| {
+                seen.push((i, m.sigma_min));
+                Ok(())
+            },
+            &|_| {},
+        )
+        .unwrap();
+        (s, out, seen)
+    };
+    let (s1, t1, seen1) = text(1);
+    let (s2, t2, seen2) = text(2);
+    assert_eq!(s1, s2);
+    assert_eq!(t1, t2);
+    assert_eq!(seen1, seen2);
+    let lines: Vec<&str> = t1.lines().collect();
+    assert_eq!(lines.len(), samples);
+    let (_, rows) = run_spec(&v, &spec, 2);
+    for (k, (line, r)) in lines.iter().zip(&rows).enumerate() {
+        assert!(line.starts_with(&format!("{k} ")), "{line}");
+        assert_eq!(seen1[k], (r.index, r.metrics.sigma_min));
     }
 }
 
