@@ -120,7 +120,9 @@ pub fn run_tcm(
         },
         progress,
     )?;
-    app.sync()?;
+    // summary.json, written last (atomically), marks a complete output: no fsync of a file
+    // of up to hundreds of MB here.
+    app.flush()?;
     drop(app);
     let mut files = vec!["samples.csv".to_string()];
     if spec.samples <= PARQUET_MAX_ROWS {

@@ -254,6 +254,14 @@ impl CsvAppender {
         Ok(())
     }
 
+    /// Hands the pending rows of a [`CsvAppender::batched`] appender to the operating system,
+    /// without forcing them to stable storage: for a large output that is not a journal (its
+    /// completion is marked by a file written after it), where an `fsync` of hundreds of MB
+    /// would be serial waiting.
+    pub fn flush(&mut self) -> Result<()> {
+        self.write_pending()
+    }
+
     /// Forces the written rows to stable storage (`fsync`); rows are already handed to the
     /// operating system by [`CsvAppender::append`] (in batches after
     /// [`CsvAppender::batched`], whose pending rows are written first).
