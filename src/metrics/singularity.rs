@@ -13,7 +13,7 @@ use nalgebra::{Matrix6xX, Vector6};
 use serde::Serialize;
 
 use super::small_svd::{
-    extreme_eigenvalues, givens_add_row, one_sided_jacobi_sq, shifted_inverse_iteration,
+    extreme_eigenvalues, givens_add_row, min_max, one_sided_jacobi_sq, shifted_inverse_iteration,
     tridiagonal_eigenvalues,
 };
 use crate::allocation::{attainable_wrench, AllocError, AttainableWrench};
@@ -258,6 +258,26 @@ impl CommandedSigma {
             .filter(|&&s| s > tol)
             .count()
     }
+
+    /// The [`SigmaExtremes`] of these singular values, the rank under `rank_rel_tol`.
+    pub fn extremes(&self, rank_rel_tol: f64) -> SigmaExtremes {
+        SigmaExtremes {
+            k: self.k,
+            sigma_min: self.sigma_min,
+            sigma_max: self.sigma_max,
+            condition_number: self.condition_number,
+            rank: self.rank(rank_rel_tol),
+        }
+    }
+}
+
+/// `σ_max/σ_min`, `+inf` unless `σ_min > 0`.
+fn condition(sigma_max: f64, sigma_min: f64) -> f64 {
+    if sigma_min > 0.0 {
+        sigma_max / sigma_min
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// Below this ratio `λ_min/λ_max` of the Gram matrix (κ > 100) [`commanded_sigma`] leaves the
@@ -377,11 +397,7 @@ fn from_squares(ev: &[f64; 6], k: usize) -> CommandedSigma {
         k,
         sigma_max: sv[0],
         sigma_min: sv[k - 1],
-        condition_number: if sv[k - 1] > 0.0 {
-            sv[0] / sv[k - 1]
-        } else {
-            f64::INFINITY
-        },
+        condition_number: condition(sv[0], sv[k - 1]),
     }
 }
 
@@ -422,42 +438,23 @@ pub fn commanded_extremes_with(
     rank_rel_tol: f64,
 ) -> SigmaExtremes {
     let k = dofs.len();
-    if g.valid && k > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO {
-        let rows = selected_rows(dofs);
-        let mut gram = g.select(&rows, k);
-        let (lo, hi) = extreme_eigenvalues(&mut gram, k);
-        if lo < EXTREMES_MIN_RATIO * hi {
-            let c = from_squares(&triangle_sigma_sq(g, t, &rows, k), k);
-            return SigmaExtremes {
-                k,
-                sigma_min: c.sigma_min,
-                sigma_max: c.sigma_max,
-                condition_number: c.condition_number,
-                rank: c.rank(rank_rel_tol),
-            };
-        } else {
-            let (sigma_min, sigma_max) = (lo.max(0.0).sqrt(), hi.max(0.0).sqrt());
-            return SigmaExtremes {
-                k,
-                sigma_min,
-                sigma_max,
-                condition_number: if sigma_min > 0.0 {
-                    sigma_max / sigma_min
-                } else {
-                    f64::INFINITY
-                },
-                rank: k,
-            };
-        }
+    if !(g.valid && k > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO) {
+        // Invalid input, nothing commanded, or a rank tolerance the Gram route cannot certify.
+        return commanded_sigma_with(g, t, dofs).extremes(rank_rel_tol);
     }
-    // Invalid input, nothing commanded, or a rank tolerance the Gram route cannot certify.
-    let c = commanded_sigma_with(g, t, dofs);
+    let rows = selected_rows(dofs);
+    let mut gram = g.select(&rows, k);
+    let (lo, hi) = extreme_eigenvalues(&mut gram, k);
+    if lo < EXTREMES_MIN_RATIO * hi {
+        return from_squares(&triangle_sigma_sq(g, t, &rows, k), k).extremes(rank_rel_tol);
+    }
+    let (sigma_min, sigma_max) = (lo.max(0.0).sqrt(), hi.max(0.0).sqrt());
     SigmaExtremes {
         k,
-        sigma_min: c.sigma_min,
-        sigma_max: c.sigma_max,
-        condition_number: c.condition_number,
-        rank: c.rank(rank_rel_tol),
+        sigma_min,
+        sigma_max,
+        condition_number: condition(sigma_max, sigma_min),
+        rank: k,
     }
 }
 
@@ -552,13 +549,6 @@ fn select_scaled(col: &[f64], rows: &[usize; 6], k: usize, l: f64) -> [f64; 6] {
         *xi = if r < 3 { col[r] } else { col[r] / l };
     }
     x
-}
-
-fn min_max(xs: &[f64]) -> (f64, f64) {
-    xs.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
-            (lo.min(x), hi.max(x))
-        })
 }
 
 /// Fraction of samples whose σ_min is below `threshold` (SPEC §6, "how often T is singular");

@@ -113,11 +113,11 @@ pub(crate) fn tridiagonal_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> [f64; 
 }
 
 /// The smallest and largest eigenvalues of the symmetric positive semi-definite `k×k`
-/// leading block of `a` (a Gram matrix; destroyed): Householder reduction to tridiagonal form, then Laguerre's iteration on the
-/// characteristic polynomial from a bound on each side of the spectrum (Gershgorin, tightened by
-/// `0 ≤ λ ≤ trace`; [`laguerre_extreme`]); the implicit
-/// QL algorithm ([`tridiagonal_eigenvalues`]' second half) when Laguerre's iteration does not
-/// settle. Same absolute accuracy (about `ε‖a‖`) as [`tridiagonal_eigenvalues`] at about a
+/// leading block of `a` (a Gram matrix; destroyed): Householder reduction to tridiagonal
+/// form, then Laguerre's iteration on the characteristic polynomial from a bound on each side
+/// of the spectrum (Gershgorin, tightened by `0 ≤ λ ≤ trace`; [`laguerre_extreme`]); the
+/// implicit QL algorithm ([`tridiagonal_eigenvalues`]' second half) when Laguerre's iteration
+/// does not settle. Same absolute accuracy (about `ε‖a‖`) as [`tridiagonal_eigenvalues`] at about a
 /// third of its cost: only the two extreme roots are sought.
 pub(crate) fn extreme_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> (f64, f64) {
     let mut d = [0.0; 6];
@@ -155,9 +155,7 @@ pub(crate) fn extreme_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> (f64, f64)
         (Some(lo), Some(hi)) => (lo, hi),
         _ => {
             implicit_ql(&mut d, &mut e, k);
-            let lo = d[..k].iter().fold(f64::INFINITY, |m, &x| m.min(x));
-            let hi = d[..k].iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x));
-            (lo, hi)
+            min_max(&d[..k])
         }
     }
 }
@@ -206,16 +204,24 @@ fn laguerre_extreme<const K: usize>(
         let next = x - step;
         // From below the iterates rise, from above they fall; a step the other way is
         // rounding at the root.
-        if (from_below && next <= x) || (!from_below && next >= x) || step.abs() <= tiny {
-            return Some(if (from_below && next > x) || (!from_below && next < x) {
-                next
-            } else {
-                x
-            });
+        let inward = if from_below { next > x } else { next < x };
+        if !inward {
+            return Some(x);
+        }
+        if step.abs() <= tiny {
+            return Some(next);
         }
         x = next;
     }
     None
+}
+
+/// The smallest and largest of `xs` (`(inf, -inf)` when empty).
+pub(crate) fn min_max(xs: &[f64]) -> (f64, f64) {
+    xs.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        })
 }
 
 /// Reduce the symmetric `k×k` block of `a` to tridiagonal form by Householder reflections

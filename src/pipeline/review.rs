@@ -408,8 +408,7 @@ impl Page<'_> {
     /// What success means here, and how many cases met it.
     fn success_section(&self, h: &mut String) {
         h.push_str("<section id=\"success\">\n<h2>What success means</h2>\n");
-        let has_success = self.has_success;
-        let rule = if has_success {
+        let rule = if self.has_success {
             "A case is <span class=\"r-ok\">successful</span> when its run finished \
              (<code>status</code> = <code>ok</code>) and it met its scenario's success criteria \
              (<code>success</code> column true)."

@@ -20,7 +20,7 @@ use serde::Serialize;
 use super::error::{create_dir, PipelineError};
 use crate::model::Vehicle;
 use crate::report::{
-    atomic_write, heatmap, histogram, push_csv_value, read_csv_typed, write_parquet, ColourScale,
+    atomic_write, heatmap, histogram, push_csv_row, read_csv_typed, write_parquet, ColourScale,
     ColumnKind, CsvAppender, Value,
 };
 use crate::study::static_tcm::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
@@ -92,7 +92,7 @@ pub fn run_tcm(
     // Each worker formats its samples' rows (the bytes `CsvAppender::append` would write);
     // this thread keeps the σ_min columns for the histograms and writes the text in order.
     let format = |index: usize, q: &[f64], m: &SampleMetrics, text: &mut String| {
-        let cells = [
+        let metrics = [
             Value::F64(m.sigma_min),
             Value::F64(m.kappa),
             Value::I64(m.rank as i64),
@@ -100,12 +100,14 @@ pub fn run_tcm(
             Value::F64(m.sigma_min_commanded),
             Value::F64(m.kappa_commanded),
         ];
-        push_csv_value(text, &Value::I64(index as i64));
-        for v in q.iter().map(|q| Value::F64(*q)).chain(cells) {
-            text.push(',');
-            push_csv_value(text, &v);
-        }
-        text.push('\n');
+        let angles = q.iter().map(|q| Value::F64(*q));
+        push_csv_row(
+            text,
+            [Value::I64(index as i64)]
+                .into_iter()
+                .chain(angles)
+                .chain(metrics),
+        );
     };
     let summary = analyse_text(
         vehicle,

@@ -22,9 +22,7 @@ fn push_csv_str(buf: &mut String, s: &str) {
     }
 }
 
-/// Appends one CSV cell (no separator) exactly as [`CsvAppender::append`] writes it: for
-/// callers that format rows themselves ([`CsvAppender::append_lines`]).
-pub fn push_csv_value(buf: &mut String, v: &Value<'_>) {
+fn push_csv_value(buf: &mut String, v: &Value<'_>) {
     match v {
         Value::F64(x) => push_f64(buf, *x),
         Value::I64(x) => {
@@ -34,6 +32,19 @@ pub fn push_csv_value(buf: &mut String, v: &Value<'_>) {
         Value::Str(s) => push_csv_str(buf, s),
         Value::Bool(b) => buf.push_str(if *b { "true" } else { "false" }),
     }
+}
+
+/// Appends one CSV row, cells separated by `,` and ended by a newline, exactly as
+/// [`CsvAppender::append`] writes it: for callers that format rows themselves
+/// ([`CsvAppender::append_lines`]).
+pub fn push_csv_row<'v>(buf: &mut String, cells: impl IntoIterator<Item = Value<'v>>) {
+    for (i, v) in cells.into_iter().enumerate() {
+        if i > 0 {
+            buf.push(',');
+        }
+        push_csv_value(buf, &v);
+    }
+    buf.push('\n');
 }
 
 fn csv_header_line(schema: &[(String, ColumnKind)]) -> String {
@@ -60,13 +71,7 @@ pub fn write_csv_streamed(table: &Table, path: &Path) -> Result<()> {
         for i in 0..table.n_rows() {
             let row = table.row(i).map_err(std::io::Error::other)?;
             line.clear();
-            for (j, v) in row.iter().enumerate() {
-                if j > 0 {
-                    line.push(',');
-                }
-                push_csv_value(&mut line, v);
-            }
-            line.push('\n');
+            push_csv_row(&mut line, row);
             w.write_all(line.as_bytes())?;
         }
         Ok(())
@@ -197,26 +202,21 @@ impl CsvAppender {
                 });
             }
         }
-        for (i, v) in row.iter().enumerate() {
-            if i > 0 {
-                self.line.push(',');
-            }
-            push_csv_value(&mut self.line, v);
-        }
-        self.line.push('\n');
-        self.rows += 1;
-        if self.line.len() >= self.batch {
-            self.write_pending()?;
-        }
-        Ok(())
+        push_csv_row(&mut self.line, row.iter().copied());
+        self.added(1)
     }
 
-    /// Appends complete rows already formatted by the caller (cells by [`push_csv_value`],
-    /// `,` between them, each line ending in `\n`) in the appender's schema: the rows of a
-    /// parallel formatter, written in order. Counted by their newlines.
+    /// Appends complete rows already formatted by the caller ([`push_csv_row`]) in the
+    /// appender's schema: the rows of a parallel formatter, written in order. Counted by
+    /// their newlines.
     pub fn append_lines(&mut self, text: &str) -> Result<()> {
         self.line.push_str(text);
-        self.rows += text.bytes().filter(|&b| b == b'\n').count();
+        self.added(text.bytes().filter(|&b| b == b'\n').count())
+    }
+
+    /// `rows` more rows are pending: write them once a batch is full (at once unbatched).
+    fn added(&mut self, rows: usize) -> Result<()> {
+        self.rows += rows;
         if self.line.len() >= self.batch {
             self.write_pending()?;
         }
@@ -225,8 +225,8 @@ impl CsvAppender {
 
     /// The same appender writing rows in batches of about 64 KiB instead of one `write_all`
     /// per row: for large outputs that are not a journal (a crash may lose the last batch);
-    /// [`CsvAppender::sync`] writes what is pending. Dropping it without `sync` loses the
-    /// pending rows.
+    /// [`CsvAppender::flush`] and [`CsvAppender::sync`] write what is pending. Dropping it
+    /// without either loses the pending rows.
     pub fn batched(mut self) -> Self {
         self.batch = 1 << 16;
         self

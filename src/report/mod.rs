@@ -37,7 +37,7 @@ pub mod table;
 pub mod table_io;
 
 pub use atomic::{atomic_write, file_stem_safe};
-pub use csv_append::{push_csv_value, write_csv_streamed, CsvAppender};
+pub use csv_append::{push_csv_row, write_csv_streamed, CsvAppender};
 pub use error::{ReportError, Result};
 pub use markdown::MarkdownTable;
 pub use number::{fmt_num, fmt_short, format_f64};

@@ -212,6 +212,30 @@ enum Output<'a, 'b> {
     Text(&'a RowText, &'a mut TextSink<'b>, &'a mut RowSink<'b>),
 }
 
+impl<'a> Output<'a, '_> {
+    /// The row formatter run by the workers, if the rows go out as text.
+    fn format(&self) -> Option<&'a RowText> {
+        match self {
+            Output::Text(f, _, _) => Some(*f),
+            Output::Rows(_) => None,
+        }
+    }
+
+    /// One sample to the row sink.
+    fn row(&mut self, index: usize, q: &[f64], m: &SampleMetrics) -> Result<(), StaticError> {
+        let (Output::Rows(sink) | Output::Text(_, _, sink)) = self;
+        sink(index, q, m).map_err(StaticError::Sink)
+    }
+
+    /// Formatted rows to the text sink (none without one).
+    fn text(&mut self, text: &str) -> Result<(), StaticError> {
+        match self {
+            Output::Text(_, write, _) => write(text).map_err(StaticError::Sink),
+            Output::Rows(_) => Ok(()),
+        }
+    }
+}
+
 /// The consumer of [`analyse_text`]'s formatted rows, in index order; an `Err` stops the
 /// analysis.
 pub type TextSink<'a> = dyn FnMut(&str) -> Result<(), String> + 'a;
@@ -348,10 +372,7 @@ fn analyse_with(
         metrics: eval.at(&mut scratch),
     };
     let mut tally = Tally::new(spec);
-    let format: Option<&RowText> = match &out {
-        Output::Text(f, _, _) => Some(*f),
-        Output::Rows(_) => None,
-    };
+    let format = out.format();
     match pool(threads)? {
         None => {
             let s = &mut scratch;
@@ -361,18 +382,13 @@ fn analyse_with(
                 map_joint(vehicle, &s.u, &mut s.q);
                 let m = eval.at(s);
                 tally.add(i, &s.q, m);
-                match &mut out {
-                    Output::Rows(sink) => sink(i, &s.q, &m).map_err(StaticError::Sink)?,
-                    Output::Text(f, _, sink) => {
-                        f(i, &s.q, &m, &mut text);
-                        sink(i, &s.q, &m).map_err(StaticError::Sink)?;
-                    }
+                if let Some(f) = format {
+                    f(i, &s.q, &m, &mut text);
                 }
+                out.row(i, &s.q, &m)?;
                 if (i + 1) % CHUNK == 0 || i + 1 == spec.samples {
-                    if let Output::Text(_, write, _) = &mut out {
-                        write(&text).map_err(StaticError::Sink)?;
-                        text.clear();
-                    }
+                    out.text(&text)?;
+                    text.clear();
                     progress(i + 1);
                 }
             }
@@ -478,13 +494,10 @@ fn hand_over(
     for (j, m) in buf.ms[..len].iter().enumerate() {
         let q = &buf.qs[j * n..(j + 1) * n];
         tally.add(start + j, q, *m);
-        let (Output::Rows(sink) | Output::Text(_, _, sink)) = out;
-        sink(start + j, q, m).map_err(StaticError::Sink)?;
+        out.row(start + j, q, m)?;
     }
-    if let Output::Text(_, write, _) = out {
-        for t in &buf.texts[..len.div_ceil(BATCH)] {
-            write(t).map_err(StaticError::Sink)?;
-        }
+    for t in &buf.texts[..len.div_ceil(BATCH)] {
+        out.text(t)?;
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! The explicit form of a design (`usm-study design show`), written so that it parses back
 //! to the same vehicle bit for bit.
 
-use crate::model::{Hydro, Vehicle};
+use crate::model::{Hydro, Thruster, Vehicle};
 use crate::spatial::{Mat3, Vec3};
 use std::fmt::Write as _;
 
@@ -175,22 +175,11 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         write_rpy(&mut o, &j.placement.r);
         let _ = writeln!(o, "limits_deg = {}", farr(&[deg(j.min), deg(j.max)]));
     }
-    let unique_names = v
-        .bodies
-        .iter()
-        .enumerate()
-        .all(|(i, b)| v.bodies[..i].iter().all(|o| o.name != b.name));
+    let unique_names = unique_body_names(v);
     for t in &v.thrusters {
         let _ = writeln!(o, "\n[[thruster]]");
         let _ = writeln!(o, "name = {}", tstr(&t.name));
-        match v.bodies.get(t.body) {
-            Some(b) if unique_names => {
-                let _ = writeln!(o, "body = {}", tstr(&b.name));
-            }
-            _ => {
-                let _ = writeln!(o, "body = {}", t.body);
-            }
-        }
+        let _ = writeln!(o, "body = {}", body_ref(v, t, unique_names));
         let _ = writeln!(o, "position = {}", farr(t.position.as_slice()));
         let _ = writeln!(o, "direction = {}", farr(t.direction.as_slice()));
         let _ = writeln!(o, "u_min = {}", fnum(t.u_min));
@@ -205,17 +194,29 @@ pub fn design_to_toml(v: &Vehicle) -> String {
     o
 }
 
+/// Whether every body of `v` has its own name (thrusters then name their body).
+fn unique_body_names(v: &Vehicle) -> bool {
+    v.bodies
+        .iter()
+        .enumerate()
+        .all(|(i, b)| v.bodies[..i].iter().all(|o| o.name != b.name))
+}
+
+/// The `body` of thruster `t`: its body's name when `unique_names`, else its index.
+fn body_ref(v: &Vehicle, t: &Thruster, unique_names: bool) -> toml::Value {
+    match v.bodies.get(t.body) {
+        Some(b) if unique_names => toml::Value::String(b.name.clone()),
+        _ => toml::Value::Integer(t.body as i64),
+    }
+}
+
 /// The `[[thruster]]` array of [`design_to_toml`]`(v)` as a TOML value, equal to what parsing
 /// that text gives (same keys, the same floats bit for bit), without writing and parsing the
 /// whole design: a sweep that edits one generated thruster per case writes the generated ones
 /// out with it.
 pub fn thrusters_to_toml(v: &Vehicle) -> toml::Value {
     use toml::Value;
-    let unique_names = v
-        .bodies
-        .iter()
-        .enumerate()
-        .all(|(i, b)| v.bodies[..i].iter().all(|o| o.name != b.name));
+    let unique_names = unique_body_names(v);
     let floats = |x: &[f64]| Value::Array(x.iter().map(|&c| Value::Float(c)).collect());
     let tables = v
         .thrusters
@@ -223,11 +224,7 @@ pub fn thrusters_to_toml(v: &Vehicle) -> toml::Value {
         .map(|t| {
             let mut m = toml::Table::new();
             m.insert("name".into(), Value::String(t.name.clone()));
-            let body = match v.bodies.get(t.body) {
-                Some(b) if unique_names => Value::String(b.name.clone()),
-                _ => Value::Integer(t.body as i64),
-            };
-            m.insert("body".into(), body);
+            m.insert("body".into(), body_ref(v, t, unique_names));
             m.insert("position".into(), floats(t.position.as_slice()));
             m.insert("direction".into(), floats(t.direction.as_slice()));
             m.insert("u_min".into(), Value::Float(t.u_min));
