@@ -51,7 +51,7 @@ use super::records::{
 };
 use super::runner::TIMEOUT;
 use super::schema::Study;
-use super::tune::{CaseTuner, TuningHook};
+use super::tune::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 
@@ -244,21 +244,6 @@ pub fn run_sweep(
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
     }
     Ok(outcome)
-}
-
-/// The tuner of `study` through `hook`; `None` without `[tune]`. A study with `[tune]` but
-/// no hook cannot be run as written: refused.
-pub fn case_tuner(
-    study: &Study,
-    hook: Option<TuningHook>,
-) -> Result<Option<Box<dyn CaseTuner>>, StudyError> {
-    match hook {
-        Some(h) => Ok(h.tuner(study)?),
-        None if study.tune.is_some() => Err(StudyError::Other(
-            "the study has a [tune] section but no tuner was wired into the sweep".into(),
-        )),
-        None => Ok(None),
-    }
 }
 
 /// With `--resume` and no journal: the outcome of an output that is already complete for

@@ -5,14 +5,13 @@ use std::path::Path;
 
 use super::cases::resolve_case;
 use super::doe::expand;
-use super::engine::case_tuner;
 use super::error::StudyError;
 use super::manifest::{read_manifest, Manifest};
 use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
-use super::tune::{tuned_columns, TuneError, TuningHook};
+use super::tune::{case_tuner, tuned_columns, TuneError, TuningHook};
 use super::worker::evaluate_resolved;
 use crate::evaluate::{Deadline, Evaluator};
 use crate::report::{read_csv_typed, write_csv, ReportError, Table};

@@ -11,7 +11,7 @@ use std::fmt;
 
 use super::cases::Resolved;
 use super::doe::Case;
-use super::error::InputError;
+use super::error::{InputError, StudyError};
 use super::schema::{Study, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use crate::evaluate::{Deadline, Metrics};
 
@@ -116,5 +116,20 @@ impl TuningHook {
 impl fmt::Debug for TuningHook {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str("TuningHook")
+    }
+}
+
+/// The tuner of `study` through `hook`; `None` without `[tune]`. A study with `[tune]` but
+/// no hook cannot be run as written: refused.
+pub fn case_tuner(
+    study: &Study,
+    hook: Option<TuningHook>,
+) -> Result<Option<Box<dyn CaseTuner>>, StudyError> {
+    match hook {
+        Some(h) => Ok(h.tuner(study)?),
+        None if study.tune.is_some() => Err(StudyError::Other(
+            "the study has a [tune] section but no tuner was wired into the sweep".into(),
+        )),
+        None => Ok(None),
     }
 }
