@@ -16,6 +16,7 @@
 pub mod allocation;
 pub mod control;
 pub mod dynamics;
+pub mod evaluate;
 pub mod input;
 pub mod kinematics;
 pub mod metrics;

@@ -12,13 +12,13 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
+use usm_study::optimise::tune::{Tuner, HOOK as TUNING};
 use usm_study::pipeline::review::write_review;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::study::shards::{slurm_script, SlurmPlan};
-use usm_study::study::tune::Tuner;
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -182,6 +182,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         max_cases: a.max_cases,
         case_timeout: case_budget(a.case_timeout)?,
         force: a.force,
+        tuning: Some(TUNING),
     };
     if a.dry_run {
         let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
@@ -277,7 +278,7 @@ pub struct MergeArgs {
 
 /// Run `usm-study merge`.
 pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
-    let (m, warnings) = merge(&a.dirs, &a.out).map_err(study_err)?;
+    let (m, warnings) = merge(&a.dirs, &a.out, Some(TUNING)).map_err(study_err)?;
     for w in &warnings {
         eprintln!("[merge] warning: {w}");
     }

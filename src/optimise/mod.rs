@@ -11,8 +11,11 @@
 //!   the feasibility-first ranking.
 //! - [`history`]: evaluation records, the history table and the resume journal.
 //! - [`search`]: the argmin cost function, gradient, observer and the three solvers.
-//! - [`evaluate`]: a problem's point → its metrics (the sweep's case machinery).
+//! - [`evaluate`]: a problem's point → its metrics (through the one case evaluator,
+//!   [`crate::evaluate`]).
 //! - [`engine`]: [`run`] and [`minimise`]: start point, solver runs, outcome.
+//! - [`tune`]: per-case tuning of a sweep (`[tune]`), wired into the sweep engine through its
+//!   hook ([`tune::HOOK`]).
 //!
 //! The library API a caller (the `optimise` verb, a sweep tuning each case) uses is
 //! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
@@ -24,6 +27,7 @@ pub mod problem;
 pub mod score;
 pub mod search;
 pub mod space;
+pub mod tune;
 
 pub use engine::{minimise, run, OptimiseError, Options, Outcome};
 pub use problem::{load_problem, parse_problem, Problem, Spec};

@@ -205,7 +205,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
         for (&i, e) in todo.iter().zip(done) {
             if let Some(j) = st.journal.as_mut() {
                 if let Err(err) = j.append(&plan[i].x, &e) {
-                    st.journal_error.get_or_insert(err);
+                    st.journal_error.get_or_insert(err.to_string());
                 }
             }
             st.memo.insert(plan[i].key.clone(), e);

@@ -133,9 +133,9 @@ fn write_best_files(
     out: &Path,
 ) -> Result<(), PipelineError> {
     for v in 0..problem.spec.variants.len() {
-        let r = ev
-            .resolve(x, v)
-            .map_err(|m| PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m)))?;
+        let r = ev.resolve(x, v).map_err(|m| {
+            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
+        })?;
         let text = case_file_text(problem, &r, x)?;
         atomic_write(&out.join(best_file_name(problem, v)), text.as_bytes())?;
     }
@@ -364,9 +364,9 @@ fn runs_figure(
     };
     let mut figs = Vec::new();
     for (label, r) in [("start", o.start()), ("best", o.best())] {
-        let resolved = ev
-            .resolve(&r.x, 0)
-            .map_err(|m| PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m)))?;
+        let resolved = ev.resolve(&r.x, 0).map_err(|m| {
+            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
+        })?;
         let run = ev.run_case(&resolved, true);
         let vehicle = parse_design_table(&resolved.design, "optimised design")?;
         let yaw: Vec<usize> = yaw_joint_mask(&vehicle)

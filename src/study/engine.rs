@@ -51,7 +51,7 @@ use super::records::{
 };
 use super::runner::TIMEOUT;
 use super::schema::Study;
-use super::tune::Tuner;
+use super::tune::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 
@@ -73,6 +73,9 @@ pub struct SweepOptions {
     pub case_timeout: Option<Duration>,
     /// Replace the output of another study in the output directory.
     pub force: bool,
+    /// How cases of a study with `[tune]` are tuned (the optimiser's tuner, wired in by the
+    /// caller); a study with `[tune]` and no hook is refused.
+    pub tuning: Option<TuningHook>,
 }
 
 /// Progress of a sweep, reported after every finished case.
@@ -151,7 +154,7 @@ pub fn run_sweep(
             )));
         }
     }
-    let tuner = Tuner::new(study)?;
+    let tuner = case_tuner(study, opts.tuning)?;
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
     let out = output_dir(study, opts);
     let _lock = outdir::lock(&out)?;
@@ -182,7 +185,7 @@ pub fn run_sweep(
         done: &done,
         max: opts.max_cases.unwrap_or(usize::MAX),
         budget: opts.case_timeout,
-        tuner: tuner.as_ref(),
+        tuner: tuner.as_deref(),
     };
     let streamed = stream_cases(&run, &cases, &pool, &mut appender, progress)?;
     let _ = appender.sync();
@@ -235,7 +238,7 @@ pub fn run_sweep(
     write_manifest(&out, &manifest)?;
     if opts.shard.is_none() {
         // Inside the sweep's pool, so the best/worst reruns respect --jobs.
-        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study)));
+        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study), opts.tuning));
         outcome.warnings.extend(w);
         // Last: a kill before this leaves a journal that --resume completes from.
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
@@ -322,7 +325,7 @@ struct RunSpec<'a> {
     done: &'a HashSet<String>,
     max: usize,
     budget: Option<Duration>,
-    tuner: Option<&'a Tuner>,
+    tuner: Option<&'a dyn CaseTuner>,
 }
 
 /// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs, each within the
@@ -390,7 +393,8 @@ fn stream_cases(
                     }
                     if write_error.is_none() {
                         let texts: Vec<String> = row.axes.iter().map(axis_text).collect();
-                        if let Err(e) = appender.append(&row.values(run.study, &texts)) {
+                        let packed = row.packed(run.study);
+                        if let Err(e) = appender.append(&row.values(run.study, &texts, &packed)) {
                             write_error = Some(e.into());
                             cancel.store(true, Ordering::Relaxed);
                         }
@@ -431,15 +435,9 @@ fn process(
         return Msg::NotRun;
     }
     let row = match resolved {
-        Ok(r) => match run.tuner {
-            None => w.evaluate(study, case, &r, false).0,
-            Some(t) => {
-                let deadline = w.budget.map(|b| Instant::now() + b);
-                t.evaluate(w, study, case, &r, deadline)
-            }
-        },
+        Ok(r) => w.evaluate(study, case, &r, false, run.tuner).0,
         Err(reason) => {
-            let mut row = Row::new(study, case.id, hash, case.values.clone());
+            let mut row = Row::new(case.id, hash, case.values.clone());
             row.end(CaseStatus::Skipped, &reason);
             row
         }

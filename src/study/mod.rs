@@ -6,7 +6,7 @@
 //!
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
-//! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
+//! - [`runner`]: the single adapter to the scenario module's settings (modes, defaults).
 //! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space;
 //!   `static_dist`: the distributions (exact quantiles) of its per-sample quantities.
 //! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
@@ -16,9 +16,11 @@
 //! - [`parse`]: study files (TOML) → validated [`Study`].
 //! - [`doe`]: grid and sampled designs of experiments → cases.
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
-//! - [`records`]: case status, row, columns of the raw and final tables.
-//! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
-//! - [`tune`]: per-case tuning (`[tune]`): tune a case with the optimiser, score it there.
+//! - [`tune`]: the per-case tuning hook (`[tune]`): the optimiser's tuner reaches the sweep
+//!   through it, handed in by the caller.
+//! - [`records`]: rows (named metrics), columns of the raw and final tables.
+//! - [`worker`]: one resolved case → one row through the case evaluator
+//!   ([`crate::evaluate`]), tuned first through the hook.
 //! - [`manifest`]: the `manifest.json` of an output directory.
 //! - [`outdir`]: the output directory's lock, its ownership by one study, stale temporaries.
 //! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.

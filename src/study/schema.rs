@@ -213,7 +213,8 @@ pub struct Study {
     /// SHA-256 of the study text, the base design and the tool version (hex).
     pub hash: String,
     /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`); validated
-    /// by [`crate::study::tune::Tuner::new`] before any case runs.
+    /// by the tuner wired into the sweep (`crate::optimise::tune::Tuner::new`) before any
+    /// case runs.
     pub tune: Option<toml::Table>,
 }
 

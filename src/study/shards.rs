@@ -10,11 +10,17 @@ use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manife
 use super::outdir;
 use super::parse::load_study;
 use super::records::{compact, write_tables, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use super::tune::TuningHook;
 use crate::report::{read_csv_typed, Table};
 
 /// Merge shard outputs into `out`: check they come from the same study, concatenate their raw
-/// rows, sort by case id, deduplicate by hash, and write the final tables, manifest and report.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), StudyError> {
+/// rows, sort by case id, deduplicate by hash, and write the final tables, manifest and report
+/// (the best/worst reruns of a study with `[tune]` at their tuned values through `tuning`).
+pub fn merge(
+    dirs: &[PathBuf],
+    out: &Path,
+    tuning: Option<TuningHook>,
+) -> Result<(Manifest, Vec<String>), StudyError> {
     let start_time = now_rfc3339();
     let first_dir = dirs
         .first()
@@ -65,7 +71,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
     let study = load_study(Path::new(&m.study_file))
         .ok()
         .filter(|s| s.hash == m.study_hash);
-    warnings.extend(finish_report(out, &table, &m, study.as_ref()));
+    warnings.extend(finish_report(out, &table, &m, study.as_ref(), tuning));
     // The merged rows are in cases.csv: no journal is left behind.
     let journal = out.join(PARTIAL_FILE);
     std::fs::remove_file(&journal).map_err(|e| StudyError::io(&journal, e))?;
