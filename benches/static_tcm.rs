@@ -30,7 +30,7 @@ use usm_study::metrics::singularity::{
     DEFAULT_RANK_REL_TOL,
 };
 use usm_study::model::presets::usm_paper;
-use usm_study::study::static_tcm::{analyse, StaticSpec};
+use usm_study::statics::{analyse, StaticSpec};
 
 fn bench_static(c: &mut Criterion) {
     let v = usm_paper();

@@ -10,7 +10,7 @@ use usm_study::control::{InertialTask, Srmtp, TaskInverse, TaskVariable};
 use usm_study::kinematics::{forward_kinematics, BasePose, KinWorkspace};
 use usm_study::model::presets::preset;
 use usm_study::model::Vehicle;
-use usm_study::scenario::antonelli::{
+use usm_study::paper::antonelli::{
     antonelli_case, planar_weights, run_kinematic_case, AntonelliCase, KinematicHistory,
 };
 use usm_study::spatial::Vec3;
@@ -214,7 +214,7 @@ fn run(which: AntonelliCase) -> KinematicHistory {
     run_kinematic_case(&planar(), &antonelli_case(which)).unwrap()
 }
 
-fn trace<'a>(h: &'a KinematicHistory, name: &str) -> &'a usm_study::scenario::antonelli::TaskTrace {
+fn trace<'a>(h: &'a KinematicHistory, name: &str) -> &'a usm_study::paper::antonelli::TaskTrace {
     h.primary
         .iter()
         .chain(&h.secondary)

@@ -1,4 +1,4 @@
-//! Antonelli & Chiaverini case 3: the NPS AUV II model (`model::nps_auv2`) in still water,
+//! Antonelli & Chiaverini case 3: the NPS AUV II model (`paper::nps_auv2`) in still water,
 //! its energy and momentum without dissipation, the sliding-mode runs 3a/3b and Table I in
 //! `paper antonelli`'s summary.json; the `simulate antonelli-…` presets.
 
@@ -7,11 +7,11 @@ mod common;
 use usm_study::dynamics::{
     ActuatorCommand, DynOptions, Integrator, SimConfig, SimState, Simulator,
 };
-use usm_study::model::nps_auv2::{nps_auv2, LENGTH, MASS, RHO};
 use usm_study::model::{Hydro, Vehicle};
-use usm_study::pipeline::antonelli::run_antonelli;
-use usm_study::scenario::antonelli::dynamic::{run_dynamic_case, BaseTrajectory, DynamicCase};
-use usm_study::scenario::antonelli::{antonelli_case, run_kinematic_case, AntonelliCase};
+use usm_study::paper::antonelli::dynamic::{run_dynamic_case, BaseTrajectory, DynamicCase};
+use usm_study::paper::antonelli::{antonelli_case, run_kinematic_case, AntonelliCase};
+use usm_study::paper::antonelli_outputs::run_antonelli;
+use usm_study::paper::nps_auv2::{nps_auv2, LENGTH, MASS, RHO};
 use usm_study::spatial::{Vec3, Vec6};
 
 fn sim(v: &Vehicle, options: DynOptions, dt: f64) -> Simulator {

@@ -12,8 +12,8 @@ use usm_study::model::design::load_design;
 use usm_study::pipeline::tcm::{run_tcm, TcmConfig};
 use usm_study::report::fmt_num;
 use usm_study::sampling::Sampling;
-use usm_study::scenario::config::Mode;
-use usm_study::study::static_tcm::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
+use usm_study::scenario::Mode;
+use usm_study::statics::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
 
 /// Most `--samples` accepted: 16 bytes are kept per sample (0.8 GB at the cap); more would
 /// end in an allocation abort instead of a message.
@@ -25,7 +25,7 @@ pub struct TcmArgs {
     /// Preset name (usm-paper, uvms-planar) or path to a design file (TOML).
     pub design: String,
     /// Number of joint configurations sampled within the joint limits.
-    #[arg(long, default_value_t = usm_study::study::static_tcm::DEFAULT_SAMPLES)]
+    #[arg(long, default_value_t = usm_study::statics::DEFAULT_SAMPLES)]
     pub samples: usize,
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]
@@ -58,7 +58,7 @@ pub struct TcmArgs {
     #[arg(long, default_value = "transport", value_parser = parse_mode)]
     pub mode: Mode,
     /// Number of worst (lowest σ_min) configurations reported.
-    #[arg(long, default_value_t = usm_study::study::static_tcm::DEFAULT_WORST)]
+    #[arg(long, default_value_t = usm_study::statics::DEFAULT_WORST)]
     pub worst: usize,
 }
 
@@ -110,9 +110,9 @@ pub fn run(a: &TcmArgs) -> anyhow::Result<ExitCode> {
             char_length: a.char_length,
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
             worst: a.worst,
-            mode: a.mode,
-            commanded: a.mode.default_commanded_dofs(),
-        },
+            ..StaticSpec::default()
+        }
+        .for_mode(a.mode),
         out: a.out.clone().unwrap_or_else(|| {
             Path::new("results/tcm").join(usm_study::report::file_stem_safe(&vehicle.name))
         }),

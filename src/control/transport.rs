@@ -43,7 +43,7 @@
 //!
 //! # Interpretation choices and why (results/paper/FINDINGS.md has the numbers)
 //!
-//! `usm-study paper readings` (`crate::pipeline::readings`) runs both Table III methods under
+//! `usm-study paper readings` (`crate::paper::readings`) runs both Table III methods under
 //! all 32 combinations of the open choices (n or not, feedback on the uncommanded axes or not,
 //! front-heading or base yaw rate, with or without `ψ̇_r`, PI or PD surge). Only the default
 //! below (no `n`, feedback, front-heading rate, `ψ̇ − ψ̇_r`, PI: two departures from the
@@ -76,12 +76,11 @@
 
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
 use super::kinematic::SecondaryTasks;
-use super::{
-    check_finite, check_nonneg, check_pos, heading, heading_rate, wrap_angle, ControlError,
-};
+use super::{check_finite, check_nonneg, check_pos, ControlError};
 use crate::kinematics::{BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{ang, lin, Vec3, Vec6};
+use crate::spatial::{heading, heading_rate, wrap_angle};
 use serde::{Deserialize, Serialize};
 
 /// The paper's two transport methods (USM section VI-B, Table III).

@@ -4,7 +4,7 @@
 //! drag, all about a reference point `CO` in axes of their own.
 //!
 //! The coefficients are dimensional (the prime values already scaled by `½ρL²…½ρL⁵` for the
-//! fluid the vehicle was built for, see [`crate::model::nps_auv2`]). Unlike
+//! fluid the vehicle was built for, see [`crate::paper::nps_auv2`]). Unlike
 //! [`super::Hydro::Coefficients`], the velocity-product table is by default the *measured*
 //! force of the moving hull, which includes what the Kirchhoff term `V_r ×* (M_A V_r)` would
 //! add; the dynamics then leave that term out for such a body ([`Manoeuvring::kirchhoff`],

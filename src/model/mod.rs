@@ -9,7 +9,6 @@
 pub mod design;
 pub mod generator;
 pub mod manoeuvring;
-pub mod nps_auv2;
 pub mod presets;
 
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};

@@ -17,6 +17,7 @@ use super::search::Evaluator;
 use crate::model::design::parse_design_table;
 use crate::report::Table;
 use crate::sampling::derive_seed;
+use crate::statics::analyse;
 use crate::study::axes::study_target;
 use crate::study::cases::{resolve_case, Resolved};
 use crate::study::doe::Case;
@@ -24,7 +25,6 @@ use crate::study::records::{DESIGN_COLUMNS, TCM_COLUMNS};
 use crate::study::runner;
 use crate::study::schema::{Axis, AxisSpec, Study};
 use crate::study::static_table::{static_spec, STATIC_TABLE};
-use crate::study::static_tcm::analyse;
 use crate::study::worker::{design_metrics, tcm_metrics};
 
 /// The metrics of one case (one scenario at one point).

@@ -23,8 +23,8 @@ use crate::report::{
     atomic_write, heatmap, histogram, push_csv_row, read_csv_typed, write_parquet, ColourScale,
     ColumnKind, CsvAppender, Value,
 };
-use crate::study::static_tcm::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
-use crate::study::static_tcm_slice::{influential_joints, slice_grid};
+use crate::statics::slice::{influential_joints, slice_grid};
+use crate::statics::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
 
 /// Largest sample count for which `samples.parquet` is written.
 pub const PARQUET_MAX_ROWS: usize = 200_000;

@@ -162,7 +162,7 @@ pub fn run_case_until(
     log: bool,
     deadline: Option<Instant>,
 ) -> Result<CaseOutcome, String> {
-    let run = crate::scenario::run_case(vehicle, scenario, seed, log, deadline)
+    let run = crate::outcome::run_case(vehicle, scenario, seed, log, deadline)
         .map_err(|e| e.to_string())?;
     let trajectory = match run.trajectory {
         Some(t) => Some(crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?),

@@ -14,11 +14,11 @@ use super::records::{pack_metrics, CaseStatus, Row, DESIGN_COLUMNS, TCM_COLUMNS}
 use super::runner;
 use super::schema::Study;
 use super::static_table::{static_spec, STATIC_TABLE};
-use super::static_tcm::{analyse, Distribution, StaticError, StaticSummary};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
 use crate::sampling::derive_seed;
+use crate::statics::{analyse, Distribution, StaticError, StaticSummary};
 use std::time::{Duration, Instant};
 
 /// Per-worker state of a sweep (one per rayon worker): a one-entry vehicle cache keyed by

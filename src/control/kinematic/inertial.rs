@@ -12,12 +12,13 @@
 //! | joint `q_k` [rad] | `q_k` | `e_{6+k}ᵀ` |
 //!
 //! `J_e = [J_e,v; J_e,ω]` is the end-effector Jacobian in `F_e` (USM-18), `g(R)` the
-//! [`crate::control::heading_gradient`] (`ψ̇ = g·ω` for body-fixed `ω`; `g = e_z` when the frame
+//! [`crate::spatial::heading_gradient`] (`ψ̇ = g·ω` for body-fixed `ω`; `g = e_z` when the frame
 //! is level, as in the paper's planar system). Heading errors are wrapped into `(−π, π]`.
 
 use super::ee_pose;
-use crate::control::{check_nonneg, heading, heading_gradient, wrap_angle, ControlError};
+use crate::control::{check_nonneg, ControlError};
 use crate::kinematics::{ee_jacobian, BasePose, KinWorkspace};
+use crate::spatial::{heading, heading_gradient, wrap_angle};
 use faer::{Mat, MatRef};
 
 /// One scalar task coordinate measured in the inertial frame.

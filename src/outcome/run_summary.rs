@@ -5,12 +5,14 @@
 //! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
 use super::success::judge;
-use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
-use crate::control::wrap_angle;
+use crate::metrics::trajectory::{
+    segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
+};
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
 use crate::scenario::success::Missed;
+use crate::spatial::wrap_angle;
 
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;

@@ -18,7 +18,7 @@
 //! `sign(s)` by a saturation (no chattering: a chattering switch term would add its own
 //! amplitude to the force integrals of Table I), and every gain (the paper gives none).
 
-use super::{check_nonneg, ControlError};
+use crate::control::{check_nonneg, ControlError};
 use crate::kinematics::BasePose;
 use crate::spatial::{quat_error_vec, Vec3, Vec6};
 use nalgebra::UnitQuaternion;

@@ -4,8 +4,8 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm::{evaluator, pool, StaticError, StaticSpec};
-use super::static_tcm_eval::Scratch;
+use super::analysis::{evaluator, pool, StaticError, StaticSpec};
+use super::eval::Scratch;
 use crate::model::Vehicle;
 
 /// σ_min over a 2-D slice of joint space: joints `i` and `j` on a `resolution × resolution`

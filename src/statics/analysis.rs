@@ -27,16 +27,16 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm_eval::{local_pool, map_joint, Eval, Scratch};
+use super::eval::{local_pool, map_joint, Eval, Scratch};
 use crate::metrics::singularity::{
     CommandedDofs, SingularityError, AXIS_NAMES, DEFAULT_RANK_REL_TOL, SINGULARITY_THRESHOLD,
 };
 use crate::model::Vehicle;
 use crate::sampling::{Sampler, Sampling};
-use crate::scenario::config::Mode;
+use crate::scenario::Mode;
 
-pub use super::static_dist::{distribution, quantile_sorted, Distribution, QUANTILES};
-pub use super::static_tcm_eval::SampleMetrics;
+use super::dist::{distribution, Distribution};
+use super::eval::SampleMetrics;
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
 /// for streaming rows).
@@ -139,6 +139,16 @@ impl Default for StaticSpec {
 }
 
 impl StaticSpec {
+    /// Score the base axes `mode`'s default controller commands: sets [`StaticSpec::mode`] and
+    /// [`StaticSpec::commanded`] together (the `tcm` command's `--mode`).
+    pub fn for_mode(self, mode: Mode) -> Self {
+        Self {
+            mode,
+            commanded: mode.default_commanded_dofs(),
+            ..self
+        }
+    }
+
     /// Check the settings; the error names the key that is wrong.
     pub fn validate(&self) -> Result<(), StaticError> {
         let bad = |key, message: String| Err(StaticError::Setting { key, message });
@@ -661,5 +671,5 @@ fn keep_worst(worst: &mut Vec<SampleEval>, index: usize, q: &[f64], m: SampleMet
 }
 
 #[cfg(test)]
-#[path = "static_tcm_tests.rs"]
+#[path = "analysis_tests.rs"]
 mod tests;

@@ -116,7 +116,7 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
 
 #[cfg(test)]
 mod tests {
-    use crate::metrics::success::judge;
+    use crate::outcome::success::judge;
     use crate::scenario::config::Mode;
     use crate::scenario::success::{Criterion, SuccessSpec};
 
