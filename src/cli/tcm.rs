@@ -1,5 +1,5 @@
 //! `usm-study tcm DESIGN`: static configuration-space analysis of the thruster configuration
-//! matrix (SPEC §6) — how often `T(q)` is singular over the joint space. The files written are
+//! matrix (docs/model.md §6) — how often `T(q)` is singular over the joint space. The files written are
 //! described in [`usm_study::pipeline::tcm`].
 
 use super::progress::Progress;
@@ -11,7 +11,7 @@ use usm_study::metrics::singularity::DEFAULT_RANK_REL_TOL;
 use usm_study::model::design::load_design;
 use usm_study::pipeline::tcm::{run_tcm, TcmConfig};
 use usm_study::report::fmt_num;
-use usm_study::sampling::Sampling;
+use usm_study::sampling::{Sampling, UnknownSampling};
 use usm_study::scenario::Mode;
 use usm_study::statics::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
 
@@ -62,24 +62,36 @@ pub struct TcmArgs {
     pub worst: usize,
 }
 
-fn parse_sampling(s: &str) -> Result<Sampling, String> {
+/// A command-line value of `tcm` that does not parse.
+#[derive(Debug, thiserror::Error)]
+enum ArgError {
+    /// `--mode` names no mode.
+    #[error("unknown mode '{0}'; valid: transport, work")]
+    Mode(String),
+    /// `--slice` is not two comma-separated values.
+    #[error("expected I,J (two joint indices), got '{0}'")]
+    Pair(String),
+    /// One value of `--slice` is not an index.
+    #[error("'{0}' is not a joint index")]
+    Index(String),
+}
+
+fn parse_sampling(s: &str) -> Result<Sampling, UnknownSampling> {
     s.parse()
 }
 
-fn parse_mode(s: &str) -> Result<Mode, String> {
+fn parse_mode(s: &str) -> Result<Mode, ArgError> {
     toml::Value::String(s.into())
         .try_into()
-        .map_err(|_| format!("unknown mode '{s}'; valid: transport, work"))
+        .map_err(|_| ArgError::Mode(s.into()))
 }
 
-fn parse_pair(s: &str) -> Result<(usize, usize), String> {
-    let (a, b) = s
-        .split_once(',')
-        .ok_or_else(|| format!("expected I,J (two joint indices), got '{s}'"))?;
+fn parse_pair(s: &str) -> Result<(usize, usize), ArgError> {
+    let (a, b) = s.split_once(',').ok_or_else(|| ArgError::Pair(s.into()))?;
     let p = |x: &str| {
         x.trim()
             .parse::<usize>()
-            .map_err(|_| format!("'{x}' is not a joint index"))
+            .map_err(|_| ArgError::Index(x.into()))
     };
     Ok((p(a)?, p(b)?))
 }

@@ -14,8 +14,8 @@ mod eval;
 pub mod slice;
 
 pub use analysis::{
-    analyse, analyse_text, StaticError, StaticSpec, StaticSummary, DEFAULT_MODE, DEFAULT_SAMPLES,
-    DEFAULT_SAMPLING, DEFAULT_THRESHOLD, DEFAULT_WORST,
+    analyse, analyse_text, SinkError, StaticError, StaticSpec, StaticSummary, DEFAULT_MODE,
+    DEFAULT_SAMPLES, DEFAULT_SAMPLING, DEFAULT_THRESHOLD, DEFAULT_WORST,
 };
 pub use dist::{distribution, quantile_sorted, Distribution, QUANTILES};
 pub use eval::SampleMetrics;

@@ -144,7 +144,7 @@ fn static_phase(v: &Vehicle, r: &Resolved, deadline: Option<Instant>, row: &mut 
         }
     };
     let mut on_time = |_: usize, _: &[f64], _: &_| match deadline {
-        Some(d) if Instant::now() >= d => Err(runner::TIMEOUT.to_string()),
+        Some(d) if Instant::now() >= d => Err(runner::TIMEOUT.into()),
         _ => Ok(()),
     };
     match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
