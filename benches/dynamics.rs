@@ -1,4 +1,4 @@
-//! Benchmarks of the dynamics core on `usm-paper` (SPEC §4): mass matrix (CRBA), bias
+//! Benchmarks of the dynamics core on `usm-paper` (docs/model.md §4): mass matrix (CRBA), bias
 //! forces (RNEA), forward and hybrid dynamics, one RK4 step with full hydrodynamics, and one
 //! 50 ms control period advanced by the adaptive Dormand–Prince integrator.
 //!

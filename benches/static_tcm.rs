@@ -1,4 +1,4 @@
-//! Static TCM analysis benchmarks (SPEC §6, issue 11 item 3): the pieces of one joint
+//! Static TCM analysis benchmarks (docs/model.md §6, issue 11 item 3): the pieces of one joint
 //! configuration of the `usm-paper` design and whole analyses.
 //!
 //! Groups:

@@ -1,6 +1,6 @@
-//! Spatial algebra on SE(3) for the `[v; ω]` (linear first) ordering of SPEC §1.
+//! Spatial algebra on SE(3) for the `[v; ω]` (linear first) ordering of docs/model.md §1.
 //!
-//! Conventions (SPEC §1):
+//! Conventions (docs/model.md §1):
 //! - a transform `g = (R, p)` maps points of the child frame into the parent frame,
 //!   `x_parent = R x_child + p`;
 //! - twists `V = [v; ω]` and wrenches `F = [f; m]` are expressed in a named frame;
@@ -49,7 +49,7 @@ pub fn stack(a: &Vec3, b: &Vec3) -> Vec6 {
     Vec6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }
 
-/// A rigid transform `g = (R, p)` ∈ SE(3) (SPEC §1): `R` rotation, `p` translation in metres.
+/// A rigid transform `g = (R, p)` ∈ SE(3) (docs/model.md §1): `R` rotation, `p` translation in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se3 {
     /// Rotation of the child frame's axes, expressed in the parent frame.
@@ -125,7 +125,7 @@ impl Se3 {
         self.r * x
     }
 
-    /// The adjoint `Ad_g = [[R, p̂R], [0, R]]` (SPEC §1).
+    /// The adjoint `Ad_g = [[R, p̂R], [0, R]]` (docs/model.md §1).
     pub fn adjoint(&self) -> Mat6 {
         let mut m = Mat6::zeros();
         let pr = skew(&self.p) * self.r;
@@ -135,7 +135,7 @@ impl Se3 {
         m
     }
 
-    /// The inverse adjoint `Ad_g⁻¹ = [[Rᵀ, −Rᵀp̂], [0, Rᵀ]]` (SPEC §1).
+    /// The inverse adjoint `Ad_g⁻¹ = [[Rᵀ, −Rᵀp̂], [0, Rᵀ]]` (docs/model.md §1).
     pub fn adjoint_inv(&self) -> Mat6 {
         self.inverse().adjoint()
     }
@@ -212,7 +212,7 @@ pub fn cross_motion(v: &Vec6, w: &Vec6) -> Vec6 {
 }
 
 /// Force cross product `V ×* F = −ad_Vᵀ F` (the velocity-product term of Newton–Euler,
-/// and the Kirchhoff term `V ×* (M_A V)` of SPEC §4).
+/// and the Kirchhoff term `V ×* (M_A V)` of docs/model.md §4).
 #[inline]
 pub fn cross_force(v: &Vec6, f: &Vec6) -> Vec6 {
     let (vl, va) = (lin(v), ang(v));
@@ -248,7 +248,7 @@ pub fn quat_integrate(q: &UnitQuaternion<f64>, omega: &Vec3, dt: f64) -> UnitQua
 }
 
 /// Vector part of the quaternion error `q_d⁻¹ ⊗ q` with a non-negative scalar part, used as
-/// the orientation error of the end-effector task (SPEC §5). Both quaternions map body
+/// the orientation error of the end-effector task (docs/model.md §5). Both quaternions map body
 /// vectors to the inertial frame; the result is expressed in the current body frame's
 /// orientation-error sense (`≈ ½ θ axis` for small errors).
 pub fn quat_error_vec(q_d: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> Vec3 {

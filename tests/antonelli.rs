@@ -1,4 +1,4 @@
-//! Antonelli & Chiaverini (1998) kinematic case studies on `uvms-planar` (SPEC §8): the
+//! Antonelli & Chiaverini (1998) kinematic case studies on `uvms-planar` (docs/model.md §8): the
 //! inertial-frame task variables, the singularity-robust task priority (AC-7…9) and the
 //! paper's cases 1, 1b and 2. Reference values are the seed's text
 //! (`shared/seeds/004_2e118a4aa85a2683.txt`, section 5).

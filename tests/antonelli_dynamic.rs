@@ -165,7 +165,7 @@ fn free_body_invariants(kirchhoff: bool) -> ((f64, Vec6), (f64, Vec6)) {
 #[test]
 fn without_dissipation_energy_and_momentum_are_conserved_with_fossen_c_a() {
     // With the Kirchhoff term (the paper's AC-3 form, `Manoeuvring::kirchhoff`), ½ζᵀMζ and
-    // the inertial momentum are invariants of a free body (SPEC §4).
+    // the inertial momentum are invariants of a free body (docs/model.md §4).
     let ((e0, p0), (e1, p1)) = free_body_invariants(true);
     assert!((e1 - e0).abs() < 1e-8 * e0, "{e0} -> {e1}");
     assert!((p1 - p0).norm() < 1e-8 * p0.norm(), "{p0} -> {p1}");

@@ -1,4 +1,4 @@
-//! Line-of-sight guidance along a path of straight segments (SPEC §5 transport mode, USM-39).
+//! Line-of-sight guidance along a path of straight segments (docs/model.md §5 transport mode, USM-39).
 //!
 //! For the active segment `k` from `a_k` to `b_k` with direction `α_k` (angle of `b_k − a_k`
 //! about the inertial +z axis) and a point `p` (the front of the vehicle: the end-effector

@@ -1,4 +1,4 @@
-//! Control laws of the USM motion-control framework (SPEC §5, USM section IV–V, Fig. 5):
+//! Control laws of the USM motion-control framework (docs/model.md §5, USM section IV–V, Fig. 5):
 //! guidance → kinematic control → dynamic control (→ thrust allocation, in [`crate::allocation`]).
 //!
 //! | module | law | equations |
@@ -15,7 +15,7 @@
 //! `deny_unknown_fields`, defaults = the paper's values), a controller struct that owns all
 //! its buffers and state (integrators), and a per-step call that does not allocate.
 //!
-//! Frames and units (SPEC §1): inertial frame `I` with z up; base frame `F_b` at the tail
+//! Frames and units (docs/model.md §1): inertial frame `I` with z up; base frame `F_b` at the tail
 //! face of body 0; end-effector frame `F_e` at the front face of the last body. Twists are
 //! `[v; ω]` (m/s, rad/s) in the frame named by the variable (`v_b` in `F_b`, `v_e` in `F_e`);
 //! the generalised velocity is `ζ = [V_b; q̇]`. Angles in radians. The *heading* ψ of a frame is
@@ -94,7 +94,7 @@ pub(crate) fn check_pos(key: &str, x: f64) -> Result<(), ControlError> {
     Ok(())
 }
 
-/// Orientation error `ε̃` of the end-effector task (SPEC §5, USM-42): the vector part of the
+/// Orientation error `ε̃` of the end-effector task (docs/model.md §5, USM-42): the vector part of the
 /// error quaternion `q⁻¹ ⊗ q_d` (sign chosen with a non-negative scalar part), i.e. the rotation
 /// that takes the current frame onto the desired one, **expressed in the current frame**
 /// (`≈ ½ θ a` for a small rotation `θ` about the unit axis `a`). Both quaternions map

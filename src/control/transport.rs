@@ -1,11 +1,11 @@
-//! Transport mode (SPEC §5, USM section V-A): LOS path following with joint bending and base
+//! Transport mode (docs/model.md §5, USM section V-A): LOS path following with joint bending and base
 //! surge/yaw accelerations.
 //!
 //! - **Joint references (USM-38)**: `q_r,i = s_q k_ψ wrap(ψ − ψ_r)` for the yaw joints, 0 for the
 //!   others (pitch), clamped to the joint limits. `ψ` is the heading of the front link (the yaw of
 //!   the end-effector frame about inertial +z), `ψ_r` from [`super::guidance`] (USM-39).
 //!
-//!   **Sign `s_q` (`joint_sign`, default −1).** Our joint convention (SPEC §1) makes a positive
+//!   **Sign `s_q` (`joint_sign`, default −1).** Our joint convention (docs/model.md §1) makes a positive
 //!   yaw-joint angle rotate the child counter-clockwise about +z (seen from above, z up)
 //!   relative to its parent, so in a level configuration the head's heading relative to the tail
 //!   is `ψ − ψ_b = Σ q_yaw`. If the head points left of the reference (`ψ > ψ_r`) the body must

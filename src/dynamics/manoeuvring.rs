@@ -1,4 +1,4 @@
-//! The manoeuvring-derivative kernel (SPEC §8 case 3, [`Manoeuvring`]): a pure function of
+//! The manoeuvring-derivative kernel (docs/model.md §8 case 3, [`Manoeuvring`]): a pure function of
 //! one body's relative twist `V_r` (body frame, at its origin) returning the hydrodynamic
 //! wrench other than inertia (body frame, about its origin), split into its three parts so
 //! that reports can say which term carries a force.

@@ -1,4 +1,4 @@
-//! Metric kernels (SPEC §6), below the control laws: pure functions of a
+//! Metric kernels (docs/model.md §6), below the control laws: pure functions of a
 //! configuration or a trajectory — the scaled singularity metrics of `T(q)` ([`singularity`],
 //! on the allocation-free 6×6 kernels of `small_svd`) and the energy, tracking and exposure
 //! integrals of a trajectory ([`trajectory`]). A run's summary and success checks, which read

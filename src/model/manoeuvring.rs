@@ -1,5 +1,5 @@
 //! Manoeuvring-derivative hydrodynamics of a streamlined hull (SNAME / Healey & Lienard
-//! style, the form of the NPS AUV II model in Fossen's MSS; SPEC §8 case 3): constant added
+//! style, the form of the NPS AUV II model in Fossen's MSS; docs/model.md §8 case 3): constant added
 //! mass, velocity-product derivatives, a quadratic resistance and a strip-theory cross-flow
 //! drag, all about a reference point `CO` in axes of their own.
 //!

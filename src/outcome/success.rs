@@ -1,4 +1,4 @@
-//! The verdict on a closed-loop run (SPEC §6 "Success"): its summary metrics judged against
+//! The verdict on a closed-loop run (docs/model.md §6 "Success"): its summary metrics judged against
 //! the scenario's `[success]` criteria ([`SuccessSpec`]), in the order of [`Criterion::ALL`].
 
 use crate::scenario::config::Mode;

@@ -1,4 +1,4 @@
-//! The kinematic case studies of Antonelli & Chiaverini (1998), section 5 (SPEC §8), on the
+//! The kinematic case studies of Antonelli & Chiaverini (1998), section 5 (docs/model.md §8), on the
 //! planar UVMS preset `uvms-planar`: closed-loop task-priority inverse kinematics (AC-7…9)
 //!
 //! `ζ = J_p^# w_p + (I − J_p^# J_p) J_s^# w_s`, `w_p = ξ̇_p,d + K_p(ξ_p,d − ξ_p)`,

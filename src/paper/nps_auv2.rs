@@ -1,5 +1,5 @@
 //! The NPS AUV II (Healey & Lienard 1993) as a one-body floating base for Antonelli &
-//! Chiaverini's case 3 (SPEC §8): mass, inertia, hydrostatics and manoeuvring derivatives
+//! Chiaverini's case 3 (docs/model.md §8): mass, inertia, hydrostatics and manoeuvring derivatives
 //! from `../shared/data/nps_auv2.toml` (Fossen's MSS `npsauv.m`, commit `6bca7942…`; the
 //! legacy file `VESSELS/npsauv.m` at `b661a212…` for ρ, g and m), driven by six ideal
 //! generalised-force actuators (the paper's `τ_r = B u_r`, AC-2, with `B` invertible).

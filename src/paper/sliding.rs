@@ -1,4 +1,4 @@
-//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (SPEC §8), after their
+//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (docs/model.md §8), after their
 //! reference [1] (Antonelli & Chiaverini, ACC 1998, "Singularity-free regulation of UVMS"),
 //! whose law is not restated in the seed and whose text we did not have. We use the
 //! quaternion-based sliding-mode law in the form of Antonelli's later book ("Underwater

@@ -2,7 +2,7 @@
 //! the command's files (CSV, Parquet, SVG, JSON, Markdown), so that the binary only parses
 //! arguments, calls one of these, and prints.
 //!
-//! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
+//! - [`tcm`]: the static analysis of `T(q)` over joint space (docs/model.md §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`shapes`]: the body along a run (`shapes.svg`, `animation.svg`);
 //! - [`draw`]: the drawing of a design at one state (`design draw`);

@@ -1,5 +1,5 @@
 //! The closed loop of the USM paper's Fig. 5: guidance → kinematic control → dynamic control
-//! (USM-33) → thrust allocation (USM-36/37) → vehicle (SPEC §4), observed by a recorder.
+//! (USM-33) → thrust allocation (USM-36/37) → vehicle (docs/model.md §4), observed by a recorder.
 //!
 //! Rates: the physics advances with the `[physics] integrator` (RK4 steps of `dt`, or
 //! adaptive Dormand–Prince steps) over each control period; the controllers and the allocator run
@@ -110,7 +110,7 @@ impl ClosedLoop<'_> {
 
     /// Control period `k`: measure, control, allocate, sample the thrusters and record, then
     /// advance the physics (except after the last period) and integrate the thruster sample
-    /// over the period just simulated (SPEC §6 energy: rectangle rule on the zero-order hold,
+    /// over the period just simulated (docs/model.md §6 energy: rectangle rule on the zero-order hold,
     /// at the control rate; the joint work is integrated by the simulator with the motion; the
     /// thrusters of a period that fails are not counted).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {

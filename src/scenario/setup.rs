@@ -19,7 +19,7 @@ use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
 pub(crate) struct ClosedLoop<'f> {
     /// The scenario.
     pub file: &'f ScenarioFile,
-    /// The design with the file's current (SPEC §4).
+    /// The design with the file's current (docs/model.md §4).
     pub vehicle: Vehicle,
     /// The physics.
     pub sim: Simulator,

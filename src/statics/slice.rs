@@ -1,4 +1,4 @@
-//! Slices of the static TCM analysis (SPEC §6): σ_min over a 2-D grid of two joints (others
+//! Slices of the static TCM analysis (docs/model.md §6): σ_min over a 2-D grid of two joints (others
 //! straight) and the two joints whose bending most restores the TCM.
 
 use rayon::prelude::*;

@@ -1,4 +1,4 @@
-//! Batch studies (SPEC §7): the study schema, designs of experiments, the parallel
+//! Batch studies (docs/model.md §7): the study schema, designs of experiments, the parallel
 //! sweep engine with resume and shards, and the sweep report.
 //!
 //! Modules in dependency order (each uses only modules above it):

@@ -1,4 +1,4 @@
-//! Inertial-frame task variables (Antonelli & Chiaverini, AC-4 and AC-10…13; SPEC §8): scalar
+//! Inertial-frame task variables (Antonelli & Chiaverini, AC-4 and AC-10…13; docs/model.md §8): scalar
 //! task coordinates `ξ` of a floating-base chain measured in the inertial frame `I`, stacked
 //! into a task vector with its Jacobian `J` (`ξ̇ = J ζ`, `ζ = [V_b; q̇]` as everywhere in the
 //! crate), and the closed-loop task rate of AC-8/9, `w = ξ̇_d + K (ξ_d − ξ)`.

@@ -1,4 +1,4 @@
-//! Antonelli & Chiaverini's case 3 (SPEC §8): the NPS AUV II with its full 6-DOF dynamic
+//! Antonelli & Chiaverini's case 3 (docs/model.md §8): the NPS AUV II with its full 6-DOF dynamic
 //! model ([`crate::paper::nps_auv2`], through the crate's floating-base dynamics) under the
 //! constant irrotational current `ν_c = (0.1√2, 0.1√2, 0)` m/s, driven by the sliding-mode
 //! law of [`crate::paper::sliding`], for 100 s:
@@ -14,7 +14,7 @@
 //! (the control wrench is held over each control period, so the sums are exact).
 //!
 //! Inferred (the paper does not say; overridable in [`DynamicCase`]): the vehicle alone (the
-//! arm's parameters are unknown, SPEC §8), starting at rest; depth, roll and pitch references
+//! arm's parameters are unknown, docs/model.md §8), starting at rest; depth, roll and pitch references
 //! zero; control at 100 Hz with fixed RK4 steps of 10 ms; samples logged at 5 Hz.
 
 use super::KinematicHistory;
