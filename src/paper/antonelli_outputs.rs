@@ -431,9 +431,8 @@ pub fn run_antonelli(
     let dynamic = vec![summarize_dynamic(&a), summarize_dynamic(&b)];
     let current = DynamicCase::paper("").current;
     let summary = Summary {
-        source: "Antonelli & Chiaverini (1998), section 5 and Table I; docs/model.md §8",
-        inferred:
-            "arm geometry of uvms-planar (docs/model.md §8); 10 s kinematic runs (the quintic's \
+        source: "Antonelli & Chiaverini (1998), section 5 and Table I; SPEC §8",
+        inferred: "arm geometry of uvms-planar (SPEC §8); 10 s kinematic runs (the quintic's \
                    duration); RK4 at 1 ms, samples every 50 ms; Moore–Penrose pseudoinverses \
                    of the planar Jacobians (λ = 0). Case 3: the NPS AUV II alone (legacy MSS \
                    constants ρ = 1000, m = 5454.54), starting at rest; the MSS derivative \

@@ -90,7 +90,7 @@ convergence_window = 60.0
 /// first physics step after the 180° turn is commanded, 173 N·m in the 10 Hz log).
 const TORQUE_LIMITED_SERVO: &str = r#"
 [servo]
-# Torque-level PD joint servos (docs/model.md §4) with the [servo] defaults' gains and a 50 N·m
+# Torque-level PD joint servos (SPEC §4) with the [servo] defaults' gains and a 50 N·m
 # saturation (inferred: above the few N·m a straight cruise needs, well below the ideal
 # servos' spike at the turn).
 kind = "torque_pd"
