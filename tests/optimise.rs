@@ -352,8 +352,9 @@ fn history_and_best_do_not_depend_on_the_number_of_threads() {
 
 #[test]
 fn best_toml_reproduces_the_best_objective() {
+    use usm_study::outcome::run_scenario;
     use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles};
-    use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario};
+    use usm_study::scenario::{load_table, parse_table, resolve_design};
     let p = parse_problem(SMALL, Path::new("small.toml")).unwrap();
     let o = run(&p, &options(2)).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -376,8 +377,9 @@ fn best_toml_reproduces_the_best_objective() {
 
 #[test]
 fn the_metric_catalogue_names_every_metric_a_run_reports() {
-    use usm_study::metrics::run_summary::is_run_metric;
-    use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, Mode};
+    use usm_study::outcome::run_scenario;
+    use usm_study::outcome::run_summary::is_run_metric;
+    use usm_study::scenario::{load_table, parse_table, resolve_design, Mode};
     for (preset, mode) in [
         ("transport-method2", Mode::Transport),
         ("work-setpoint", Mode::Work),

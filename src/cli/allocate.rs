@@ -1,4 +1,4 @@
-//! `usm-study allocate`: solve one thrust-allocation case (SPEC §5, USM-36/37) with one or all
+//! `usm-study allocate`: solve one thrust-allocation case (docs/model.md §5, USM-36/37) with one or all
 //! methods and print the result as a table or JSON. The case file and the JSON output are
 //! described in [`usm_study::pipeline::allocate`].
 //!
@@ -103,7 +103,7 @@ fn render_text(path: &Path, case: &Case, results: &Results) -> String {
     s
 }
 
-/// Run `usm-study allocate` (SPEC §5): read the case, solve it with the requested method(s),
+/// Run `usm-study allocate` (docs/model.md §5): read the case, solve it with the requested method(s),
 /// print a table or JSON on stdout. Returns exit code 0, or 1 when a Clarabel solve failed; bad
 /// input is an `Err` whose message names the file and the key.
 pub fn run(args: &AllocateArgs) -> anyhow::Result<ExitCode> {

@@ -7,7 +7,6 @@
 //! problem-file errors are reported before any evaluation.
 
 use super::progress::Progress;
-use anyhow::anyhow;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,7 +41,7 @@ pub struct OptimiseArgs {
 
 /// Run `usm-study optimise`.
 pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
-    let problem = load_problem(&a.problem).map_err(|e| anyhow!(e.to_string()))?;
+    let problem = load_problem(&a.problem)?;
     let s = &problem.study;
     let out = a.out.clone().unwrap_or_else(|| {
         if s.output == Path::new("results/sweeps").join(&s.name) {

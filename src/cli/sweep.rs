@@ -1,5 +1,5 @@
 //! `usm-study sweep STUDY.toml`, `usm-study merge DIR... --out DIR`, `usm-study report DIR`:
-//! the batch engine's commands (SPEC §7; schema in `docs/study-format.md`).
+//! the batch engine's commands (docs/model.md §7; schema in `docs/study-format.md`).
 //!
 //! Each writes the output directory's `report.html` (the design-review page) last.
 //!

@@ -9,14 +9,14 @@
 
 use super::deadline::{Deadline, Phase};
 use super::metrics::{design_metrics, tcm_metrics, Metrics, DESIGN_COLUMNS, TCM_COLUMNS};
+use super::static_table::{static_spec, STATIC_TABLE};
 use super::status::{missed_criterion, CaseStatus};
 use crate::input::keypath::{set, Seg};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
 use crate::sampling::derive_seed;
-use crate::study::static_table::{static_spec, STATIC_TABLE};
-use crate::study::static_tcm::{analyse, StaticError};
+use crate::statics::{analyse, SinkError, StaticError};
 
 /// Which phases a case runs besides building its design.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -250,14 +250,14 @@ fn static_phase(
     };
     let deadline = input.deadline;
     let mut on_time =
-        |_: usize, _: &[f64], _: &_| deadline.check(Phase::Static).map_err(|e| e.to_string());
+        |_: usize, _: &[f64], _: &_| deadline.check(Phase::Static).map_err(SinkError::from);
     match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
         Ok(s) => {
             out.metrics.push_all(&TCM_COLUMNS, &tcm_metrics(&s));
             true
         }
         Err(StaticError::Sink(m)) => {
-            out.end(CaseStatus::Failed, m);
+            out.end(CaseStatus::Failed, m.to_string());
             false
         }
         Err(e) => {
@@ -273,7 +273,7 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     let mut sc = scenario.clone();
     sc.remove(STATIC_TABLE);
     let deadline = input.deadline.instant();
-    let run = match crate::scenario::run_case(v, &sc, input.seed, input.trajectory, deadline) {
+    let run = match crate::outcome::run_case(v, &sc, input.seed, input.trajectory, deadline) {
         Ok(r) => r,
         Err(e) => return out.end(CaseStatus::Failed, e.to_string()),
     };

@@ -3,7 +3,7 @@
 //! by name; a metric a case did not compute reads as NaN.
 
 use crate::model::Vehicle;
-use crate::study::static_tcm::{Distribution, StaticSummary};
+use crate::statics::{Distribution, StaticSummary};
 
 /// Number of thrusters of the built design.
 pub const DESIGN_THRUSTERS: &str = "design_thrusters";

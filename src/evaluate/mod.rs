@@ -10,10 +10,13 @@
 //! - [`metrics`]: [`Metrics`] (named metrics) and the design and static column names.
 //! - [`status`]: [`CaseStatus`] and the criterion a case missed.
 //! - [`case`]: [`CaseInput`], [`Evaluator`] (design cache, panic guard, phases), [`CaseResult`].
+//! - [`static_table`]: a case's `[static]` table ↔ [`crate::statics::StaticSpec`] (the study
+//!   file's section; the evaluator reads it for every case).
 
 pub mod case;
 pub mod deadline;
 pub mod metrics;
+pub mod static_table;
 pub mod status;
 
 pub use case::{

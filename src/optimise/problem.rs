@@ -499,10 +499,10 @@ fn known_metric(name: &str, study: &Study) -> bool {
         || match study.mode {
             StudyMode::Static => false,
             StudyMode::Transport => {
-                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Transport, name)
+                crate::outcome::run_summary::is_run_metric(crate::scenario::Mode::Transport, name)
             }
             StudyMode::Work => {
-                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Work, name)
+                crate::outcome::run_summary::is_run_metric(crate::scenario::Mode::Work, name)
             }
         }
 }
@@ -519,7 +519,7 @@ pub fn metric_catalogue(study: &Study) -> Vec<String> {
         StudyMode::Work => Some(crate::scenario::Mode::Work),
     };
     if let Some(m) = mode {
-        v.extend(crate::metrics::run_summary::metric_catalogue(m));
+        v.extend(crate::outcome::run_summary::metric_catalogue(m));
     }
     v
 }

@@ -1,4 +1,4 @@
-//! One thrust-allocation case (SPEC §5, USM-36/37) read from a JSON case file, validated and
+//! One thrust-allocation case (docs/model.md §5, USM-36/37) read from a JSON case file, validated and
 //! solved with one or more methods; the results serialise as the JSON of `usm-study allocate`.
 //!
 //! The case file is JSON with these keys (unknown keys are rejected):

@@ -1,6 +1,6 @@
 //! `design draw`: a design at one state as a drawing ([`crate::report::drawing`]) — bodies,
 //! joint axes, thrust arrows, base and end-effector frames — with a caption of the scaled
-//! singular values of `T(q)` (SPEC §6) and the lost and weakest base directions.
+//! singular values of `T(q)` (docs/model.md §6) and the lost and weakest base directions.
 
 use std::path::Path;
 
@@ -20,7 +20,7 @@ const TRIAD_FRACTION: f64 = 0.08;
 const AXIS_RADII: f64 = 1.8;
 
 /// Whether body `i` is drawn as a joint module: an inner body (joints at both ends) without
-/// thrusters, no longer than its diameter (the 0.104 m modules of SPEC §2 and the generator).
+/// thrusters, no longer than its diameter (the 0.104 m modules of docs/model.md §2 and the generator).
 pub fn is_joint_module(v: &Vehicle, i: usize) -> bool {
     let b = &v.bodies[i];
     i > 0
@@ -122,7 +122,7 @@ pub fn vehicle_scene(v: &Vehicle, s: &VehicleState) -> Scene {
 }
 
 /// The weakest of the six base DOFs under the thrust limits: the axis whose attainable wrench
-/// (the smaller of `±e_k`, moments divided by `L` so that all six are in N, SPEC §6) is least;
+/// (the smaller of `±e_k`, moments divided by `L` so that all six are in N, docs/model.md §6) is least;
 /// its name and that value [N].
 pub fn weakest_axis(m: &TcmMetrics) -> Option<(&'static str, f64)> {
     let att = m.attainable.as_ref()?;
@@ -134,7 +134,7 @@ pub fn weakest_axis(m: &TcmMetrics) -> Option<(&'static str, f64)> {
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The scaled `T(q)` metrics of `v` at `s` (SPEC §6, moments divided by `L` = half the
+/// The scaled `T(q)` metrics of `v` at `s` (docs/model.md §6, moments divided by `L` = half the
 /// vehicle length, default rank tolerance, attainable wrench under the thrust limits);
 /// `None` without thrusters.
 pub fn state_metrics(v: &Vehicle, s: &VehicleState) -> Result<Option<TcmMetrics>, PipelineError> {

@@ -7,7 +7,7 @@ use crate::metrics::singularity::SingularityError;
 use crate::model::design::DesignError;
 use crate::report::ReportError;
 use crate::scenario::ScenarioError;
-use crate::study::static_tcm::StaticError;
+use crate::statics::StaticError;
 
 /// Why a pipeline stopped. Errors of the stages it calls pass through unchanged (same message,
 /// same source chain); file-system errors name the path.

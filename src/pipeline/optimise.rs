@@ -12,6 +12,7 @@ use serde_json::json;
 
 use super::error::PipelineError;
 use crate::control::transport::yaw_joint_mask;
+use crate::evaluate::static_table::STATIC_TABLE;
 use crate::model::design::parse_design_table;
 use crate::optimise::evaluate::CaseEvaluator;
 use crate::optimise::history::{best_so_far, history_table, Record};
@@ -26,7 +27,6 @@ use crate::scenario::Mode;
 use crate::study::cases::Resolved;
 use crate::study::manifest::{git_commit, now_rfc3339};
 use crate::study::runner::StudyMode;
-use crate::study::static_table::STATIC_TABLE;
 
 /// The history table's file stem in an output directory.
 pub const HISTORY: &str = "history";

@@ -1,11 +1,11 @@
 //! The `tcm` pipeline: static configuration-space analysis of the thruster configuration
-//! matrix (SPEC §6) — how often `T(q)` is singular over the joint space — and its files.
+//! matrix (docs/model.md §6) — how often `T(q)` is singular over the joint space — and its files.
 //!
 //! Writes to the output directory:
 //! - `samples.csv`: one row per sample (streamed; memory stays bounded for any N):
 //!   `index`, `q1_rad … qn_rad`, `sigma_min` (scaled σ_min, N per N), `kappa`, `rank`,
 //!   `lost_axis` (empty unless σ_min < threshold or rank < 6), then `sigma_min_commanded`
-//!   and `kappa_commanded` of the rows the mode's controller commands (SPEC §6);
+//!   and `kappa_commanded` of the rows the mode's controller commands (docs/model.md §6);
 //! - `samples.parquet`: the same table, only when N ≤ [`PARQUET_MAX_ROWS`] (larger tables stay
 //!   CSV only);
 //! - `summary.json`: the [`StaticSummary`] plus the slice joints and the files written;
@@ -23,8 +23,8 @@ use crate::report::{
     atomic_write, heatmap, histogram, push_csv_row, read_csv_typed, write_parquet, ColourScale,
     ColumnKind, CsvAppender, Value,
 };
-use crate::study::static_tcm::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
-use crate::study::static_tcm_slice::{influential_joints, slice_grid};
+use crate::statics::slice::{influential_joints, slice_grid};
+use crate::statics::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
 
 /// Largest sample count for which `samples.parquet` is written.
 pub const PARQUET_MAX_ROWS: usize = 200_000;
@@ -114,7 +114,7 @@ pub fn run_tcm(
         spec,
         config.jobs,
         &format,
-        &mut |text| app.append_lines(text).map_err(|e| e.to_string()),
+        &mut |text| app.append_lines(text).map_err(Into::into),
         &mut |_, _, m| {
             sigmas.push(m.sigma_min);
             commanded.push(m.sigma_min_commanded);

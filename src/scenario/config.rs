@@ -69,7 +69,7 @@ pub enum Mode {
 }
 
 impl Mode {
-    /// The base axes the mode's default controller commands (SPEC §5), as
+    /// The base axes the mode's default controller commands (docs/model.md §5), as
     /// [`ScenarioFile::commanded_dofs`] of a file without `[control]`/`[base_control]`: both
     /// of the paper's modes leave roll free (`K_p,roll = 0`; work: zero base-roll weight).
     pub fn default_commanded_dofs(self) -> CommandedDofs {
@@ -177,7 +177,7 @@ impl Default for InitialSpec {
     }
 }
 
-/// `[allocation]`: the thrust allocation method and its settings (SPEC §5, USM-37).
+/// `[allocation]`: the thrust allocation method and its settings (docs/model.md §5, USM-37).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AllocationSpec {
@@ -253,7 +253,7 @@ impl AllocationSpec {
     }
 }
 
-/// `[metrics]`: thresholds and the power model (SPEC §6).
+/// `[metrics]`: thresholds and the power model (docs/model.md §6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MetricsSpec {
@@ -274,7 +274,7 @@ pub struct MetricsSpec {
     pub position_tolerance: f64,
     /// Orientation tolerance for settling (roll excluded) [deg] (work).
     pub orientation_tolerance_deg: f64,
-    /// Propeller diameter D [m] of the actuator-disk power model (SPEC §6). Default 0.07 m
+    /// Propeller diameter D [m] of the actuator-disk power model (docs/model.md §6). Default 0.07 m
     /// (inferred: the paper gives no propeller data).
     pub propeller_diameter: f64,
     /// Overall efficiency η of the power model, shaft power = ideal power / η. Default 0.5
@@ -350,7 +350,7 @@ pub struct ScenarioFile {
     /// Metric settings.
     #[serde(default)]
     pub metrics: MetricsSpec,
-    /// Success criteria (SPEC §6).
+    /// Success criteria (docs/model.md §6).
     #[serde(default)]
     pub success: SuccessSpec,
 }
@@ -398,7 +398,7 @@ impl ScenarioFile {
             })
     }
 
-    /// The base axes this scenario's controller commands (SPEC §5), from its mode, `[control]`
+    /// The base axes this scenario's controller commands (docs/model.md §5), from its mode, `[control]`
     /// and `[base_control]` gains: the selection `S` of `singularity_exposure` and
     /// `allocation_residual_fraction` ([`CommandedDofs::transport`] — surge, yaw and the axes
     /// with `K_p > 0` when the base control feeds back on the uncommanded axes —,
@@ -415,7 +415,7 @@ impl ScenarioFile {
     }
 
     /// The characteristic length L [m] of the scaled TCM: `metrics.char_length`, or half the
-    /// length of `v` when that is 0 (SPEC §6).
+    /// length of `v` when that is 0 (docs/model.md §6).
     pub fn char_length(&self, v: &Vehicle) -> f64 {
         if self.metrics.char_length > 0.0 {
             self.metrics.char_length

@@ -1,16 +1,11 @@
-//! Batch studies (SPEC §7): the study schema, designs of experiments, the parallel sweep
-//! engine with resume and shards, the static configuration-space TCM analysis, and the sweep
-//! report.
+//! Batch studies (docs/model.md §7): the study schema, designs of experiments, the parallel
+//! sweep engine with resume and shards, and the sweep report.
 //!
 //! Modules in dependency order (each uses only modules above it):
 //!
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
 //! - [`runner`]: the single adapter to the scenario module's settings (modes, defaults).
-//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space;
-//!   `static_dist`: the distributions (exact quantiles) of its per-sample quantities.
-//! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
-//! - [`static_tcm_slice`]: σ_min over 2-D slices of joint space, the most influential joints.
 //! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
 //! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
 //! - [`parse`]: study files (TOML) → validated [`Study`].
@@ -46,11 +41,6 @@ pub mod runner;
 pub mod schema;
 pub mod selection;
 pub mod shards;
-mod static_dist;
-pub mod static_table;
-pub mod static_tcm;
-mod static_tcm_eval;
-pub mod static_tcm_slice;
 pub mod summary;
 pub mod tune;
 pub mod worker;
@@ -62,4 +52,3 @@ pub use parse::load_study;
 pub use records::CaseStatus;
 pub use schema::{DoeKind, Study};
 pub use shards::merge;
-pub use static_tcm::{analyse, StaticSpec, StaticSummary};

@@ -15,7 +15,7 @@ use super::error::InputError;
 use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
-use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
+use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{flatten, pattern_allowed};
 use crate::input::located::Location;

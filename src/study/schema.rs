@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use super::runner::{StudyMode, SCENARIO_TABLES};
-use super::static_table::STATIC_TABLE;
+use crate::evaluate::static_table::STATIC_TABLE;
 use crate::input::keypath::KeyPath;
 use crate::sampling::Sampling;
 

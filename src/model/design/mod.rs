@@ -1,5 +1,5 @@
 //! Design files (TOML): a [`Vehicle`] described by a preset name, by explicit body / joint /
-//! thruster lists, or by a `[generator]` table (SPEC §2).
+//! thruster lists, or by a `[generator]` table (docs/model.md §2).
 //!
 //! # Forms
 //! A design file uses exactly one of three forms:

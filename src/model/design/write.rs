@@ -161,7 +161,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 let _ = writeln!(o, "quadratic = {}", fmat(quadratic, ""));
             }
             Hydro::Manoeuvring(_) => {
-                // Built-in derivative tables (model::nps_auv2) have no design-file form:
+                // Built-in derivative tables (paper::nps_auv2) have no design-file form:
                 // reading this back fails with "unknown hydro kind".
                 let _ = writeln!(o, "kind = \"manoeuvring\"  # built in, not readable");
             }
