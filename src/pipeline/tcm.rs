@@ -113,11 +113,15 @@ pub fn run_tcm(
             return Err(e);
         }
     };
-    std::fs::rename(&tmp_path, &csv_path).map_err(|source| crate::report::ReportError::Io {
-        path: csv_path.clone(),
-        action: "renaming into place",
-        source,
-    })?;
+    if let Err(source) = std::fs::rename(&tmp_path, &csv_path) {
+        let _ = std::fs::remove_file(&tmp_path);
+        return Err(crate::report::ReportError::Io {
+            path: csv_path,
+            action: "renaming into place",
+            source,
+        }
+        .into());
+    }
     write_rest(vehicle, config, &schema, &summary, sigmas, commanded)?;
     Ok(summary)
 }
