@@ -29,6 +29,11 @@ use super::manifest::now_rfc3339;
 /// The lock file's name in an output directory.
 pub const LOCK_FILE: &str = ".usm-study.lock";
 
+/// What a run stopped by SIGTERM/SIGINT renames its lock file to (releasing the lock): the
+/// next run reads the stopped run's token from it, removes that run's temporaries and this
+/// file ([`super::outdir::claim`]).
+pub const RELEASED_FILE: &str = ".usm-study.lock.released";
+
 /// How often a held lock file is touched (its modification time is the holder's heartbeat).
 pub const HEARTBEAT: Duration = Duration::from_secs(60);
 
@@ -220,6 +225,12 @@ pub fn lock(dir: &Path, owner: &LockOwner) -> Result<OutputLock, StudyError> {
                 f.write_all(text.as_bytes())
                     .and_then(|()| f.sync_all())
                     .map_err(|e| StudyError::io(&path, e))?;
+                if replaced.is_none() {
+                    // A run stopped by a signal: its temporaries are removed by `claim`.
+                    replaced = std::fs::read_to_string(dir.join(RELEASED_FILE))
+                        .ok()
+                        .map(|t| Holder::parse(&t));
+                }
                 let created = f
                     .metadata()
                     .and_then(|m| m.modified())
@@ -288,6 +299,7 @@ fn heartbeat(file: std::fs::File) -> mpsc::Sender<()> {
 /// A held lock as the signal handler sees it: the lock file's path and the message to print.
 struct Slot {
     path: CString,
+    released: CString,
     message: Vec<u8>,
 }
 
@@ -302,6 +314,7 @@ static INSTALLED: std::sync::Once = std::sync::Once::new();
 /// Record a held lock for the signal handler (installing it on first use); its slot.
 fn register(path: &Path, dir: &Path) -> Option<usize> {
     use std::os::unix::ffi::OsStrExt;
+    let released = CString::new(dir.join(RELEASED_FILE).as_os_str().as_bytes()).ok()?;
     let path = CString::new(path.as_os_str().as_bytes()).ok()?;
     let message = format!(
         "\nusm-study: interrupted; the lock of {} is released and its finished work kept: run \
@@ -309,7 +322,11 @@ fn register(path: &Path, dir: &Path) -> Option<usize> {
         dir.display()
     )
     .into_bytes();
-    let slot = Box::into_raw(Box::new(Slot { path, message }));
+    let slot = Box::into_raw(Box::new(Slot {
+        path,
+        released,
+        message,
+    }));
     INSTALLED.call_once(install_handlers);
     for (i, s) in SLOTS.iter().enumerate() {
         if s.compare_exchange(
@@ -367,7 +384,8 @@ pub fn pending_signal() -> Option<i32> {
     }
 }
 
-/// Remove every held lock, print how to resume and exit with `128 + sig` (async-signal-safe).
+/// Release every held lock (renamed to [`RELEASED_FILE`], which keeps the run's token for the
+/// next run), print how to resume and exit with `128 + sig` (async-signal-safe).
 pub fn exit_interrupted(sig: i32) -> ! {
     for s in &SLOTS {
         let p = s.load(Ordering::SeqCst);
@@ -376,7 +394,9 @@ pub fn exit_interrupted(sig: i32) -> ! {
             // async-signal-safe.
             unsafe {
                 let slot = &*p;
-                libc::unlink(slot.path.as_ptr());
+                if libc::rename(slot.path.as_ptr(), slot.released.as_ptr()) != 0 {
+                    libc::unlink(slot.path.as_ptr());
+                }
                 libc::write(2, slot.message.as_ptr().cast(), slot.message.len());
             }
         }

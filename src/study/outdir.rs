@@ -25,7 +25,7 @@ use super::error::StudyError;
 use super::manifest::MANIFEST_FILE;
 use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, STUDY_COPY};
 
-pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE};
+pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE, RELEASED_FILE};
 
 /// The tool's record of the files it wrote into an output directory.
 pub const OWNED_FILE: &str = ".usm-study.files";
@@ -163,6 +163,10 @@ pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Vec<String>, St
                 dir.display()
             ));
         }
+    }
+    let released = dir.join(RELEASED_FILE);
+    if released.exists() {
+        std::fs::remove_file(&released).map_err(|e| StudyError::io(&released, e))?;
     }
     Ok(notes)
 }
