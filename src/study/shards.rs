@@ -333,7 +333,7 @@ mod tests {
         assert!(s.contains("shard-$SLURM_ARRAY_TASK_ID-of-3\"')"), "{s}");
         assert!(s.contains("--dependency=afterok:\"$array\""), "{s}");
         assert!(s.contains("merge --list \"$USM_OUT/shards.txt\" --out \"$USM_OUT\" --force'"));
-        assert!(s.contains("# Slurm submission of study gains__x_:"), "{s}");
+        assert!(s.contains("# Slurm submission of study gains___x_:"), "{s}");
         assert_eq!(
             s.matches("$(x)").count(),
             1,
