@@ -41,6 +41,7 @@ use super::doe::{case_count, expand, Case};
 use super::error::StudyError;
 use super::finish::finish_report;
 use super::journal;
+use super::lock;
 use super::manifest::{
     git_commit, now_rfc3339, read_manifest, write_manifest, AxisInfo, Counts, Manifest,
 };
@@ -156,9 +157,19 @@ pub fn run_sweep(
     }
     let tuner = case_tuner(study, opts.tuning)?;
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
-    let out = output_dir(study, opts);
-    let _lock = outdir::lock(&out)?;
-    let mut notes = outdir::claim(&out, &study.name, opts.force)?;
+    let out = outdir::resolve(&output_dir(study, opts))?;
+    let owner = outdir::LockOwner {
+        study: &study.hash,
+        resume: opts.resume,
+    };
+    let lock = outdir::lock(&out, &owner)?;
+    let claim = outdir::Claim {
+        study: &study.name,
+        force: opts.force,
+        resume: opts.resume,
+    };
+    let mut notes = outdir::claim(&out, &lock, &claim)?;
+    outdir::record_owned(&out, lock.created, &outdir::SWEEP_FILES)?;
     let partial = out.join(PARTIAL_FILE);
     if opts.resume && !partial.exists() {
         if let Some(done) = already_complete(study, opts, &out, cases.len()) {
@@ -240,6 +251,7 @@ pub fn run_sweep(
         // Inside the sweep's pool, so the best/worst reruns respect --jobs.
         let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study), opts.tuning));
         outcome.warnings.extend(w);
+        outdir::record_owned(&out, lock.created, &outdir::SWEEP_FILES)?;
         // Last: a kill before this leaves a journal that --resume completes from.
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
     }
@@ -378,7 +390,25 @@ fn stream_cases(
             });
             drop(tx);
         });
-        for msg in rx {
+        // A SIGTERM/SIGINT is acted on between rows: the journal is synced, then the lock
+        // released (see `super::lock`).
+        lock::set_graceful(true);
+        loop {
+            let msg = match rx.recv_timeout(Duration::from_millis(100)) {
+                Ok(m) => m,
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if let Some(sig) = lock::pending_signal() {
+                        let _ = appender.sync();
+                        lock::exit_interrupted(sig);
+                    }
+                    continue;
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            };
+            if let Some(sig) = lock::pending_signal() {
+                let _ = appender.sync();
+                lock::exit_interrupted(sig);
+            }
             match msg {
                 Msg::Resumed(h) => {
                     st.plan_hashes.insert(h);
@@ -408,6 +438,7 @@ fn stream_cases(
             st.progress.finished = st.progress.ran + st.progress.resumed;
             progress(&st.progress);
         }
+        lock::set_graceful(false);
     });
     match write_error {
         Some(e) => Err(e),

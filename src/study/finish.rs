@@ -114,7 +114,7 @@ pub fn report(dir: &Path) -> Result<Vec<String>, StudyError> {
         crate::report::read_parquet(&pq)?
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
-        let schema = m.schema().map_err(StudyError::Input)?;
+        let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
     Ok(write_report(dir, &table, &m))

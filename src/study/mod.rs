@@ -17,7 +17,9 @@
 //! - [`worker`]: one resolved case → one row through the case evaluator
 //!   ([`crate::evaluate`]), tuned first through the hook.
 //! - [`manifest`]: the `manifest.json` of an output directory.
-//! - [`outdir`]: the output directory's lock, its ownership by one study, stale temporaries.
+//! - [`lock`]: the output directory's lock (heartbeat, takeover on `--resume`, signals).
+//! - [`outdir`]: the output directory resolved once, kept free of links out, owned by one
+//!   study; the record of the files the tool wrote.
 //! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
@@ -32,6 +34,7 @@ pub mod error;
 pub mod finish;
 pub mod hash;
 pub mod journal;
+pub mod lock;
 pub mod manifest;
 pub mod outdir;
 pub mod parse;
