@@ -47,7 +47,7 @@ pub fn fmt_short(x: f64) -> String {
 }
 
 /// A TOML value as printed for people (dry-run listings, string columns of mixed axes): a
-/// string as is, a float in the tables' format ([`format_f64`]: `1e200`, never its 200-digit
+/// string as is, a float in the tables' format ([`format_f64`]: `1e+200`, never its 200-digit
 /// decimal), anything else (arrays included) in TOML notation.
 pub fn fmt_value(v: &toml::Value) -> String {
     match v {

@@ -136,7 +136,7 @@ fn short_display_format() {
 
 #[test]
 fn values_print_short_for_people() {
-    assert_eq!(fmt_value(&toml::Value::Float(1e200)), "1e200");
+    assert_eq!(fmt_value(&toml::Value::Float(1e200)), "1e+200");
     assert_eq!(fmt_value(&toml::Value::Float(0.25)), "0.25");
     assert_eq!(fmt_value(&toml::Value::Float(2.0)), "2.0");
     assert_eq!(fmt_value(&toml::Value::Integer(7)), "7");
