@@ -416,7 +416,7 @@ fn no_input_panics_aborts_or_hangs() {
             });
         }
         // The watchdog: an input without progress for HANG_S is a hang.
-        let (corpus, current, done) = (&corpus, &current, &done);
+        let (corpus, current, done, failures) = (&corpus, &current, &done, &failures);
         s.spawn(move || {
             let mut last_report = Instant::now();
             while done.load(Ordering::Relaxed) < threads {
@@ -433,10 +433,12 @@ fn no_input_panics_aborts_or_hangs() {
                 }
                 if last_report.elapsed() > Duration::from_secs(30) {
                     last_report = Instant::now();
+                    // Failures so far too: a run cut short still says what it found.
                     eprintln!(
-                        "[fuzz] {} of {n} inputs started, {:.0} s",
+                        "[fuzz] {} of {n} inputs started, {:.0} s, {} failures so far",
                         next.load(Ordering::Relaxed).min(n),
-                        t0.elapsed().as_secs_f64()
+                        t0.elapsed().as_secs_f64(),
+                        failures.lock().map_or(0, |f| f.len())
                     );
                 }
             }
