@@ -11,7 +11,7 @@ use super::deadline::{Deadline, Phase};
 use super::metrics::{design_metrics, tcm_metrics, Metrics, DESIGN_COLUMNS, TCM_COLUMNS};
 use super::static_table::{static_spec, STATIC_TABLE};
 use super::status::{missed_criterion, CaseStatus};
-use crate::input::keypath::{set, Seg};
+use crate::input::keypath::{set, Seg, SetError};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
@@ -51,12 +51,13 @@ pub struct Override {
 
 /// An override that does not apply to the case's tables (the case is skipped).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{message}")]
+#[error("{source}")]
 pub struct OverrideError {
     /// The key as a user wrote it.
     pub shown: String,
     /// Why it does not apply (naming the key).
-    pub message: String,
+    #[source]
+    pub source: SetError,
 }
 
 /// Edits applied on top of a case's tables (e.g. a sampled world); empty for a nominal case.
@@ -225,9 +226,9 @@ fn apply(input: &CaseInput<'_>) -> Result<(toml::Table, toml::Table), OverrideEr
             Side::Design => &mut design,
             Side::Scenario => &mut scenario,
         };
-        set(t, &o.path, o.value.clone(), &o.shown).map_err(|message| OverrideError {
+        set(t, &o.path, o.value.clone(), &o.shown).map_err(|source| OverrideError {
             shown: o.shown.clone(),
-            message,
+            source,
         })?;
     }
     Ok((design, scenario))

@@ -5,6 +5,7 @@
 //! Modules in dependency order (this file only declares and re-exports):
 //!
 //! - [`space`]: parameters, bounds and scales, the normalised unit box the solvers work in.
+//! - [`solver`]: `[solver]`: method, budgets and tolerances, with their limits.
 //! - [`problem`]: problem files → a validated [`Problem`] (study part + optimiser sections);
 //!   [`problem::parse_spec`] reads the optimiser sections under any key prefix.
 //! - [`score`]: objective normalisation, combination over scenarios, constraint violation and
@@ -26,6 +27,7 @@ pub mod history;
 pub mod problem;
 pub mod score;
 pub mod search;
+pub mod solver;
 pub mod space;
 pub mod tune;
 

@@ -130,7 +130,7 @@ fn key_len(key: &str, v: &[f64], m: usize) -> Result<(), CaseError> {
 
 /// Reads and validates the case file at `path`.
 pub fn read_case(path: &Path) -> Result<Case, CaseFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CaseFileError::Read {
+    let text = crate::input::document::read_text(path).map_err(|source| CaseFileError::Read {
         path: path.to_path_buf(),
         source,
     })?;

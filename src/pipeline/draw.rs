@@ -205,14 +205,57 @@ pub fn caption(v: &Vehicle, state_label: &str, m: Option<&TcmMetrics>) -> Vec<St
     lines
 }
 
-/// The drawing of `v` at `s` as an SVG document; `state_label` says which state it is.
+/// Largest coordinate of a drawing [m]: far beyond any vehicle, small enough that the
+/// renderer's spans and scales stay finite.
+pub const MAX_DRAWING_COORD: f64 = 1e9;
+
+/// Every point of `scene` is finite and within [`MAX_DRAWING_COORD`] of the origin.
+fn check_range(scene: &Scene) -> Result<(), PipelineError> {
+    let points = scene
+        .cylinders
+        .iter()
+        .map(|c| (format!("body {}", c.name), c.pose.p))
+        .chain(
+            scene
+                .joints
+                .iter()
+                .map(|j| (format!("joint {}", j.name), j.position)),
+        )
+        .chain(
+            scene
+                .arrows
+                .iter()
+                .map(|a| (format!("thruster {}", a.name), a.start)),
+        )
+        .chain(
+            scene
+                .triads
+                .iter()
+                .map(|t| (format!("the {} frame", t.name), t.pose.p)),
+        );
+    for (what, p) in points {
+        if let Some(x) = p.iter().find(|x| !(x.abs() <= MAX_DRAWING_COORD)) {
+            return Err(PipelineError::DrawingRange {
+                what,
+                value: crate::input::located::fmt_exact(*x),
+                limit: MAX_DRAWING_COORD,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The drawing of `v` at `s` as an SVG document; `state_label` says which state it is. A
+/// state that puts the geometry out of range ([`MAX_DRAWING_COORD`]) is an error.
 pub fn draw_design(
     v: &Vehicle,
     s: &VehicleState,
     state_label: &str,
 ) -> Result<String, PipelineError> {
+    let scene = vehicle_scene(v, s);
+    check_range(&scene)?;
     let m = state_metrics(v, s)?;
-    let mut scene = vehicle_scene(v, s);
+    let mut scene = scene;
     scene.caption = caption(v, state_label, m.as_ref());
     Ok(render_svg(&scene))
 }
@@ -278,5 +321,16 @@ mod tests {
         }
         let ee = scene.triads[1].pose.p;
         assert!((ee - ws.g_be.p).norm() < 1e-12);
+    }
+
+    #[test]
+    fn a_state_out_of_range_is_refused_not_drawn_with_nan() {
+        let v = usm_paper();
+        let mut s = VehicleState::rest(&v);
+        assert!(draw_design(&v, &s, "rest").is_ok());
+        s.base.position[0] = 1e308;
+        let e = draw_design(&v, &s, "far").unwrap_err();
+        assert!(matches!(e, PipelineError::DrawingRange { .. }), "{e}");
+        assert!(e.to_string().contains("1e308"), "{e}");
     }
 }

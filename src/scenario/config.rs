@@ -50,7 +50,7 @@ use crate::control::work::WorkGains;
 use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
-use crate::input::located::KeyError;
+use crate::input::located::{fmt_exact, KeyError};
 use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
@@ -503,7 +503,10 @@ impl ScenarioFile {
     pub fn validate(&self) -> Result<(), KeyError> {
         self.validate_rates()?;
         let finite = |k: &str, xs: &[f64]| match xs.iter().find(|x| !x.is_finite()) {
-            Some(x) => Err(KeyError::new(k, format!("must be finite, got {x}"))),
+            Some(x) => Err(KeyError::new(
+                k,
+                format!("must be finite, got {}", fmt_exact(*x)),
+            )),
             None => Ok(()),
         };
         finite("initial.position", &self.initial.position)?;
@@ -541,6 +544,7 @@ impl ScenarioFile {
     /// `[scenario]`: positive durations, control and logging periods whole multiples.
     fn validate_rates(&self) -> Result<(), KeyError> {
         let s = &self.scenario;
+        check_scenario_name(&s.name)?;
         for (k, v) in [
             ("scenario.duration", s.duration),
             ("scenario.dt", s.dt),
@@ -558,7 +562,8 @@ impl ScenarioFile {
                 "scenario.control_dt",
                 format!(
                     "{} must be a whole multiple of scenario.dt ({})",
-                    s.control_dt, s.dt
+                    fmt_exact(s.control_dt),
+                    fmt_exact(s.dt)
                 ),
             ));
         }
@@ -567,7 +572,19 @@ impl ScenarioFile {
                 "scenario.log_dt",
                 format!(
                     "{} must be a whole multiple of scenario.control_dt ({})",
-                    s.log_dt, s.control_dt
+                    fmt_exact(s.log_dt),
+                    fmt_exact(s.control_dt)
+                ),
+            ));
+        }
+        if s.duration < s.control_dt {
+            return Err(KeyError::new(
+                "scenario.duration",
+                format!(
+                    "{} s is shorter than one control period (scenario.control_dt = {} s): \
+                     the run would have no step",
+                    fmt_exact(s.duration),
+                    fmt_exact(s.control_dt)
                 ),
             ));
         }
@@ -575,9 +592,9 @@ impl ScenarioFile {
             return Err(KeyError::new(
                 "scenario.control_dt",
                 format!(
-                    "gives {:.0} steps of scenario.dt per control period, more than {MAX_SUBSTEPS:e} \
+                    "gives {} steps of scenario.dt per control period, more than {MAX_SUBSTEPS:e} \
                      (a run's time budget is checked once per control period)",
-                    s.control_dt / s.dt
+                    fmt_exact((s.control_dt / s.dt).round())
                 ),
             ));
         }
@@ -585,8 +602,8 @@ impl ScenarioFile {
             return Err(KeyError::new(
                 "scenario.duration",
                 format!(
-                    "gives {:.0} steps of scenario.dt, more than 5e7",
-                    s.duration / s.dt
+                    "gives {} steps of scenario.dt, more than 5e7",
+                    fmt_exact((s.duration / s.dt).round())
                 ),
             ));
         }
@@ -625,11 +642,37 @@ impl ScenarioFile {
 pub const MAX_SUBSTEPS: f64 = 1.0e5;
 
 /// `key` must be a finite number > 0.
+/// Longest scenario name (it names `out/<name>` and appears in file names).
+const MAX_NAME_CHARS: usize = 100;
+
+/// `scenario.name` names the output directory (`out/<name>`): non-empty, at most
+/// [`MAX_NAME_CHARS`] ASCII letters, digits, `_`, `-` and `.`, not starting with `.` — so that
+/// `""`, `.`, `..` and `~` are refused rather than written into `out/` itself or mapped to one
+/// shared name.
+fn check_scenario_name(name: &str) -> Result<(), KeyError> {
+    let ok = !name.is_empty()
+        && name.len() <= MAX_NAME_CHARS
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c));
+    if ok {
+        return Ok(());
+    }
+    Err(KeyError::new(
+        "scenario.name",
+        format!(
+            "`{name}`: must be 1 to {MAX_NAME_CHARS} letters, digits, `_`, `-` and `.`, not \
+             starting with `.` (it names the output directory out/<name>)"
+        ),
+    ))
+}
+
 fn positive(key: &str, v: f64) -> Result<(), KeyError> {
     if !v.is_finite() || v <= 0.0 {
         return Err(KeyError::new(
             key,
-            format!("must be a finite number > 0, got {v}"),
+            format!("must be a finite number > 0, got {}", fmt_exact(v)),
         ));
     }
     Ok(())

@@ -238,7 +238,7 @@ impl Source {
 pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     let path = Path::new(arg);
     let (text, dir) = if path.is_file() {
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::document::read_text(path)
             .map_err(|e| ScenarioError::Invalid(format!("{arg}: {e}")))?;
         (
             text,

@@ -161,10 +161,7 @@ pub fn metric_columns(study: &Study) -> Vec<String> {
 
 /// Text of a non-numeric axis value.
 pub fn axis_text(v: &toml::Value) -> String {
-    match v {
-        toml::Value::String(s) => s.clone(),
-        other => other.to_string(),
-    }
+    crate::report::fmt_value(v)
 }
 
 fn axis_number(v: &toml::Value) -> f64 {

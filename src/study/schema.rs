@@ -126,13 +126,24 @@ impl fmt::Display for DoeKind {
     }
 }
 
+/// A `[doe] kind` that is not one of [`DoeKind::ALL`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown kind '{0}'; valid: grid, random, lhs, sobol")]
+pub struct UnknownDoeKind(pub String);
+
+impl From<UnknownDoeKind> for String {
+    fn from(e: UnknownDoeKind) -> String {
+        e.to_string()
+    }
+}
+
 impl FromStr for DoeKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownDoeKind;
+    fn from_str(s: &str) -> Result<Self, UnknownDoeKind> {
         DoeKind::ALL
             .into_iter()
             .find(|k| k.as_str() == s)
-            .ok_or_else(|| format!("unknown kind '{s}'; valid: grid, random, lhs, sobol"))
+            .ok_or_else(|| UnknownDoeKind(s.to_string()))
     }
 }
 
