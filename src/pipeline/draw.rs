@@ -234,7 +234,7 @@ fn check_range(scene: &Scene) -> Result<(), PipelineError> {
                 .map(|t| (format!("the {} frame", t.name), t.pose.p)),
         );
     for (what, p) in points {
-        if let Some(x) = p.iter().find(|x| !(x.abs() <= MAX_DRAWING_COORD)) {
+        if let Some(x) = p.iter().find(|x| x.is_nan() || x.abs() > MAX_DRAWING_COORD) {
             return Err(PipelineError::DrawingRange {
                 what,
                 value: crate::input::located::fmt_exact(*x),
