@@ -243,8 +243,10 @@ fn a_scenario_name_cannot_lead_the_output_out_of_its_root() {
         .args(["simulate", s.to_str().unwrap(), "--no-plots"])
         .output()
         .unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(d.path().join("out/______escaped").is_dir());
+    // Refused since issue 21 (a name is a single safe path component), naming file, line, key.
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("s.toml:3:1: scenario.name"), "{}", stderr(&o));
+    assert!(!d.path().join("out").exists());
     assert!(!d.path().parent().unwrap().join("escaped").exists());
 }
 
