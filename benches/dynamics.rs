@@ -1,5 +1,7 @@
 //! Benchmarks of the dynamics core on `usm-paper` (SPEC §4): mass matrix (CRBA), bias
-//! forces (RNEA), forward and hybrid dynamics, one RK4 step with full hydrodynamics, and one
+//! forces (RNEA), forward and hybrid dynamics by the dense route (CRBA + Cholesky) and by
+//! the O(n) route the simulator uses (articulated-body forward dynamics, O(n) hybrid
+//! dynamics: its terms and its solve), one RK4 step with full hydrodynamics, and one
 //! 50 ms control period advanced by the adaptive Dormand–Prince integrator.
 //!
 //! Group `whole_run`: a whole closed-loop run of the presets `transport-method1` (140 s,
@@ -17,8 +19,9 @@ use common::ALLOCS;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::sync::atomic::Ordering;
 use usm_study::dynamics::{
-    bias, dynamics_terms, forward_dynamics, hybrid_dynamics, mass_matrix, solve_forward,
-    ActuatorCommand, DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
+    bias, dynamics_terms, forward_dynamics, forward_dynamics_aba, hybrid_dynamics,
+    hybrid_dynamics_on, hybrid_terms, mass_matrix, solve_forward, solve_hybrid_on, ActuatorCommand,
+    DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
 };
 use usm_study::kinematics::BasePose;
 use usm_study::model::presets::usm_paper;
@@ -117,6 +120,32 @@ fn bench_dynamics(c: &mut Criterion) {
     c.bench_function("hybrid_dynamics", |b| {
         b.iter(|| {
             hybrid_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    c.bench_function("forward_dynamics_aba", |b| {
+        b.iter(|| {
+            forward_dynamics_aba(
+                &v,
+                &mut ws,
+                &pose,
+                black_box(&q),
+                black_box(&zeta),
+                &tau,
+                &opts,
+            )
+            .unwrap()
+        })
+    });
+    c.bench_function("hybrid_terms_on", |b| {
+        b.iter(|| hybrid_terms(&v, &mut ws, &pose, black_box(&q), black_box(&zeta), &opts))
+    });
+    hybrid_terms(&v, &mut ws, &pose, &q, &zeta, &opts);
+    c.bench_function("solve_hybrid_on", |b| {
+        b.iter(|| solve_hybrid_on(&mut ws, black_box(&tau), &qdd).unwrap())
+    });
+    c.bench_function("hybrid_dynamics_on", |b| {
+        b.iter(|| {
+            hybrid_dynamics_on(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
         })
     });
     c.bench_function("rk4_step_full_hydro", |b| {
