@@ -156,6 +156,45 @@ fn bench_dynamics(c: &mut Criterion) {
     });
 }
 
+/// Scaling: the dense and the O(n) routes on the generated 9-link design (17 bodies, 16
+/// joints, 22 DOF), full hydrodynamics with current.
+fn bench_scaling(c: &mut Criterion) {
+    let spec = usm_study::model::generator::GeneratorSpec {
+        links: 9,
+        ..Default::default()
+    };
+    let mut v = spec.build("gen9").unwrap();
+    v.fluid.current = Vec3::new(0.2, 0.1, 0.0);
+    let opts = DynOptions::full();
+    let n = v.n_joints();
+    let pose = state().0;
+    let q: Vec<f64> = (0..n).map(|k| 0.3 * ((k as f64) * 1.3).sin()).collect();
+    let zeta: Vec<f64> = (0..6 + n).map(|k| 0.2 * ((k as f64) * 0.7).cos()).collect();
+    let tau: Vec<f64> = (0..6 + n).map(|k| k as f64 - 6.0).collect();
+    let qdd: Vec<f64> = (0..n).map(|k| 0.1 * k as f64).collect();
+    let mut ws = DynWorkspace::new(&v);
+    let mut g = c.benchmark_group("gen9");
+    g.bench_function("forward_dynamics", |b| {
+        b.iter(|| forward_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &opts).unwrap())
+    });
+    g.bench_function("forward_dynamics_aba", |b| {
+        b.iter(|| {
+            forward_dynamics_aba(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &opts).unwrap()
+        })
+    });
+    g.bench_function("hybrid_dynamics", |b| {
+        b.iter(|| {
+            hybrid_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    g.bench_function("hybrid_dynamics_on", |b| {
+        b.iter(|| {
+            hybrid_dynamics_on(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    g.finish();
+}
+
 fn bench_whole_run(c: &mut Criterion) {
     let mut g = c.benchmark_group("whole_run");
     g.sample_size(10);
@@ -174,5 +213,5 @@ fn bench_whole_run(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_dynamics, bench_whole_run);
+criterion_group!(benches, bench_dynamics, bench_scaling, bench_whole_run);
 criterion_main!(benches);

@@ -236,9 +236,9 @@ pub fn solve_hybrid_on(ws: &mut DynWorkspace, q_ext: &[f64], qdd: &[f64]) -> Res
     check_finite("bias", &ws.bias)?;
     // w_l from the tip (no cancellation), into the ABA's U buffer (unused here).
     let mut w0 = Vec6::zeros();
-    for l in (0..n).rev() {
-        w0 += ws.comp_twist[l] * qdd[l];
-        ws.aba_u[l] = w0;
+    for ((f, a), w) in ws.comp_twist.iter().zip(qdd).zip(&mut ws.aba_u[..n]).rev() {
+        w0 += f * *a;
+        *w = w0;
     }
     let m11 = Matrix6::from_fn(|r, c| ws.mass[(r, c)]);
     let rhs = Vec6::from_fn(|r, _| q_ext[r] - ws.bias[r] - w0[r]);
