@@ -1,4 +1,4 @@
-//! Thrust-allocation benchmarks (SPEC §5): one allocation step per path on a 6×7 T typical of
+//! Thrust-allocation benchmarks (docs/model.md §5): one allocation step per path on a 6×7 T typical of
 //! a bent USM (seeded random unit thrust directions, positions within ±1.5 m), with the
 //! [`Allocator`] reused across steps as in a closed loop. Each iteration takes the next of 8
 //! precomputed (T, τ) pairs, so every solve sees new data.

@@ -1,4 +1,4 @@
-//! Benchmarks of the dynamics core on `usm-paper` (SPEC §4): mass matrix (CRBA), bias
+//! Benchmarks of the dynamics core on `usm-paper` (docs/model.md §4): mass matrix (CRBA), bias
 //! forces (RNEA), forward and hybrid dynamics by the dense route (CRBA + Cholesky) and by
 //! the O(n) route the simulator uses (articulated-body forward dynamics, O(n) hybrid
 //! dynamics: its terms and its solve), one RK4 step with full hydrodynamics, and one
@@ -204,7 +204,7 @@ fn bench_whole_run(c: &mut Criterion) {
         let v = scenario::resolve_design(&file, &src).unwrap();
         g.bench_function(preset, |b| {
             b.iter(|| {
-                let r = scenario::run_scenario(&v, black_box(&file)).unwrap();
+                let r = usm_study::outcome::run_scenario(&v, black_box(&file)).unwrap();
                 assert!(r.failure.is_none(), "{preset}: {:?}", r.failure);
                 black_box(r)
             })

@@ -1,4 +1,4 @@
-//! Static TCM analysis benchmarks (SPEC §6, issue 11 item 3): the pieces of one joint
+//! Static TCM analysis benchmarks (docs/model.md §6, issue 11 item 3): the pieces of one joint
 //! configuration of the `usm-paper` design and whole analyses.
 //!
 //! Groups:
@@ -30,7 +30,7 @@ use usm_study::metrics::singularity::{
     DEFAULT_RANK_REL_TOL,
 };
 use usm_study::model::presets::usm_paper;
-use usm_study::study::static_tcm::{analyse, StaticSpec};
+use usm_study::statics::{analyse, StaticSpec};
 
 fn bench_static(c: &mut Criterion) {
     let v = usm_paper();

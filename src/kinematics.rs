@@ -1,4 +1,4 @@
-//! Forward kinematics, geometric Jacobians and the thruster configuration matrix (SPEC §3,
+//! Forward kinematics, geometric Jacobians and the thruster configuration matrix (docs/model.md §3,
 //! USM-1 … USM-18, USM-25/26).
 //!
 //! All functions write into a preallocated [`KinWorkspace`] or output buffer: nothing here
@@ -306,10 +306,10 @@ mod tests {
         // End-effector at the total length 3.300 m (USM Table II).
         assert!((ws.g_be.p - Vec3::new(3.3, 0.0, 0.0)).norm() < 1e-12);
         let t = thruster_matrix_owned(&v, &ws);
-        // No thruster makes a roll moment when straight (SPEC §2).
+        // No thruster makes a roll moment when straight (docs/model.md §2).
         assert!(t.row(3).amax() < 1e-15);
         assert_eq!(t.rank(1e-9), 5);
-        // Bending a joint *between* thruster-carrying links gives full rank (SPEC §2). Joints
+        // Bending a joint *between* thruster-carrying links gives full rank (docs/model.md §2). Joints
         // 0 and 1 lie behind every thruster: bending them turns all thrusters rigidly and
         // the rank stays 5.
         let mut ws2 = ws.clone();
@@ -372,7 +372,7 @@ mod tests {
 
     #[test]
     fn uvms_planar_reference_pose() {
-        // SPEC §8 (Antonelli & Chiaverini): q = (1.47, −1.00, 0.30) at vehicle pose 0 puts the
+        // docs/model.md §8 (Antonelli & Chiaverini): q = (1.47, −1.00, 0.30) at vehicle pose 0 puts the
         // end-effector at (5.92, 4.29) with heading 0.77 rad (values printed to 2 decimals).
         let v = uvms_planar();
         let mut ws = KinWorkspace::new(&v);

@@ -5,26 +5,33 @@
 //! task-priority kinematic control, thrust allocation in Clarabel, thruster-matrix
 //! singularity scoring, closed-loop scenarios and parallel parameter sweeps.
 //!
-//! The physics and control formulation is `SPEC.md` (equations cited as USM-nn / AC-nn);
-//! modules follow the layout of `DESIGN.md`: data flows from [`model`] through
-//! [`kinematics`] to the dynamics and the scenario loop, and results flow out to reports
-//! ([`report`]) through the output pipelines ([`pipeline`], [`study`]). The command-line
-//! interface is the binary's own (`src/cli/`), not part of this library.
+//! The physics and control formulation is `docs/model.md` in the repository (equations cited
+//! as USM-nn / AC-nn). The modules are rooms in the order `docs/architecture.md` declares,
+//! each importing only rooms below it: data flows from [`model`] through [`kinematics`] to the
+//! dynamics, the control laws and the scenario loop, a run's [`outcome`] is judged above it, and
+//! results flow out to reports ([`report`]) through the static analysis ([`statics`]), the
+//! sweep ([`study`]), the optimiser ([`optimise`]) and the output pipelines ([`pipeline`]); the
+//! paper reproductions ([`paper`]) sit on top. The command-line interface is the binary's own
+//! (`src/cli/`), not part of this library.
 
 #![warn(missing_docs)]
 
 pub mod allocation;
 pub mod control;
 pub mod dynamics;
+pub mod evaluate;
 pub mod input;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
 pub mod optimise;
+pub mod outcome;
+pub mod paper;
 pub mod pipeline;
 pub mod report;
 pub mod sampling;
 pub mod scenario;
 pub mod spatial;
 pub mod state;
+pub mod statics;
 pub mod study;

@@ -11,11 +11,26 @@ fn main() -> ExitCode {
     match cli::run() {
         Ok(code) => code,
         Err(err) => {
-            let chain: Vec<String> = err.chain().map(|c| c.to_string()).collect();
-            eprintln!("error: {}", chain.join(": "));
+            eprintln!("error: {}", one_line(&err));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes on one line, `a: b: c`; a cause whose text its parent's message
+/// already ends with (an error that prints its source too) is not repeated.
+fn one_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if line.is_empty() {
+            line = text;
+        } else if !line.ends_with(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+    }
+    line
 }
 
 /// A closed output pipe (`usm-study … | head`) ends the program quietly, as it ends other
@@ -27,5 +42,30 @@ fn quiet_on_closed_pipe() {
     // `SIG_DFL` only changes this process's disposition of SIGPIPE.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("disk full")]
+    struct Inner;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("writing x: {0}")]
+    struct Outer(#[source] Inner);
+
+    #[test]
+    fn each_cause_is_printed_once() {
+        // An error that prints its source too: the source is not repeated.
+        assert_eq!(
+            one_line(&anyhow::Error::new(Outer(Inner))),
+            "writing x: disk full"
+        );
+        // Context added by the caller: the chain, joined.
+        let e = anyhow::Error::new(Inner).context("reading y");
+        assert_eq!(one_line(&e), "reading y: disk full");
     }
 }

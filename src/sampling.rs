@@ -37,19 +37,41 @@ impl fmt::Display for Sampling {
     }
 }
 
+/// A sampling name that is none of [`Sampling::NAMES`].
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("unknown sampling '{name}'; valid: {}", Sampling::NAMES.join(", "))]
+pub struct UnknownSampling {
+    /// The name given.
+    pub name: String,
+}
+
 impl FromStr for Sampling {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownSampling;
+    fn from_str(s: &str) -> Result<Self, UnknownSampling> {
         match s {
             "random" => Ok(Sampling::Random),
             "lhs" => Ok(Sampling::Lhs),
             "sobol" => Ok(Sampling::Sobol),
-            _ => Err(format!(
-                "unknown sampling '{s}'; valid: {}",
-                Self::NAMES.join(", ")
-            )),
+            _ => Err(UnknownSampling { name: s.into() }),
         }
     }
+}
+
+/// Why a [`Sampler`] cannot be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SamplerError {
+    /// More dimensions than the Sobol tables hold.
+    #[error("sobol sampling supports at most {MAX_SOBOL_DIMS} dimensions, got {dims}")]
+    SobolDimensions {
+        /// The dimensions asked for.
+        dims: usize,
+    },
+    /// More points than a sampler indexes (`u32`).
+    #[error("at most {} samples, got {n}", u32::MAX)]
+    TooManySamples {
+        /// The points asked for.
+        n: usize,
+    },
 }
 
 /// Mix a seed with a stream index (SplitMix64 finaliser): a stable, well-spread derived seed.
@@ -83,14 +105,12 @@ pub const MAX_SOBOL_DIMS: usize = sobol_burley::NUM_DIMENSIONS as usize;
 impl Sampler {
     /// A sampler for `n` points in `dims` dimensions. Errors if `dims` exceeds what Sobol
     /// supports.
-    pub fn new(method: Sampling, n: usize, dims: usize, seed: u64) -> Result<Self, String> {
+    pub fn new(method: Sampling, n: usize, dims: usize, seed: u64) -> Result<Self, SamplerError> {
         if method == Sampling::Sobol && dims > MAX_SOBOL_DIMS {
-            return Err(format!(
-                "sobol sampling supports at most {MAX_SOBOL_DIMS} dimensions, got {dims}"
-            ));
+            return Err(SamplerError::SobolDimensions { dims });
         }
         if n > u32::MAX as usize {
-            return Err(format!("at most {} samples, got {n}", u32::MAX));
+            return Err(SamplerError::TooManySamples { n });
         }
         let perms = if method == Sampling::Lhs {
             (0..dims)

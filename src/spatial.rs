@@ -1,15 +1,20 @@
-//! Spatial algebra on SE(3) for the `[v; ω]` (linear first) ordering of SPEC §1.
+//! Spatial algebra on SE(3) for the `[v; ω]` (linear first) ordering of docs/model.md §1.
 //!
-//! Conventions (SPEC §1):
+//! Conventions (docs/model.md §1):
 //! - a transform `g = (R, p)` maps points of the child frame into the parent frame,
 //!   `x_parent = R x_child + p`;
 //! - twists `V = [v; ω]` and wrenches `F = [f; m]` are expressed in a named frame;
 //! - `Ad_g = [[R, p̂R], [0, R]]` maps a twist from the child to the parent frame and
 //!   `Ad_g⁻ᵀ` maps a wrench from the child to the parent frame.
 //!
+//! Angle helpers of rotation geometry live here too: [`wrap_angle`], the heading ψ of a frame
+//! ([`heading`], `ψ = atan2(R₁₀, R₀₀)`, the yaw of its x axis about the inertial +z axis), its
+//! rate and gradient.
+//!
 //! Everything here is fixed-size nalgebra and allocation-free.
 
 use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
+use std::f64::consts::PI;
 
 /// A 6-vector: a twist `[v; ω]` (m/s, rad/s) or a wrench `[f; m]` (N, N·m).
 pub type Vec6 = Vector6<f64>;
@@ -44,7 +49,7 @@ pub fn stack(a: &Vec3, b: &Vec3) -> Vec6 {
     Vec6::new(a.x, a.y, a.z, b.x, b.y, b.z)
 }
 
-/// A rigid transform `g = (R, p)` ∈ SE(3) (SPEC §1): `R` rotation, `p` translation in metres.
+/// A rigid transform `g = (R, p)` ∈ SE(3) (docs/model.md §1): `R` rotation, `p` translation in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se3 {
     /// Rotation of the child frame's axes, expressed in the parent frame.
@@ -120,7 +125,7 @@ impl Se3 {
         self.r * x
     }
 
-    /// The adjoint `Ad_g = [[R, p̂R], [0, R]]` (SPEC §1).
+    /// The adjoint `Ad_g = [[R, p̂R], [0, R]]` (docs/model.md §1).
     pub fn adjoint(&self) -> Mat6 {
         let mut m = Mat6::zeros();
         let pr = skew(&self.p) * self.r;
@@ -130,7 +135,7 @@ impl Se3 {
         m
     }
 
-    /// The inverse adjoint `Ad_g⁻¹ = [[Rᵀ, −Rᵀp̂], [0, Rᵀ]]` (SPEC §1).
+    /// The inverse adjoint `Ad_g⁻¹ = [[Rᵀ, −Rᵀp̂], [0, Rᵀ]]` (docs/model.md §1).
     pub fn adjoint_inv(&self) -> Mat6 {
         self.inverse().adjoint()
     }
@@ -207,7 +212,7 @@ pub fn cross_motion(v: &Vec6, w: &Vec6) -> Vec6 {
 }
 
 /// Force cross product `V ×* F = −ad_Vᵀ F` (the velocity-product term of Newton–Euler,
-/// and the Kirchhoff term `V ×* (M_A V)` of SPEC §4).
+/// and the Kirchhoff term `V ×* (M_A V)` of docs/model.md §4).
 #[inline]
 pub fn cross_force(v: &Vec6, f: &Vec6) -> Vec6 {
     let (vl, va) = (lin(v), ang(v));
@@ -243,7 +248,7 @@ pub fn quat_integrate(q: &UnitQuaternion<f64>, omega: &Vec3, dt: f64) -> UnitQua
 }
 
 /// Vector part of the quaternion error `q_d⁻¹ ⊗ q` with a non-negative scalar part, used as
-/// the orientation error of the end-effector task (SPEC §5). Both quaternions map body
+/// the orientation error of the end-effector task (docs/model.md §5). Both quaternions map body
 /// vectors to the inertial frame; the result is expressed in the current body frame's
 /// orientation-error sense (`≈ ½ θ axis` for small errors).
 pub fn quat_error_vec(q_d: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> Vec3 {
@@ -264,6 +269,56 @@ pub fn euler_zyx(r: &Mat3) -> Vec3 {
 pub fn orthonormality_error(r: &Mat3) -> f64 {
     let e = (r.transpose() * r - Mat3::identity()).abs().max();
     e.max((r.determinant() - 1.0).abs())
+}
+
+/// Wrap an angle [rad] into `(−π, π]`.
+#[inline]
+pub fn wrap_angle(a: f64) -> f64 {
+    if !a.is_finite() {
+        return a;
+    }
+    let mut w = a.rem_euclid(2.0 * PI); // [0, 2π)
+    if w > PI {
+        w -= 2.0 * PI;
+    }
+    w
+}
+
+/// Heading ψ [rad] of a frame whose orientation in `I` is `r`: the yaw of its x axis about
+/// the inertial +z axis, `ψ = atan2(R₁₀, R₀₀)` (equal to the ZYX yaw angle), in `(−π, π]`.
+#[inline]
+pub fn heading(r: &Mat3) -> f64 {
+    r[(1, 0)].atan2(r[(0, 0)])
+}
+
+/// Time derivative ψ̇ [rad/s] of [`heading`] for a frame with orientation `r` (in `I`) and
+/// body-fixed angular velocity `omega` (rad/s, in the same frame): with `Ṙ = R ω̂`,
+/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`.
+/// Equal to ω_z for a frame level in the horizontal plane; 0 when the x axis is vertical.
+#[inline]
+pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
+    let (r00, r10) = (r[(0, 0)], r[(1, 0)]);
+    let d00 = r[(0, 1)] * omega.z - r[(0, 2)] * omega.y;
+    let d10 = r[(1, 1)] * omega.z - r[(1, 2)] * omega.y;
+    let den = r00 * r00 + r10 * r10;
+    if den < 1e-12 {
+        0.0
+    } else {
+        (r00 * d10 - r10 * d00) / den
+    }
+}
+
+/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
+/// `g(R)` with `ψ̇ = g(R)·ω` — [`heading_rate`] is linear in `ω`, so `g` is its value on the
+/// unit vectors: `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z`
+/// for a frame level in the horizontal plane; zero when the x axis is vertical.
+#[inline]
+pub fn heading_gradient(r: &Mat3) -> Vec3 {
+    Vec3::new(
+        heading_rate(r, &Vec3::x()),
+        heading_rate(r, &Vec3::y()),
+        heading_rate(r, &Vec3::z()),
+    )
 }
 
 #[cfg(test)]
@@ -338,5 +393,36 @@ mod tests {
         let r = UnitQuaternion::from_euler_angles(0.2, -0.4, 1.3);
         let e = euler_zyx(r.to_rotation_matrix().matrix());
         assert!((e - Vec3::new(0.2, -0.4, 1.3)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn wrap_angle_range() {
+        for (a, w) in [
+            (0.0, 0.0),
+            (PI, PI),
+            (-PI, PI),
+            (3.0 * PI, PI),
+            (1.5 * PI, -0.5 * PI),
+            (-1.5 * PI, 0.5 * PI),
+            (7.0, 7.0 - 2.0 * PI),
+        ] {
+            assert!(
+                (wrap_angle(a) - w).abs() < 1e-12,
+                "{a} -> {}",
+                wrap_angle(a)
+            );
+        }
+    }
+
+    #[test]
+    fn heading_rate_matches_difference() {
+        let r = rot_axis_angle(&Vec3::new(0.3, 0.5, 0.8).normalize(), 0.9);
+        let w = Vec3::new(0.2, -0.4, 0.7);
+        let h = 1e-6;
+        let rp = r * rot_axis_angle(&w.normalize(), w.norm() * h);
+        let rm = r * rot_axis_angle(&w.normalize(), -w.norm() * h);
+        let fd = wrap_angle(heading(&rp) - heading(&rm)) / (2.0 * h);
+        // Central difference of an O(1) smooth function: error ~h² + 1e-16/h ≈ 1e-10.
+        assert!((heading_rate(&r, &w) - fd).abs() < 1e-8);
     }
 }

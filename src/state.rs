@@ -57,7 +57,7 @@ impl VehicleState {
 /// JSON syntax and schema errors, the line and column.
 pub fn load_state(path: &Path, v: &Vehicle) -> Result<VehicleState, InputError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Located {
+    let text = crate::input::document::read_text(path).map_err(|e| Located {
         at: Location::origin(&file),
         error: e.to_string(),
     })?;

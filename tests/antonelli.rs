@@ -1,4 +1,4 @@
-//! Antonelli & Chiaverini (1998) kinematic case studies on `uvms-planar` (SPEC §8): the
+//! Antonelli & Chiaverini (1998) kinematic case studies on `uvms-planar` (docs/model.md §8): the
 //! inertial-frame task variables, the singularity-robust task priority (AC-7…9) and the
 //! paper's cases 1, 1b and 2. Reference values are the seed's text
 //! (`shared/seeds/004_2e118a4aa85a2683.txt`, section 5).
@@ -10,7 +10,7 @@ use usm_study::control::{InertialTask, Srmtp, TaskInverse, TaskVariable};
 use usm_study::kinematics::{forward_kinematics, BasePose, KinWorkspace};
 use usm_study::model::presets::preset;
 use usm_study::model::Vehicle;
-use usm_study::scenario::antonelli::{
+use usm_study::paper::antonelli::{
     antonelli_case, planar_weights, run_kinematic_case, AntonelliCase, KinematicHistory,
 };
 use usm_study::spatial::Vec3;
@@ -214,7 +214,7 @@ fn run(which: AntonelliCase) -> KinematicHistory {
     run_kinematic_case(&planar(), &antonelli_case(which)).unwrap()
 }
 
-fn trace<'a>(h: &'a KinematicHistory, name: &str) -> &'a usm_study::scenario::antonelli::TaskTrace {
+fn trace<'a>(h: &'a KinematicHistory, name: &str) -> &'a usm_study::paper::antonelli::TaskTrace {
     h.primary
         .iter()
         .chain(&h.secondary)

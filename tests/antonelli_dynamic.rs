@@ -1,4 +1,4 @@
-//! Antonelli & Chiaverini case 3: the NPS AUV II model (`model::nps_auv2`) in still water,
+//! Antonelli & Chiaverini case 3: the NPS AUV II model (`paper::nps_auv2`) in still water,
 //! its energy and momentum without dissipation, the sliding-mode runs 3a/3b and Table I in
 //! `paper antonelli`'s summary.json; the `simulate antonelli-…` presets.
 
@@ -7,11 +7,11 @@ mod common;
 use usm_study::dynamics::{
     ActuatorCommand, DynOptions, Integrator, SimConfig, SimState, Simulator,
 };
-use usm_study::model::nps_auv2::{nps_auv2, LENGTH, MASS, RHO};
 use usm_study::model::{Hydro, Vehicle};
-use usm_study::pipeline::antonelli::run_antonelli;
-use usm_study::scenario::antonelli::dynamic::{run_dynamic_case, BaseTrajectory, DynamicCase};
-use usm_study::scenario::antonelli::{antonelli_case, run_kinematic_case, AntonelliCase};
+use usm_study::paper::antonelli::dynamic::{run_dynamic_case, BaseTrajectory, DynamicCase};
+use usm_study::paper::antonelli::{antonelli_case, run_kinematic_case, AntonelliCase};
+use usm_study::paper::antonelli_outputs::run_antonelli;
+use usm_study::paper::nps_auv2::{nps_auv2, LENGTH, MASS, RHO};
 use usm_study::spatial::{Vec3, Vec6};
 
 fn sim(v: &Vehicle, options: DynOptions, dt: f64) -> Simulator {
@@ -165,7 +165,7 @@ fn free_body_invariants(kirchhoff: bool) -> ((f64, Vec6), (f64, Vec6)) {
 #[test]
 fn without_dissipation_energy_and_momentum_are_conserved_with_fossen_c_a() {
     // With the Kirchhoff term (the paper's AC-3 form, `Manoeuvring::kirchhoff`), ½ζᵀMζ and
-    // the inertial momentum are invariants of a free body (SPEC §4).
+    // the inertial momentum are invariants of a free body (docs/model.md §4).
     let ((e0, p0), (e1, p1)) = free_body_invariants(true);
     assert!((e1 - e0).abs() < 1e-8 * e0, "{e0} -> {e1}");
     assert!((p1 - p0).norm() < 1e-8 * p0.norm(), "{p0} -> {p1}");

@@ -1,6 +1,8 @@
-//! The shape of the house, checked on the source itself (issue 9): dependencies between the
-//! files of `src/` run one way (no import cycles), no source file grows past the size we can
-//! read in one sitting, and the library exposes no command-line layer.
+//! The shape of the house, checked on the source itself (issues 9, 20): dependencies between
+//! the files of `src/` run one way (no import cycles) and down the rooms in the order
+//! `docs/architecture.md` declares (its rooms table, read here), every file of `src/` is in
+//! that document's file map, no source file grows past the size we can read in one sitting,
+//! and the library exposes no command-line layer.
 //!
 //! File X depends on file Y when X names an item defined in Y, through a `use` or a path in
 //! code (`crate::…`, `super::…`, a module alias). Re-exports (`pub use`) are followed to the
@@ -729,4 +731,426 @@ fn the_function_measure_skips_tests_and_counts_bodies() {
     let src = "fn a() {\n    let x = 1;\n}\ntrait T { fn d(&self); }\n#[cfg(test)]\nmod tests {\n    fn b() {\n    }\n}\nfn c() { }\n";
     let f = functions(src);
     assert_eq!(f, vec![("a".to_string(), 1, 3), ("c".to_string(), 10, 1)]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rooms in their declared order (issue 20): the order and the file map are read from
+// docs/architecture.md, so the document and the code cannot drift apart.
+
+/// Imports against the room order tolerated during a move; each entry is (importing file,
+/// imported room). The check fails on an entry no longer needed, so the list can only shrink.
+/// Empty since the case evaluator (issue 20 item 1) moved tuning next to the optimiser.
+const PENDING_EXCEPTIONS: &[(&str, &str)] = &[];
+
+/// The rooms of the document's `## Rooms` table, lowest first: `room → rank`. A row may name
+/// several rooms (`state`, `sampling`): they share a rank and may not import each other.
+fn room_ranks(doc: &str) -> BTreeMap<String, usize> {
+    let mut ranks = BTreeMap::new();
+    let mut in_section = false;
+    let mut rank = 0;
+    for line in doc.lines() {
+        if line.starts_with("## ") {
+            in_section = line.trim() == "## Rooms";
+            continue;
+        }
+        if !in_section || !line.starts_with("| `") {
+            continue;
+        }
+        let first = line.split('|').nth(1).unwrap_or("");
+        for (i, name) in first.split('`').enumerate() {
+            if i % 2 == 1 {
+                ranks.insert(name.to_string(), rank);
+            }
+        }
+        rank += 1;
+    }
+    ranks
+}
+
+/// The files the document's `## Files` block lists, as `src/…` paths: a line `src/dir/` opens
+/// a directory, a line indented by two spaces names a file in it (`name.rs` or `sub/name.rs`),
+/// an unindented `src/name.rs` a file at the top; the rest of each line describes it.
+fn listed_files(doc: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    let mut in_section = false;
+    let mut in_block = false;
+    let mut dir: Option<String> = None;
+    for line in doc.lines() {
+        if line.starts_with("## ") {
+            in_section = line.trim() == "## Files";
+            continue;
+        }
+        if !in_section {
+            continue;
+        }
+        if line.starts_with("```") {
+            in_block = !in_block;
+            continue;
+        }
+        if !in_block {
+            continue;
+        }
+        let first = line.split_whitespace().next().unwrap_or("");
+        if !line.starts_with(' ') {
+            if first.starts_with("src/") && first.ends_with('/') {
+                dir = Some(first.to_string());
+            } else {
+                dir = None;
+                if first.starts_with("src/") && first.ends_with(".rs") {
+                    out.insert(first.to_string());
+                }
+            }
+        } else if line.starts_with("  ") && !line.starts_with("   ") && first.ends_with(".rs") {
+            if let Some(d) = &dir {
+                out.insert(format!("{d}{first}"));
+            }
+        }
+    }
+    out
+}
+
+/// The room of a file given as `src/…`: the first component under `src/` (`src/kinematics.rs`
+/// → `kinematics`); the binary's `main.rs` is the `cli` room; `lib.rs` is no room.
+fn room_of(rel: &str) -> Option<String> {
+    let rest = rel.strip_prefix("src/")?;
+    match rest {
+        "lib.rs" => None,
+        "main.rs" => Some("cli".into()),
+        _ => {
+            let head = rest.split('/').next()?;
+            Some(head.trim_end_matches(".rs").to_string())
+        }
+    }
+}
+
+/// `src/…` form of a path under `base` (the directory holding `src/`).
+fn rel(base: &Path, p: &Path) -> String {
+    p.strip_prefix(base)
+        .unwrap_or(p)
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
+/// Every import between two rooms that does not run down the declared order, for the crate
+/// roots `lib.rs` and `main.rs` under `base/src` (those that exist); `exceptions` as
+/// [`PENDING_EXCEPTIONS`]. Returns the violations and the exceptions actually used.
+fn order_violations(
+    base: &Path,
+    ranks: &BTreeMap<String, usize>,
+    exceptions: &[(&str, &str)],
+) -> (Vec<String>, BTreeSet<(String, String)>) {
+    let mut bad = Vec::new();
+    let mut used = BTreeSet::new();
+    for root in ["src/lib.rs", "src/main.rs"] {
+        if !base.join(root).exists() {
+            continue;
+        }
+        let (edges, _) = dependency_graph(&base.join(root));
+        for (from, tos) in &edges {
+            let f = rel(base, from);
+            let Some(rf) = room_of(&f) else { continue };
+            let Some(&kf) = ranks.get(&rf) else {
+                bad.push(format!("{f}: room `{rf}` is not in the rooms table"));
+                continue;
+            };
+            for to in tos {
+                let t = rel(base, to);
+                let Some(rt) = room_of(&t) else { continue };
+                if rt == rf {
+                    continue;
+                }
+                let above = ranks.get(&rt).is_some_and(|&kt| kt < kf);
+                if above {
+                    continue;
+                }
+                if exceptions.iter().any(|(ef, er)| *ef == f && *er == rt) {
+                    used.insert((f.clone(), rt.clone()));
+                    continue;
+                }
+                bad.push(format!(
+                    "{f} (room `{rf}`) imports {t} (room `{rt}`), which is not above it"
+                ));
+            }
+        }
+    }
+    (bad, used)
+}
+
+/// Files of `base/src` the document does not list, and listed files that do not exist.
+fn map_mismatches(base: &Path, listed: &BTreeSet<String>) -> Vec<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let mut entries: Vec<_> = std::fs::read_dir(dir).unwrap().flatten().collect();
+        entries.sort_by_key(|e| e.path());
+        for e in entries {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut found = Vec::new();
+    walk(&base.join("src"), &mut found);
+    let found: BTreeSet<String> = found.iter().map(|p| rel(base, p)).collect();
+    let mut out: Vec<String> = found
+        .difference(listed)
+        .map(|f| format!("{f} is not in the file map"))
+        .collect();
+    out.extend(
+        listed
+            .difference(&found)
+            .map(|f| format!("{f} is in the file map but does not exist")),
+    );
+    out
+}
+
+fn architecture_doc() -> String {
+    std::fs::read_to_string(root().join("docs/architecture.md")).unwrap()
+}
+
+#[test]
+fn imports_run_down_the_declared_room_order() {
+    let doc = architecture_doc();
+    let ranks = room_ranks(&doc);
+    assert!(ranks.len() >= 15, "rooms table not found: {ranks:?}");
+    let (bad, used) = order_violations(&root(), &ranks, PENDING_EXCEPTIONS);
+    assert!(
+        bad.is_empty(),
+        "imports against the room order:\n{}",
+        bad.join("\n")
+    );
+    let stale: Vec<_> = PENDING_EXCEPTIONS
+        .iter()
+        .filter(|(f, r)| !used.contains(&(f.to_string(), r.to_string())))
+        .collect();
+    assert!(
+        stale.is_empty(),
+        "exceptions no longer needed (remove them): {stale:?}"
+    );
+}
+
+#[test]
+fn every_source_file_is_in_the_file_map() {
+    let listed = listed_files(&architecture_doc());
+    assert!(
+        listed.len() > 100,
+        "file map not found: {} files",
+        listed.len()
+    );
+    let bad = map_mismatches(&root(), &listed);
+    assert!(
+        bad.is_empty(),
+        "docs/architecture.md file map:\n{}",
+        bad.join("\n")
+    );
+}
+
+/// A small crate (`low` below `high`) and its document, in a temporary directory.
+fn planted_tree() -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("high")).unwrap();
+    std::fs::write(src.join("lib.rs"), "pub mod high;\npub mod low;\n").unwrap();
+    std::fs::write(src.join("low.rs"), "pub struct L;\n").unwrap();
+    std::fs::write(src.join("high/mod.rs"), "pub mod h;\n").unwrap();
+    std::fs::write(
+        src.join("high/h.rs"),
+        "use crate::low::L;\npub struct H(pub L);\n",
+    )
+    .unwrap();
+    let doc = "# Shape\n\n## Rooms\n\n| room | holds |\n|---|---|\n| `low` | below |\n\
+               | `high` | above |\n\n## Files\n\n```\nsrc/lib.rs   the rooms\nsrc/low.rs   L\n\
+               src/high/\n  mod.rs     declarations\n  h.rs       H, over L\n```\n"
+        .to_string();
+    (dir, doc)
+}
+
+#[test]
+fn the_room_check_sees_an_import_against_the_order() {
+    let (dir, doc) = planted_tree();
+    let base = dir.path();
+    let ranks = room_ranks(&doc);
+    assert_eq!(ranks.len(), 2, "{ranks:?}");
+    assert_eq!(
+        map_mismatches(base, &listed_files(&doc)),
+        Vec::<String>::new()
+    );
+    assert_eq!(order_violations(base, &ranks, &[]).0, Vec::<String>::new());
+    // Plant an import of the higher room in the lower one.
+    std::fs::write(
+        base.join("src/low.rs"),
+        "pub struct L;\npub fn f(_: &crate::high::h::H) {}\n",
+    )
+    .unwrap();
+    let (bad, _) = order_violations(base, &ranks, &[]);
+    assert_eq!(bad.len(), 1, "{bad:?}");
+    assert!(
+        bad[0].starts_with("src/low.rs (room `low`) imports src/high/h.rs"),
+        "{bad:?}"
+    );
+    // An exception covers it and is reported as used.
+    let (bad, used) = order_violations(base, &ranks, &[("src/low.rs", "high")]);
+    assert!(bad.is_empty() && used.len() == 1, "{bad:?} {used:?}");
+    // The same tree under the document's reversed order: the original import is the bad one.
+    let reversed = doc
+        .replace("| `low` | below |", "| `tmp` |")
+        .replace("| `high` | above |", "| `low` | below |")
+        .replace("| `tmp` |", "| `high` | above |");
+    std::fs::write(base.join("src/low.rs"), "pub struct L;\n").unwrap();
+    let (bad, _) = order_violations(base, &room_ranks(&reversed), &[]);
+    assert_eq!(bad.len(), 1, "{bad:?}");
+    // A room the table does not name.
+    std::fs::write(
+        base.join("src/lib.rs"),
+        "pub mod high;\npub mod low;\npub mod odd;\n",
+    )
+    .unwrap();
+    std::fs::write(base.join("src/odd.rs"), "pub fn g(_: crate::low::L) {}\n").unwrap();
+    let (bad, _) = order_violations(base, &ranks, &[]);
+    assert!(
+        bad.iter()
+            .any(|b| b.contains("room `odd` is not in the rooms table")),
+        "{bad:?}"
+    );
+}
+
+#[test]
+fn the_file_map_check_sees_an_unlisted_and_a_missing_file() {
+    let (dir, doc) = planted_tree();
+    let base = dir.path();
+    std::fs::write(base.join("src/high/extra.rs"), "pub struct E;\n").unwrap();
+    let bad = map_mismatches(base, &listed_files(&doc));
+    assert_eq!(
+        bad,
+        vec!["src/high/extra.rs is not in the file map".to_string()]
+    );
+    std::fs::remove_file(base.join("src/low.rs")).unwrap();
+    std::fs::remove_file(base.join("src/high/extra.rs")).unwrap();
+    let bad = map_mismatches(base, &listed_files(&doc));
+    assert_eq!(
+        bad,
+        vec!["src/low.rs is in the file map but does not exist".to_string()]
+    );
+    // Continuation lines (deeper indent) never name files.
+    let doc2 = doc.replace(
+        "  h.rs       H, over L\n",
+        "  h.rs       H, over L,\n             x.rs is a word here\n",
+    );
+    assert!(!listed_files(&doc2).contains("src/high/x.rs"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The repository stands on its own (issue 20 item 6): the formulation is docs/model.md.
+
+/// Equation ids cited in `text`: `USM-28`, and the ranges and alternatives written
+/// `USM-28…32`, `USM-28–32`, `AC-8/9` expanded to every id they name.
+fn cited_equations(text: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    let cs: Vec<char> = text.chars().collect();
+    let number = |i: &mut usize| -> Option<u32> {
+        let s = *i;
+        while *i < cs.len() && cs[*i].is_ascii_digit() {
+            *i += 1;
+        }
+        cs[s..*i].iter().collect::<String>().parse().ok()
+    };
+    for prefix in ["USM-", "AC-"] {
+        let p: Vec<char> = prefix.chars().collect();
+        let mut i = 0;
+        while i + p.len() < cs.len() {
+            let boundary = i == 0 || !cs[i - 1].is_alphanumeric();
+            if !(boundary && cs[i..i + p.len()] == p[..]) {
+                i += 1;
+                continue;
+            }
+            i += p.len();
+            let Some(a) = number(&mut i) else { continue };
+            out.insert(format!("{prefix}{a}"));
+            match cs.get(i) {
+                Some('…' | '–') => {
+                    i += 1;
+                    if let Some(b) = number(&mut i) {
+                        out.extend((a..=b.min(a + 60)).map(|k| format!("{prefix}{k}")));
+                    }
+                }
+                Some('/') => {
+                    i += 1;
+                    if let Some(b) = number(&mut i) {
+                        out.insert(format!("{prefix}{b}"));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_cited_equation_is_in_docs_model() {
+    let model = std::fs::read_to_string(root().join("docs/model.md")).expect("docs/model.md");
+    let stated = cited_equations(&model);
+    let mut cited = BTreeMap::new();
+    let (lib, _) = dependency_graph(&root().join("src/lib.rs"));
+    let (bin, _) = dependency_graph(&root().join("src/main.rs"));
+    for p in lib.keys().chain(bin.keys()) {
+        for id in cited_equations(&std::fs::read_to_string(p).unwrap()) {
+            cited.entry(id).or_insert_with(|| rel(&root(), p));
+        }
+    }
+    assert!(cited.len() > 30, "only {} citations found", cited.len());
+    let missing: Vec<String> = cited
+        .iter()
+        .filter(|(id, _)| !stated.contains(*id))
+        .map(|(id, f)| format!("{id} (cited in {f})"))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "cited in src/ but not in docs/model.md: {missing:?}"
+    );
+}
+
+#[test]
+fn citations_are_read_with_their_ranges() {
+    let ids = cited_equations("USM-28…31, AC-8/9 and USM-42; not XUSM-5, USM-, AC-10–11");
+    let want = [
+        "USM-28", "USM-29", "USM-30", "USM-31", "AC-8", "AC-9", "USM-42", "AC-10", "AC-11",
+    ];
+    assert_eq!(
+        ids,
+        want.iter().map(|s| s.to_string()).collect::<BTreeSet<_>>()
+    );
+}
+
+#[test]
+fn sources_cite_the_repository_formulation() {
+    // README.md and the library's front page send readers to docs/model.md, not to a SPEC
+    // outside the repository.
+    for f in ["README.md", "src/lib.rs"] {
+        let text = std::fs::read_to_string(root().join(f)).unwrap();
+        assert!(
+            text.contains("docs/model.md"),
+            "{f} does not point to docs/model.md"
+        );
+        assert!(!text.contains("SPEC.md"), "{f} still points to SPEC.md");
+    }
+    let (lib, _) = dependency_graph(&root().join("src/lib.rs"));
+    let (bin, _) = dependency_graph(&root().join("src/main.rs"));
+    // In comments only: string literals that reach output files (summary.json's `source`, a
+    // preset's TOML) keep their text so that outputs stay byte-identical.
+    let cites_spec = |text: &str| {
+        text.lines()
+            .any(|l| l.find("//").is_some_and(|i| l[i..].contains("SPEC §")))
+    };
+    let outside: Vec<String> = lib
+        .keys()
+        .chain(bin.keys())
+        .filter(|p| cites_spec(&std::fs::read_to_string(p).unwrap()))
+        .map(|p| rel(&root(), p))
+        .collect();
+    assert!(
+        outside.is_empty(),
+        "cite docs/model.md, not SPEC: {outside:?}"
+    );
 }

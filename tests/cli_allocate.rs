@@ -1,4 +1,4 @@
-//! End-to-end tests of `usm-study allocate` (SPEC §5): JSON and text output, method selection,
+//! End-to-end tests of `usm-study allocate` (docs/model.md §5): JSON and text output, method selection,
 //! and exit code 2 with a message naming the file and the key on bad input.
 
 mod common;

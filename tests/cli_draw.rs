@@ -1,5 +1,5 @@
 //! End-to-end tests of `usm-study design draw`: the drawn thrust arrows start at the design's
-//! thruster positions projected into each view (straight and bent), point along the SPEC §2
+//! thruster positions projected into each view (straight and bent), point along the docs/model.md §2
 //! directions, the SVG is deterministic, every preset and example design draws, and bad
 //! inputs exit with code 2 naming the file.
 //!
@@ -119,7 +119,7 @@ fn usm_paper_arrows_start_at_the_thrusters_and_point_along_spec_directions() {
     let v = load_design("usm-paper").unwrap();
     check_arrow_starts("usm-paper", &svg, &VehicleState::rest(&v));
     let views = views(&svg);
-    // SPEC §2: T3 sits on L2 (body 4, starting at 0.62 + 0.104 + 0.584 + 0.104 = 1.412 m),
+    // docs/model.md §2: T3 sits on L2 (body 4, starting at 0.62 + 0.104 + 0.584 + 0.104 = 1.412 m),
     // 0.278 m along it and 0.10 m to starboard (−y).
     let top = &views["top"];
     let (x, y) = top.to_svg(1.412 + 0.278, -0.10);

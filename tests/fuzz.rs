@@ -1,7 +1,13 @@
 //! A fuzz harness on stable Rust: seeded mutations of the shipped input files (study files,
-//! design files and presets, scenario presets, an allocation case) at the byte and token
-//! level, fed to every parser and, for inputs that parse, to the allocator (all four methods)
-//! and the study's case resolution. Nothing may panic, abort or hang.
+//! problem files, design files and presets, scenario presets, `--set KEY=VALUE` lists, an
+//! allocation case) at the byte and token level, fed to every parser and, for inputs that
+//! parse, to the allocator (all four methods), the study's case resolution, the optimiser's
+//! parameter space, and the scenario a `--set` list edits. Nothing may panic, abort or hang.
+//!
+//! The problem-file grammar comes from the shipped problems (`studies/*.toml` with
+//! `[[param]]`) plus generated `[solver]` / `[[variant]]` / `[[axis]]` sections with nasty
+//! values; the `--set` grammar from every key path of the scenario presets (`key=value`
+//! lines, values from the preset, nasty values and bare words).
 //!
 //! CI runs 20 000 inputs (the default). The long run, documented in `docs/reliability.md`:
 //!
@@ -23,9 +29,11 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use usm_study::allocation::Method;
+use usm_study::input::keypath::{parse_override, set};
 use usm_study::kinematics::{forward_kinematics, thruster_matrix_owned, KinWorkspace};
 use usm_study::model::design::{design_to_toml, parse_design, parse_design_table};
 use usm_study::model::presets::preset;
+use usm_study::optimise::parse_problem;
 use usm_study::pipeline::allocate::{parse_case, solve_case};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::{case_count, expand};
@@ -43,10 +51,43 @@ fn hang_s() -> u64 {
 #[derive(Clone, Copy, Debug)]
 enum Kind {
     Study,
+    Problem,
     Design,
     Scenario,
+    /// `--set KEY=VALUE` lines applied to a scenario preset.
+    Overrides,
     AllocationCase,
 }
+
+/// Key paths and values of `table` as `--set` lines (`control.k_psi=0.45`), arrays by element.
+fn set_lines(table: &toml::Table, prefix: &str, out: &mut Vec<String>) {
+    for (k, v) in table {
+        let key = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        match v {
+            toml::Value::Table(t) => set_lines(t, &key, out),
+            toml::Value::Array(a) => {
+                out.push(format!("{key}={v}"));
+                for (i, x) in a.iter().enumerate().take(3) {
+                    out.push(format!("{key}[{i}]={x}"));
+                }
+            }
+            other => out.push(format!("{key}={other}")),
+        }
+    }
+}
+
+/// Generated problem-file sections: solver budgets, variants and a stray axis, with values
+/// that stress the bounds (the mutations then edit them further).
+const PROBLEM_TAILS: [&str; 4] = [
+    "\n[solver]\nmethod = \"particle-swarm\"\nparticles = 1000000000\nmax_evals = 4\nrestarts = 1000000000\n",
+    "\n[[variant]]\nname = \"v\"\nset = {\"control.k_psi\" = 0.3, \"scenario.duration\" = 1e-9}\n",
+    "\n[[axis]]\nname = \"control.look_ahead\"\nvalues = [1.0, \"a\\nb\"]\n",
+    "\n[study]\nobjective = \"\"\nmaximise = [\"bogus\", \"success\"]\npareto = [\"x\", \"y\"]\n",
+];
 
 /// The seed corpus: the shipped files and presets.
 fn corpus() -> Vec<(Kind, String)> {
@@ -60,22 +101,46 @@ fn corpus() -> Vec<(Kind, String)> {
             .collect();
         paths.sort();
         for p in paths {
-            let kind = if dir == "studies" {
-                Kind::Study
-            } else {
+            let text = std::fs::read_to_string(p).unwrap();
+            let kind = if dir != "studies" {
                 Kind::Design
+            } else if text.contains("[[param]]") {
+                for tail in PROBLEM_TAILS {
+                    c.push((Kind::Problem, format!("{text}{tail}")));
+                }
+                Kind::Problem
+            } else {
+                Kind::Study
             };
-            c.push((kind, std::fs::read_to_string(p).unwrap()));
+            c.push((kind, text));
         }
     }
     for name in ["usm-paper", "uvms-planar"] {
         c.push((Kind::Design, design_to_toml(&preset(name).unwrap())));
     }
     for name in usm_study::scenario::preset_names() {
-        c.push((
-            Kind::Scenario,
-            usm_study::scenario::preset_text(name).unwrap(),
-        ));
+        let text = usm_study::scenario::preset_text(name).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        let mut lines = Vec::new();
+        set_lines(&table, "", &mut lines);
+        lines.extend(
+            [
+                "scenario.name=~",
+                "scenario.name=",
+                "scenario.duration=1e-9",
+                "control.k_psi=nan",
+                "allocation.method=qp",
+                "path.waypoints[0][1]=1e308",
+                "x[99999999999999999999]=1",
+                "=1",
+            ]
+            .map(String::from),
+        );
+        // Several short lists per preset, so that one input applies a handful of overrides.
+        for chunk in lines.chunks(6) {
+            c.push((Kind::Overrides, format!("{name}\n{}", chunk.join("\n"))));
+        }
+        c.push((Kind::Scenario, text));
     }
     c.push((
         Kind::AllocationCase,
@@ -244,6 +309,36 @@ fn exercise(kind: Kind, text: &str) {
                 }
             }
         }
+        Kind::Problem => {
+            let Ok(p) = parse_problem(text, Path::new("studies/fuzz.toml")) else {
+                return;
+            };
+            let space = &p.spec.space;
+            let n = space.dim();
+            for u in [space.start(), vec![0.0; n], vec![1.0; n], vec![-1e308; n]] {
+                let (u, _) = space.project(&u);
+                let _ = space.values(&u);
+            }
+            let _ = p.spec.metrics();
+        }
+        Kind::Overrides => {
+            let mut lines = text.lines();
+            let preset = lines.next().unwrap_or_default();
+            let Some(base) = usm_study::scenario::preset_text(preset) else {
+                return;
+            };
+            let Ok((mut t, src)) = usm_study::scenario::parse_text(&base, "fuzz.toml") else {
+                return;
+            };
+            for line in lines.take(8) {
+                if let Ok((path, value)) = parse_override(line) {
+                    let _ = set(&mut t, &path.0, value, line);
+                }
+            }
+            if let Ok(f) = usm_study::scenario::parse_table(&t, &src) {
+                let _ = usm_study::scenario::resolve_design(&f, &src);
+            }
+        }
         Kind::AllocationCase => {
             if let Ok(case) = parse_case(text) {
                 let _ = solve_case(&case, &Method::ALL);
@@ -321,7 +416,7 @@ fn no_input_panics_aborts_or_hangs() {
             });
         }
         // The watchdog: an input without progress for HANG_S is a hang.
-        let (corpus, current, done) = (&corpus, &current, &done);
+        let (corpus, current, done, failures) = (&corpus, &current, &done, &failures);
         s.spawn(move || {
             let mut last_report = Instant::now();
             while done.load(Ordering::Relaxed) < threads {
@@ -338,10 +433,12 @@ fn no_input_panics_aborts_or_hangs() {
                 }
                 if last_report.elapsed() > Duration::from_secs(30) {
                     last_report = Instant::now();
+                    // Failures so far too: a run cut short still says what it found.
                     eprintln!(
-                        "[fuzz] {} of {n} inputs started, {:.0} s",
+                        "[fuzz] {} of {n} inputs started, {:.0} s, {} failures so far",
                         next.load(Ordering::Relaxed).min(n),
-                        t0.elapsed().as_secs_f64()
+                        t0.elapsed().as_secs_f64(),
+                        failures.lock().map_or(0, |f| f.len())
                     );
                 }
             }
@@ -361,6 +458,12 @@ fn no_input_panics_aborts_or_hangs() {
 fn mutations_are_deterministic_and_touch_numbers() {
     let corpus = corpus();
     assert!(corpus.len() >= 12, "{} corpus files", corpus.len());
+    for kind in ["Problem", "Overrides", "Study", "Design", "Scenario"] {
+        assert!(
+            corpus.iter().any(|(k, _)| format!("{k:?}") == kind),
+            "no {kind} input in the corpus"
+        );
+    }
     assert_eq!(input(&corpus, 1, 7).1, input(&corpus, 1, 7).1);
     assert_eq!(
         number_spans("a = 1.5e-3, b_2 = [-4, x7]"),

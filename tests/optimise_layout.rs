@@ -1,5 +1,5 @@
 //! The shipped layout study (`studies/layout.toml`) on a reduced budget: from the paper's
-//! thruster layout (USM SPEC §2, feasible), Nelder–Mead finds positions along the links and
+//! thruster layout (docs/model.md §2, feasible), Nelder–Mead finds positions along the links and
 //! directions whose commanded-subspace singular fraction is lower and whose p05 σ_min of the
 //! commanded rows is higher than the paper layout's, while the short transport run still
 //! meets its success criteria. The full budget (240 evaluations) finds its best at evaluation 9

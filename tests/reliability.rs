@@ -1,6 +1,9 @@
-//! Reliability of the batch commands (issue 15), through the binary: per-case time budgets,
-//! refusals before running (sizes, aliased axes, an invalid base scenario), the output
-//! directory's lock and ownership, the journal on `--resume`, and write failures.
+//! Reliability of the batch commands (issues 15 and 21), through the binary: per-case time
+//! budgets, refusals before running (sizes, aliased axes, an invalid base scenario), the output
+//! directory's lock and ownership, the journal on `--resume`, and write failures; issue 21:
+//! links out of the output, `--force` by provenance, Slurm scripts under a stand-in `sbatch`,
+//! complete-or-refused merges, `tcm` and `allocate` results that cannot look complete,
+//! `report` refusals, signals and lock takeover, `optimise`'s lock and output checks.
 
 mod common;
 
@@ -155,11 +158,25 @@ fn one_run_per_output_directory_and_another_study_needs_force() {
         "{}",
         stderr(&o)
     );
-    std::fs::write(out.join("plots/axis_stale.svg"), "<svg/>").unwrap();
+    let written = std::fs::read_dir(out.join("plots")).unwrap().count();
+    assert!(written > 0);
+    // A user's own files in the output: --force leaves them alone.
+    std::fs::write(out.join("plots/user_diagram.svg"), "<svg/>").unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let o = sweep(&other, &out, &["--force"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(stderr(&o).contains("--force: removed"), "{}", stderr(&o));
-    assert!(!out.join("plots/axis_stale.svg").exists());
+    assert_eq!(read(&out.join("plots/user_diagram.svg")), b"<svg/>");
+    assert_eq!(read(&out.join("notes.txt")), b"mine");
+    let record = String::from_utf8(read(&out.join(".usm-study.files"))).unwrap();
+    assert!(
+        record.contains("cases.csv\n") && record.contains("plots/"),
+        "{record}"
+    );
+    assert!(
+        !record.contains("user_diagram") && !record.contains("notes"),
+        "{record}"
+    );
 }
 
 #[test]
@@ -229,4 +246,587 @@ fn a_scenario_name_cannot_lead_the_output_out_of_its_root() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(d.path().join("out/______escaped").is_dir());
     assert!(!d.path().parent().unwrap().join("escaped").exists());
+}
+
+// ---- issue 21 ------------------------------------------------------------------------------
+
+/// The `study_hash` of a finished output.
+fn study_hash(out: &std::path::Path) -> String {
+    let m: serde_json::Value = serde_json::from_slice(&read(&out.join("manifest.json"))).unwrap();
+    m["study_hash"].as_str().unwrap().to_string()
+}
+
+/// Every file under `dir` (following nothing), as sorted relative paths.
+fn tree(dir: &std::path::Path) -> Vec<String> {
+    let mut v = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if e.file_type().unwrap().is_dir() {
+                stack.push(p.clone());
+            }
+            v.push(p.strip_prefix(dir).unwrap().display().to_string());
+        }
+    }
+    v.sort();
+    v
+}
+
+#[test]
+fn a_symlink_leading_out_of_the_output_is_refused_and_nothing_outside_is_touched() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("o");
+    assert_eq!(sweep(&s, &out, &[]).status.code(), Some(0));
+    let victim = d.path().join("victim_dir");
+    std::fs::create_dir(&victim).unwrap();
+    std::fs::write(victim.join("precious.svg"), "<svg>mine</svg>").unwrap();
+    std::fs::write(victim.join(".data.tmp-42"), "mine too").unwrap();
+    std::fs::remove_dir_all(out.join("plots")).unwrap();
+    std::os::unix::fs::symlink(&victim, out.join("plots")).unwrap();
+    let before = tree(&victim);
+    for extra in [&["--force"][..], &[], &["--resume"]] {
+        let o = sweep(&s, &out, extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("symbolic link leading out of the output directory"),
+            "{}",
+            stderr(&o)
+        );
+        assert_eq!(tree(&victim), before, "{extra:?}");
+        assert_eq!(read(&victim.join("precious.svg")), b"<svg>mine</svg>");
+        assert!(!out.join(".usm-study.lock").exists());
+    }
+    let o = run(&["report", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert_eq!(tree(&victim), before);
+}
+
+#[test]
+fn force_never_removes_files_the_tool_did_not_write() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    // A plain project directory with the user's own files named like outputs.
+    let proj = d.path().join("proj");
+    std::fs::create_dir(&proj).unwrap();
+    for f in ["manifest.json", "summary.md", "cases.csv"] {
+        std::fs::write(proj.join(f), "mine").unwrap();
+    }
+    let o = sweep(&s, &proj, &["--force"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("that usm-study did not write"),
+        "{}",
+        stderr(&o)
+    );
+    for f in ["manifest.json", "summary.md", "cases.csv"] {
+        assert_eq!(read(&proj.join(f)), b"mine", "{f}");
+    }
+}
+
+#[test]
+fn a_rerun_without_resume_keeps_every_finished_case() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &["--max-cases", "2", "--jobs", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let journal = read(&out.join("cases.partial.csv"));
+    let o = sweep(&s, &out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("--resume") && e.contains("--force") && e.contains("finished cases"),
+        "{e}"
+    );
+    assert_eq!(
+        read(&out.join("cases.partial.csv")),
+        journal,
+        "finished cases kept"
+    );
+    let o = sweep(&s, &out, &["--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("resumed 2 cases, ran 2"),
+        "{}",
+        stderr(&o)
+    );
+    // A complete output too: refused without --resume; --force starts over.
+    let o = sweep(&s, &out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let o = sweep(&s, &out, &["--force"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("resumed 0 cases, ran 4"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// A stand-in `sbatch` on PATH: logs its arguments (one per line, then `--`), and with
+/// `RUN_JOBS=1` runs `--wrap` like Slurm would (each array task in turn, `sh -c`).
+const SBATCH: &str = r#"#!/usr/bin/env bash
+set -u
+{ for a in "$@"; do printf '%s\n' "$a"; done; echo --; } >>"$SBATCH_LOG"
+wrap= array=
+for a in "$@"; do
+  case "$a" in --wrap=*) wrap=${a#--wrap=};; --array=*) array=${a#--array=};; esac
+done
+if [ "${RUN_JOBS:-0}" = 1 ]; then
+  if [ -n "$array" ]; then
+    n=$(( ${array#0-} + 1 ))
+    for ((i = 0; i < n; i++)); do
+      SLURM_ARRAY_TASK_ID=$i SLURM_ARRAY_TASK_COUNT=$n SLURM_ARRAY_TASK_MIN=0 sh -c "$wrap" || exit 1
+    done
+  else
+    sh -c "$wrap" || exit 1
+  fi
+fi
+if [ -n "$array" ]; then echo 1001; else echo 1002; fi
+"#;
+
+/// A temporary directory with the stand-in `sbatch`; returns it and a PATH with it first.
+fn stand_in_sbatch(d: &std::path::Path) -> String {
+    let bin = d.join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let p = write(&bin, "sbatch", SBATCH);
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+    format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    )
+}
+
+#[test]
+fn the_emitted_slurm_script_runs_nothing_from_hostile_paths() {
+    let d = tempfile::tempdir().unwrap();
+    let path = stand_in_sbatch(d.path());
+    let hostile = d.path().join("$(touch PWNED1) `touch PWNED2` it's");
+    std::fs::create_dir(&hostile).unwrap();
+    let s = write(&hostile, "quick $(touch PWNED3).toml", QUICK);
+    let out = hostile.join("out `touch PWNED4` $(touch PWNED5)");
+    let script = d.path().join("submit.sh");
+    let o = common::usm_study()
+        .current_dir(d.path())
+        .args(["sweep", s.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "--emit-slurm",
+            script.to_str().unwrap(),
+            "--cases-per-task",
+            "2",
+            "--force",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8(read(&script)).unwrap();
+    assert!(
+        text.contains("--resume --force --jobs 1"),
+        "--force kept: {text}"
+    );
+    let log = d.path().join("sbatch.log");
+    let o = std::process::Command::new("bash")
+        .arg(&script)
+        .current_dir(d.path())
+        .env("PATH", &path)
+        .env("SBATCH_LOG", &log)
+        .env("RUN_JOBS", "1")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for dir in [d.path(), &hostile, &out] {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let n = e.file_name().to_string_lossy().to_string();
+            assert!(
+                !n.starts_with("PWNED"),
+                "{n} was created in {}",
+                dir.display()
+            );
+        }
+    }
+    let calls = String::from_utf8(read(&log)).unwrap();
+    assert_eq!(
+        calls.matches("\n--\n").count(),
+        2,
+        "array and merge: {calls}"
+    );
+    // The jobs ran for real: the merged table equals an unsharded local run.
+    let local = d.path().join("local");
+    assert_eq!(sweep(&s, &local, &[]).status.code(), Some(0));
+    assert_eq!(read(&out.join("cases.csv")), read(&local.join("cases.csv")));
+}
+
+#[test]
+fn the_merge_job_of_a_3000_task_array_submits() {
+    let d = tempfile::tempdir().unwrap();
+    let path = stand_in_sbatch(d.path());
+    let big = QUICK.replace(
+        "values = [4, 5, 6, 7]",
+        "values = [4, 5, 6]\n[[axis]]\nname = \"static.threshold\"\nrange = { start = 0.01, stop = 0.1, steps = 1000 }",
+    );
+    let s = write(d.path(), "big.toml", &big);
+    let script = d.path().join("submit.sh");
+    let o = run(&[
+        "sweep",
+        s.to_str().unwrap(),
+        "--out",
+        d.path().join("o").to_str().unwrap(),
+        "--emit-slurm",
+        script.to_str().unwrap(),
+        "--cases-per-task",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3000 array tasks"), "{}", stderr(&o));
+    let log = d.path().join("sbatch.log");
+    let o = std::process::Command::new("bash")
+        .arg(&script)
+        .env("PATH", &path)
+        .env("SBATCH_LOG", &log)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("merge job 1002"));
+    let calls = String::from_utf8(read(&log)).unwrap();
+    let merge = calls.split("\n--\n").nth(1).unwrap();
+    assert!(merge.contains("--dependency=afterok:1001"), "{merge}");
+    assert!(merge.len() < 1000, "the merge command stays short: {merge}");
+    let list = String::from_utf8(read(&d.path().join("o/shards.txt"))).unwrap();
+    assert_eq!(list.lines().count(), 3000);
+    assert_eq!(list.lines().nth(2999), Some("shard-2999-of-3000"));
+}
+
+#[test]
+fn merge_refuses_missing_repeated_and_mismatched_shards_and_keeps_input_journals() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let sh = |i: usize, n: usize| {
+        let o = d.path().join(format!("s{i}of{n}"));
+        let r = sweep(&s, &o, &["--shard", &format!("{i}/{n}")]);
+        assert_eq!(r.status.code(), Some(0), "{}", stderr(&r));
+        o.to_str().unwrap().to_string()
+    };
+    let (s0, s1, s2) = (sh(0, 3), sh(1, 3), sh(2, 3));
+    let other = sh(0, 2);
+    let out = d.path().join("m").to_str().unwrap().to_string();
+    let merge = |dirs: &[&str], extra: &[&str]| {
+        let mut a = vec!["merge"];
+        a.extend_from_slice(dirs);
+        a.extend_from_slice(&["--out", &out]);
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let o = merge(&[&s0, &s1], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("missing 1 of 3 shards: shard-2-of-3"),
+        "{}",
+        stderr(&o)
+    );
+    let o = merge(&[&s0, &s0, &s0, &s1, &s2], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("shard 0 given 3 times"),
+        "{}",
+        stderr(&o)
+    );
+    let o = merge(&[&s0, &s1, &s2, &other], &[]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("mismatched shard counts"),
+        "{}",
+        stderr(&o)
+    );
+    let o = merge(&[&s0, &s1], &["--partial"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--partial: missing 1 of 3 shards"),
+        "{}",
+        stderr(&o)
+    );
+    // --out = an input: its journal (the shard's raw output) stays, with every row it had
+    // (the merge compacts the merged rows into it).
+    let j0 = std::path::Path::new(&s0).join("cases.partial.csv");
+    let journal = String::from_utf8(read(&j0)).unwrap();
+    let o = run(&["merge", &s0, &s1, &s2, "--out", &s0]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let after = String::from_utf8(read(&j0)).unwrap();
+    for line in journal.lines() {
+        assert!(after.lines().any(|l| l == line), "{line} lost from {after}");
+    }
+}
+
+#[test]
+fn tcm_never_leaves_an_old_summary_beside_new_rows() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("t");
+    let tcm = |seed: &str| {
+        run(&[
+            "tcm",
+            "usm-paper",
+            "--out",
+            out.to_str().unwrap(),
+            "--samples",
+            "64",
+            "--seed",
+            seed,
+            "--resolution",
+            "5",
+        ])
+    };
+    let o = tcm("1");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(out.join("summary.json").is_file());
+    // samples.csv cannot be replaced (a directory in its place): the rerun fails, leaving no
+    // summary.json of the previous run and no temporary file.
+    std::fs::remove_file(out.join("samples.csv")).unwrap();
+    std::fs::create_dir(out.join("samples.csv")).unwrap();
+    std::fs::write(out.join("samples.csv/x"), "").unwrap();
+    let o = tcm("2");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        !out.join("summary.json").exists(),
+        "an incomplete output has no summary"
+    );
+    let leftovers: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn non_finite_allocation_results_are_a_status_never_solved() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(
+        d.path(),
+        "huge.json",
+        r#"{"T": [[1,1,0,0,0,0,0.6],[0,0,1,1,0,0,0],[0,0,0,0,1,1,0.8],
+            [0,0,0,0,0,0,0],[0,0,0,0,-0.6,-1.4,-0.8],[0,0,0.4,1.6,0,0,0]],
+            "tau": [1e308, -1e308, 1e308, 0, -1e308, 1e308]}"#,
+    );
+    let o = run(&[
+        "allocate",
+        "--input",
+        p.to_str().unwrap(),
+        "--method",
+        "pinv",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert_eq!(v["pinv"]["status"], "non_finite", "{v}");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+}
+
+#[test]
+fn report_refuses_a_folder_that_is_not_a_finished_output_or_is_locked() {
+    let d = tempfile::tempdir().unwrap();
+    let empty = d.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let o = run(&["report", empty.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is not a finished usm-study output"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!empty.join("report.html").exists());
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("o");
+    assert_eq!(sweep(&s, &out, &[]).status.code(), Some(0));
+    let me = format!(
+        "pid={}\nhost={}\nsince=now\n",
+        std::process::id(),
+        usm_study::study::outdir::host_name()
+    );
+    std::fs::write(out.join(".usm-study.lock"), me).unwrap();
+    let o = run(&["report", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("in use by another run"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::remove_file(out.join(".usm-study.lock")).unwrap();
+    assert_eq!(
+        run(&["report", out.to_str().unwrap()]).status.code(),
+        Some(0)
+    );
+    assert!(!out.join(".usm-study.lock").exists());
+}
+
+#[test]
+fn sigterm_and_sigint_release_the_lock_after_the_journal_and_say_how_to_resume() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "slow.toml", SLOW);
+    for (sig, code) in [(libc::SIGTERM, 143), (libc::SIGINT, 130)] {
+        let out = d.path().join(format!("o{sig}"));
+        let mut child = common::usm_study()
+            .args([
+                "sweep",
+                s.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--jobs",
+                "1",
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Wait for the first finished case in the journal (no time is asserted).
+        let journal = out.join("cases.partial.csv");
+        while std::fs::read_to_string(&journal).map_or(0, |t| t.lines().count()) < 2 {
+            assert!(child.try_wait().unwrap().is_none(), "ended before a signal");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // SAFETY: signalling our own child process.
+        unsafe { libc::kill(child.id() as libc::pid_t, sig) };
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(code), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("--resume to continue"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!out.join(".usm-study.lock").exists(), "lock released");
+        let rows = std::fs::read_to_string(&journal).unwrap().lines().count() - 1;
+        assert!(rows >= 1);
+        let o = sweep(&s, &out, &["--resume", "--case-timeout", "0.001"]);
+        assert!(
+            o.status.code() == Some(0) || o.status.code() == Some(1),
+            "{}",
+            stderr(&o)
+        );
+        assert!(
+            stderr(&o).contains(&format!("resumed {rows} cases")),
+            "{}",
+            stderr(&o)
+        );
+    }
+}
+
+#[test]
+fn resume_takes_over_an_abandoned_or_requeued_lock_of_another_host() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let full = d.path().join("full");
+    assert_eq!(sweep(&s, &full, &[]).status.code(), Some(0));
+    let hash = study_hash(&full);
+    let out = d.path().join("o");
+    assert_eq!(
+        sweep(&s, &out, &["--max-cases", "1"]).status.code(),
+        Some(0)
+    );
+    let lock = out.join(".usm-study.lock");
+    let held = |extra: &str| {
+        let text = format!("pid=1\nhost=node-that-died\nsince=x\ntoken=1-a\nstudy={hash}\n{extra}");
+        std::fs::write(&lock, text).unwrap();
+    };
+    // A fresh lock of another host: refused, also with --resume.
+    held("");
+    assert_eq!(sweep(&s, &out, &["--resume"]).status.code(), Some(2));
+    // Untouched for longer than the takeover age: --resume takes it over; without: refused.
+    let old = std::time::SystemTime::now() - std::time::Duration::from_secs(11 * 60);
+    std::fs::File::options()
+        .write(true)
+        .open(&lock)
+        .unwrap()
+        .set_modified(old)
+        .unwrap();
+    assert_eq!(sweep(&s, &out, &[]).status.code(), Some(2));
+    let o = sweep(&s, &out, &["--resume", "--max-cases", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("took over the lock of pid 1 on host node-that-died"),
+        "{}",
+        stderr(&o)
+    );
+    // A requeued Slurm job on another node: taken over at once.
+    held("slurm_job=4242\n");
+    let o = common::usm_study()
+        .args([
+            "sweep",
+            s.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--resume",
+        ])
+        .env("SLURM_JOB_ID", "4242")
+        .env("SLURM_RESTART_COUNT", "1")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("took over the lock of Slurm job 4242"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(read(&out.join("cases.csv")), read(&full.join("cases.csv")));
+    // Another study's hash is never taken over.
+    held("");
+    std::fs::File::options()
+        .write(true)
+        .open(&lock)
+        .unwrap()
+        .set_modified(old)
+        .unwrap();
+    let text = std::fs::read_to_string(&lock)
+        .unwrap()
+        .replace(&hash, "0123");
+    std::fs::write(&lock, text).unwrap();
+    std::fs::File::options()
+        .write(true)
+        .open(&lock)
+        .unwrap()
+        .set_modified(old)
+        .unwrap();
+    assert_eq!(sweep(&s, &out, &["--resume"]).status.code(), Some(2));
+}
+
+#[test]
+fn optimise_holds_the_lock_and_refuses_a_sweeps_output() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("o");
+    assert_eq!(sweep(&s, &out, &[]).status.code(), Some(0));
+    let problem = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/layout.toml");
+    let o = run(&[
+        "optimise",
+        problem.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("holds a sweep's output"),
+        "{}",
+        stderr(&o)
+    );
+    let busy = d.path().join("busy");
+    std::fs::create_dir(&busy).unwrap();
+    let me = format!(
+        "pid={}\nhost={}\nsince=now\n",
+        std::process::id(),
+        usm_study::study::outdir::host_name()
+    );
+    std::fs::write(busy.join(".usm-study.lock"), me).unwrap();
+    let o = run(&[
+        "optimise",
+        problem.to_str().unwrap(),
+        "--out",
+        busy.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("in use by another run"),
+        "{}",
+        stderr(&o)
+    );
 }

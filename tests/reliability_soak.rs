@@ -1,7 +1,9 @@
 //! Kill/resume soak: a sweep SIGKILLed at random points (while running cases, while writing
 //! the final tables, the manifest and the report, while resuming) and resumed until it
 //! completes must end with the same bytes as an uninterrupted run, leaving no journal, lock
-//! or temporary file behind.
+//! or temporary file behind. The same with SIGTERM (the lock released by the run itself), and
+//! with a SIGKILLed run "requeued on another host": its lock rewritten with another host name
+//! and a Slurm job id, and resumed with that `SLURM_JOB_ID` and `SLURM_RESTART_COUNT=1`.
 //!
 //! CI runs `SOAK_KILLS` = 5 kills (the default). The long run, documented in
 //! `docs/reliability.md`:
@@ -66,9 +68,29 @@ enum End {
     KilledFinishing,
 }
 
+/// How a run is stopped, and the environment of the next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Stop {
+    /// SIGKILL.
+    Kill,
+    /// SIGTERM: the run releases its lock itself (exit 143).
+    Term,
+    /// SIGKILL, then the lock moved to another host as a requeued Slurm job would find it.
+    Requeue,
+}
+
+/// The Slurm job id of the requeue rounds.
+const JOB: &str = "777";
+
 /// Start a sweep of `study` into `out` (with `--resume` when asked); kill it after `after`
 /// unless it ended first.
 fn sweep_killed_after(study: &Path, out: &Path, resume: bool, after: Duration) -> End {
+    sweep_stopped_after(study, out, resume, after, Stop::Kill)
+}
+
+/// [`sweep_killed_after`] with the given way of stopping (and, for `Requeue`, the Slurm
+/// environment of a requeued job).
+fn sweep_stopped_after(study: &Path, out: &Path, resume: bool, after: Duration, stop: Stop) -> End {
     let mut cmd = usm_study();
     cmd.args([
         "sweep",
@@ -80,6 +102,9 @@ fn sweep_killed_after(study: &Path, out: &Path, resume: bool, after: Duration) -
     if resume {
         cmd.arg("--resume");
     }
+    if stop == Stop::Requeue {
+        cmd.env("SLURM_JOB_ID", JOB).env("SLURM_RESTART_COUNT", "1");
+    }
     cmd.stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null());
     let mut child = cmd.spawn().expect("spawn usm-study");
@@ -89,8 +114,36 @@ fn sweep_killed_after(study: &Path, out: &Path, resume: bool, after: Duration) -
             return End::Exited(status.code().unwrap_or(-1));
         }
         if start.elapsed() >= after {
-            child.kill().unwrap(); // SIGKILL
-            child.wait().unwrap();
+            if stop == Stop::Term {
+                // SAFETY: signalling our own child process.
+                unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+                let status = child.wait().unwrap();
+                match status.code() {
+                    Some(0) => return End::Exited(0), // finished before the signal landed
+                    Some(code) => {
+                        assert_eq!(code, 143, "SIGTERM: exit 128 + 15");
+                        assert!(!out.join(".usm-study.lock").exists(), "lock released");
+                    }
+                    // Before the handler was installed (the lock not yet held): the default
+                    // action, like a kill.
+                    None => {}
+                }
+            } else {
+                child.kill().unwrap(); // SIGKILL
+                child.wait().unwrap();
+                let lock = out.join(".usm-study.lock");
+                if stop == Stop::Requeue && lock.exists() {
+                    // The node died: the lock names another host and this Slurm job.
+                    let text = std::fs::read_to_string(&lock).unwrap();
+                    let moved: String = text
+                        .lines()
+                        .filter(|l| !l.starts_with("host=") && !l.starts_with("slurm_job="))
+                        .map(|l| format!("{l}\n"))
+                        .collect();
+                    std::fs::write(&lock, format!("{moved}host=dead-node\nslurm_job={JOB}\n"))
+                        .unwrap();
+                }
+            }
             let finishing =
                 out.join("cases.csv").exists() && out.join("cases.partial.csv").exists();
             return if finishing {
@@ -109,7 +162,7 @@ fn leftovers(dir: &Path) -> Vec<String> {
     for d in [dir.to_path_buf(), dir.join("plots")] {
         for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
             let n = e.file_name().to_string_lossy().to_string();
-            if n == "cases.partial.csv" || n.starts_with('.') {
+            if n == "cases.partial.csv" || (n.starts_with('.') && n != ".usm-study.files") {
                 v.push(n);
             }
         }
@@ -136,6 +189,8 @@ fn killed_sweeps_resume_to_the_uninterrupted_bytes() {
         rounds += 1;
         let out = d.path().join(format!("r{rounds}"));
         let mut resume = false;
+        // Rounds alternate SIGKILL, SIGTERM and a requeue on another host.
+        let stop = [Stop::Kill, Stop::Term, Stop::Requeue][(rounds % 3) as usize];
         // Kill, resume, kill again … until a run completes (at most 4 kills per round).
         for attempt in 0.. {
             let after = if attempt < 4 {
@@ -143,7 +198,7 @@ fn killed_sweeps_resume_to_the_uninterrupted_bytes() {
             } else {
                 Duration::from_secs(3600)
             };
-            match sweep_killed_after(&s, &out, resume, after) {
+            match sweep_stopped_after(&s, &out, resume, after, stop) {
                 End::Exited(code) => {
                     assert_eq!(code, 0, "round {rounds}, attempt {attempt}");
                     break;

@@ -3,8 +3,9 @@
 //! work-mode tasks, `[secondary] controllability_gain`) raises the smallest commanded σ_min
 //! along a work-mode run, and keeps the pose task.
 
-use usm_study::pipeline::secondary::secondary_profile;
-use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
+use usm_study::outcome::{run_scenario, RunResult};
+use usm_study::paper::secondary::secondary_profile;
+use usm_study::scenario::{load_table, parse_table, resolve_design};
 
 /// `work-setpoint` with the paper-like far setpoint pinned (x = 3.7 m, beyond the 3.3 m body,
 /// yawed 25° and pitched 10°), and `controllability_gain = k_c`: the run and the smallest

@@ -12,7 +12,8 @@ use common::{arg, optimise_study, run, stderr, write};
 use usm_study::control::spline::{PoseReference, Via};
 use usm_study::control::Quintic;
 use usm_study::model::presets::usm_paper;
-use usm_study::scenario::{parse_table, parse_text, run_scenario};
+use usm_study::outcome::run_scenario;
+use usm_study::scenario::{parse_table, parse_text};
 
 const START: [f64; 6] = [3.3, 0.0, 0.0, 0.0, 0.0, 0.0];
 const END: [f64; 6] = [3.0, 0.5, -0.3, 0.0, 0.1745, 0.4363];

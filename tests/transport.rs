@@ -8,10 +8,9 @@
 use usm_study::control::transport::TransportMethod;
 use usm_study::dynamics::{ActuatorCommand, SimConfig, Simulator};
 use usm_study::model::presets::usm_paper;
-use usm_study::pipeline::readings::{run_reading, ReadingRun, TransportReading};
-use usm_study::scenario::{
-    load_table, parse_table, resolve_design, run_scenario, Channel, RunResult,
-};
+use usm_study::outcome::{run_scenario, RunResult};
+use usm_study::paper::readings::{run_reading, ReadingRun, TransportReading};
+use usm_study::scenario::{load_table, parse_table, resolve_design, Channel};
 
 /// Run a preset, extended from the paper's 140 s to 170 s so that convergence within 60 s
 /// of the segment commanded at 95 s can be judged.

@@ -1,5 +1,5 @@
 //! The [`Allocator`] (built once per case, called every control step) and its result types,
-//! [`Allocation`] and [`AllocStatus`] (SPEC §5, USM-36/37).
+//! [`Allocation`] and [`AllocStatus`] (docs/model.md §5, USM-36/37).
 
 use std::fmt;
 
@@ -110,7 +110,7 @@ impl AllocPath {
     }
 }
 
-/// Result of one allocation (SPEC §5).
+/// Result of one allocation (docs/model.md §5).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Allocation {
     /// Thruster forces (N), length `n_thrusters`.
@@ -154,7 +154,7 @@ impl Allocation {
 }
 
 /// A thrust allocator for one method, thruster count, bounds, weights and settings, built once
-/// per case and called every control step (SPEC §5). It owns the Clarabel solver and all
+/// per case and called every control step (docs/model.md §5). It owns the Clarabel solver and all
 /// scratch, so a step allocates nothing outside the solver (use [`Allocator::allocate_into`]).
 ///
 /// The previous output is remembered as `u_prev` for the rate terms; override it with

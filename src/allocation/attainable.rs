@@ -1,4 +1,4 @@
-//! Attainable wrench along the base axes under thrust limits (SPEC §6, TCM singularity metric).
+//! Attainable wrench along the base axes under thrust limits (docs/model.md §6, TCM singularity metric).
 //!
 //! For each base axis `k` and sign `±`, the linear programme
 //! `max α` s.t. `T u = ±α e_k`, `u_min ≤ u ≤ u_max` gives the largest pure force (k = 0..2, N) or
@@ -14,7 +14,7 @@ use serde::Serialize;
 use super::conic::clarabel_settings;
 use super::error::{check_bounds, check_t, AllocError};
 
-/// Largest pure wrench along each base axis (SPEC §6). Index order surge, sway, heave (N), roll,
+/// Largest pure wrench along each base axis (docs/model.md §6). Index order surge, sway, heave (N), roll,
 /// pitch, yaw (N·m), base frame. `NaN` (serialised as `null`) where the programme failed or is
 /// infeasible (possible only when `u = 0` violates the bounds).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -26,7 +26,7 @@ pub struct AttainableWrench {
 }
 
 /// Attainable wrench along `±e_k`, k = 0..5, for `T` (6×n_thrusters, base frame, N and N·m per N of
-/// thrust) and bounds `u_min ≤ u ≤ u_max` (N) (SPEC §6). Errors only on bad input.
+/// thrust) and bounds `u_min ≤ u ≤ u_max` (N) (docs/model.md §6). Errors only on bad input.
 pub fn attainable_wrench(
     t: &Matrix6xX<f64>,
     u_min: &[f64],

@@ -1,4 +1,4 @@
-//! Clarabel formulations of the constrained allocation forms (SPEC §5).
+//! Clarabel formulations of the constrained allocation forms (docs/model.md §5).
 //!
 //! Clarabel solves `min ½xᵀPx + qᵀx` s.t. `Ax + s = b`, `s ∈ K`. With `n_u` thrusters
 //! (`n_uhrusters` in the code) the variables are

@@ -1,4 +1,4 @@
-//! The interior shortcut of the `qp` form (SPEC §5): when the unconstrained optimum lies inside
+//! The interior shortcut of the `qp` form (docs/model.md §5): when the unconstrained optimum lies inside
 //! the bounds, it is the QP solution, found by one small SPD solve instead of Clarabel.
 //!
 //! The `qp` problem is `min uᵀWu + q‖s‖² + ‖u − u_prev‖²_R` s.t. `T u = τ + s`,

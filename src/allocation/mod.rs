@@ -1,4 +1,4 @@
-//! Thrust allocation (SPEC §5, USM-36/37): map a commanded base wrench `τ_c` to thruster forces `u`.
+//! Thrust allocation (docs/model.md §5, USM-36/37): map a commanded base wrench `τ_c` to thruster forces `u`.
 //!
 //! Conventions used throughout this module:
 //! - `n_thrusters` is the number of thrusters (never called `m`: `m` is a moment below).
@@ -87,7 +87,7 @@ pub fn damped_pinv(
 }
 
 /// One-shot allocation: build an [`Allocator`] for `method` and allocate `τ` once with `T`
-/// (6×n_thrusters, base frame), bounds `u_min`, `u_max` (N) and weights `w` (SPEC §5, USM-36/37).
+/// (6×n_thrusters, base frame), bounds `u_min`, `u_max` (N) and weights `w` (docs/model.md §5, USM-36/37).
 pub fn allocate(
     method: Method,
     t: &Matrix6xX<f64>,

@@ -1,4 +1,4 @@
-//! Allocation settings (SPEC §5): the [`Method`], the [`Formulation`] of the constrained forms,
+//! Allocation settings (docs/model.md §5): the [`Method`], the [`Formulation`] of the constrained forms,
 //! the rate terms and the [`AllocSettings`] with every default beside its field and a
 //! `validate()` (Clarabel's `settings.rs` habit).
 
@@ -11,16 +11,16 @@ use super::error::{check_lambda, check_setting, check_vec, AllocError};
 
 /// Default damping factor λ of the pseudoinverse (USM-37; the paper uses λ = 0.1).
 pub const DEFAULT_LAMBDA: f64 = 0.1;
-/// Default slack weight `q` of the constrained forms (SPEC §5, `‖s‖²_Q` with `Q = qI`).
+/// Default slack weight `q` of the constrained forms (docs/model.md §5, `‖s‖²_Q` with `Q = qI`).
 pub const DEFAULT_Q: f64 = 1e4;
-/// Default regularisation weight ε of the minimax form (SPEC §5).
+/// Default regularisation weight ε of the minimax form (docs/model.md §5).
 pub const DEFAULT_EPS: f64 = 1e-6;
 /// Default Clarabel tolerance, see [`AllocSettings::tol`].
 pub const DEFAULT_TOL: f64 = 1e-8;
 /// Default relative slack tolerance, see [`AllocSettings::slack_tol`].
 pub const DEFAULT_SLACK_TOL: f64 = 1e-2;
 
-/// Allocation method (SPEC §5). Parses from and prints as its lowercase name
+/// Allocation method (docs/model.md §5). Parses from and prints as its lowercase name
 /// (`pinv`, `qp`, `minimax`, `power`); serde uses the same names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -31,7 +31,7 @@ pub enum Method {
     Qp,
     /// Minimise the largest thruster force (minimax).
     Minimax,
-    /// Power-optimal: minimise `Σ w_j |u_j|^{3/2}` (momentum theory, SPEC §6).
+    /// Power-optimal: minimise `Σ w_j |u_j|^{3/2}` (momentum theory, docs/model.md §6).
     Power,
 }
 
@@ -75,7 +75,7 @@ impl FromStr for Method {
     }
 }
 
-/// Rate / fluctuation settings of the constrained forms (SPEC §5): the objective gains
+/// Rate / fluctuation settings of the constrained forms (docs/model.md §5): the objective gains
 /// `‖u − u_prev‖²_R` with `R = diag(weights)` and each step obeys `|u_j − u_prev,j| ≤ max_step_j`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RateSettings {
@@ -143,7 +143,7 @@ pub enum Formulation {
     SlackEliminated,
 }
 
-/// Settings of an [`Allocator`](super::Allocator) (SPEC §5). Each field's doc gives its
+/// Settings of an [`Allocator`](super::Allocator) (docs/model.md §5). Each field's doc gives its
 /// default (the `DEFAULT_*` constants above, or the literal), which [`Default`] uses;
 /// [`AllocSettings::validate`] checks the ranges.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,4 +1,4 @@
-//! `usm-study allocate`: solve one thrust-allocation case (SPEC §5, USM-36/37) with one or all
+//! `usm-study allocate`: solve one thrust-allocation case (docs/model.md §5, USM-36/37) with one or all
 //! methods and print the result as a table or JSON. The case file and the JSON output are
 //! described in [`usm_study::pipeline::allocate`].
 //!
@@ -13,7 +13,7 @@ use anyhow::Context;
 
 use super::format::Format;
 use usm_study::allocation::Method;
-use usm_study::pipeline::allocate::{read_case, solve_case, Case, Results, FAILED};
+use usm_study::pipeline::allocate::{read_case, solve_case, Case, Results, FAILED, NON_FINITE};
 
 /// Which method(s) to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -103,9 +103,10 @@ fn render_text(path: &Path, case: &Case, results: &Results) -> String {
     s
 }
 
-/// Run `usm-study allocate` (SPEC §5): read the case, solve it with the requested method(s),
-/// print a table or JSON on stdout. Returns exit code 0, or 1 when a Clarabel solve failed; bad
-/// input is an `Err` whose message names the file and the key.
+/// Run `usm-study allocate` (docs/model.md §5): read the case, solve it with the requested method(s),
+/// print a table or JSON on stdout. Returns exit code 0, or 1 when a Clarabel solve failed or a
+/// result is not finite (`non_finite`); bad input is an `Err` whose message names the file and
+/// the key.
 pub fn run(args: &AllocateArgs) -> anyhow::Result<ExitCode> {
     let case = read_case(&args.input)?;
     let methods: Vec<Method> = match args.method {
@@ -124,7 +125,10 @@ pub fn run(args: &AllocateArgs) -> anyhow::Result<ExitCode> {
         }
         Format::Text => print!("{}", render_text(&args.input, &case, &results)),
     }
-    let failed = results.0.iter().any(|(_, r)| r.status == FAILED);
+    let failed = results
+        .0
+        .iter()
+        .any(|(_, r)| r.status == FAILED || r.status == NON_FINITE);
     Ok(if failed {
         ExitCode::from(1)
     } else {

@@ -54,9 +54,35 @@ enum Command {
     Optimise(optimise::OptimiseArgs),
 }
 
+/// Threads per core `--jobs` may ask for: more only adds thread start-up and memory (results
+/// do not depend on the thread count).
+const JOBS_PER_CORE: usize = 4;
+
+/// `--jobs` capped at [`JOBS_PER_CORE`] × the cores of this machine (at least 8), with a note
+/// on stderr when capped; 0 (all cores) is kept.
+fn cap_jobs(jobs: &mut usize, verb: &str) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cap = (JOBS_PER_CORE * cores).max(8);
+    if *jobs > cap {
+        eprintln!(
+            "[{verb}] note: --jobs {} capped to {cap} ({JOBS_PER_CORE} × {cores} cores); \
+             results do not depend on it",
+            *jobs
+        );
+        *jobs = cap;
+    }
+}
+
 /// Parse `std::env::args` and run the chosen command.
 pub fn run() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let mut cli = Cli::parse();
+    match &mut cli.command {
+        // A Slurm script's --jobs is for the compute nodes, not this machine.
+        Command::Sweep(a) if a.emit_slurm.is_none() => cap_jobs(&mut a.jobs, "sweep"),
+        Command::Optimise(a) => cap_jobs(&mut a.jobs, "optimise"),
+        Command::Tcm(a) => cap_jobs(&mut a.jobs, "tcm"),
+        _ => {}
+    }
     match &cli.command {
         Command::Inspect(a) => inspect::run(a),
         Command::Design(c) => design::run(c),

@@ -7,7 +7,7 @@
 //! problem-file errors are reported before any evaluation.
 
 use super::progress::Progress;
-use anyhow::anyhow;
+use anyhow::{anyhow, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -17,6 +17,7 @@ use usm_study::optimise::{load_problem, run, Options};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles, BEST_FILE};
 use usm_study::report::fmt_num;
+use usm_study::study::outdir;
 
 /// Arguments of `optimise`.
 #[derive(Debug, Args)]
@@ -40,9 +41,44 @@ pub struct OptimiseArgs {
     pub no_plots: bool,
 }
 
+/// Refuse an output directory that a link leads out of, that holds a sweep's output, or the
+/// optimisation of another problem (its `manifest.json` names it).
+fn check_output(out: &Path, problem: &str) -> anyhow::Result<()> {
+    outdir::check_contained(out).map_err(|e| anyhow!(e.to_string()))?;
+    let sweep_files = [
+        "cases.csv",
+        "cases.parquet",
+        "cases.partial.csv",
+        "study.toml",
+    ];
+    if let Some(f) = sweep_files.iter().find(|f| out.join(f).exists()) {
+        bail!(
+            "{} holds a sweep's output ({f}): an optimisation needs its own directory; use \
+             another --out",
+            out.display()
+        );
+    }
+    let manifest = out.join("manifest.json");
+    if let Ok(text) = std::fs::read_to_string(&manifest) {
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        match v["problem"].as_str() {
+            Some(p) if p == problem => {}
+            Some(p) => bail!(
+                "{} holds the optimisation of another problem ({p}); use another --out",
+                out.display()
+            ),
+            None => bail!(
+                "{} holds a manifest.json that is not an optimisation's; use another --out",
+                out.display()
+            ),
+        }
+    }
+    Ok(())
+}
+
 /// Run `usm-study optimise`.
 pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
-    let problem = load_problem(&a.problem).map_err(|e| anyhow!(e.to_string()))?;
+    let problem = load_problem(&a.problem)?;
     let s = &problem.study;
     let out = a.out.clone().unwrap_or_else(|| {
         if s.output == Path::new("results/sweeps").join(&s.name) {
@@ -52,6 +88,21 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
         }
     });
     create_dir(&out)?;
+    // The same lock and output checks as `sweep`: one run per directory, no link out of it,
+    // no other output mixed in.
+    let out = outdir::resolve(&out).map_err(|e| anyhow!(e.to_string()))?;
+    let lock = outdir::lock(
+        &out,
+        &outdir::LockOwner {
+            study: &s.hash,
+            resume: a.resume,
+        },
+    )
+    .map_err(|e| anyhow!(e.to_string()))?;
+    if let Some(t) = &lock.takeover {
+        eprintln!("[optimise] {t}");
+    }
+    check_output(&out, &s.name)?;
     let spec = &problem.spec;
     eprintln!(
         "[optimise] {} ({} mode, {} parameters, {} scenario{}, {} metrics): {} up to {} evaluations, output {}",
@@ -126,6 +177,9 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
         out.join(BEST_FILE).display()
     );
     super::sweep::review("optimise", &out)?;
+    outdir::record_owned(&out, lock.created, &["report.html"])
+        .map_err(|e| anyhow!(e.to_string()))?;
+    drop(lock);
     Ok(if b.score.feasible {
         ExitCode::SUCCESS
     } else {

@@ -1,16 +1,16 @@
 //! `usm-study paper [usm|antonelli|readings|secondary] [--out DIR]`: regenerate a seed paper's
-//! simulations — the USM paper (see [`usm_study::pipeline::paper`], the default), Antonelli &
-//! Chiaverini's case studies and Table I (see [`usm_study::pipeline::antonelli`]), the USM
-//! transport readings comparison (see [`usm_study::pipeline::readings`]), or the secondary
-//! objectives comparison (see [`usm_study::pipeline::secondary`]).
+//! simulations — the USM paper (see [`usm_study::paper::usm`], the default), Antonelli &
+//! Chiaverini's case studies and Table I (see [`usm_study::paper::antonelli_outputs`]), the USM
+//! transport readings comparison (see [`usm_study::paper::readings`]), or the secondary
+//! objectives comparison (see [`usm_study::paper::secondary`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use usm_study::pipeline::antonelli::run_antonelli;
-use usm_study::pipeline::paper::run_paper;
-use usm_study::pipeline::readings::run_readings;
-use usm_study::pipeline::secondary::run_secondary_comparison;
+use usm_study::paper::antonelli_outputs::run_antonelli;
+use usm_study::paper::readings::run_readings;
+use usm_study::paper::secondary::run_secondary_comparison;
+use usm_study::paper::usm::run_paper;
 
 /// Which paper to regenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

@@ -5,11 +5,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::allocation::Method;
 use usm_study::input::keypath::{parse_override, set};
-use usm_study::pipeline::antonelli::{run_antonelli_preset as run_preset, AntonelliPreset};
+use usm_study::outcome::{run_scenario, RunResult};
+use usm_study::paper::antonelli_outputs::{run_antonelli_preset as run_preset, AntonelliPreset};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use usm_study::report::fmt_num;
-use usm_study::scenario::{load_table, parse_table, resolve_design, run_scenario, RunResult};
+use usm_study::scenario::{load_table, parse_table, resolve_design};
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]

@@ -1,5 +1,5 @@
 //! `usm-study sweep STUDY.toml`, `usm-study merge DIR... --out DIR`, `usm-study report DIR`:
-//! the batch engine's commands (SPEC §7; schema in `docs/study-format.md`).
+//! the batch engine's commands (docs/model.md §7; schema in `docs/study-format.md`).
 //!
 //! Each writes the output directory's `report.html` (the design-review page) last.
 //!
@@ -12,13 +12,14 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
+use usm_study::optimise::tune::{Tuner, HOOK as TUNING};
 use usm_study::pipeline::review::write_review;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::engine::output_dir;
+use usm_study::study::outdir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
-use usm_study::study::shards::{slurm_script, SlurmPlan};
-use usm_study::study::tune::Tuner;
+use usm_study::study::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
 use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
 
 /// Arguments of `sweep`.
@@ -82,6 +83,7 @@ fn emit_slurm(a: &SweepArgs, study: &usm_study::study::Study, file: &Path) -> an
         cpus: if a.jobs == 0 { 1 } else { a.jobs },
         case_timeout_s: a.case_timeout,
         name: study.name.clone(),
+        force: a.force,
     };
     usm_study::report::atomic_write(file, slurm_script(&plan).as_bytes())
         .map_err(|e| anyhow!(e.to_string()))?;
@@ -182,6 +184,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         max_cases: a.max_cases,
         case_timeout: case_budget(a.case_timeout)?,
         force: a.force,
+        tuning: Some(TUNING),
     };
     if a.dry_run {
         let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
@@ -268,23 +271,42 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
 #[derive(Debug, Args)]
 pub struct MergeArgs {
     /// Shard output directories (each with manifest.json and cases.partial.csv).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "list")]
     pub dirs: Vec<PathBuf>,
+    /// Read the shard directories from FILE, one a line (relative to the file's directory),
+    /// after those given as arguments.
+    #[arg(long, value_name = "FILE")]
+    pub list: Option<PathBuf>,
     /// Output directory of the merged study.
     #[arg(long)]
     pub out: PathBuf,
+    /// Merge what is there although shards are missing, given twice or of different shard
+    /// counts (without it: exit 2 naming them).
+    #[arg(long)]
+    pub partial: bool,
+    /// Replace another study's output in the output directory (only files usm-study wrote).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Run `usm-study merge`.
 pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
-    let (m, warnings) = merge(&a.dirs, &a.out).map_err(study_err)?;
+    let mut dirs = a.dirs.clone();
+    if let Some(list) = &a.list {
+        dirs.extend(read_shard_list(list).map_err(study_err)?);
+    }
+    let opts = MergeOptions {
+        partial: a.partial,
+        force: a.force,
+    };
+    let (m, warnings) = merge(&dirs, &a.out, opts, Some(TUNING)).map_err(study_err)?;
     for w in &warnings {
         eprintln!("[merge] warning: {w}");
     }
     review("merge", &a.out)?;
     eprintln!(
         "[merge] {} directories: {} cases ({} ok, {} unsuccessful, {} failed, {} skipped); wrote {}",
-        a.dirs.len(),
+        dirs.len(),
         m.cases.in_output,
         m.cases.ok,
         m.cases.unsuccessful,
@@ -336,13 +358,33 @@ pub(crate) fn review(verb: &str, dir: &Path) -> anyhow::Result<()> {
 }
 
 /// Run `usm-study report`: regenerate `summary.md` and the plots of a sweep directory (one
-/// with a case table), then `report.html`.
+/// with a case table), then `report.html`. Refused (exit 2) for a folder that is not a
+/// finished output (no `manifest.json` or `summary.json`) and while another run holds its
+/// lock (the report takes the lock itself).
 pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
     if !a.dir.is_dir() {
         bail!("{} is not a directory", a.dir.display());
     }
-    if a.dir.join(CASES_PARQUET).is_file() || a.dir.join(PARTIAL_FILE).is_file() {
-        let warnings = report(&a.dir).map_err(study_err)?;
+    let dir = &outdir::resolve(&a.dir).map_err(study_err)?;
+    let lock = outdir::lock(
+        dir,
+        &outdir::LockOwner {
+            study: "",
+            resume: false,
+        },
+    )
+    .map_err(study_err)?;
+    outdir::check_contained(dir).map_err(study_err)?;
+    if !dir.join("manifest.json").is_file() && !dir.join("summary.json").is_file() {
+        bail!(
+            "{} is not a finished usm-study output (no manifest.json or summary.json); an \
+             interrupted sweep is finished with `sweep STUDY --out {} --resume`",
+            a.dir.display(),
+            a.dir.display()
+        );
+    }
+    if dir.join(CASES_PARQUET).is_file() || dir.join(PARTIAL_FILE).is_file() {
+        let warnings = report(dir).map_err(study_err)?;
         for w in &warnings {
             eprintln!("[report] warning: {w}");
         }
@@ -353,8 +395,10 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
                 warnings.len()
             );
         }
+        outdir::record_owned(dir, lock.created, &outdir::SWEEP_FILES).map_err(study_err)?;
         eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
     }
-    review("report", &a.dir)?;
+    review("report", dir)?;
+    drop(lock);
     Ok(ExitCode::SUCCESS)
 }

@@ -1,5 +1,5 @@
 //! `usm-study tcm DESIGN`: static configuration-space analysis of the thruster configuration
-//! matrix (SPEC §6) — how often `T(q)` is singular over the joint space. The files written are
+//! matrix (docs/model.md §6) — how often `T(q)` is singular over the joint space. The files written are
 //! described in [`usm_study::pipeline::tcm`].
 
 use super::progress::Progress;
@@ -11,9 +11,9 @@ use usm_study::metrics::singularity::DEFAULT_RANK_REL_TOL;
 use usm_study::model::design::load_design;
 use usm_study::pipeline::tcm::{run_tcm, TcmConfig};
 use usm_study::report::fmt_num;
-use usm_study::sampling::Sampling;
-use usm_study::scenario::config::Mode;
-use usm_study::study::static_tcm::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
+use usm_study::sampling::{Sampling, UnknownSampling};
+use usm_study::scenario::Mode;
+use usm_study::statics::{Distribution, StaticSpec, StaticSummary, DEFAULT_THRESHOLD};
 
 /// Most `--samples` accepted: 16 bytes are kept per sample (0.8 GB at the cap); more would
 /// end in an allocation abort instead of a message.
@@ -25,7 +25,7 @@ pub struct TcmArgs {
     /// Preset name (usm-paper, uvms-planar) or path to a design file (TOML).
     pub design: String,
     /// Number of joint configurations sampled within the joint limits.
-    #[arg(long, default_value_t = usm_study::study::static_tcm::DEFAULT_SAMPLES)]
+    #[arg(long, default_value_t = usm_study::statics::DEFAULT_SAMPLES)]
     pub samples: usize,
     /// Seed of the sampler.
     #[arg(long, default_value_t = 0)]
@@ -58,28 +58,40 @@ pub struct TcmArgs {
     #[arg(long, default_value = "transport", value_parser = parse_mode)]
     pub mode: Mode,
     /// Number of worst (lowest σ_min) configurations reported.
-    #[arg(long, default_value_t = usm_study::study::static_tcm::DEFAULT_WORST)]
+    #[arg(long, default_value_t = usm_study::statics::DEFAULT_WORST)]
     pub worst: usize,
 }
 
-fn parse_sampling(s: &str) -> Result<Sampling, String> {
+/// A command-line value of `tcm` that does not parse.
+#[derive(Debug, thiserror::Error)]
+enum ArgError {
+    /// `--mode` names no mode.
+    #[error("unknown mode '{0}'; valid: transport, work")]
+    Mode(String),
+    /// `--slice` is not two comma-separated values.
+    #[error("expected I,J (two joint indices), got '{0}'")]
+    Pair(String),
+    /// One value of `--slice` is not an index.
+    #[error("'{0}' is not a joint index")]
+    Index(String),
+}
+
+fn parse_sampling(s: &str) -> Result<Sampling, UnknownSampling> {
     s.parse()
 }
 
-fn parse_mode(s: &str) -> Result<Mode, String> {
+fn parse_mode(s: &str) -> Result<Mode, ArgError> {
     toml::Value::String(s.into())
         .try_into()
-        .map_err(|_| format!("unknown mode '{s}'; valid: transport, work"))
+        .map_err(|_| ArgError::Mode(s.into()))
 }
 
-fn parse_pair(s: &str) -> Result<(usize, usize), String> {
-    let (a, b) = s
-        .split_once(',')
-        .ok_or_else(|| format!("expected I,J (two joint indices), got '{s}'"))?;
+fn parse_pair(s: &str) -> Result<(usize, usize), ArgError> {
+    let (a, b) = s.split_once(',').ok_or_else(|| ArgError::Pair(s.into()))?;
     let p = |x: &str| {
         x.trim()
             .parse::<usize>()
-            .map_err(|_| format!("'{x}' is not a joint index"))
+            .map_err(|_| ArgError::Index(x.into()))
     };
     Ok((p(a)?, p(b)?))
 }
@@ -110,9 +122,9 @@ pub fn run(a: &TcmArgs) -> anyhow::Result<ExitCode> {
             char_length: a.char_length,
             rank_rel_tol: DEFAULT_RANK_REL_TOL,
             worst: a.worst,
-            mode: a.mode,
-            commanded: a.mode.default_commanded_dofs(),
-        },
+            ..StaticSpec::default()
+        }
+        .for_mode(a.mode),
         out: a.out.clone().unwrap_or_else(|| {
             Path::new("results/tcm").join(usm_study::report::file_stem_safe(&vehicle.name))
         }),

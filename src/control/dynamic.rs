@@ -1,4 +1,4 @@
-//! Dynamic (base) control (SPEC §5, USM section IV-B, USM-33/34): feedback-linearising
+//! Dynamic (base) control (docs/model.md §5, USM section IV-B, USM-33/34): feedback-linearising
 //! tracking of the base reference twist from the kinematic controller,
 //!
 //! `τ_c = M_11(q) a^b + n(R_Ib, q, ζ)` (USM-33),

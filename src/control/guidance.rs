@@ -1,4 +1,4 @@
-//! Line-of-sight guidance along a path of straight segments (SPEC §5 transport mode, USM-39).
+//! Line-of-sight guidance along a path of straight segments (docs/model.md §5 transport mode, USM-39).
 //!
 //! For the active segment `k` from `a_k` to `b_k` with direction `α_k` (angle of `b_k − a_k`
 //! about the inertial +z axis) and a point `p` (the front of the vehicle: the end-effector
@@ -24,7 +24,8 @@
 //! The last segment (and any segment still waiting for a timed successor) extends as a line
 //! beyond its end.
 
-use super::{check_finite, check_nonneg, check_pos, wrap_angle, ControlError};
+use super::{check_finite, check_nonneg, check_pos, ControlError};
+use crate::spatial::wrap_angle;
 use crate::spatial::Vec3;
 use serde::{Deserialize, Serialize};
 

@@ -1,8 +1,8 @@
-//! Kinematic control (SPEC §5, USM section IV-A, USM-27…32): damped weighted pseudoinverse,
+//! Kinematic control (docs/model.md §5, USM section IV-A, USM-27…32): damped weighted pseudoinverse,
 //! singularity-robust multiple task priority (SRMTP), and the task errors and Jacobians of the
 //! end-effector pose, base position and joint-limit tasks.
 //!
-//! - Damped weighted pseudoinverse (USM-31 with the usage-weight reading of SPEC §5):
+//! - Damped weighted pseudoinverse (USM-31 with the usage-weight reading of docs/model.md §5):
 //!   `J^# = U Jᵀ (J U Jᵀ + λ² I)⁻¹`, `U = diag(u)` a **usage** weight (`u_i = 0` forbids
 //!   coordinate `i`, larger `u_i` prefers it; the paper's `W` multiplies as `U`, not as `W⁻¹`).
 //! - SRMTP (USM-32): `ζ_r = J_1^#(σ̇_1d + Λ_1σ̃_1) + N_1 J_2^#(σ̇_2d + Λ_2σ̃_2) + …`, where the
@@ -524,7 +524,7 @@ impl Srmtp {
     }
 }
 
-/// End-effector pose error `ẽ = [p̃_e; ε̃_e]` in the end-effector frame (SPEC §5, USM-42):
+/// End-effector pose error `ẽ = [p̃_e; ε̃_e]` in the end-effector frame (docs/model.md §5, USM-42):
 /// `p̃_e = R_Ieᵀ (p_d − p_Ie)` [m] and `ε̃_e` the quaternion vector-part error of
 /// [`super::orientation_error`] (current → desired, in `F_e`). `g_ie` is the end-effector pose
 /// in `I`; `p_d` [m, `I`] and `q_d` (maps `F_e,d` vectors to `I`) the setpoint. With
@@ -541,7 +541,7 @@ pub fn ee_pose(base: &BasePose, g_be: &Se3) -> Se3 {
     base.to_se3().compose(g_be)
 }
 
-/// Base-position task Jacobian (SPEC §5, USM-42): `J_b = [R_Ib 0_{3×(n+3)}]`, 3×(6+n), so that
+/// Base-position task Jacobian (docs/model.md §5, USM-42): `J_b = [R_Ib 0_{3×(n+3)}]`, 3×(6+n), so that
 /// `ṗ_Ib = J_b ζ` (inertial, m/s). `out` must be 3×(6+n); every entry is written.
 pub fn base_position_jacobian(r_ib: &Mat3, out: &mut Mat<f64>) {
     for r in 0..3 {

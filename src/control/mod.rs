@@ -1,4 +1,4 @@
-//! Control laws of the USM motion-control framework (SPEC §5, USM section IV–V, Fig. 5):
+//! Control laws of the USM motion-control framework (docs/model.md §5, USM section IV–V, Fig. 5):
 //! guidance → kinematic control → dynamic control (→ thrust allocation, in [`crate::allocation`]).
 //!
 //! | module | law | equations |
@@ -10,13 +10,12 @@
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
 //! | [`work`] | work mode: end-effector pose + base position by SRMTP | USM-42 |
 //! | [`dynamic`] | feedback-linearising base control | USM-33/34 |
-//! | [`sliding`] | sliding-mode base control (Antonelli & Chiaverini case 3) | AC ref. [1] |
 //!
 //! Every controller is split like the rest of the crate: settings (serde-deserialisable,
 //! `deny_unknown_fields`, defaults = the paper's values), a controller struct that owns all
 //! its buffers and state (integrators), and a per-step call that does not allocate.
 //!
-//! Frames and units (SPEC §1): inertial frame `I` with z up; base frame `F_b` at the tail
+//! Frames and units (docs/model.md §1): inertial frame `I` with z up; base frame `F_b` at the tail
 //! face of body 0; end-effector frame `F_e` at the front face of the last body. Twists are
 //! `[v; ω]` (m/s, rad/s) in the frame named by the variable (`v_b` in `F_b`, `v_e` in `F_e`);
 //! the generalised velocity is `ζ = [V_b; q̇]`. Angles in radians. The *heading* ψ of a frame is
@@ -26,14 +25,12 @@ pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
-pub mod sliding;
 pub mod spline;
 pub mod transport;
 pub mod work;
 
-use crate::spatial::{quat_error_vec, Mat3, Vec3};
+use crate::spatial::{quat_error_vec, Vec3};
 use nalgebra::UnitQuaternion;
-use std::f64::consts::PI;
 use thiserror::Error;
 
 pub use dynamic::{DynamicController, DynamicGains, DynamicOutput};
@@ -97,57 +94,7 @@ pub(crate) fn check_pos(key: &str, x: f64) -> Result<(), ControlError> {
     Ok(())
 }
 
-/// Wrap an angle [rad] into `(−π, π]`.
-#[inline]
-pub fn wrap_angle(a: f64) -> f64 {
-    if !a.is_finite() {
-        return a;
-    }
-    let mut w = a.rem_euclid(2.0 * PI); // [0, 2π)
-    if w > PI {
-        w -= 2.0 * PI;
-    }
-    w
-}
-
-/// Heading ψ [rad] of a frame whose orientation in `I` is `r`: the yaw of its x axis about
-/// the inertial +z axis, `ψ = atan2(R₁₀, R₀₀)` (equal to the ZYX yaw angle), in `(−π, π]`.
-#[inline]
-pub fn heading(r: &Mat3) -> f64 {
-    r[(1, 0)].atan2(r[(0, 0)])
-}
-
-/// Time derivative ψ̇ [rad/s] of [`heading`] for a frame with orientation `r` (in `I`) and
-/// body-fixed angular velocity `omega` (rad/s, in the same frame): with `Ṙ = R ω̂`,
-/// `Ṙ e_x = R (ω × e_x) = R (0, ω_z, −ω_y)`, and `ψ̇ = (R₀₀ Ṙ₁₀ − R₁₀ Ṙ₀₀)/(R₀₀² + R₁₀²)`.
-/// Equal to ω_z for a frame level in the horizontal plane; 0 when the x axis is vertical.
-#[inline]
-pub fn heading_rate(r: &Mat3, omega: &Vec3) -> f64 {
-    let (r00, r10) = (r[(0, 0)], r[(1, 0)]);
-    let d00 = r[(0, 1)] * omega.z - r[(0, 2)] * omega.y;
-    let d10 = r[(1, 1)] * omega.z - r[(1, 2)] * omega.y;
-    let den = r00 * r00 + r10 * r10;
-    if den < 1e-12 {
-        0.0
-    } else {
-        (r00 * d10 - r10 * d00) / den
-    }
-}
-
-/// Gradient of [`heading`] with respect to the frame's body-fixed angular velocity: the row
-/// `g(R)` with `ψ̇ = g(R)·ω` — [`heading_rate`] is linear in `ω`, so `g` is its value on the
-/// unit vectors: `g = (0, R₁₀R₀₂ − R₀₀R₁₂, R₀₀R₁₁ − R₁₀R₀₁)/(R₀₀² + R₁₀²)`. Equal to `e_z`
-/// for a frame level in the horizontal plane; zero when the x axis is vertical.
-#[inline]
-pub fn heading_gradient(r: &Mat3) -> Vec3 {
-    Vec3::new(
-        heading_rate(r, &Vec3::x()),
-        heading_rate(r, &Vec3::y()),
-        heading_rate(r, &Vec3::z()),
-    )
-}
-
-/// Orientation error `ε̃` of the end-effector task (SPEC §5, USM-42): the vector part of the
+/// Orientation error `ε̃` of the end-effector task (docs/model.md §5, USM-42): the vector part of the
 /// error quaternion `q⁻¹ ⊗ q_d` (sign chosen with a non-negative scalar part), i.e. the rotation
 /// that takes the current frame onto the desired one, **expressed in the current frame**
 /// (`≈ ½ θ a` for a small rotation `θ` about the unit axis `a`). Both quaternions map
@@ -165,38 +112,7 @@ pub fn orientation_error(q_d: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spatial::{quat_integrate, rot_axis_angle};
-
-    #[test]
-    fn wrap_angle_range() {
-        for (a, w) in [
-            (0.0, 0.0),
-            (PI, PI),
-            (-PI, PI),
-            (3.0 * PI, PI),
-            (1.5 * PI, -0.5 * PI),
-            (-1.5 * PI, 0.5 * PI),
-            (7.0, 7.0 - 2.0 * PI),
-        ] {
-            assert!(
-                (wrap_angle(a) - w).abs() < 1e-12,
-                "{a} -> {}",
-                wrap_angle(a)
-            );
-        }
-    }
-
-    #[test]
-    fn heading_rate_matches_difference() {
-        let r = rot_axis_angle(&Vec3::new(0.3, 0.5, 0.8).normalize(), 0.9);
-        let w = Vec3::new(0.2, -0.4, 0.7);
-        let h = 1e-6;
-        let rp = r * rot_axis_angle(&w.normalize(), w.norm() * h);
-        let rm = r * rot_axis_angle(&w.normalize(), -w.norm() * h);
-        let fd = wrap_angle(heading(&rp) - heading(&rm)) / (2.0 * h);
-        // Central difference of an O(1) smooth function: error ~h² + 1e-16/h ≈ 1e-10.
-        assert!((heading_rate(&r, &w) - fd).abs() < 1e-8);
-    }
+    use crate::spatial::quat_integrate;
 
     #[test]
     fn orientation_error_feedback_converges() {

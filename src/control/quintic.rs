@@ -1,5 +1,5 @@
 //! Quintic point-to-point references (Antonelli & Chiaverini, section 5: "a quintic polynomial
-//! interpolating law with null initial and final velocities and accelerations"; SPEC §8).
+//! interpolating law with null initial and final velocities and accelerations"; docs/model.md §8).
 //!
 //! The timing law `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵`, `τ = t/T ∈ [0, 1]`, is the unique quintic with
 //! `s(0) = 0`, `s(1) = 1` and zero first and second derivatives at both ends. A scalar reference

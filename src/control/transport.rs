@@ -1,11 +1,11 @@
-//! Transport mode (SPEC §5, USM section V-A): LOS path following with joint bending and base
+//! Transport mode (docs/model.md §5, USM section V-A): LOS path following with joint bending and base
 //! surge/yaw accelerations.
 //!
 //! - **Joint references (USM-38)**: `q_r,i = s_q k_ψ wrap(ψ − ψ_r)` for the yaw joints, 0 for the
 //!   others (pitch), clamped to the joint limits. `ψ` is the heading of the front link (the yaw of
 //!   the end-effector frame about inertial +z), `ψ_r` from [`super::guidance`] (USM-39).
 //!
-//!   **Sign `s_q` (`joint_sign`, default −1).** Our joint convention (SPEC §1) makes a positive
+//!   **Sign `s_q` (`joint_sign`, default −1).** Our joint convention (docs/model.md §1) makes a positive
 //!   yaw-joint angle rotate the child counter-clockwise about +z (seen from above, z up)
 //!   relative to its parent, so in a level configuration the head's heading relative to the tail
 //!   is `ψ − ψ_b = Σ q_yaw`. If the head points left of the reference (`ψ > ψ_r`) the body must
@@ -43,7 +43,7 @@
 //!
 //! # Interpretation choices and why (results/paper/FINDINGS.md has the numbers)
 //!
-//! `usm-study paper readings` (`crate::pipeline::readings`) runs both Table III methods under
+//! `usm-study paper readings` (`crate::paper::readings`) runs both Table III methods under
 //! all 32 combinations of the open choices (n or not, feedback on the uncommanded axes or not,
 //! front-heading or base yaw rate, with or without `ψ̇_r`, PI or PD surge). Only the default
 //! below (no `n`, feedback, front-heading rate, `ψ̇ − ψ̇_r`, PI: two departures from the
@@ -76,12 +76,11 @@
 
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
 use super::kinematic::SecondaryTasks;
-use super::{
-    check_finite, check_nonneg, check_pos, heading, heading_rate, wrap_angle, ControlError,
-};
+use super::{check_finite, check_nonneg, check_pos, ControlError};
 use crate::kinematics::{BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{ang, lin, Vec3, Vec6};
+use crate::spatial::{heading, heading_rate, wrap_angle};
 use serde::{Deserialize, Serialize};
 
 /// The paper's two transport methods (USM section VI-B, Table III).

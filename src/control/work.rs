@@ -1,10 +1,10 @@
-//! Work mode (SPEC §5, USM section V-B, USM-42): end-effector pose regulation with the base
+//! Work mode (docs/model.md §5, USM section V-B, USM-42): end-effector pose regulation with the base
 //! held at a home position in the null space, by SRMTP:
 //!
 //! `ζ_r = J_e^#(q) (V_e,d + k_e ẽ) + (I − J_e^# J_e) J_b⁺ k_b p̃_b`
 //!
 //! - `J_e` the end-effector Jacobian (6×(6+n), `F_e`, USM-18), `J_e^#` its weighted
-//!   pseudoinverse with usage weights `U`, as printed: `U J_eᵀ (J_e U J_eᵀ)⁻¹` (SPEC §5 reads
+//!   pseudoinverse with usage weights `U`, as printed: `U J_eᵀ (J_e U J_eᵀ)⁻¹` (docs/model.md §5 reads
 //!   the paper's `W` as a usage weight). Damping is only a singularity-robust option: with
 //!   `σ = σ_min(J_e U^{1/2})` below the singular region ε ([`WorkGains::singular_region`]),
 //!   `J_e^# = U J_eᵀ (J_e U J_eᵀ + λ² I)⁻¹` with the variable damping

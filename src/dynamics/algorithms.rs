@@ -1,4 +1,4 @@
-//! Recursive multibody algorithms on the floating-base chain (SPEC §4, USM-19 … USM-22):
+//! Recursive multibody algorithms on the floating-base chain (docs/model.md §4, USM-19 … USM-22):
 //! composite-rigid-body mass matrix, recursive Newton–Euler bias forces and inverse
 //! dynamics, forward and hybrid dynamics, energy and momentum.
 //!
@@ -165,7 +165,7 @@ pub fn forward_dynamics(
 
 /// Hybrid dynamics from the `M` and `h` already in the workspace (after
 /// [`dynamics_terms`]): the joints follow the prescribed `qdd` [rad/s²] and the base obeys
-/// `M_11 V̇_b = τ_b − M_12 q̈ − h_1` (SPEC §4, 6×6 Cholesky); the joint torques are recovered
+/// `M_11 V̇_b = τ_b − M_12 q̈ − h_1` (docs/model.md §4, 6×6 Cholesky); the joint torques are recovered
 /// as `τ_q = M_21 V̇_b + M_22 q̈ + h_2 − Q_ext,q` into `ws.joint_torque`, and
 /// `ws.zeta_dot = [V̇_b; q̈]`.
 ///
@@ -223,7 +223,7 @@ pub fn solve_hybrid(ws: &mut DynWorkspace, q_ext: &[f64], qdd: &[f64]) -> Result
     check_finite("joint_torques", &ws.joint_torque)
 }
 
-/// Hybrid dynamics (SPEC §4, ideal servos): prescribed joint accelerations `qdd`
+/// Hybrid dynamics (docs/model.md §4, ideal servos): prescribed joint accelerations `qdd`
 /// [rad/s²], base acceleration from `M_11 V̇_b = τ_b − M_12 q̈ − h_1`, joint torques
 /// recovered. Arguments as in [`bias`], plus `q_ext` (see [`solve_hybrid`]).
 #[allow(clippy::too_many_arguments)]
@@ -266,7 +266,7 @@ pub fn kinetic_energy(
 /// Total spatial momentum `[p; L]` in the inertial frame about the inertial origin
 /// [N·s, N·m·s]: `Σ_i Ad_{g_Ii}⁻ᵀ (I_RB,i + M_A,i) V_i` (`M_A` only when
 /// `opts.added_mass`), with the absolute body twists `V_i`. Conserved under zero external
-/// forces when the fluid is at rest (SPEC §4).
+/// forces when the fluid is at rest (docs/model.md §4).
 pub fn spatial_momentum(
     v: &Vehicle,
     ws: &mut DynWorkspace,

@@ -1,10 +1,10 @@
-//! Simulator configuration (SPEC §4 joint actuation, SPEC §2 thruster dynamics): the joint
+//! Simulator configuration (docs/model.md §4 joint actuation, docs/model.md §2 thruster dynamics): the joint
 //! [`ServoModel`], the [`ThrusterModel`], the time [`Integrator`] and the [`SimConfig`] that
 //! bundles them with the [`DynOptions`], each default beside its field and a `validate()`.
 
 use super::{DynOptions, SimError};
 
-/// Joint servo model (SPEC §4 joint actuation).
+/// Joint servo model (docs/model.md §4 joint actuation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ServoModel {
     /// Ideal servos: the joints follow the second-order reference filter
@@ -38,7 +38,7 @@ impl ServoModel {
     pub const DEFAULT_ZETA: f64 = 1.0;
 }
 
-/// Thruster dynamics model (SPEC §2: optional lag and rate limit per thruster).
+/// Thruster dynamics model (docs/model.md §2: optional lag and rate limit per thruster).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ThrusterModel {
     /// Actual thrust = saturated command.

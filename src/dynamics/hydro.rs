@@ -1,4 +1,4 @@
-//! Hydrodynamic and hydrostatic kernels (SPEC §2, §4): pure functions of one body's local
+//! Hydrodynamic and hydrostatic kernels (docs/model.md §2, §4): pure functions of one body's local
 //! quantities, MuJoCo style. Every twist is the body's *relative* twist
 //! `V_r = V − [R_Iiᵀ ν_c; 0]` (m/s, rad/s) in the body frame (origin at the rear face, x
 //! towards the head), and every returned wrench `[f; m]` (N, N·m) acts on the body, in the
@@ -8,7 +8,7 @@ use super::manoeuvring::ManoeuvringKernel;
 use crate::model::{Body, Hydro};
 use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 
-/// Strip-theory drag of a slender cylinder along its body x axis (SPEC §2), with the
+/// Strip-theory drag of a slender cylinder along its body x axis (docs/model.md §2), with the
 /// constants folded in once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CylinderDrag {
@@ -53,7 +53,7 @@ impl CylinderDrag {
         }
     }
 
-    /// The damping wrench on the body for relative twist `v_r` (SPEC §2):
+    /// The damping wrench on the body for relative twist `v_r` (docs/model.md §2):
     /// cross-flow `−½ρ C_d,y|z (2r) |v⊥(s)| v⊥(s)` per unit length with
     /// `v⊥(s) = (0, v_y + ω_z s, v_z − ω_y s)` integrated by the midpoint rule (so rotation
     /// makes moments), axial `−½ρ C_d,x πr² |u| u`, and linear damping at the centre.
@@ -94,7 +94,7 @@ impl CylinderDrag {
     }
 }
 
-/// Coefficient damping about the body frame origin (SPEC §2 `Hydro::Coefficients`):
+/// Coefficient damping about the body frame origin (docs/model.md §2 `Hydro::Coefficients`):
 /// `−(D_l ν_r + D_q (|ν_r| ∘ ν_r))`, `v_r` the relative twist.
 #[inline]
 pub fn coefficient_damping(d_l: &Mat6, d_q: &Mat6, v_r: &Vec6) -> Vec6 {
@@ -116,7 +116,7 @@ pub enum DampingKernel {
         /// `D_q`.
         quadratic: Mat6,
     },
-    /// Manoeuvring derivatives of a streamlined hull (NPS AUV II, SPEC §8 case 3).
+    /// Manoeuvring derivatives of a streamlined hull (NPS AUV II, docs/model.md §8 case 3).
     Manoeuvring(Box<ManoeuvringKernel>),
 }
 
@@ -179,7 +179,7 @@ impl DampingKernel {
     }
 }
 
-/// Hydrostatic parameters of one body (SPEC §4 restoring forces).
+/// Hydrostatic parameters of one body (docs/model.md §4 restoring forces).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Restoring {
     /// Weight `m g` [N].
@@ -204,7 +204,7 @@ impl Restoring {
         }
     }
 
-    /// The restoring wrench on the body (SPEC §4, USM-19 `N`): weight `−m g e_z` at the CG
+    /// The restoring wrench on the body (docs/model.md §4, USM-19 `N`): weight `−m g e_z` at the CG
     /// and buoyancy `+ρ V g e_z` at the CB, both along the inertial vertical. `r_ii` is the
     /// body's orientation `R_Ii` (body → inertial).
     #[inline]
@@ -267,7 +267,7 @@ mod tests {
     #[test]
     fn pure_translation_drag_closed_form() {
         // A cylinder in pure cross-flow v_y: every strip sees the same v, so the total is
-        // exactly −½ρ C_d,y (2r) l v|v| − d_y v (SPEC §2), acting at the centre.
+        // exactly −½ρ C_d,y (2r) l v|v| − d_y v (docs/model.md §2), acting at the centre.
         let c = cyl();
         let v = 0.7;
         let w = c.wrench(&Vec6::new(0.0, v, 0.0, 0.0, 0.0, 0.0));

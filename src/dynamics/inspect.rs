@@ -8,7 +8,7 @@ use crate::model::Vehicle;
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-/// Dynamics at one state (SPEC §4), JSON keys as named.
+/// Dynamics at one state (docs/model.md §4), JSON keys as named.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DynamicsReport {
     /// Mass matrix `M(q)` (USM-22), rows of length 6+n; base block in `F_b`.

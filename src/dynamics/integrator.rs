@@ -258,7 +258,7 @@ pub(super) struct Quadrature<'a> {
 /// its sign, else the sum of `|Δy|` over the pieces between the sign changes of the rate,
 /// located on the cubic Hermite interpolant of `(y0, p0, y1, p1)` (its derivative is a
 /// quadratic; the pieces add up to `y1 − y0` exactly). This keeps the kinks of `|ẏ|` out of
-/// the integrator: the joint work `Σ_k ∫ |τ_k q̇_k| dt` (SPEC §6) is integrated as the smooth
+/// the integrator: the joint work `Σ_k ∫ |τ_k q̇_k| dt` (docs/model.md §6) is integrated as the smooth
 /// signed work of each joint and folded here, so its error is the integrator's own plus
 /// `O(h⁴)` at each sign change, instead of the `O(h²)` of integrating a kinked integrand.
 pub(crate) fn abs_increment(y0: f64, y1: f64, p0: f64, p1: f64, h: f64) -> f64 {

@@ -1,4 +1,4 @@
-//! The manoeuvring-derivative kernel (SPEC §8 case 3, [`Manoeuvring`]): a pure function of
+//! The manoeuvring-derivative kernel (docs/model.md §8 case 3, [`Manoeuvring`]): a pure function of
 //! one body's relative twist `V_r` (body frame, at its origin) returning the hydrodynamic
 //! wrench other than inertia (body frame, about its origin), split into its three parts so
 //! that reports can say which term carries a force.
@@ -83,54 +83,5 @@ impl ManoeuvringKernel {
     #[inline]
     pub fn wrench(&self, v_r: &Vec6) -> Vec6 {
         self.parts(v_r).total()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::nps_auv2::{nps_auv2_hydro, LENGTH, RHO};
-    use proptest::prelude::*;
-
-    fn kernel() -> ManoeuvringKernel {
-        ManoeuvringKernel::new(&nps_auv2_hydro(RHO))
-    }
-
-    /// `v_r` at the body origin for a twist `nu` at CO in SNAME axes.
-    fn at_origin(k: &ManoeuvringKernel, nu: &Vec6) -> Vec6 {
-        k.g.twist_to_parent(nu)
-    }
-
-    #[test]
-    fn pure_sway_matches_the_mss_expressions() {
-        // u = 0, v = 0.2 m/s (SNAME): X = r2 Xvv v², Z = r2 Zvv v², M = r3 Mvv v², and the
-        // cross-flow −½ρ (L/10)·11·Cdy·Hx·v|v| on Y with no yaw moment (symmetric stations).
-        let k = kernel();
-        let v = 0.2;
-        let nu = Vec6::new(0.0, v, 0.0, 0.0, 0.0, 0.0);
-        let p = k.parts(&at_origin(&k, &nu));
-        let back = |w: &Vec6| k.g.wrench_to_child(w);
-        let (r2, r3) = (0.5 * RHO * LENGTH.powi(2), 0.5 * RHO * LENGTH.powi(3));
-        let prod = back(&p.products);
-        assert!((prod[0] - r2 * 5.3e-2 * v * v).abs() < 1e-9);
-        assert!((prod[2] - r2 * -6.8e-2 * v * v).abs() < 1e-9);
-        assert!((prod[4] - r3 * -2.6e-2 * v * v).abs() < 1e-9);
-        let cf = back(&p.crossflow);
-        let expect = -0.5 * RHO * 0.5 * 0.53 * 1.1 * LENGTH * v * v;
-        assert!((cf[1] - expect).abs() < 1e-9 * expect.abs(), "{}", cf[1]);
-        assert!(cf[5].abs() < 1e-9, "{}", cf[5]);
-    }
-
-    proptest! {
-        #[test]
-        fn resistance_and_crossflow_dissipate(v in proptest::array::uniform6(-2.0f64..2.0)) {
-            // The drag parts never add energy: V_rᵀ F ≤ 0 (the velocity products may: they
-            // are lift terms, linear in the surge speed).
-            let k = kernel();
-            let v = Vec6::from_row_slice(&v);
-            let p = k.parts(&v);
-            prop_assert!(v.dot(&p.resistance) <= 1e-12);
-            prop_assert!(v.dot(&p.crossflow) <= 1e-9);
-        }
     }
 }

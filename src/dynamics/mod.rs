@@ -1,4 +1,4 @@
-//! Floating-base hydrodynamic multibody dynamics (SPEC §4, USM-19 … USM-22, USM-35).
+//! Floating-base hydrodynamic multibody dynamics (docs/model.md §4, USM-19 … USM-22, USM-35).
 //!
 //! The equation of motion, with the base twist `V_b = [v; ω]` in the base frame `F_b` and
 //! generalised velocity `ζ = [V_b; q̇]` (size 6+n):
@@ -64,7 +64,7 @@ pub use workspace::DynWorkspace;
 
 use thiserror::Error;
 
-/// Which physical effects enter the dynamics (SPEC §4).
+/// Which physical effects enter the dynamics (docs/model.md §4).
 ///
 /// `full()` is the paper's model and the default (every field on); `rigid()` is the vehicle
 /// in vacuum (no added mass, no drag, no restoring forces, no current) — what

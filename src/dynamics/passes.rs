@@ -1,5 +1,5 @@
 //! The staged passes of the recursive algorithms (MuJoCo's position → velocity →
-//! acceleration staging, SPEC §4): inertial orientations and the composite-rigid-body mass
+//! acceleration staging, docs/model.md §4): inertial orientations and the composite-rigid-body mass
 //! matrix after the position pass, then the Newton–Euler forward pass (twists,
 //! accelerations), the per-body wrenches and the backward pass into generalised forces.
 //! The public algorithms of [`super::algorithms`] chain them; names and frames as in
@@ -154,7 +154,7 @@ pub(super) fn body_current(v: &Vehicle, ws: &DynWorkspace, opts: &DynOptions, i:
     }
 }
 
-/// Body twist relative to the water, `V_r = V_i − [v_c; 0]` (SPEC §4; `v_c` the body-frame
+/// Body twist relative to the water, `V_r = V_i − [v_c; 0]` (docs/model.md §4; `v_c` the body-frame
 /// current [m/s], the angular part unchanged).
 #[inline]
 pub(super) fn relative_twist(vi: &Vec6, vc: &Vec3) -> Vec6 {
@@ -173,7 +173,7 @@ pub(super) fn uses_current(v: &Vehicle, opts: &DynOptions) -> bool {
     opts.current && v.fluid.current != Vec3::zeros()
 }
 
-/// Per-body Newton–Euler wrench (SPEC §4), after [`forward_pass`]:
+/// Per-body Newton–Euler wrench (docs/model.md §4), after [`forward_pass`]:
 ///
 /// `f_i = I_RB a_i + V_i ×* (I_RB V_i) + M_A (a_i + [ω_i × v_c; 0]) + V_r ×* (M_A V_r)
 ///        − F_damp(V_r) − F_restoring(R_Ii)`,

@@ -1,4 +1,4 @@
-//! Actuator models, the Lie-group time integrators and the [`Simulator`] (SPEC §4).
+//! Actuator models, the Lie-group time integrators and the [`Simulator`] (docs/model.md §4).
 //!
 //! State: base pose (inertial position, unit quaternion `R_Ib`), joint angles, base twist
 //! `V_b` in `F_b`, joint rates, and one thrust state per thruster. Joint servos are either
@@ -11,7 +11,7 @@
 //! The flat state `x = [p, Q, q, V_b, q̇, S]` with the quaternion kinematics
 //! `Q̇ = ½ Q ⊗ [0; ω]`, `ṗ = R_Ib v`, `q̇`, `ζ̇` and each joint's signed work
 //! `Ṡ_k = τ_k q̇_k`, a quadrature state outside the error control: the joint work
-//! `W = Σ_k ∫ |τ_k q̇_k| dt` (the joint-energy metric, SPEC §6) is integrated with the
+//! `W = Σ_k ∫ |τ_k q̇_k| dt` (the joint-energy metric, docs/model.md §6) is integrated with the
 //! motion instead of from logged samples, by folding each step's `ΔS_k` at the sign changes
 //! of `τ_k q̇_k` (`integrator::abs_increment`), so the kinks of `|τ_k q̇_k|` neither cost
 //! accuracy nor force small steps. Every stage uses the normalised stage
@@ -128,7 +128,7 @@ const fn work_index(n: usize) -> usize {
     JOINTS + 2 * n + 6
 }
 
-/// A simulator of one vehicle (SPEC §4): owns a copy of the vehicle, its [`DynWorkspace`],
+/// A simulator of one vehicle (docs/model.md §4): owns a copy of the vehicle, its [`DynWorkspace`],
 /// the state, the actuator models and the integrators' buffers; [`Simulator::step`] and
 /// [`Simulator::advance`] allocate nothing.
 #[derive(Clone, Debug)]
@@ -294,7 +294,7 @@ impl Simulator {
     }
 
     /// Joint work `W = ∫ Σ_k |τ_k q̇_k| dt` [J] since the simulator was built: the joint
-    /// energy of SPEC §6, integrated with the motion (same method and accuracy).
+    /// energy of docs/model.md §6, integrated with the motion (same method and accuracy).
     pub fn joint_work(&self) -> f64 {
         self.joint_work
     }
@@ -574,7 +574,7 @@ impl Simulator {
 }
 
 /// One stage: the time derivative `dx` of the flat state `x` with actual thrust `u_act`
-/// (SPEC §4 dynamics + the servo model, and the joint power `Σ|τ_k q̇_k|`). With
+/// (docs/model.md §4 dynamics + the servo model, and the joint power `Σ|τ_k q̇_k|`). With
 /// `terms_ready` the workspace already holds `M`, `h` and the kinematics of `x`.
 #[allow(clippy::too_many_arguments)]
 fn eval_stage(

@@ -1,4 +1,4 @@
-//! The thruster model of the [`Simulator`](super::Simulator) (SPEC §4): a first-order lag
+//! The thruster model of the [`Simulator`](super::Simulator) (docs/model.md §4): a first-order lag
 //! with time constant `T` and rate limit `r`, either of which may be absent, solved in closed
 //! form (`u̇ = clamp((u_c − u)/T, −r, r)`), and the saturation to the thrust limits.
 

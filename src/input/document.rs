@@ -247,6 +247,39 @@ impl Document {
     }
 }
 
+/// Largest input file (study, problem, design, scenario, state, case file) read [bytes]:
+/// hand-written input is a few kB; anything past this is refused before it fills memory.
+pub const MAX_INPUT_BYTES: u64 = 16 << 20;
+
+/// The text of the input file `path`, as `std::fs::read_to_string` returns it, but refused
+/// before reading when the file is larger than [`MAX_INPUT_BYTES`], and after reading that many
+/// bytes from anything that is not a regular file (`/dev/zero`, a FIFO): an input file never
+/// fills memory. The error names the limit.
+pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if meta.is_dir() {
+        return Err(std::io::Error::other("is a directory, not a file"));
+    }
+    let too_large = || {
+        std::io::Error::other(format!(
+            "larger than {} MiB, the limit of an input file (is it the right file?)",
+            MAX_INPUT_BYTES >> 20
+        ))
+    };
+    if meta.len() > MAX_INPUT_BYTES {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_INPUT_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(too_large());
+    }
+    String::from_utf8(bytes)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "is not UTF-8 text"))
+}
+
 /// Deserialise an in-memory table into `T`. On failure the table is printed and parsed
 /// again so that the error names its key path (keys under `prefix`, e.g. `control`);
 /// the success path is a plain `T::deserialize` of the table.

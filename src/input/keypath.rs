@@ -41,14 +41,121 @@ impl fmt::Display for KeyPath {
 const MAX_LEN: usize = 512;
 const MAX_INDEX: usize = 1_000_000;
 
+/// Why a key path does not parse (positions are 1-based characters of `path`).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum KeyPathError {
+    /// The path is empty.
+    #[error("empty parameter path")]
+    Empty,
+    /// The path is longer than the limit.
+    #[error("parameter path longer than {MAX_LEN} characters")]
+    TooLong,
+    /// A key name was expected.
+    #[error("`{path}`: expected a key name at character {at}")]
+    ExpectedKey {
+        /// The path as written.
+        path: String,
+        /// Position.
+        at: usize,
+    },
+    /// `[` not followed by digits and `]`.
+    #[error("`{path}`: expected `[index]` with a non-negative integer at character {at}")]
+    BadIndex {
+        /// The path as written.
+        path: String,
+        /// Position of the `[`.
+        at: usize,
+    },
+    /// An index beyond the limit.
+    #[error("`{path}`: index too large at character {at}")]
+    IndexTooLarge {
+        /// The path as written.
+        path: String,
+        /// Position of the first digit.
+        at: usize,
+    },
+    /// A character that no rule of the grammar accepts there.
+    #[error("`{path}`: unexpected character `{found}` at position {at}")]
+    Unexpected {
+        /// The path as written.
+        path: String,
+        /// The character.
+        found: char,
+        /// Position.
+        at: usize,
+    },
+}
+
+/// Why [`set`] cannot assign a path in a table.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SetError {
+    /// The path does not start with a key.
+    #[error("`{shown}`: a path starts with a key")]
+    NoKey {
+        /// The path as the user wrote it.
+        shown: String,
+    },
+    /// An index beyond the array.
+    #[error("`{shown}`: index {index} is out of range, `{at}` has {len} element{}", if *.len == 1 { "" } else { "s" })]
+    OutOfRange {
+        /// The path as the user wrote it.
+        shown: String,
+        /// The index.
+        index: usize,
+        /// The array's path.
+        at: String,
+        /// The array's length.
+        len: usize,
+    },
+    /// A key below something that is not a table.
+    #[error("`{shown}`: `{at}` is a {found}, not a table with key `{key}`")]
+    NotATable {
+        /// The path as the user wrote it.
+        shown: String,
+        /// The path of the value.
+        at: String,
+        /// Its TOML type.
+        found: &'static str,
+        /// The key asked for.
+        key: String,
+    },
+    /// An index into something that is not an array.
+    #[error("`{shown}`: `{at}` is a {found}, not an array to index with [{index}]")]
+    NotAnArray {
+        /// The path as the user wrote it.
+        shown: String,
+        /// The path of the value.
+        at: String,
+        /// Its TOML type.
+        found: &'static str,
+        /// The index asked for.
+        index: usize,
+    },
+}
+
+/// The message of a key-path error, for callers that report messages (a located
+/// [`crate::input::located::InputError`], a skipped case's reason).
+impl From<KeyPathError> for String {
+    fn from(e: KeyPathError) -> String {
+        e.to_string()
+    }
+}
+
+/// The message of a [`SetError`] (see `From<KeyPathError> for String`).
+impl From<SetError> for String {
+    fn from(e: SetError) -> String {
+        e.to_string()
+    }
+}
+
 impl KeyPath {
     /// Parse a path; the error says what is wrong and where. Never panics.
-    pub fn parse(s: &str) -> Result<KeyPath, String> {
+    pub fn parse(s: &str) -> Result<KeyPath, KeyPathError> {
         if s.is_empty() {
-            return Err("empty parameter path".into());
+            return Err(KeyPathError::Empty);
         }
         if s.len() > MAX_LEN {
-            return Err(format!("parameter path longer than {MAX_LEN} characters"));
+            return Err(KeyPathError::TooLong);
         }
         let bytes = s.as_bytes();
         let mut segs = Vec::new();
@@ -60,10 +167,10 @@ impl KeyPath {
                 i += 1;
             }
             if i == start {
-                return Err(format!(
-                    "`{s}`: expected a key name at character {}",
-                    start + 1
-                ));
+                return Err(KeyPathError::ExpectedKey {
+                    path: s.to_string(),
+                    at: start + 1,
+                });
             }
             segs.push(Seg::Key(s[start..i].to_string()));
             while i < bytes.len() && bytes[i] == b'[' {
@@ -74,16 +181,19 @@ impl KeyPath {
                     i += 1;
                 }
                 if i == d0 || i >= bytes.len() || bytes[i] != b']' {
-                    return Err(format!(
-                        "`{s}`: expected `[index]` with a non-negative integer at character {}",
-                        open + 1
-                    ));
+                    return Err(KeyPathError::BadIndex {
+                        path: s.to_string(),
+                        at: open + 1,
+                    });
                 }
                 let n: usize = s[d0..i]
                     .parse()
                     .ok()
                     .filter(|n| *n <= MAX_INDEX)
-                    .ok_or_else(|| format!("`{s}`: index too large at character {}", d0 + 1))?;
+                    .ok_or_else(|| KeyPathError::IndexTooLarge {
+                        path: s.to_string(),
+                        at: d0 + 1,
+                    })?;
                 segs.push(Seg::Index(n));
                 i += 1;
             }
@@ -91,11 +201,11 @@ impl KeyPath {
                 break;
             }
             if bytes[i] != b'.' {
-                return Err(format!(
-                    "`{s}`: unexpected character `{}` at position {}",
-                    s[i..].chars().next().unwrap_or('?'),
-                    i + 1
-                ));
+                return Err(KeyPathError::Unexpected {
+                    path: s.to_string(),
+                    found: s[i..].chars().next().unwrap_or('?'),
+                    at: i + 1,
+                });
             }
             i += 1;
         }
@@ -175,9 +285,11 @@ pub fn set(
     path: &[Seg],
     value: toml::Value,
     shown: &str,
-) -> Result<(), String> {
+) -> Result<(), SetError> {
     let Some((Seg::Key(first), rest)) = path.split_first() else {
-        return Err(format!("`{shown}`: a path starts with a key"));
+        return Err(SetError::NoKey {
+            shown: shown.to_string(),
+        });
     };
     if rest.is_empty() {
         let old = table.get(first);
@@ -198,7 +310,7 @@ fn set_in(
     value: toml::Value,
     shown: &str,
     at: &str,
-) -> Result<(), String> {
+) -> Result<(), SetError> {
     let Some((seg, rest)) = path.split_first() else {
         let v = coerce(value, Some(node));
         *node = v;
@@ -220,21 +332,27 @@ fn set_in(
         (Seg::Index(i), toml::Value::Array(a)) => {
             let len = a.len();
             let Some(el) = a.get_mut(*i) else {
-                return Err(format!(
-                    "`{shown}`: index {i} is out of range, `{at}` has {len} element{}",
-                    if len == 1 { "" } else { "s" }
-                ));
+                return Err(SetError::OutOfRange {
+                    shown: shown.to_string(),
+                    index: *i,
+                    at: at.to_string(),
+                    len,
+                });
             };
             set_in(el, rest, value, shown, &format!("{at}[{i}]"))
         }
-        (Seg::Key(k), other) => Err(format!(
-            "`{shown}`: `{at}` is a {}, not a table with key `{k}`",
-            other.type_str()
-        )),
-        (Seg::Index(i), other) => Err(format!(
-            "`{shown}`: `{at}` is a {}, not an array to index with [{i}]",
-            other.type_str()
-        )),
+        (Seg::Key(k), other) => Err(SetError::NotATable {
+            shown: shown.to_string(),
+            at: at.to_string(),
+            found: other.type_str(),
+            key: k.clone(),
+        }),
+        (Seg::Index(i), other) => Err(SetError::NotAnArray {
+            shown: shown.to_string(),
+            at: at.to_string(),
+            found: other.type_str(),
+            index: *i,
+        }),
     }
 }
 
@@ -266,8 +384,8 @@ pub enum OverrideError {
     BadPath {
         /// The argument as given.
         arg: String,
-        /// Why the path does not parse.
-        reason: String,
+        /// Why the path does not parse (in the message, so not also a source).
+        reason: KeyPathError,
     },
 }
 
@@ -339,6 +457,42 @@ pub fn pattern_allowed(pattern: &str, names: &BTreeSet<String>, arrays: &BTreeSe
         }
     }
     false
+}
+
+/// The candidate closest to `name` by edit distance, when it is close enough to be a likely
+/// typo (at most a third of the name's characters, and at least one, differ); for "did you
+/// mean" hints. Ties go to the earlier candidate.
+pub fn closest<'c>(name: &str, candidates: impl IntoIterator<Item = &'c str>) -> Option<&'c str> {
+    let limit = (name.chars().count() / 3).max(1);
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+/// Levenshtein distance in characters (names are short: an O(nm) table row is fine).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diag = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let up = row[j + 1];
+            row[j + 1] = (diag + usize::from(ca != *cb)).min(up + 1).min(row[j] + 1);
+            diag = up;
+        }
+    }
+    row[b.len()]
+}
+
+/// `; did you mean `x`?` for the candidate [`closest`] to `name`, or nothing.
+pub fn did_you_mean<'c>(name: &str, candidates: impl IntoIterator<Item = &'c str>) -> String {
+    closest(name, candidates)
+        .map(|c| format!("; did you mean `{c}`?"))
+        .unwrap_or_default()
 }
 
 /// A pattern for display: `[]` shown as `[i]`.
@@ -432,5 +586,17 @@ mod tests {
         assert_eq!(parent_path("a.b[2]"), Some("a.b"));
         assert_eq!(parent_path("a"), None);
         assert_eq!(join_key("", "a"), "a");
+    }
+
+    #[test]
+    fn close_names_are_suggested_and_far_ones_not() {
+        let names = ["energy_per_metre", "thruster_energy", "success"];
+        assert_eq!(closest("energy_per_meter", names), Some("energy_per_metre"));
+        assert_eq!(closest("sucess", names), Some("success"));
+        assert_eq!(closest("no_such_metric", names), None);
+        assert_eq!(closest("", names), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(did_you_mean("sucess", names), "; did you mean `success`?");
+        assert_eq!(did_you_mean("zzz", names), "");
     }
 }

@@ -23,6 +23,17 @@ pub fn one_line(s: &str) -> String {
     s.trim().replace('\n', "; ")
 }
 
+/// A number for messages: the shortest digits that read back to `x`, positional for
+/// `1e-5 <= |x| < 1e16` (and 0), scientific beyond (`1e200`, `-2.5e-9`), so that no message
+/// prints a 200-digit decimal.
+pub fn fmt_exact(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Where in the user's input a problem is.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Location {
@@ -122,6 +133,16 @@ mod tests {
         assert_eq!(line_col(t, 10), (2, 4));
         assert_eq!(line_col(t, 8), (2, 2)); // inside 'é': clamped back
         assert_eq!(line_col(t, 999).0, 4);
+    }
+
+    #[test]
+    fn message_numbers_stay_short() {
+        assert_eq!(fmt_exact(1e200), "1e200");
+        assert_eq!(fmt_exact(-2.5e-9), "-2.5e-9");
+        assert_eq!(fmt_exact(0.05), "0.05");
+        assert_eq!(fmt_exact(140.0), "140");
+        assert_eq!(fmt_exact(f64::INFINITY), "inf");
+        assert_eq!(fmt_exact(0.0), "0");
     }
 
     #[test]

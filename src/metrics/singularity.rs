@@ -1,4 +1,4 @@
-//! Thruster-configuration-matrix (TCM) singularity metrics (SPEC §6).
+//! Thruster-configuration-matrix (TCM) singularity metrics (docs/model.md §6).
 //!
 //! `T` (6 × n_thrusters, base frame, rows force x, y, z in N per N of thrust then moment x, y, z
 //! in N·m per N) is made dimensionally homogeneous by dividing its moment rows by a
@@ -23,13 +23,13 @@ pub const DEFAULT_RANK_REL_TOL: f64 = 1e-6;
 
 /// The one threshold on the scaled σ_min (N per N) below which a configuration counts as
 /// singular, shared by the static analysis (`[static] threshold`, `tcm --threshold`) and the
-/// trajectory metrics (`[metrics] threshold`, `singularity_exposure`) (SPEC §6).
+/// trajectory metrics (`[metrics] threshold`, `singularity_exposure`) (docs/model.md §6).
 /// See `docs/singularity.md` for its calibration.
 pub const SINGULARITY_THRESHOLD: f64 = 0.05;
 
 /// Default relative tolerance of [`residual_exceeds`] (`[metrics] residual_tolerance`): the
 /// allocator counts as not delivering the commanded wrench when the commanded slack exceeds
-/// 1 % of it, the allocator's own `slack_tol` (SPEC §5).
+/// 1 % of it, the allocator's own `slack_tol` (docs/model.md §5).
 pub const RESIDUAL_TOLERANCE: f64 = 1e-2;
 
 /// Names of the six base-frame wrench axes, in row order of `T`.
@@ -49,7 +49,7 @@ pub enum SingularityError {
     Input(#[from] AllocError),
 }
 
-/// A wrench direction the thrusters cannot produce (SPEC §6): a left singular vector of `T_L` whose
+/// A wrench direction the thrusters cannot produce (docs/model.md §6): a left singular vector of `T_L` whose
 /// singular value is below the rank tolerance.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LostDirection {
@@ -62,7 +62,7 @@ pub struct LostDirection {
     pub dominant_axis: &'static str,
 }
 
-/// TCM singularity metrics of one configuration (SPEC §6).
+/// TCM singularity metrics of one configuration (docs/model.md §6).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TcmMetrics {
     /// Characteristic length `L` used to scale the moment rows (m).
@@ -87,7 +87,7 @@ pub struct TcmMetrics {
 }
 
 /// `T_L = diag(1, 1, 1, 1/L, 1/L, 1/L) T`: moment rows of `T` divided by `char_length` (m)
-/// (SPEC §6).
+/// (docs/model.md §6).
 pub fn scale_moment_rows(t: &Matrix6xX<f64>, char_length: f64) -> Matrix6xX<f64> {
     let mut s = t.clone();
     for mut col in s.column_iter_mut() {
@@ -113,7 +113,7 @@ fn check_inputs(
     Ok(())
 }
 
-/// Singular values of `T_L` (SPEC §6), six of them, descending (zeros appended when
+/// Singular values of `T_L` (docs/model.md §6), six of them, descending (zeros appended when
 /// n_thrusters < 6).
 /// `t` must be finite (checked by the public entry points).
 fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matrix6<f64>) {
@@ -136,7 +136,7 @@ fn scaled_svd(t: &Matrix6xX<f64>, char_length: f64) -> ([f64; 6], nalgebra::Matr
     (sv, u)
 }
 
-/// Whether the allocator failed to deliver the commanded wrench (SPEC §6,
+/// Whether the allocator failed to deliver the commanded wrench (docs/model.md §6,
 /// `allocation_residual_fraction`): the commanded rows of the wrench slack `s = T u − τ` exceed
 /// `tol` times the commanded wrench, `‖S s_L‖ > tol·‖S τ_L‖`, both scaled like `T_L` (moments
 /// divided by `char_length` L [m]) so that forces [N] and moments [N·m] weigh alike. A zero
@@ -157,7 +157,7 @@ pub fn residual_exceeds(
     ss.sqrt() > tol * tt.sqrt()
 }
 
-/// The base wrench axes a controller commands (SPEC §5): a subset of surge, sway, heave, roll,
+/// The base wrench axes a controller commands (docs/model.md §5): a subset of surge, sway, heave, roll,
 /// pitch, yaw, in the row order of `T`. The selection matrix `S` of the commanded-subspace
 /// metrics keeps exactly these rows of `T_L`.
 ///
@@ -230,7 +230,7 @@ impl CommandedDofs {
     }
 }
 
-/// Singular values of the commanded rows `S·T_L` of the scaled TCM (SPEC §6): how strongly
+/// Singular values of the commanded rows `S·T_L` of the scaled TCM (docs/model.md §6): how strongly
 /// the thrusters can push along the weakest and strongest commanded wrench directions.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CommandedSigma {
@@ -285,7 +285,7 @@ fn condition(sigma_max: f64, sigma_min: f64) -> f64 {
 /// of about `ε·σ_max²`, a relative error of about `ε κ²/2` on σ_min (≤ 1e-12 for κ ≤ 100).
 pub const GRAM_MIN_RATIO: f64 = 1e-4;
 
-/// σ_min, σ_max and κ of the commanded rows `S·T_L` of the scaled TCM (SPEC §6; `S` keeps the
+/// σ_min, σ_max and κ of the commanded rows `S·T_L` of the scaled TCM (docs/model.md §6; `S` keeps the
 /// rows of `dofs`, `T_L = diag(1, 1, 1, 1/L, 1/L, 1/L) T`, `char_length` = L [m]).
 ///
 /// σ_min is the weakest commanded wrench per unit thrust: for every unit-norm direction `w` of
@@ -401,7 +401,7 @@ fn from_squares(ev: &[f64; 6], k: usize) -> CommandedSigma {
     }
 }
 
-/// The extreme singular values of the commanded rows `S·T_L` and the rank (SPEC §6): what
+/// The extreme singular values of the commanded rows `S·T_L` and the rank (docs/model.md §6): what
 /// the static analysis reports per configuration, at a third of [`commanded_sigma_with`]'s
 /// cost.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -551,7 +551,7 @@ fn select_scaled(col: &[f64], rows: &[usize; 6], k: usize, l: f64) -> [f64; 6] {
     x
 }
 
-/// Fraction of samples whose σ_min is below `threshold` (SPEC §6, "how often T is singular");
+/// Fraction of samples whose σ_min is below `threshold` (docs/model.md §6, "how often T is singular");
 /// 0 for an empty slice. NaN samples count as singular.
 pub fn singular_fraction(sigma_mins: &[f64], threshold: f64) -> f64 {
     if sigma_mins.is_empty() {
@@ -564,7 +564,7 @@ pub fn singular_fraction(sigma_mins: &[f64], threshold: f64) -> f64 {
     n as f64 / sigma_mins.len() as f64
 }
 
-/// TCM singularity metrics without the attainable-wrench LPs (SPEC §6).
+/// TCM singularity metrics without the attainable-wrench LPs (docs/model.md §6).
 ///
 /// `t`: 6 × n_thrusters, base frame; `char_length`: L [m] (> 0); `rank_rel_tol`: relative rank
 /// tolerance (e.g. [`DEFAULT_RANK_REL_TOL`]).
@@ -612,7 +612,7 @@ pub fn tcm_svd_metrics(
     })
 }
 
-/// Full TCM singularity metrics (SPEC §6): [`tcm_svd_metrics`] plus the attainable wrench along
+/// Full TCM singularity metrics (docs/model.md §6): [`tcm_svd_metrics`] plus the attainable wrench along
 /// each base axis under `u_min ≤ u ≤ u_max` (N), see [`attainable_wrench`].
 pub fn tcm_metrics(
     t: &Matrix6xX<f64>,

@@ -1,5 +1,5 @@
 //! Singular values of small matrices (at most 6 rows) without heap allocation, for the
-//! commanded-subspace singularity metrics (SPEC §6): the eigenvalues of a symmetric `k×k`
+//! commanded-subspace singularity metrics (docs/model.md §6): the eigenvalues of a symmetric `k×k`
 //! (Gram) matrix by Householder tridiagonalisation and implicit QL; a row-by-row Givens QR into
 //! a `k×k` triangle and one-sided (Hestenes) Jacobi on it; and shifted inverse iteration for an
 //! eigenvector. Fixed 6×6 arrays on the stack; only the leading `k×k` block is used.

@@ -1,4 +1,4 @@
-//! Metrics of a run (SPEC §6): thruster power by actuator-disk momentum theory with axial
+//! Metrics of a run (docs/model.md §6): thruster power by actuator-disk momentum theory with axial
 //! inflow and the effort and energy integrals of the actuators, accumulated at every control
 //! step by an [`EnergyIntegrator`] (not from the log); and, as pure functions of a sampled
 //! trajectory, singularity exposure and tracking quality (cross-track error, convergence,
@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Parameters of the actuator-disk (momentum-theory) thruster power model (SPEC §6). Both
+/// Parameters of the actuator-disk (momentum-theory) thruster power model (docs/model.md §6). Both
 /// defaults are inferred (the paper gives no propeller data): a 70 mm propeller, the size of
 /// the small ROV thrusters such a vehicle carries, and an overall shaft efficiency η = 0.5.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -35,16 +35,26 @@ impl Default for PowerModel {
     }
 }
 
+/// A [`PowerModel`] parameter that is not a finite number > 0.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("metrics.{key} must be a finite number > 0, got {value}")]
+pub struct PowerModelError {
+    /// The parameter (`propeller_diameter`, `efficiency`, `rho`).
+    pub key: &'static str,
+    /// Its value.
+    pub value: f64,
+}
+
 impl PowerModel {
     /// Check the parameters are physical.
-    pub fn validate(&self) -> Result<(), String> {
-        for (k, v) in [
+    pub fn validate(&self) -> Result<(), PowerModelError> {
+        for (key, value) in [
             ("propeller_diameter", self.propeller_diameter),
             ("efficiency", self.efficiency),
             ("rho", self.rho),
         ] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(format!("metrics.{k} must be a finite number > 0, got {v}"));
+            if !value.is_finite() || value <= 0.0 {
+                return Err(PowerModelError { key, value });
             }
         }
         Ok(())
@@ -58,7 +68,7 @@ impl PowerModel {
 
     /// `(w, V_a + w)` [m/s] of a disk delivering thrust `u` [N] with axial inflow `v_a`
     /// [m/s]: the induced velocity, the non-negative root of `|u| = 2ρA w (V_a + w)`
-    /// (SPEC §6), `w = (−V_a + √(V_a² + 4c)) / 2` with `c = |u| / (2ρA)`, and the flow
+    /// (docs/model.md §6), `w = (−V_a + √(V_a² + 4c)) / 2` with `c = |u| / (2ρA)`, and the flow
     /// speed through the disk. Both without cancellation for either sign of `v_a`: where a
     /// printed form subtracts nearly equal numbers it is replaced by the conjugate
     /// `2c / (|V_a| + √(V_a² + 4c))` (for `w` when `V_a > 0`, for `V_a + w` when `V_a < 0`).
@@ -88,7 +98,7 @@ impl PowerModel {
 
     /// Shaft power [W] of one thruster delivering thrust `u` [N] with axial inflow `v_a`
     /// [m/s]: the ideal power `P = |u| (V_a + w)` of the actuator disk (useful power `|u| V_a`
-    /// plus the induced loss `|u| w`) divided by η (SPEC §6).
+    /// plus the induced loss `|u| w`) divided by η (docs/model.md §6).
     ///
     /// Sign convention: `v_a` is the speed of the water through the disk in the direction of
     /// the jet, i.e. the thruster's velocity relative to the water projected on the direction
@@ -104,7 +114,7 @@ impl PowerModel {
     }
 
     /// Shaft power [W] at zero inflow (hover, the bollard figure):
-    /// `P = |u|^{3/2} / (η √(2ρA))` (SPEC §6).
+    /// `P = |u|^{3/2} / (η √(2ρA))` (docs/model.md §6).
     #[inline]
     pub fn static_power(&self, u: f64) -> f64 {
         u.abs().powf(1.5) / (self.efficiency * (2.0 * self.rho * self.disk_area()).sqrt())
@@ -187,7 +197,7 @@ impl PowerSample {
     }
 }
 
-/// Effort and energy of a run (SPEC §6), integrated over the control intervals.
+/// Effort and energy of a run (docs/model.md §6), integrated over the control intervals.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct EnergyMetrics {
     /// Thruster shaft energy with axial inflow, `∫ Σ_j P_j(u_j, V_a,j) / η dt` [J].
@@ -289,7 +299,7 @@ impl EnergyIntegrator {
 }
 
 /// Singularity exposure: fraction of time the scaled σ_min of T(q) is below `threshold`
-/// (SPEC §6, "how often T is singular" over the configurations a scenario visits).
+/// (docs/model.md §6, "how often T is singular" over the configurations a scenario visits).
 pub fn singularity_exposure(t: &[f64], sigma_min: &[f64], threshold: f64) -> f64 {
     time_fraction(t, |k| sigma_min[k] < threshold)
 }

@@ -18,7 +18,7 @@ use std::str::FromStr;
 pub enum ThrusterRule {
     /// The paper's 7-thruster pattern generalised: vertical + lateral on link 1, a
     /// longitudinal pair and a vertical on the middle link `⌊N/2⌋`, lateral + vertical on
-    /// link `N-2` (for `N = 5` with the paper's lengths this is the SPEC §2 layout).
+    /// link `N-2` (for `N = 5` with the paper's lengths this is the docs/model.md §2 layout).
     Paper,
     /// A lateral and a vertical thruster on every inner link, plus the longitudinal pair on
     /// the middle link.
@@ -55,17 +55,28 @@ impl fmt::Display for ThrusterRule {
     }
 }
 
+/// A thruster rule name that is none of [`ThrusterRule::ALL`].
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("unknown thruster rule '{name}'; valid: {}", ThrusterRule::names().join(", "))]
+pub struct UnknownThrusterRule {
+    /// The name given.
+    pub name: String,
+}
+
+impl ThrusterRule {
+    fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|r| r.name()).collect()
+    }
+}
+
 impl FromStr for ThrusterRule {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownThrusterRule;
+    fn from_str(s: &str) -> Result<Self, UnknownThrusterRule> {
         Self::ALL
             .iter()
             .copied()
             .find(|r| r.name() == s)
-            .ok_or_else(|| {
-                let names: Vec<_> = Self::ALL.iter().map(|r| r.name()).collect();
-                format!("unknown thruster rule '{s}'; valid: {}", names.join(", "))
-            })
+            .ok_or_else(|| UnknownThrusterRule { name: s.into() })
     }
 }
 
@@ -256,7 +267,7 @@ impl GeneratorSpec {
         };
         match self.thruster_rule {
             ThrusterRule::Paper => {
-                // Fractions of the link length from the SPEC §2 layout on usm-paper:
+                // Fractions of the link length from the docs/model.md §2 layout on usm-paper:
                 // 0.237/0.584, 0.347/0.584, 0.278/0.726, 0.488/0.726.
                 let (f1, f2) = (0.237 / 0.584, 0.347 / 0.584);
                 add(inner_first, f1, 0.0, ez);
@@ -314,7 +325,7 @@ mod tests {
 
     #[test]
     fn paper_rule_reproduces_paper_layout() {
-        // With the paper's lengths the rule puts thrusters where SPEC §2 lists them.
+        // With the paper's lengths the rule puts thrusters where docs/model.md §2 lists them.
         let spec = GeneratorSpec {
             links: 5,
             link_length: vec![0.62, 0.584, 0.726, 0.584, 0.37],

@@ -1,10 +1,10 @@
 //! Manoeuvring-derivative hydrodynamics of a streamlined hull (SNAME / Healey & Lienard
-//! style, the form of the NPS AUV II model in Fossen's MSS; SPEC §8 case 3): constant added
+//! style, the form of the NPS AUV II model in Fossen's MSS; docs/model.md §8 case 3): constant added
 //! mass, velocity-product derivatives, a quadratic resistance and a strip-theory cross-flow
 //! drag, all about a reference point `CO` in axes of their own.
 //!
 //! The coefficients are dimensional (the prime values already scaled by `½ρL²…½ρL⁵` for the
-//! fluid the vehicle was built for, see [`crate::model::nps_auv2`]). Unlike
+//! fluid the vehicle was built for, see [`crate::paper::nps_auv2`]). Unlike
 //! [`super::Hydro::Coefficients`], the velocity-product table is by default the *measured*
 //! force of the moving hull, which includes what the Kirchhoff term `V_r ×* (M_A V_r)` would
 //! add; the dynamics then leave that term out for such a body ([`Manoeuvring::kirchhoff`],

@@ -1,15 +1,14 @@
-//! The vehicle model (SPEC §2): a floating-base serial chain of rigid bodies joined by 1-DOF
+//! The vehicle model (docs/model.md §2): a floating-base serial chain of rigid bodies joined by 1-DOF
 //! revolute joints, with thrusters fixed to bodies and per-body hydrodynamic parameters.
 //!
 //! Frames: every body frame has its origin at the body's rear (tail) face and its x axis
-//! along the body towards the head. Joint `i` (1-based in the SPEC, index `i-1` here) joins
+//! along the body towards the head. Joint `i` (1-based in docs/model.md, index `i-1` here) joins
 //! body `i-1` (parent) to body `i` (child). Nothing here assumes a USM: a UVMS is one large
-//! vehicle body with thrusters followed by thruster-less links (SPEC §8).
+//! vehicle body with thrusters followed by thruster-less links (docs/model.md §8).
 
 pub mod design;
 pub mod generator;
 pub mod manoeuvring;
-pub mod nps_auv2;
 pub mod presets;
 
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};
@@ -17,9 +16,9 @@ use nalgebra::Vector6;
 use std::f64::consts::PI;
 use thiserror::Error;
 
-/// Default water density [kg/m³] (SPEC §2, ρ = 1026).
+/// Default water density [kg/m³] (docs/model.md §2, ρ = 1026).
 pub const RHO_SEAWATER: f64 = 1026.0;
-/// Gravitational acceleration [m/s²] (SPEC §1).
+/// Gravitational acceleration [m/s²] (docs/model.md §1).
 pub const GRAVITY: f64 = 9.81;
 
 /// The fluid the vehicle moves in. Each field's doc gives its default ([`Default`]); the
@@ -46,7 +45,7 @@ impl Default for Fluid {
     }
 }
 
-/// Per-body hydrodynamics (SPEC §2): a sum type over the two ways a body is described.
+/// Per-body hydrodynamics (docs/model.md §2): a sum type over the two ways a body is described.
 ///
 /// The `Coefficients` variant is large (three 6×6 matrices); bodies are few and built once,
 /// so it is kept inline rather than boxed.
@@ -64,7 +63,7 @@ pub enum Hydro {
         /// Cross-flow drag coefficient along body z.
         cd_z: f64,
         /// Small linear damping on every axis, `[N·s/m ×3, N·m·s/rad ×3]`, applied to the
-        /// relative twist at the body's geometric centre (inferred, SPEC §2).
+        /// relative twist at the body's geometric centre (inferred, docs/model.md §2).
         linear_damping: [f64; 6],
         /// Number of integration points along the body for the cross-flow strip integral.
         strips: usize,
@@ -85,7 +84,7 @@ pub enum Hydro {
     /// Manoeuvring derivatives of a streamlined hull (added mass, velocity products,
     /// resistance, cross-flow drag) about a reference point in axes of their own: the NPS
     /// AUV II of Antonelli & Chiaverini's case 3 ([`nps_auv2`]). The velocity-product table
-    /// replaces the Kirchhoff term of the added mass (SPEC §4).
+    /// replaces the Kirchhoff term of the added mass (docs/model.md §4).
     Manoeuvring(Box<manoeuvring::Manoeuvring>),
 }
 
@@ -104,7 +103,7 @@ impl Hydro {
     }
 }
 
-/// A rigid body of the chain (SPEC §2).
+/// A rigid body of the chain (docs/model.md §2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Body {
     /// Name used in reports and design files.
@@ -129,7 +128,7 @@ pub struct Body {
 
 impl Body {
     /// A solid cylinder body with CG = CB at the geometric centre, inertia
-    /// `Ixx = m r²/2, Iyy = Izz = m(3r²+l²)/12` and volume `πr²l` (SPEC §2 defaults).
+    /// `Ixx = m r²/2, Iyy = Izz = m(3r²+l²)/12` and volume `πr²l` (docs/model.md §2 defaults).
     pub fn cylinder(name: &str, mass: f64, length: f64, radius: f64, hydro: Hydro) -> Self {
         let c = Vec3::new(length / 2.0, 0.0, 0.0);
         let ixx = mass * radius * radius / 2.0;
@@ -157,7 +156,7 @@ impl Body {
         rigid_inertia(self.mass, &self.cg, &self.inertia)
     }
 
-    /// Added-mass spatial inertia `M_A` about the body frame origin (SPEC §2), in fluid
+    /// Added-mass spatial inertia `M_A` about the body frame origin (docs/model.md §2), in fluid
     /// of density `rho` [kg/m³].
     pub fn added_mass(&self, rho: f64) -> Mat6 {
         match &self.hydro {
@@ -178,7 +177,7 @@ impl Body {
     }
 }
 
-/// A revolute joint (SPEC §2). The child body's frame at zero angle is `placement` in the
+/// A revolute joint (docs/model.md §2). The child body's frame at zero angle is `placement` in the
 /// parent body's frame; the joint rotates the child about `axis` (a unit vector in the
 /// child frame, through its origin).
 #[derive(Clone, Debug, PartialEq)]
@@ -195,7 +194,7 @@ pub struct Joint {
     pub max: f64,
 }
 
-/// A thruster fixed to a body (SPEC §2).
+/// A thruster fixed to a body (docs/model.md §2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Thruster {
     /// Name used in reports and design files.
@@ -216,7 +215,7 @@ pub struct Thruster {
     pub rate_limit: Option<f64>,
 }
 
-/// A complete design: the floating-base chain (SPEC §2).
+/// A complete design: the floating-base chain (docs/model.md §2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vehicle {
     /// Design name.
@@ -301,7 +300,7 @@ impl Vehicle {
         self.bodies.iter().map(|b| b.length).sum()
     }
 
-    /// Characteristic length for scaling moments (SPEC §6 default: half the vehicle length) [m].
+    /// Characteristic length for scaling moments (docs/model.md §6 default: half the vehicle length) [m].
     pub fn characteristic_length(&self) -> f64 {
         0.5 * self.total_length()
     }

@@ -1,4 +1,4 @@
-//! Named designs: `usm-paper` (SPEC §2, USM Table II) and `uvms-planar` (SPEC §8).
+//! Named designs: `usm-paper` (docs/model.md §2, USM Table II) and `uvms-planar` (docs/model.md §8).
 
 use super::{Body, Fluid, Hydro, Joint, ModelError, Thruster, Vehicle};
 use crate::spatial::{Mat3, Se3, Vec3};
@@ -61,9 +61,9 @@ pub(crate) fn thruster(name: &str, body: usize, x: f64, y: f64, dir: Vec3, limit
     }
 }
 
-/// The USM of the paper (SPEC §2): nine bodies L0 J1 L1 … J4 L4 from USM Table II, radius
+/// The USM of the paper (docs/model.md §2): nine bodies L0 J1 L1 … J4 L4 from USM Table II, radius
 /// 0.085 m, neutrally buoyant, eight joints (yaw at the rear face of each joint module,
-/// pitch at its front face, ±90°), seven thrusters of ±40 N in the layout of SPEC §2.
+/// pitch at its front face, ±90°), seven thrusters of ±40 N in the layout of docs/model.md §2.
 pub fn usm_paper() -> Vehicle {
     let fluid = Fluid::default();
     let rho = fluid.rho;
@@ -122,7 +122,7 @@ pub fn usm_paper() -> Vehicle {
     }
 }
 
-/// The planar UVMS of Antonelli & Chiaverini (SPEC §8): a 5.3 m vehicle (NPS AUV II mass and
+/// The planar UVMS of Antonelli & Chiaverini (docs/model.md §8): a 5.3 m vehicle (NPS AUV II mass and
 /// inertia, base frame at its centre) carrying a three-link arm of 2.0 m links whose first
 /// joint is at (2.5, 0, 0) in the vehicle frame; all arm joints about z.
 ///

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::history::{read_journal, Journal, Record};
+use super::history::{read_journal, Journal, JournalError, Record};
 use super::problem::{Problem, Spec};
 use super::score::{best_index, Scorer};
 use super::search::{run_solver, Evaluator, Search};
@@ -12,12 +12,15 @@ use super::search::{run_solver, Evaluator, Search};
 /// Why an optimisation could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum OptimiseError {
-    /// The resume journal could not be read or written, or belongs to another problem.
+    /// The resume journal could not be read or created, or belongs to another problem.
     #[error("journal: {0}")]
-    Journal(String),
+    Journal(#[from] JournalError),
+    /// A line could not be appended to the journal (the first such error of the run).
+    #[error("journal: {0}")]
+    JournalWrite(String),
     /// The thread pool could not be built.
     #[error("building the thread pool: {0}")]
-    Pool(String),
+    Pool(#[from] rayon::ThreadPoolBuildError),
     /// The start point could not be evaluated.
     #[error("evaluating the start point: {0}")]
     Start(String),
@@ -92,19 +95,14 @@ pub fn minimise<E: Evaluator>(
         n => Some(
             rayon::ThreadPoolBuilder::new()
                 .num_threads(n.max(1))
-                .build()
-                .map_err(|e| OptimiseError::Pool(e.to_string()))?,
+                .build()?,
         ),
     };
     let (memo, journal) = match opts.journal {
-        Some(p) if opts.resume && p.is_file() => (
-            read_journal(p, hash).map_err(OptimiseError::Journal)?,
-            Some(Journal::append_to(p).map_err(OptimiseError::Journal)?),
-        ),
-        Some(p) => (
-            Default::default(),
-            Some(Journal::create(p, hash).map_err(OptimiseError::Journal)?),
-        ),
+        Some(p) if opts.resume && p.is_file() => {
+            (read_journal(p, hash)?, Some(Journal::append_to(p)?))
+        }
+        Some(p) => (Default::default(), Some(Journal::create(p, hash)?)),
         None => (Default::default(), None),
     };
     let replayable = memo.len();
@@ -123,7 +121,7 @@ pub fn minimise<E: Evaluator>(
     let stops = run_solver(&search, &spec.solver);
     let (records, journal_error) = search.finish();
     if let Some(e) = journal_error {
-        return Err(OptimiseError::Journal(e));
+        return Err(OptimiseError::JournalWrite(e));
     }
     let scorer = Scorer::new(
         &spec.objective,

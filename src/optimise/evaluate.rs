@@ -1,42 +1,28 @@
 //! Evaluating a problem's point: the parameters (and each scenario's settings) applied to the
-//! study's tables exactly as a sweep applies axis values ([`resolve_case`]), then the design
-//! columns, the static TCM analysis when the study enables it, and the closed-loop run of a
-//! dynamic mode — the metrics a sweep row holds, by name. A panic or an invalid design is
-//! the evaluation's failure (its metrics NaN), never the optimiser's.
+//! study's tables exactly as a sweep applies axis values ([`resolve_case`]), then scored by the
+//! one case evaluator ([`crate::evaluate`]) — design columns, the static TCM analysis when the
+//! study enables it, the closed-loop run of a dynamic mode: the metrics a sweep row holds, by
+//! name. A panic or an invalid design is the evaluation's failure, never the optimiser's.
 //!
 //! Every evaluation uses one case id (0; a sweep's own id for a case tuned in place,
 //! [`CaseEvaluator::for_case`]) and so the same seed (`derive_seed(study.seed, id)`): the
 //! static analysis samples the same joint configurations at every point, and the objective
 //! is a deterministic function of the parameters.
 
-use std::time::Instant;
-
 use super::history::Evaluation;
 use super::problem::Problem;
 use super::search::Evaluator;
-use crate::model::design::parse_design_table;
-use crate::report::Table;
-use crate::sampling::derive_seed;
+use crate::evaluate::{self as case_eval, CaseInput, CaseResult, Deadline, Metrics, Phases};
 use crate::study::axes::study_target;
 use crate::study::cases::{resolve_case, Resolved};
 use crate::study::doe::Case;
-use crate::study::records::{DESIGN_COLUMNS, TCM_COLUMNS};
-use crate::study::runner;
 use crate::study::schema::{Axis, AxisSpec, Study};
-use crate::study::static_table::{static_spec, STATIC_TABLE};
-use crate::study::static_tcm::analyse;
-use crate::study::worker::{design_metrics, tcm_metrics};
 
-/// The metrics of one case (one scenario at one point).
-#[derive(Clone, Debug, Default)]
-pub struct CaseMetrics {
-    /// Named metrics: design columns, TCM columns (static), run metrics (dynamic).
-    pub named: Vec<(String, f64)>,
-    /// Why the case failed, if it did.
-    pub failure: Option<String>,
-    /// The trajectory (dynamic modes, when asked for).
-    pub trajectory: Option<Table>,
-}
+/// A point's parameters could not be applied to the study's tables (an index beyond an
+/// array, a design the generator cannot build).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ResolveError(pub String);
 
 /// The evaluator of a problem file's points.
 pub struct CaseEvaluator<'a> {
@@ -48,8 +34,8 @@ pub struct CaseEvaluator<'a> {
     metrics: Vec<String>,
     /// The case id every evaluation runs as (its seed `derive_seed(study.seed, id)`).
     case_id: usize,
-    /// Wall-clock deadline of every run (`None`: unlimited).
-    deadline: Option<Instant>,
+    /// Wall-clock deadline of every run.
+    deadline: Deadline,
 }
 
 impl<'a> CaseEvaluator<'a> {
@@ -109,13 +95,13 @@ impl<'a> CaseEvaluator<'a> {
             variant_values,
             metrics: spec.metrics(),
             case_id: 0,
-            deadline: None,
+            deadline: Deadline::NONE,
         }
     }
 
     /// The same evaluator running every point as case `id` of its study (a sweep's case
     /// tuned in place: the case's seed) within `deadline` (a run past it fails `timeout`).
-    pub fn for_case(self, id: usize, deadline: Option<Instant>) -> Self {
+    pub fn for_case(self, id: usize, deadline: Deadline) -> Self {
         CaseEvaluator {
             case_id: id,
             deadline,
@@ -124,7 +110,7 @@ impl<'a> CaseEvaluator<'a> {
     }
 
     /// The tables of scenario `variant` at physical parameter values `x`.
-    pub fn resolve(&self, x: &[f64], variant: usize) -> Result<Resolved, String> {
+    pub fn resolve(&self, x: &[f64], variant: usize) -> Result<Resolved, ResolveError> {
         let mut values: Vec<toml::Value> = x.iter().map(|v| toml::Value::Float(*v)).collect();
         values.extend(self.variant_values[variant].iter().cloned());
         resolve_case(
@@ -134,25 +120,31 @@ impl<'a> CaseEvaluator<'a> {
                 values,
             },
         )
+        .map_err(ResolveError)
     }
 
-    /// Run one resolved case (with its trajectory when `log`).
-    pub fn run_case(&self, r: &Resolved, log: bool) -> CaseMetrics {
+    /// Run one resolved case (with its trajectory when `log`) through the case evaluator.
+    pub fn run_case(&self, r: &Resolved, log: bool) -> CaseResult {
         let study = &self.problem.study;
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            case_metrics(study, r, log, self.deadline)
-        }));
-        outcome.unwrap_or_else(|p| {
-            let msg = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            CaseMetrics {
-                failure: Some(format!("panic: {msg}")),
-                ..CaseMetrics::default()
-            }
+        case_eval::Evaluator::new().evaluate(&CaseInput {
+            design: &r.design,
+            design_hash: &r.design_hash,
+            scenario: &r.scenario,
+            overrides: &[],
+            seed: r.seed,
+            deadline: self.deadline,
+            phases: phases(study),
+            trajectory: log,
+            label: "optimised design",
         })
+    }
+}
+
+/// The phases a point of `study` runs.
+fn phases(study: &Study) -> Phases {
+    Phases {
+        static_analysis: study.static_enabled,
+        closed_loop: study.mode.is_dynamic(),
     }
 }
 
@@ -165,15 +157,16 @@ impl Evaluator for CaseEvaluator<'_> {
         let mut rows = Vec::new();
         let mut failures = Vec::new();
         for (v, variant) in self.problem.spec.variants.iter().enumerate() {
-            let case = match self.resolve(x, v) {
-                Ok(r) => self.run_case(&r, false),
-                Err(m) => CaseMetrics {
-                    failure: Some(m),
-                    ..CaseMetrics::default()
-                },
+            let (metrics, failure) = match self.resolve(x, v) {
+                Ok(r) => {
+                    let res = self.run_case(&r, false);
+                    let failure = res.failure().map(str::to_string);
+                    (res.metrics, failure)
+                }
+                Err(e) => (Metrics::new(), Some(e.to_string())),
             };
-            rows.push(pick(&case.named, &self.metrics));
-            if let Some(f) = case.failure {
+            rows.push(metrics.pick(&self.metrics));
+            if let Some(f) = failure {
                 failures.push(if variant.name.is_empty() {
                     f
                 } else {
@@ -190,60 +183,5 @@ impl Evaluator for CaseEvaluator<'_> {
 
 /// The values of `names` among `named` (NaN when absent).
 pub fn pick(named: &[(String, f64)], names: &[String]) -> Vec<f64> {
-    names
-        .iter()
-        .map(|n| {
-            named
-                .iter()
-                .find(|(k, _)| k == n)
-                .map_or(f64::NAN, |(_, x)| *x)
-        })
-        .collect()
-}
-
-/// The named metrics of a resolved case (see the module docs).
-fn case_metrics(study: &Study, r: &Resolved, log: bool, deadline: Option<Instant>) -> CaseMetrics {
-    let mut out = CaseMetrics::default();
-    let v = match parse_design_table(&r.design, "optimised design") {
-        Ok(v) => v,
-        Err(e) => {
-            out.failure = Some(format!("invalid design: {e}"));
-            return out;
-        }
-    };
-    let named = |names: &[&str], values: &[f64]| -> Vec<(String, f64)> {
-        names
-            .iter()
-            .map(|n| n.to_string())
-            .zip(values.iter().copied())
-            .collect()
-    };
-    out.named = named(&DESIGN_COLUMNS, &design_metrics(&v));
-    if study.static_enabled {
-        let s = static_spec(&r.scenario, derive_seed(r.seed, 1))
-            .map_err(|m| m.to_string())
-            .and_then(|spec| {
-                analyse(&v, &spec, 1, &mut |_, _, _| Ok(()), &|_| {}).map_err(|e| e.to_string())
-            });
-        match s {
-            Ok(s) => out.named.extend(named(&TCM_COLUMNS, &tcm_metrics(&s))),
-            Err(m) => {
-                out.failure = Some(m);
-                return out;
-            }
-        }
-    }
-    if study.mode.is_dynamic() {
-        let mut sc = r.scenario.clone();
-        sc.remove(STATIC_TABLE);
-        match runner::run_case_until(&v, &sc, r.seed, log, deadline) {
-            Ok(run) => {
-                out.named.extend(run.metrics);
-                out.failure = run.failure;
-                out.trajectory = run.trajectory;
-            }
-            Err(m) => out.failure = Some(m),
-        }
-    }
-    out
+    named.iter().cloned().collect::<Metrics>().pick(names)
 }

@@ -16,6 +16,50 @@ use serde::{Deserialize, Serialize};
 use super::score::{mean_of, Score};
 use crate::report::{Column, ColumnData, Table};
 
+/// Why the journal could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum JournalError {
+    /// Reading or writing the file.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The journal file.
+        path: PathBuf,
+        /// The file-system error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A line could not be written as JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// The file has no header line.
+    #[error("{}: not a journal (no header line)", path.display())]
+    NoHeader {
+        /// The journal file.
+        path: PathBuf,
+    },
+    /// The journal belongs to another problem.
+    #[error(
+        "{}: the journal is of another problem (hash {found}, this problem {expected}); \
+         run without --resume to start afresh",
+        path.display()
+    )]
+    OtherProblem {
+        /// The journal file.
+        path: PathBuf,
+        /// The journal's problem hash.
+        found: String,
+        /// This problem's hash.
+        expected: String,
+    },
+}
+
+fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> JournalError + '_ {
+    move |source| JournalError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
 /// File name of the journal in an output directory.
 pub const JOURNAL_FILE: &str = "journal.jsonl";
 
@@ -79,14 +123,12 @@ fn floats(v: &[u64]) -> Vec<f64> {
 
 impl Journal {
     /// Start a new journal for the problem with hash `hash` (replacing any old one).
-    pub fn create(path: &Path, hash: &str) -> Result<Journal, String> {
-        let mut file =
-            std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    pub fn create(path: &Path, hash: &str) -> Result<Journal, JournalError> {
+        let mut file = std::fs::File::create(path).map_err(io_error(path))?;
         let h = serde_json::to_string(&Header {
             problem_hash: hash.to_string(),
-        })
-        .map_err(|e| e.to_string())?;
-        writeln!(file, "{h}").map_err(|e| format!("{}: {e}", path.display()))?;
+        })?;
+        writeln!(file, "{h}").map_err(io_error(path))?;
         Ok(Journal {
             path: path.to_path_buf(),
             file,
@@ -94,11 +136,11 @@ impl Journal {
     }
 
     /// Append to an existing journal.
-    pub fn append_to(path: &Path) -> Result<Journal, String> {
+    pub fn append_to(path: &Path) -> Result<Journal, JournalError> {
         let file = std::fs::OpenOptions::new()
             .append(true)
             .open(path)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+            .map_err(io_error(path))?;
         Ok(Journal {
             path: path.to_path_buf(),
             file,
@@ -106,35 +148,39 @@ impl Journal {
     }
 
     /// Record one simulated point (flushed line by line).
-    pub fn append(&mut self, x: &[f64], e: &Evaluation) -> Result<(), String> {
+    pub fn append(&mut self, x: &[f64], e: &Evaluation) -> Result<(), JournalError> {
         let line = Line {
             x: bits(x),
             m: e.metrics.iter().map(|r| bits(r)).collect(),
             failure: e.failure.clone(),
         };
-        let text = serde_json::to_string(&line).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string(&line)?;
         writeln!(self.file, "{text}")
             .and_then(|_| self.file.flush())
-            .map_err(|e| format!("{}: {e}", self.path.display()))
+            .map_err(io_error(&self.path))
     }
 }
 
 /// The evaluations of a journal keyed by the bits of their parameter values; `Err` when the
 /// journal belongs to another problem (its hash differs) or cannot be read.
-pub fn read_journal(path: &Path, hash: &str) -> Result<HashMap<Vec<u64>, Evaluation>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+pub fn read_journal(
+    path: &Path,
+    hash: &str,
+) -> Result<HashMap<Vec<u64>, Evaluation>, JournalError> {
+    let text = std::fs::read_to_string(path).map_err(io_error(path))?;
     let mut lines = text.lines();
     let header: Header = lines
         .next()
         .and_then(|l| serde_json::from_str(l).ok())
-        .ok_or_else(|| format!("{}: not a journal (no header line)", path.display()))?;
+        .ok_or_else(|| JournalError::NoHeader {
+            path: path.to_path_buf(),
+        })?;
     if header.problem_hash != hash {
-        return Err(format!(
-            "{}: the journal is of another problem (hash {}, this problem {hash}); \
-             run without --resume to start afresh",
-            path.display(),
-            header.problem_hash
-        ));
+        return Err(JournalError::OtherProblem {
+            path: path.to_path_buf(),
+            found: header.problem_hash,
+            expected: hash.to_string(),
+        });
     }
     let mut memo = HashMap::new();
     for l in lines {

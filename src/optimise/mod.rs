@@ -5,14 +5,18 @@
 //! Modules in dependency order (this file only declares and re-exports):
 //!
 //! - [`space`]: parameters, bounds and scales, the normalised unit box the solvers work in.
+//! - [`solver`]: `[solver]`: method, budgets and tolerances, with their limits.
 //! - [`problem`]: problem files → a validated [`Problem`] (study part + optimiser sections);
 //!   [`problem::parse_spec`] reads the optimiser sections under any key prefix.
 //! - [`score`]: objective normalisation, combination over scenarios, constraint violation and
 //!   the feasibility-first ranking.
 //! - [`history`]: evaluation records, the history table and the resume journal.
 //! - [`search`]: the argmin cost function, gradient, observer and the three solvers.
-//! - [`evaluate`]: a problem's point → its metrics (the sweep's case machinery).
+//! - [`evaluate`]: a problem's point → its metrics (through the one case evaluator,
+//!   [`crate::evaluate`]).
 //! - [`engine`]: [`run`] and [`minimise`]: start point, solver runs, outcome.
+//! - [`tune`]: per-case tuning of a sweep (`[tune]`), wired into the sweep engine through its
+//!   hook ([`tune::HOOK`]).
 //!
 //! The library API a caller (the `optimise` verb, a sweep tuning each case) uses is
 //! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
@@ -23,7 +27,9 @@ pub mod history;
 pub mod problem;
 pub mod score;
 pub mod search;
+pub mod solver;
 pub mod space;
+pub mod tune;
 
 pub use engine::{minimise, run, OptimiseError, Options, Outcome};
 pub use problem::{load_problem, parse_problem, Problem, Spec};

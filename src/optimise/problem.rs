@@ -11,14 +11,16 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use super::solver::{parse_solver, SolverFile};
+pub use super::solver::{Method, SolverSettings, MAX_EVALS, MAX_PARTICLES};
 use super::space::{Param, Scale, Space};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::join_key;
 use crate::input::located::{InputError, Located, Location};
 use crate::study::axes::study_target;
-use crate::study::parse::parse_study_table;
-use crate::study::records::{DESIGN_COLUMNS, TCM_COLUMNS};
-use crate::study::runner::StudyMode;
+pub use crate::study::parse::metric_catalogue;
+use crate::study::parse::{known_metric, parse_study_table, unknown_metric};
+use crate::study::schema::Target;
 use crate::study::Study;
 
 /// The optimiser's top-level sections of a problem file (removed before the study part is
@@ -93,63 +95,6 @@ pub struct Constraint {
     pub value: f64,
     /// Slack of `==` (default 1e-9·max(1, |value|)).
     pub tolerance: f64,
-}
-
-/// The solver of `[solver] method`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum Method {
-    /// Nelder–Mead simplex from the start point (local; argmin `NelderMead`).
-    #[serde(rename = "nelder-mead")]
-    NelderMead,
-    /// Particle swarm within the bounds (global; argmin `ParticleSwarm`, seeded).
-    #[serde(rename = "particle-swarm")]
-    ParticleSwarm,
-    /// L-BFGS with central finite-difference gradients (argmin `LBFGS`, Moré–Thuente line
-    /// search), for smooth static objectives.
-    #[serde(rename = "lbfgs")]
-    Lbfgs,
-}
-
-impl Method {
-    /// Every method, as written in problem files.
-    pub const ALL: [(&'static str, Method); 3] = [
-        ("nelder-mead", Method::NelderMead),
-        ("particle-swarm", Method::ParticleSwarm),
-        ("lbfgs", Method::Lbfgs),
-    ];
-
-    /// The name as written.
-    pub fn as_str(self) -> &'static str {
-        Method::ALL
-            .iter()
-            .find(|(_, m)| *m == self)
-            .map_or("", |(n, _)| n)
-    }
-}
-
-/// `[solver]`: the method, its budgets and tolerances.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct SolverSettings {
-    /// The method.
-    pub method: Method,
-    /// Iterations per run of the method (argmin `max_iters`; default 100).
-    pub max_iters: u64,
-    /// Evaluations in all, the start point included (default 200); repeated points are
-    /// served from memory and not counted.
-    pub max_evals: usize,
-    /// Nelder–Mead: standard deviation of the simplex's costs; L-BFGS: gradient norm and
-    /// cost change (default 1e-6).
-    pub tolerance: f64,
-    /// Further runs after the first (Nelder–Mead and L-BFGS from the best point so far,
-    /// particle swarm with a new seed; default 0).
-    pub restarts: usize,
-    /// Seed of the particle swarm (default: `study.seed`).
-    pub seed: u64,
-    /// Particles of the swarm (default 12).
-    pub particles: usize,
-    /// Nelder–Mead initial simplex edge and finite-difference step, in the unit box of the
-    /// normalised parameters (default 0.1 and 1e-4·… see `docs/optimise.md`).
-    pub step: f64,
 }
 
 /// One scenario of a robust objective: key paths set on top of the parameters.
@@ -255,23 +200,10 @@ struct ConstraintFile {
     tolerance: Option<f64>,
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SolverFile {
-    method: String,
-    max_iters: Option<u64>,
-    max_evals: Option<usize>,
-    tolerance: Option<f64>,
-    restarts: Option<usize>,
-    seed: Option<u64>,
-    particles: Option<usize>,
-    step: Option<f64>,
-}
-
 /// Read and validate a problem file.
 pub fn load_problem(path: &Path) -> Result<Problem, InputError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+    let text = crate::input::document::read_text(path).map_err(|e| InputError {
         at: Location::origin(&origin),
         error: format!("cannot read the problem file: {e}"),
     })?;
@@ -293,6 +225,17 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<Problem, InputError> {
             "tune",
             "[tune] tunes each case of a sweep; a problem file optimises its own [[param]]",
         ));
+    }
+    for (k, what) in [("axis", "[[axis]]"), ("doe", "[doe]")] {
+        if table.contains_key(k) {
+            return Err(doc.err(
+                k,
+                format!(
+                    "{what} belongs to a sweep's study file; a problem file varies its \
+                     [[param]] entries (and [[variant]] scenarios) and would ignore it"
+                ),
+            ));
+        }
     }
     let study = parse_study_table(&doc, &table, path)?;
     let spec = parse_spec(&doc, &spec_table, "", &study)?;
@@ -332,12 +275,14 @@ pub fn parse_spec(
         }
         list.push(param);
     }
+    check_axis_aliases(&list, &key("param"), study, doc)?;
     let variants = parse_variants(
         file.variant.unwrap_or_default(),
         &key("variant"),
         study,
         doc,
     )?;
+    check_variant_params(&variants, &list, &key("variant"), study, doc)?;
     let objective = parse_objective(&file.objective, &key("objective"), study, doc)?;
     let mut constraints = Vec::new();
     for (i, c) in file.constraint.unwrap_or_default().iter().enumerate() {
@@ -356,6 +301,74 @@ pub fn parse_spec(
         constraints,
         solver,
     })
+}
+
+/// Whether two targets set the same key, or one a key inside the other
+/// (`control.weights` and `control.weights[2]`).
+fn same_key(a: &Target, b: &Target) -> bool {
+    let (pa, pb) = match (a, b) {
+        (Target::Design(x), Target::Design(y)) | (Target::Scenario(x), Target::Scenario(y)) => {
+            (x, y)
+        }
+        _ => return false,
+    };
+    let n = pa.0.len().min(pb.0.len());
+    pa.0[..n] == pb.0[..n]
+}
+
+/// No parameter may set a key a sweep axis of the study sets (under any alias, e.g.
+/// `design.longitudinal_offset` and `design.generator.longitudinal_offset`): the tuned value
+/// would silently replace the axis value the case is labelled with.
+fn check_axis_aliases(
+    params: &[Param],
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<(), InputError> {
+    for (i, p) in params.iter().enumerate() {
+        if let Some(a) = study.axes.iter().find(|a| same_key(&a.target, &p.target)) {
+            return Err(doc.err(
+                &format!("{at}[{i}].name"),
+                format!(
+                    "`{}` sets the same key as the sweep axis `{}`: the tuned value would \
+                     replace the axis value every case is labelled with; tune another key \
+                     or drop the axis",
+                    p.name, a.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// No `[[variant]]` may set a key a `[[param]]` sets: the variant's value would replace the
+/// optimiser's in every run while the history reports the parameter's.
+fn check_variant_params(
+    variants: &[Variant],
+    params: &[Param],
+    at: &str,
+    study: &Study,
+    doc: &Document,
+) -> Result<(), InputError> {
+    for (i, v) in variants.iter().enumerate() {
+        for (path, _) in &v.set {
+            let Some((target, _)) = study_target(study, path).ok().flatten() else {
+                continue; // parse_variants has refused it
+            };
+            if let Some(p) = params.iter().find(|p| same_key(&p.target, &target)) {
+                return Err(doc.err(
+                    &format!("{at}[{i}].set"),
+                    format!(
+                        "`{path}` is the parameter `{}`: a variant setting it would override \
+                         the optimiser's value in every run; drop it from the variant or from \
+                         the [[param]] list",
+                        p.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn parse_param(
@@ -492,55 +505,11 @@ fn parse_variants(
     Ok(out)
 }
 
-/// Whether `name` is a metric the problem's evaluations report.
-fn known_metric(name: &str, study: &Study) -> bool {
-    DESIGN_COLUMNS.contains(&name)
-        || (study.static_enabled && TCM_COLUMNS.contains(&name))
-        || match study.mode {
-            StudyMode::Static => false,
-            StudyMode::Transport => {
-                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Transport, name)
-            }
-            StudyMode::Work => {
-                crate::metrics::run_summary::is_run_metric(crate::scenario::Mode::Work, name)
-            }
-        }
-}
-
-/// The metric catalogue of a study, for messages.
-pub fn metric_catalogue(study: &Study) -> Vec<String> {
-    let mut v: Vec<String> = DESIGN_COLUMNS.iter().map(|s| s.to_string()).collect();
-    if study.static_enabled {
-        v.extend(TCM_COLUMNS.iter().map(|s| s.to_string()));
-    }
-    let mode = match study.mode {
-        StudyMode::Static => None,
-        StudyMode::Transport => Some(crate::scenario::Mode::Transport),
-        StudyMode::Work => Some(crate::scenario::Mode::Work),
-    };
-    if let Some(m) = mode {
-        v.extend(crate::metrics::run_summary::metric_catalogue(m));
-    }
-    v
-}
-
 fn check_metric(name: &str, at: &str, study: &Study, doc: &Document) -> Result<(), InputError> {
     if known_metric(name, study) {
         return Ok(());
     }
-    Err(doc.err(
-        at,
-        format!(
-            "unknown metric `{name}` for mode \"{}\"{}; valid: {}",
-            study.mode,
-            if study.static_enabled {
-                " with [static]"
-            } else {
-                ""
-            },
-            metric_catalogue(study).join(", ")
-        ),
-    ))
+    Err(unknown_metric(name, at, study, doc))
 }
 
 fn parse_objective(
@@ -614,55 +583,4 @@ fn parse_constraint(
         value: c.value,
         tolerance,
     })
-}
-
-fn parse_solver(
-    s: &SolverFile,
-    at: &str,
-    seed: u64,
-    doc: &Document,
-) -> Result<SolverSettings, InputError> {
-    let k = |f: &str| format!("{at}.{f}");
-    let method = Method::ALL
-        .iter()
-        .find(|(n, _)| *n == s.method)
-        .map(|(_, m)| *m)
-        .ok_or_else(|| {
-            doc.err(
-                &k("method"),
-                format!(
-                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs",
-                    s.method
-                ),
-            )
-        })?;
-    let out = SolverSettings {
-        method,
-        max_iters: s.max_iters.unwrap_or(100),
-        max_evals: s.max_evals.unwrap_or(200),
-        tolerance: s.tolerance.unwrap_or(1e-6),
-        restarts: s.restarts.unwrap_or(0),
-        seed: s.seed.unwrap_or(seed),
-        particles: s.particles.unwrap_or(12),
-        step: s.step.unwrap_or(0.1),
-    };
-    if out.max_iters == 0 {
-        return Err(doc.err(&k("max_iters"), "must be >= 1"));
-    }
-    if out.max_evals < 2 {
-        return Err(doc.err(
-            &k("max_evals"),
-            "must be >= 2 (the start point and one more)",
-        ));
-    }
-    if !(out.tolerance > 0.0 && out.tolerance.is_finite()) {
-        return Err(doc.err(&k("tolerance"), "must be finite and > 0"));
-    }
-    if out.particles < 2 {
-        return Err(doc.err(&k("particles"), "must be >= 2"));
-    }
-    if !(out.step > 0.0 && out.step <= 0.5) {
-        return Err(doc.err(&k("step"), "must be in (0, 0.5]"));
-    }
-    Ok(out)
 }

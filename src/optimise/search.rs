@@ -8,11 +8,14 @@
 //!   pool (`--jobs`) and records it in the batch's order, so the history does not depend on
 //!   the number of threads.
 //! - A point seen before in this run is served from memory (recorded with `repeat`, not
-//!   counted against `max_evals`). Points simulated by an earlier, interrupted run of the same
-//!   problem (the journal) are served from memory too but count as they did then, so a resumed
-//!   run replays the interrupted one exactly and then carries on.
+//!   simulated again) but counts against `max_evals` like any other: a solver that keeps
+//!   proposing the same points (restarts of a converged search) still ends. Points simulated by
+//!   an earlier, interrupted run of the same problem (the journal) are served from memory too
+//!   and count as they did then, so a resumed run replays the interrupted one exactly and then
+//!   carries on.
 //! - The evaluation budget is enforced inside the cost function: once `max_evals` points are
-//!   recorded, it returns an error that ends the argmin run; the history decides the best.
+//!   recorded, it returns an error that ends the argmin run; the history decides the best. A
+//!   batch that does not fit is evaluated up to the budget before the error.
 //! - An argmin observer tracks the iteration each evaluation belongs to (0: the solver's
 //!   initialisation) for the history.
 
@@ -135,25 +138,25 @@ impl<'a, E: Evaluator> Search<'a, E> {
         Ok(())
     }
 
-    /// Plan a batch: project, map, and mark fresh points up to the budget; returns the plan
-    /// and whether the budget cut it short.
+    /// Plan a batch: project, map, and mark fresh points, up to the budget (every recorded
+    /// point counts, repeats included); returns the plan and whether the budget cut it short.
     fn plan<P: std::borrow::Borrow<Vec<f64>>>(
         &self,
         st: &SearchState,
         us: &[P],
     ) -> (Vec<Planned>, bool) {
         let mut fresh_keys: HashSet<Vec<u64>> = HashSet::new();
-        let fresh_before = st.records.iter().filter(|r| !r.repeat).count();
+        let used = st.records.len();
         let mut plan = Vec::new();
         for u in us {
+            if used + plan.len() >= self.budget {
+                return (plan, true);
+            }
             let (u, d2) = self.space.project(u.borrow());
             let x = self.space.values(&u);
             let key = key(&x);
             let fresh = !st.seen.contains(&key) && !fresh_keys.contains(&key);
             if fresh {
-                if fresh_before + fresh_keys.len() >= self.budget {
-                    return (plan, true);
-                }
                 fresh_keys.insert(key.clone());
             }
             plan.push(Planned {
@@ -167,13 +170,10 @@ impl<'a, E: Evaluator> Search<'a, E> {
         (plan, false)
     }
 
-    /// Whether evaluating `us` would need more fresh points than the budget has left (or the
-    /// budget is already spent); if so the search counts as exhausted from now on.
-    fn would_exceed(&self, us: &[Vec<f64>]) -> bool {
-        let mut st = self.lock();
-        let cut = st.exhausted || self.plan(&st, us).1;
-        st.exhausted |= cut;
-        cut
+    /// Whether evaluating `us` fits in what is left of the budget.
+    fn fits(&self, us: &[Vec<f64>]) -> bool {
+        let st = self.lock();
+        !st.exhausted && !self.plan(&st, us).1
     }
 
     /// Evaluate a batch in order (see the module docs); the costs, or the budget error.
@@ -205,7 +205,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
         for (&i, e) in todo.iter().zip(done) {
             if let Some(j) = st.journal.as_mut() {
                 if let Err(err) = j.append(&plan[i].x, &e) {
-                    st.journal_error.get_or_insert(err);
+                    st.journal_error.get_or_insert(err.to_string());
                 }
             }
             st.memo.insert(plan[i].key.clone(), e);
@@ -366,8 +366,10 @@ fn nelder_mead<E: Evaluator>(
         simplex.push(v);
     }
     // argmin's Nelder–Mead unwraps the costs of its initial simplex (it would panic on the
-    // budget error): a budget that cannot cover the whole simplex stops the search here.
-    if search.would_exceed(&simplex) {
+    // budget error): a budget that cannot cover the whole simplex spends what is left on its
+    // new vertices (the first, `u0`, is a recorded point) and stops the search here.
+    if !search.fits(&simplex) {
+        search.batch(&simplex[1..])?;
         return Err(Error::msg("evaluation budget reached"));
     }
     let solver = NelderMead::new(simplex).with_sd_tolerance(s.tolerance)?;

@@ -1,4 +1,4 @@
-//! One thrust-allocation case (SPEC §5, USM-36/37) read from a JSON case file, validated and
+//! One thrust-allocation case (docs/model.md §5, USM-36/37) read from a JSON case file, validated and
 //! solved with one or more methods; the results serialise as the JSON of `usm-study allocate`.
 //!
 //! The case file is JSON with these keys (unknown keys are rejected):
@@ -20,7 +20,8 @@
 //! or `rate_limit` is present.
 //!
 //! JSON output is an object keyed by method name, each with `u`, `s`, `objective`, `status`
-//! (`solved`, `slack_active`, `bounds_violated`, `solver_failed`), `status_detail`,
+//! (`solved`, `slack_active`, `bounds_violated`, `solver_failed`, `non_finite`: NaN or ∞ in
+//! the result), `status_detail`,
 //! `solver_status`, `iterations`, `path` (`pinv`, `interior`: the certified interior shortcut of
 //! `qp`, `clarabel`, `fallback`) and `solve_time_us`.
 //!
@@ -38,6 +39,10 @@ use crate::allocation::{
 
 /// The status label of a failed solve.
 pub const FAILED: &str = "solver_failed";
+
+/// The status label of a result holding NaN or infinite values (e.g. `τ` near `f64::MAX`
+/// overflowing the pseudoinverse): never `solved`.
+pub const NON_FINITE: &str = "non_finite";
 
 /// A case file that cannot be used; the message names the file, the source the key.
 #[derive(Debug, thiserror::Error)]
@@ -125,7 +130,7 @@ fn key_len(key: &str, v: &[f64], m: usize) -> Result<(), CaseError> {
 
 /// Reads and validates the case file at `path`.
 pub fn read_case(path: &Path) -> Result<Case, CaseFileError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CaseFileError::Read {
+    let text = crate::input::document::read_text(path).map_err(|source| CaseFileError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -226,7 +231,8 @@ pub struct MethodResult {
     pub s: [f64; 6],
     /// Objective value of the method.
     pub objective: f64,
-    /// Status label: `solved`, `slack_active`, `bounds_violated` or [`FAILED`].
+    /// Status label: `solved`, `slack_active`, `bounds_violated`, [`FAILED`] or
+    /// [`NON_FINITE`].
     pub status: &'static str,
     /// The status in words.
     pub status_detail: String,
@@ -244,12 +250,25 @@ impl MethodResult {
     fn new(a: &Allocation, solve_time_us: f64) -> Self {
         let mut s = [0.0; 6];
         s.copy_from_slice(a.s.as_slice());
+        let finite = a.u.iter().chain(&s).all(|v| v.is_finite()) && !a.objective.is_nan();
+        let (status, status_detail) = if finite {
+            (AllocStatus::label(&a.status), a.status.to_string())
+        } else {
+            (
+                NON_FINITE,
+                format!(
+                    "the result holds NaN or infinite values (the solver said: {}); τ or T \
+                     is too large for double precision",
+                    a.status
+                ),
+            )
+        };
         Self {
             u: a.u.clone(),
             s,
             objective: a.objective,
-            status: AllocStatus::label(&a.status),
-            status_detail: a.status.to_string(),
+            status,
+            status_detail,
             solver_status: a.solver_status,
             iterations: a.iterations,
             path: a.path.label(),

@@ -1,6 +1,6 @@
 //! `design draw`: a design at one state as a drawing ([`crate::report::drawing`]) — bodies,
 //! joint axes, thrust arrows, base and end-effector frames — with a caption of the scaled
-//! singular values of `T(q)` (SPEC §6) and the lost and weakest base directions.
+//! singular values of `T(q)` (docs/model.md §6) and the lost and weakest base directions.
 
 use std::path::Path;
 
@@ -20,7 +20,7 @@ const TRIAD_FRACTION: f64 = 0.08;
 const AXIS_RADII: f64 = 1.8;
 
 /// Whether body `i` is drawn as a joint module: an inner body (joints at both ends) without
-/// thrusters, no longer than its diameter (the 0.104 m modules of SPEC §2 and the generator).
+/// thrusters, no longer than its diameter (the 0.104 m modules of docs/model.md §2 and the generator).
 pub fn is_joint_module(v: &Vehicle, i: usize) -> bool {
     let b = &v.bodies[i];
     i > 0
@@ -122,7 +122,7 @@ pub fn vehicle_scene(v: &Vehicle, s: &VehicleState) -> Scene {
 }
 
 /// The weakest of the six base DOFs under the thrust limits: the axis whose attainable wrench
-/// (the smaller of `±e_k`, moments divided by `L` so that all six are in N, SPEC §6) is least;
+/// (the smaller of `±e_k`, moments divided by `L` so that all six are in N, docs/model.md §6) is least;
 /// its name and that value [N].
 pub fn weakest_axis(m: &TcmMetrics) -> Option<(&'static str, f64)> {
     let att = m.attainable.as_ref()?;
@@ -134,7 +134,7 @@ pub fn weakest_axis(m: &TcmMetrics) -> Option<(&'static str, f64)> {
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The scaled `T(q)` metrics of `v` at `s` (SPEC §6, moments divided by `L` = half the
+/// The scaled `T(q)` metrics of `v` at `s` (docs/model.md §6, moments divided by `L` = half the
 /// vehicle length, default rank tolerance, attainable wrench under the thrust limits);
 /// `None` without thrusters.
 pub fn state_metrics(v: &Vehicle, s: &VehicleState) -> Result<Option<TcmMetrics>, PipelineError> {
@@ -205,14 +205,57 @@ pub fn caption(v: &Vehicle, state_label: &str, m: Option<&TcmMetrics>) -> Vec<St
     lines
 }
 
-/// The drawing of `v` at `s` as an SVG document; `state_label` says which state it is.
+/// Largest coordinate of a drawing [m]: far beyond any vehicle, small enough that the
+/// renderer's spans and scales stay finite.
+pub const MAX_DRAWING_COORD: f64 = 1e9;
+
+/// Every point of `scene` is finite and within [`MAX_DRAWING_COORD`] of the origin.
+fn check_range(scene: &Scene) -> Result<(), PipelineError> {
+    let points = scene
+        .cylinders
+        .iter()
+        .map(|c| (format!("body {}", c.name), c.pose.p))
+        .chain(
+            scene
+                .joints
+                .iter()
+                .map(|j| (format!("joint {}", j.name), j.position)),
+        )
+        .chain(
+            scene
+                .arrows
+                .iter()
+                .map(|a| (format!("thruster {}", a.name), a.start)),
+        )
+        .chain(
+            scene
+                .triads
+                .iter()
+                .map(|t| (format!("the {} frame", t.name), t.pose.p)),
+        );
+    for (what, p) in points {
+        if let Some(x) = p.iter().find(|x| x.is_nan() || x.abs() > MAX_DRAWING_COORD) {
+            return Err(PipelineError::DrawingRange {
+                what,
+                value: crate::input::located::fmt_exact(*x),
+                limit: MAX_DRAWING_COORD,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The drawing of `v` at `s` as an SVG document; `state_label` says which state it is. A
+/// state that puts the geometry out of range ([`MAX_DRAWING_COORD`]) is an error.
 pub fn draw_design(
     v: &Vehicle,
     s: &VehicleState,
     state_label: &str,
 ) -> Result<String, PipelineError> {
+    let scene = vehicle_scene(v, s);
+    check_range(&scene)?;
     let m = state_metrics(v, s)?;
-    let mut scene = vehicle_scene(v, s);
+    let mut scene = scene;
     scene.caption = caption(v, state_label, m.as_ref());
     Ok(render_svg(&scene))
 }
@@ -278,5 +321,16 @@ mod tests {
         }
         let ee = scene.triads[1].pose.p;
         assert!((ee - ws.g_be.p).norm() < 1e-12);
+    }
+
+    #[test]
+    fn a_state_out_of_range_is_refused_not_drawn_with_nan() {
+        let v = usm_paper();
+        let mut s = VehicleState::rest(&v);
+        assert!(draw_design(&v, &s, "rest").is_ok());
+        s.base.position[0] = 1e308;
+        let e = draw_design(&v, &s, "far").unwrap_err();
+        assert!(matches!(e, PipelineError::DrawingRange { .. }), "{e}");
+        assert!(e.to_string().contains("1e308"), "{e}");
     }
 }

@@ -7,7 +7,7 @@ use crate::metrics::singularity::SingularityError;
 use crate::model::design::DesignError;
 use crate::report::ReportError;
 use crate::scenario::ScenarioError;
-use crate::study::static_tcm::StaticError;
+use crate::statics::StaticError;
 
 /// Why a pipeline stopped. Errors of the stages it calls pass through unchanged (same message,
 /// same source chain); file-system errors name the path.
@@ -53,6 +53,20 @@ pub enum PipelineError {
         /// The metric error.
         #[source]
         source: SingularityError,
+    },
+    /// The state puts the drawing's geometry out of range (a coordinate not finite or beyond
+    /// [`crate::pipeline::draw::MAX_DRAWING_COORD`] m), so its SVG would hold NaN.
+    #[error(
+        "the state puts {what} at {value} m, beyond the ±{limit:e} m a drawing can show \
+         (check the state's base position and joint angles)"
+    )]
+    DrawingRange {
+        /// Which part of the drawing, e.g. "body B2".
+        what: String,
+        /// The offending coordinate [m].
+        value: String,
+        /// The limit [m].
+        limit: f64,
     },
     /// The dynamics could not be evaluated at the given state.
     #[error("evaluating the dynamics at the state")]

@@ -34,7 +34,7 @@ pub struct KinematicsReport {
     pub tcm_rank: usize,
     /// Wrench directions T(q) cannot produce, each labelled by its dominant base axis.
     pub tcm_lost_directions: Vec<LostDirection>,
-    /// Metrics of the moment-scaled T(q) (SPEC §6): σ_min, κ, rank, attainable wrench.
+    /// Metrics of the moment-scaled T(q) (docs/model.md §6): σ_min, κ, rank, attainable wrench.
     pub tcm_scaled: TcmMetrics,
 }
 
@@ -43,7 +43,7 @@ pub struct KinematicsReport {
 pub struct InspectReport {
     /// Kinematics and `T(q)`.
     pub kinematics: KinematicsReport,
-    /// Mass matrix, bias, acceleration and energy (SPEC §4).
+    /// Mass matrix, bias, acceleration and energy (docs/model.md §4).
     pub dynamics: DynamicsReport,
     /// Whether the bodies were taken in vacuum (no added mass, drag, restoring forces or
     /// current).

@@ -2,34 +2,25 @@
 //! the command's files (CSV, Parquet, SVG, JSON, Markdown), so that the binary only parses
 //! arguments, calls one of these, and prints.
 //!
-//! - [`tcm`]: the static analysis of `T(q)` over joint space (SPEC §6) and its files;
+//! - [`tcm`]: the static analysis of `T(q)` over joint space (docs/model.md §6) and its files;
 //! - [`simulate`]: the files of one closed-loop scenario run;
 //! - [`shapes`]: the body along a run (`shapes.svg`, `animation.svg`);
-//! - [`paper`]: the USM paper's simulations, their files and comparison tables;
-//! - [`readings`]: transport mode under every reading of the paper's open choices;
-//! - [`secondary`]: the paper's secondary objectives on and off, work mode and transport;
 //! - [`draw`]: the drawing of a design at one state (`design draw`);
 //! - [`review`]: `report.html`, the design-review page of a study output directory;
-//! - [`antonelli`]: Antonelli & Chiaverini's case studies (kinematic 1, 1b, 2; dynamic 3a,
-//!   3b and Table I), their CSVs and summary; [`antonelli_figures`]: their figures;
 //! - [`inspect`]: the kinematic report of a design at one state (printed by the binary);
 //! - [`allocate`]: one thrust-allocation case file, validated and solved with each method;
 //! - [`optimise`]: the files of an optimisation (history, best point, summary, plots).
 //!
-//! The batch sweep's pipeline lives in [`crate::study`]. No pipeline prints: progress and
+//! The batch sweep's pipeline lives in [`crate::study`]; the paper reproductions (`paper`,
+//! `paper readings`, `paper antonelli`) in [`crate::paper`]. No pipeline prints: progress and
 //! per-run outcomes reach the caller through callbacks.
 
 pub mod allocate;
-pub mod antonelli;
-pub mod antonelli_figures;
 pub mod draw;
 pub mod error;
 pub mod inspect;
 pub mod optimise;
-pub mod paper;
-pub mod readings;
 pub mod review;
-pub mod secondary;
 pub mod shapes;
 pub mod simulate;
 pub mod tcm;

@@ -12,6 +12,7 @@ use serde_json::json;
 
 use super::error::PipelineError;
 use crate::control::transport::yaw_joint_mask;
+use crate::evaluate::static_table::STATIC_TABLE;
 use crate::model::design::parse_design_table;
 use crate::optimise::evaluate::CaseEvaluator;
 use crate::optimise::history::{best_so_far, history_table, Record};
@@ -26,7 +27,6 @@ use crate::scenario::Mode;
 use crate::study::cases::Resolved;
 use crate::study::manifest::{git_commit, now_rfc3339};
 use crate::study::runner::StudyMode;
-use crate::study::static_table::STATIC_TABLE;
 
 /// The history table's file stem in an output directory.
 pub const HISTORY: &str = "history";
@@ -133,9 +133,9 @@ fn write_best_files(
     out: &Path,
 ) -> Result<(), PipelineError> {
     for v in 0..problem.spec.variants.len() {
-        let r = ev
-            .resolve(x, v)
-            .map_err(|m| PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m)))?;
+        let r = ev.resolve(x, v).map_err(|m| {
+            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
+        })?;
         let text = case_file_text(problem, &r, x)?;
         atomic_write(&out.join(best_file_name(problem, v)), text.as_bytes())?;
     }
@@ -364,9 +364,9 @@ fn runs_figure(
     };
     let mut figs = Vec::new();
     for (label, r) in [("start", o.start()), ("best", o.best())] {
-        let resolved = ev
-            .resolve(&r.x, 0)
-            .map_err(|m| PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m)))?;
+        let resolved = ev.resolve(&r.x, 0).map_err(|m| {
+            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
+        })?;
         let run = ev.run_case(&resolved, true);
         let vehicle = parse_design_table(&resolved.design, "optimised design")?;
         let yaw: Vec<usize> = yaw_joint_mask(&vehicle)

@@ -11,10 +11,10 @@ use super::draw::vehicle_scene;
 use super::error::PipelineError;
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
+use crate::outcome::RunResult;
 use crate::report::atomic_write;
 use crate::report::drawing::run::{render_animation_svg, render_shapes_svg, RunDrawing, Snapshot};
 use crate::scenario::channels::{Channel, Pose};
-use crate::scenario::RunResult;
 use crate::spatial::Vec3;
 use crate::state::VehicleState;
 

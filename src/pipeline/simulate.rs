@@ -10,9 +10,9 @@ use super::error::PipelineError;
 use crate::allocation::Method;
 use crate::control::transport::yaw_joint_mask;
 use crate::model::Vehicle;
+use crate::outcome::RunResult;
 use crate::report::figures::{run_figure, trajectory_table};
 use crate::report::{atomic_write, write_csv, write_parquet};
-use crate::scenario::RunResult;
 
 /// Sets `allocation.method` in a scenario table (the `--allocation` override, and the paper's
 /// allocator comparison).

@@ -1,17 +1,23 @@
 //! The `tcm` pipeline: static configuration-space analysis of the thruster configuration
-//! matrix (SPEC §6) — how often `T(q)` is singular over the joint space — and its files.
+//! matrix (docs/model.md §6) — how often `T(q)` is singular over the joint space — and its files.
 //!
 //! Writes to the output directory:
 //! - `samples.csv`: one row per sample (streamed; memory stays bounded for any N):
 //!   `index`, `q1_rad … qn_rad`, `sigma_min` (scaled σ_min, N per N), `kappa`, `rank`,
 //!   `lost_axis` (empty unless σ_min < threshold or rank < 6), then `sigma_min_commanded`
-//!   and `kappa_commanded` of the rows the mode's controller commands (SPEC §6);
+//!   and `kappa_commanded` of the rows the mode's controller commands (docs/model.md §6);
 //! - `samples.parquet`: the same table, only when N ≤ [`PARQUET_MAX_ROWS`] (larger tables stay
 //!   CSV only);
 //! - `summary.json`: the [`StaticSummary`] plus the slice joints and the files written;
 //! - `sigma_min_hist.svg`, `sigma_min_commanded_hist.svg`: histograms of the full and the
 //!   commanded σ_min; `sigma_min_slice.svg`: σ_min over a 2-D slice
 //!   of joint space (the two most influential yaw joints, or the given pair; others 0).
+//!
+//! Complete or clearly incomplete: a previous `summary.json` is removed first; `samples.csv`
+//! is streamed into a temporary file (`.samples.csv.tmp-TOKEN`, removed on an error) and
+//! renamed into place when complete; the other files are written atomically; `summary.json`,
+//! written last, marks a complete output. A run killed or failing part-way leaves no
+//! `summary.json` (and never a `samples.csv` with a row cut in half or rows of two runs).
 
 use std::path::{Path, PathBuf};
 
@@ -23,8 +29,8 @@ use crate::report::{
     atomic_write, heatmap, histogram, push_csv_row, read_csv_typed, write_parquet, ColourScale,
     ColumnKind, CsvAppender, Value,
 };
-use crate::study::static_tcm::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
-use crate::study::static_tcm_slice::{influential_joints, slice_grid};
+use crate::statics::slice::{influential_joints, slice_grid};
+use crate::statics::{analyse_text, SampleMetrics, StaticSpec, StaticSummary};
 
 /// Largest sample count for which `samples.parquet` is written.
 pub const PARQUET_MAX_ROWS: usize = 200_000;
@@ -85,8 +91,54 @@ pub fn run_tcm(
     let out = &config.out;
     create_dir(out)?;
     let schema = sample_schema(vehicle.n_joints());
+    let summary_path = out.join("summary.json");
+    match std::fs::remove_file(&summary_path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(crate::report::ReportError::Io {
+                path: summary_path,
+                action: "removing",
+                source: e,
+            }
+            .into())
+        }
+        _ => {}
+    }
     let csv_path = out.join("samples.csv");
-    let mut app = CsvAppender::create(&csv_path, &schema)?.batched();
+    let tmp_path = out.join(format!(".samples.csv{}", crate::report::temporary_suffix()));
+    let result = write_samples(vehicle, config, &schema, &tmp_path, progress);
+    let (summary, sigmas, commanded) = match result {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp_path);
+            return Err(e);
+        }
+    };
+    if let Err(source) = std::fs::rename(&tmp_path, &csv_path) {
+        let _ = std::fs::remove_file(&tmp_path);
+        return Err(crate::report::ReportError::Io {
+            path: csv_path,
+            action: "renaming into place",
+            source,
+        }
+        .into());
+    }
+    write_rest(vehicle, config, &schema, &summary, sigmas, commanded)?;
+    Ok(summary)
+}
+
+/// The σ_min columns kept for the histograms: the full and the commanded ones.
+type Kept = (StaticSummary, Vec<f64>, Vec<f64>);
+
+/// Streams the samples into `path` (flushed) and returns the summary and the kept σ_min columns.
+fn write_samples(
+    vehicle: &Vehicle,
+    config: &TcmConfig,
+    schema: &[(String, ColumnKind)],
+    path: &Path,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Kept, PipelineError> {
+    let spec = &config.spec;
+    let mut app = CsvAppender::create(path, schema)?.batched();
     let mut sigmas: Vec<f64> = Vec::with_capacity(spec.samples);
     let mut commanded: Vec<f64> = Vec::with_capacity(spec.samples);
     // Each worker formats its samples' rows (the bytes `CsvAppender::append` would write);
@@ -114,7 +166,7 @@ pub fn run_tcm(
         spec,
         config.jobs,
         &format,
-        &mut |text| app.append_lines(text).map_err(|e| e.to_string()),
+        &mut |text| app.append_lines(text).map_err(Into::into),
         &mut |_, _, m| {
             sigmas.push(m.sigma_min);
             commanded.push(m.sigma_min_commanded);
@@ -126,11 +178,28 @@ pub fn run_tcm(
     // of up to hundreds of MB here.
     app.flush()?;
     drop(app);
+    Ok((summary, sigmas, commanded))
+}
+
+/// Writes the Parquet table, the plots and, last, `summary.json`.
+fn write_rest(
+    vehicle: &Vehicle,
+    config: &TcmConfig,
+    schema: &[(String, ColumnKind)],
+    summary: &StaticSummary,
+    sigmas: Vec<f64>,
+    commanded: Vec<f64>,
+) -> Result<(), PipelineError> {
+    let (spec, out) = (&config.spec, &config.out);
+    let csv_path = out.join("samples.csv");
     let mut files = vec!["samples.csv".to_string()];
     if spec.samples <= PARQUET_MAX_ROWS {
-        let t = read_csv_typed(&csv_path, &schema)?;
+        let t = read_csv_typed(&csv_path, schema)?;
         write_parquet(&t, &out.join("samples.parquet"))?;
         files.push("samples.parquet".into());
+    } else {
+        // Not written for this many samples: a previous run's table must not stay beside.
+        let _ = std::fs::remove_file(out.join("samples.parquet"));
     }
     for (values, file, what) in [
         (sigmas, "sigma_min_hist.svg", "scaled σ_min of T(q)"),
@@ -155,12 +224,12 @@ pub fn run_tcm(
     let slice_joints = write_slice(vehicle, config, out, &mut files)?;
     files.push("summary.json".into());
     let json = serde_json::to_string_pretty(&SummaryFile {
-        summary: &summary,
+        summary,
         slice_joints,
         files,
     })?;
     atomic_write(&out.join("summary.json"), (json + "\n").as_bytes())?;
-    Ok(summary)
+    Ok(())
 }
 
 /// Writes `sigma_min_slice.svg` over the configured (or most influential) pair of joints and

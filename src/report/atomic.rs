@@ -8,9 +8,28 @@ use super::error::{ReportError, Result};
 
 /// Writes `bytes` to `path` atomically: to a temporary file in the same directory, flushed and
 /// synced, then renamed into place. A reader never sees a half-written file; an interrupted
-/// write leaves at most a stray `.<name>.tmp-<pid>` file.
+/// write leaves at most a stray `.<name>.tmp-<token>` file ([`run_token`]), which the next run
+/// holding the output directory's lock removes (only that token's files).
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<()> {
     atomic_write_with(path, |w| w.write_all(bytes))
+}
+
+/// This process's run token, `PID-HEX` (pid and clock at first use): names its temporary
+/// files and is recorded in the output directory's lock, so that only a dead run's own
+/// temporaries are ever removed.
+pub fn run_token() -> &'static str {
+    static TOKEN: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TOKEN.get_or_init(|| {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        format!("{}-{:x}", std::process::id(), nanos & 0xffff_ffff_ffff)
+    })
+}
+
+/// The suffix of this run's temporary files: `.tmp-TOKEN`.
+pub fn temporary_suffix() -> String {
+    format!(".tmp-{}", run_token())
 }
 
 /// [`atomic_write`] of what `fill` writes (through a 64 KiB buffer) into the temporary file:
@@ -38,7 +57,7 @@ pub fn atomic_write_with(
     };
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(file_name);
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    tmp_name.push(temporary_suffix());
     let tmp = dir.join(tmp_name);
     let result = (|| {
         let mut file = std::fs::File::create(&tmp).map_err(io("creating", &tmp))?;

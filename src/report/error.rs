@@ -19,14 +19,15 @@ pub enum ReportError {
         source: std::io::Error,
     },
     /// polars failed to write or read `path`.
-    #[error("{action} {path}: {message}", path = .path.display())]
+    #[error("{action} {path}: {source}", path = .path.display())]
     Polars {
         /// The file concerned.
         path: PathBuf,
         /// What was being done, e.g. "writing CSV".
         action: &'static str,
-        /// polars' error message.
-        message: String,
+        /// polars' error.
+        #[source]
+        source: polars::error::PolarsError,
     },
     /// A column was pushed whose length differs from the table's row count.
     #[error("column `{column}` has {found} rows, the table has {expected}")]

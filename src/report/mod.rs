@@ -36,11 +36,11 @@ pub mod plot;
 pub mod table;
 pub mod table_io;
 
-pub use atomic::{atomic_write, file_stem_safe};
+pub use atomic::{atomic_write, file_stem_safe, run_token, temporary_suffix};
 pub use csv_append::{push_csv_row, write_csv_streamed, CsvAppender};
 pub use error::{ReportError, Result};
 pub use markdown::MarkdownTable;
-pub use number::{fmt_num, fmt_short, format_f64};
+pub use number::{fmt_num, fmt_short, fmt_value, format_f64};
 pub use pareto::pareto_front;
 pub use plot::{
     heatmap, histogram, scatter_labelled, Colour, ColourScale, Figure, Heatmap, LabelledPoint,

@@ -46,6 +46,17 @@ pub fn fmt_short(x: f64) -> String {
     }
 }
 
+/// A TOML value as printed for people (dry-run listings, string columns of mixed axes): a
+/// string as is, a float in the tables' format ([`format_f64`]: `1e+200`, never its 200-digit
+/// decimal), anything else (arrays included) in TOML notation.
+pub fn fmt_value(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Float(x) => format_f64(*x),
+        other => other.to_string(),
+    }
+}
+
 #[cfg(test)]
 #[path = "number_tests.rs"]
 mod tests;

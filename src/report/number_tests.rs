@@ -133,3 +133,14 @@ fn short_display_format() {
     assert_eq!(fmt_num(f64::NAN), "NaN");
     assert_eq!(fmt_num(f64::INFINITY), "inf");
 }
+
+#[test]
+fn values_print_short_for_people() {
+    assert_eq!(fmt_value(&toml::Value::Float(1e200)), "1e+200");
+    assert_eq!(fmt_value(&toml::Value::Float(0.25)), "0.25");
+    assert_eq!(fmt_value(&toml::Value::Float(2.0)), "2.0");
+    assert_eq!(fmt_value(&toml::Value::Integer(7)), "7");
+    assert_eq!(fmt_value(&toml::Value::String("qp".into())), "qp");
+    assert_eq!(fmt_short(1e200), "1.000e200");
+    assert_eq!(fmt_num(-1e200), "-1.000e200");
+}

@@ -32,7 +32,7 @@ use std::sync::Arc;
 
 use polars::prelude::{
     Column as PlColumn, CsvReadOptions, CsvWriter, DataFrame, DataType, Field, ParquetReader,
-    ParquetWriter, PlSmallStr, Schema, SerReader, SerWriter,
+    ParquetWriter, PlSmallStr, PolarsError, Schema, SerReader, SerWriter,
 };
 
 use super::atomic::atomic_write;
@@ -61,13 +61,13 @@ fn to_polars(data: &ColumnData, name: &str) -> PlColumn {
 }
 
 /// The table as a polars data frame.
-fn to_dataframe(table: &Table) -> std::result::Result<DataFrame, String> {
+fn to_dataframe(table: &Table) -> std::result::Result<DataFrame, PolarsError> {
     let cols = table
         .columns
         .iter()
         .map(|c| to_polars(&c.data, &c.name))
         .collect();
-    DataFrame::new(table.n_rows(), cols).map_err(|e| e.to_string())
+    DataFrame::new(table.n_rows(), cols)
 }
 
 /// A table from a polars data frame read from `path` (named in errors).
@@ -125,12 +125,12 @@ fn from_dataframe(df: &DataFrame, path: &Path) -> Result<Table> {
     Ok(t)
 }
 
-fn polars_err(path: &Path, action: &'static str) -> impl Fn(String) -> ReportError {
+fn polars_err(path: &Path, action: &'static str) -> impl Fn(PolarsError) -> ReportError {
     let path = path.to_path_buf();
-    move |message| ReportError::Polars {
+    move |source| ReportError::Polars {
         path: path.clone(),
         action,
-        message,
+        source,
     }
 }
 
@@ -143,7 +143,7 @@ pub fn write_csv(table: &Table, path: &Path) -> Result<()> {
     CsvWriter::new(&mut buf)
         .include_header(true)
         .finish(&mut df)
-        .map_err(|e| err(e.to_string()))?;
+        .map_err(&err)?;
     atomic_write(path, &buf)
 }
 
@@ -152,9 +152,7 @@ pub fn write_parquet(table: &Table, path: &Path) -> Result<()> {
     let err = polars_err(path, "writing Parquet");
     let mut df = to_dataframe(table).map_err(&err)?;
     let mut buf = Vec::new();
-    ParquetWriter::new(&mut buf)
-        .finish(&mut df)
-        .map_err(|e| err(e.to_string()))?;
+    ParquetWriter::new(&mut buf).finish(&mut df).map_err(&err)?;
     atomic_write(path, &buf)
 }
 
@@ -176,7 +174,7 @@ fn read_csv_with(path: &Path, options: CsvReadOptions) -> Result<Table> {
     let df = options
         .into_reader_with_file_handle(file)
         .finish()
-        .map_err(|e| err(e.to_string()))?;
+        .map_err(&err)?;
     from_dataframe(&df, path)
 }
 
@@ -217,6 +215,6 @@ pub fn read_parquet(path: &Path) -> Result<Table> {
     })?;
     let df = ParquetReader::new(file)
         .finish()
-        .map_err(|e| polars_err(path, "reading Parquet")(e.to_string()))?;
+        .map_err(polars_err(path, "reading Parquet"))?;
     from_dataframe(&df, path)
 }

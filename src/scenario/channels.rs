@@ -4,7 +4,7 @@
 //!
 //! [`Channel::name`] gives the column name written to `timeseries.csv` / `.parquet`;
 //! [`channel_layout`] gives the column order of a run. Units are SI, angles in rad; poses are
-//! in the inertial frame (ZYX Euler angles, SPEC §2), twists in the body's own frame.
+//! in the inertial frame (ZYX Euler angles, docs/model.md §2), twists in the body's own frame.
 
 use super::config::{Mode, ScenarioFile};
 use crate::input::located::KeyError;
@@ -137,22 +137,22 @@ pub enum Channel {
     /// Joint torque τ_k [N·m].
     Tau(usize),
     /// Joint work `∫ Σ_k |τ_k q̇_k| dt` since t = 0 [J], integrated by the simulator with the
-    /// motion (the joint-energy metric, SPEC §6).
+    /// motion (the joint-energy metric, docs/model.md §6).
     JointWork,
     /// Commanded (allocated) thrust of thruster j [N].
     UCmd(usize),
     /// Actual thrust of thruster j, clamped to its limits [N].
     U(usize),
-    /// Shaft power of thruster j by momentum theory with axial inflow [W] (SPEC §6): of the
+    /// Shaft power of thruster j by momentum theory with axial inflow [W] (docs/model.md §6): of the
     /// thrust held over the control interval starting at this sample (the allocation
     /// saturated to the limits), the integrand of `thruster_energy`.
     Power(usize),
     /// Axial inflow V_a of thruster j [m/s]: its velocity relative to the water along the
     /// direction it pushes the vehicle (positive when moving the way it pushes).
     Inflow(usize),
-    /// Scaled σ_min of the thruster configuration matrix T(q), all six wrench axes (SPEC §6).
+    /// Scaled σ_min of the thruster configuration matrix T(q), all six wrench axes (docs/model.md §6).
     SigmaMin,
-    /// Scaled σ_min of the rows of T(q) the controller commands, `S·T_L` (SPEC §6): the
+    /// Scaled σ_min of the rows of T(q) the controller commands, `S·T_L` (docs/model.md §6): the
     /// weakest commanded wrench per newton of thrust norm (N per N), see
     /// [`crate::metrics::singularity::commanded_sigma`].
     SigmaMinCommanded,

@@ -50,7 +50,7 @@ use crate::control::work::WorkGains;
 use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
-use crate::input::located::KeyError;
+use crate::input::located::{fmt_exact, KeyError};
 use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
@@ -69,7 +69,7 @@ pub enum Mode {
 }
 
 impl Mode {
-    /// The base axes the mode's default controller commands (SPEC §5), as
+    /// The base axes the mode's default controller commands (docs/model.md §5), as
     /// [`ScenarioFile::commanded_dofs`] of a file without `[control]`/`[base_control]`: both
     /// of the paper's modes leave roll free (`K_p,roll = 0`; work: zero base-roll weight).
     pub fn default_commanded_dofs(self) -> CommandedDofs {
@@ -177,7 +177,7 @@ impl Default for InitialSpec {
     }
 }
 
-/// `[allocation]`: the thrust allocation method and its settings (SPEC §5, USM-37).
+/// `[allocation]`: the thrust allocation method and its settings (docs/model.md §5, USM-37).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AllocationSpec {
@@ -253,7 +253,7 @@ impl AllocationSpec {
     }
 }
 
-/// `[metrics]`: thresholds and the power model (SPEC §6).
+/// `[metrics]`: thresholds and the power model (docs/model.md §6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MetricsSpec {
@@ -274,7 +274,7 @@ pub struct MetricsSpec {
     pub position_tolerance: f64,
     /// Orientation tolerance for settling (roll excluded) [deg] (work).
     pub orientation_tolerance_deg: f64,
-    /// Propeller diameter D [m] of the actuator-disk power model (SPEC §6). Default 0.07 m
+    /// Propeller diameter D [m] of the actuator-disk power model (docs/model.md §6). Default 0.07 m
     /// (inferred: the paper gives no propeller data).
     pub propeller_diameter: f64,
     /// Overall efficiency η of the power model, shaft power = ideal power / η. Default 0.5
@@ -350,7 +350,7 @@ pub struct ScenarioFile {
     /// Metric settings.
     #[serde(default)]
     pub metrics: MetricsSpec,
-    /// Success criteria (SPEC §6).
+    /// Success criteria (docs/model.md §6).
     #[serde(default)]
     pub success: SuccessSpec,
 }
@@ -398,7 +398,7 @@ impl ScenarioFile {
             })
     }
 
-    /// The base axes this scenario's controller commands (SPEC §5), from its mode, `[control]`
+    /// The base axes this scenario's controller commands (docs/model.md §5), from its mode, `[control]`
     /// and `[base_control]` gains: the selection `S` of `singularity_exposure` and
     /// `allocation_residual_fraction` ([`CommandedDofs::transport`] — surge, yaw and the axes
     /// with `K_p > 0` when the base control feeds back on the uncommanded axes —,
@@ -415,7 +415,7 @@ impl ScenarioFile {
     }
 
     /// The characteristic length L [m] of the scaled TCM: `metrics.char_length`, or half the
-    /// length of `v` when that is 0 (SPEC §6).
+    /// length of `v` when that is 0 (docs/model.md §6).
     pub fn char_length(&self, v: &Vehicle) -> f64 {
         if self.metrics.char_length > 0.0 {
             self.metrics.char_length
@@ -503,7 +503,10 @@ impl ScenarioFile {
     pub fn validate(&self) -> Result<(), KeyError> {
         self.validate_rates()?;
         let finite = |k: &str, xs: &[f64]| match xs.iter().find(|x| !x.is_finite()) {
-            Some(x) => Err(KeyError::new(k, format!("must be finite, got {x}"))),
+            Some(x) => Err(KeyError::new(
+                k,
+                format!("must be finite, got {}", fmt_exact(*x)),
+            )),
             None => Ok(()),
         };
         finite("initial.position", &self.initial.position)?;
@@ -541,6 +544,7 @@ impl ScenarioFile {
     /// `[scenario]`: positive durations, control and logging periods whole multiples.
     fn validate_rates(&self) -> Result<(), KeyError> {
         let s = &self.scenario;
+        check_scenario_name(&s.name)?;
         for (k, v) in [
             ("scenario.duration", s.duration),
             ("scenario.dt", s.dt),
@@ -558,7 +562,8 @@ impl ScenarioFile {
                 "scenario.control_dt",
                 format!(
                     "{} must be a whole multiple of scenario.dt ({})",
-                    s.control_dt, s.dt
+                    fmt_exact(s.control_dt),
+                    fmt_exact(s.dt)
                 ),
             ));
         }
@@ -567,7 +572,19 @@ impl ScenarioFile {
                 "scenario.log_dt",
                 format!(
                     "{} must be a whole multiple of scenario.control_dt ({})",
-                    s.log_dt, s.control_dt
+                    fmt_exact(s.log_dt),
+                    fmt_exact(s.control_dt)
+                ),
+            ));
+        }
+        if s.duration < s.control_dt {
+            return Err(KeyError::new(
+                "scenario.duration",
+                format!(
+                    "{} s is shorter than one control period (scenario.control_dt = {} s): \
+                     the run would have no step",
+                    fmt_exact(s.duration),
+                    fmt_exact(s.control_dt)
                 ),
             ));
         }
@@ -575,9 +592,9 @@ impl ScenarioFile {
             return Err(KeyError::new(
                 "scenario.control_dt",
                 format!(
-                    "gives {:.0} steps of scenario.dt per control period, more than {MAX_SUBSTEPS:e} \
+                    "gives {} steps of scenario.dt per control period, more than {MAX_SUBSTEPS:e} \
                      (a run's time budget is checked once per control period)",
-                    s.control_dt / s.dt
+                    fmt_exact((s.control_dt / s.dt).round())
                 ),
             ));
         }
@@ -585,8 +602,8 @@ impl ScenarioFile {
             return Err(KeyError::new(
                 "scenario.duration",
                 format!(
-                    "gives {:.0} steps of scenario.dt, more than 5e7",
-                    s.duration / s.dt
+                    "gives {} steps of scenario.dt, more than 5e7",
+                    fmt_exact((s.duration / s.dt).round())
                 ),
             ));
         }
@@ -625,11 +642,37 @@ impl ScenarioFile {
 pub const MAX_SUBSTEPS: f64 = 1.0e5;
 
 /// `key` must be a finite number > 0.
+/// Longest scenario name (it names `out/<name>` and appears in file names).
+const MAX_NAME_CHARS: usize = 100;
+
+/// `scenario.name` names the output directory (`out/<name>`): non-empty, at most
+/// [`MAX_NAME_CHARS`] ASCII letters, digits, `_`, `-` and `.`, not starting with `.` — so that
+/// `""`, `.`, `..` and `~` are refused rather than written into `out/` itself or mapped to one
+/// shared name.
+fn check_scenario_name(name: &str) -> Result<(), KeyError> {
+    let ok = !name.is_empty()
+        && name.len() <= MAX_NAME_CHARS
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c));
+    if ok {
+        return Ok(());
+    }
+    Err(KeyError::new(
+        "scenario.name",
+        format!(
+            "`{name}`: must be 1 to {MAX_NAME_CHARS} letters, digits, `_`, `-` and `.`, not \
+             starting with `.` (it names the output directory out/<name>)"
+        ),
+    ))
+}
+
 fn positive(key: &str, v: f64) -> Result<(), KeyError> {
     if !v.is_finite() || v <= 0.0 {
         return Err(KeyError::new(
             key,
-            format!("must be a finite number > 0, got {v}"),
+            format!("must be a finite number > 0, got {}", fmt_exact(v)),
         ));
     }
     Ok(())

@@ -19,7 +19,7 @@ use crate::model::Vehicle;
 use crate::spatial::{euler_zyx, Vec3, Vec6};
 use nalgebra::{Matrix6, UnitQuaternion};
 
-/// What the transport law logs each control period (SPEC §5): each field is the
+/// What the transport law logs each control period (docs/model.md §5): each field is the
 /// [`Channel`](super::channels::Channel) of the same name.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct TransportSignals {

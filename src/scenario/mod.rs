@@ -1,9 +1,6 @@
-//! Closed-loop scenarios (USM section V and VI, SPEC §5): transport mode (LOS path
+//! Closed-loop scenarios (USM section V and VI, docs/model.md §5): transport mode (LOS path
 //! following) and work mode (end-effector setpoint with task priority), described by a TOML
-//! file ([`config`]) and run by [`run::run_scenario`].
-//!
-//! [`antonelli`] holds the kinematic case studies of Antonelli & Chiaverini (SPEC §8): task
-//! priority on inertial-frame tasks, integrated without dynamics.
+//! file ([`config`]) and run by [`run::run_loop`] (the run's metrics and success: [`crate::outcome`]).
 //!
 //! Presets reproduce the paper's simulations: `transport-method1`, `transport-method2`
 //! (USM Table III, u_c = 0.5 m/s, straight segments parallel to X, a 180° turn commanded at
@@ -31,7 +28,6 @@
 //!   every reading). A partial `[base_control]` table takes its missing keys from the
 //!   work-mode defaults.
 
-pub mod antonelli;
 pub mod channels;
 pub mod config;
 mod controller;
@@ -46,7 +42,7 @@ pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
-pub use run::{run_scenario, run_scenario_until, RunResult, TIMEOUT};
+pub use run::{run_loop, LoopRun, TIMEOUT};
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::KeyError;
@@ -242,7 +238,7 @@ impl Source {
 pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     let path = Path::new(arg);
     let (text, dir) = if path.is_file() {
-        let text = std::fs::read_to_string(path)
+        let text = crate::input::document::read_text(path)
             .map_err(|e| ScenarioError::Invalid(format!("{arg}: {e}")))?;
         (
             text,
@@ -341,49 +337,6 @@ pub fn default_table(mode: Mode) -> Result<toml::Table, ScenarioError> {
     full.insert("base_control".into(), toml::Value::Table(base));
     full.remove("design");
     Ok(full)
-}
-
-/// One case of a sweep: the scenario-side table (overrides applied) run on `vehicle`.
-#[derive(Clone, Debug)]
-pub struct CaseRun {
-    /// Named metrics in a fixed order (see [`run::RunResult::metrics`]); a run that stopped
-    /// early has `completed = 0`.
-    pub metrics: Vec<(String, f64)>,
-    /// The trajectory, when asked for.
-    pub trajectory: Option<Trajectory>,
-    /// Why the run stopped early, if it did.
-    pub failure: Option<String>,
-    /// The first success criterion the run missed, as `criterion: detail`
-    /// ([`success::Missed`]; `no_failure` for a run that stopped early); `None` when it met
-    /// them all.
-    pub missed: Option<String>,
-}
-
-/// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
-/// runs are deterministic). A run still going at `deadline` stops with a failure starting
-/// with [`TIMEOUT`] (`timeout: …`).
-pub fn run_case(
-    vehicle: &Vehicle,
-    scenario: &toml::Table,
-    seed: u64,
-    log: bool,
-    deadline: Option<std::time::Instant>,
-) -> Result<CaseRun, ScenarioError> {
-    let _ = seed;
-    let f = parse_table(scenario, &Source::unplaced("scenario"))?;
-    let r = run_scenario_until(vehicle, &f, deadline)?;
-    Ok(CaseRun {
-        metrics: r.metrics,
-        trajectory: if log { Some(r.trajectory) } else { None },
-        failure: r.failure.map(|(t, c)| {
-            if c == TIMEOUT {
-                format!("{TIMEOUT}: the case's wall-clock budget ran out at t = {t:.3} s")
-            } else {
-                format!("run stopped at t = {t:.3} s: {c}")
-            }
-        }),
-        missed: r.missed.map(|m| m.to_string()),
-    })
 }
 
 /// Check a scenario-side table against a vehicle without running it: the schema, every

@@ -167,7 +167,7 @@ fn body_twist_in_base(ws: &KinWorkspace, base_twist: &Vec6, qd: &[f64], body: us
     v
 }
 
-/// Axial inflow `V_a` of every thruster [m/s] (SPEC §6) for the thrusts `thrust` [N]: the
+/// Axial inflow `V_a` of every thruster [m/s] (docs/model.md §6) for the thrusts `thrust` [N]: the
 /// velocity of the thruster point relative to the water (the current `ν_c` rotated into
 /// `F_b`) projected on the direction the thruster pushes the vehicle, `sign(u_j) d_j`. A
 /// thruster pushing the vehicle forward while the vehicle moves forward sees a positive

@@ -1,5 +1,5 @@
 //! The closed loop of the USM paper's Fig. 5: guidance → kinematic control → dynamic control
-//! (USM-33) → thrust allocation (USM-36/37) → vehicle (SPEC §4), observed by a recorder.
+//! (USM-33) → thrust allocation (USM-36/37) → vehicle (docs/model.md §4), observed by a recorder.
 //!
 //! Rates: the physics advances with the `[physics] integrator` (RK4 steps of `dt`, or
 //! adaptive Dormand–Prince steps) over each control period; the controllers and the allocator run
@@ -10,51 +10,34 @@
 //! `advance`), timed by phase; nothing allocates inside the loop.
 
 use super::channels::Trajectory;
-use super::config::{Mode, ScenarioFile};
+use super::config::ScenarioFile;
 use super::controller::Measurement;
 use super::error::ScenarioError;
 use super::recorder::{timed, AllocationCounts, Recorder, Timing};
 use super::setup::ClosedLoop;
-use super::success::Missed;
 use crate::dynamics::ActuatorCommand;
 use crate::kinematics::{forward_kinematics, thruster_matrix, BasePose};
-use crate::metrics::run_summary::{add_success, run_summary};
+use crate::metrics::trajectory::EnergyMetrics;
 use crate::model::Vehicle;
 use crate::spatial::Vec6;
 use nalgebra::Matrix6;
 use std::time::Instant;
 
-/// The outcome of one run: the trajectory up to the end (or the failure), the metrics, and
-/// the failure if the run stopped early.
+/// One closed-loop run before its metrics: the trajectory up to the end (or the failure), the
+/// allocation counts, the energy integrals and the timings. [`crate::outcome`] turns it into a
+/// run's summary metrics and success.
 #[derive(Clone, Debug)]
-pub struct RunResult {
-    /// Scenario name.
-    pub name: String,
-    /// Mode.
-    pub mode: Mode,
+pub struct LoopRun {
     /// Logged time series.
     pub trajectory: Trajectory,
-    /// Metrics (name, value), in a fixed order for the mode; SI units.
-    pub metrics: Vec<(String, f64)>,
     /// Why the run stopped early, if it did: (simulation time [s], cause).
     pub failure: Option<(f64, String)>,
-    /// The first `[success]` criterion the run missed; `None` for a successful run (metric
-    /// `success` = 1).
-    pub missed: Option<Missed>,
     /// Allocation outcomes.
     pub allocation_counts: AllocationCounts,
+    /// Energy integrals (thrusters at the control rate, joints from the simulator).
+    pub energy: EnergyMetrics,
     /// Wall-clock breakdown.
     pub timing: Timing,
-}
-
-impl RunResult {
-    /// A metric by name.
-    pub fn metric(&self, name: &str) -> Option<f64> {
-        self.metrics
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, x)| *x)
-    }
 }
 
 /// Why a control period ended the run: (simulation time [s], cause).
@@ -127,7 +110,7 @@ impl ClosedLoop<'_> {
 
     /// Control period `k`: measure, control, allocate, sample the thrusters and record, then
     /// advance the physics (except after the last period) and integrate the thruster sample
-    /// over the period just simulated (SPEC §6 energy: rectangle rule on the zero-order hold,
+    /// over the period just simulated (docs/model.md §6 energy: rectangle rule on the zero-order hold,
     /// at the control rate; the joint work is integrated by the simulator with the motion; the
     /// thrusters of a period that fails are not counted).
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
@@ -154,26 +137,23 @@ impl ClosedLoop<'_> {
     }
 }
 
-/// The failure cause of a run stopped by its wall-clock deadline ([`run_scenario_until`]).
+/// The failure cause of a run stopped by its wall-clock deadline ([`run_loop`]).
 pub const TIMEOUT: &str = "timeout";
 
-/// Run a scenario on a vehicle. Never panics on bad input: settings problems return
-/// [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges, NaN,
-/// singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
-pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, ScenarioError> {
-    run_scenario_until(v, file, None)
-}
-
-/// [`run_scenario`] with a wall-clock `deadline`, checked cooperatively before every control
-/// period: a run still going at the deadline stops there with the failure cause [`TIMEOUT`]
-/// (the metrics and trajectory up to then are kept, as for any failure). A control period is
-/// bounded in work: at most `MAX_SUBSTEPS` (1e5) RK4 steps (`scenario.control_dt / dt`,
-/// checked by validation) or `MAX_STEPS_PER_SPAN` (1e5) Dormand–Prince trials.
-pub fn run_scenario_until(
+/// Run the closed loop of a scenario on a vehicle. Never panics on bad input: settings
+/// problems return [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges,
+/// NaN, singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
+///
+/// A wall-clock `deadline` is checked cooperatively before every control period: a run still
+/// going at the deadline stops there with the failure cause [`TIMEOUT`] (the trajectory up to
+/// then is kept, as for any failure). A control period is bounded in work: at most
+/// `MAX_SUBSTEPS` (1e5) RK4 steps (`scenario.control_dt / dt`, checked by validation) or
+/// `MAX_STEPS_PER_SPAN` (1e5) Dormand–Prince trials.
+pub fn run_loop(
     v: &Vehicle,
     file: &ScenarioFile,
     deadline: Option<Instant>,
-) -> Result<RunResult, ScenarioError> {
+) -> Result<LoopRun, ScenarioError> {
     let started = Instant::now();
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
@@ -193,17 +173,12 @@ pub fn run_scenario_until(
     rec.timing.physics_evaluations = stats.evaluations;
     rec.energy
         .set_joints(lp.sim.joint_work(), lp.sim.joint_torque_peak());
-    let (trajectory, counts, energy, timing) = rec.finish(started);
-    let mut metrics = run_summary(file, &trajectory, failure.is_some(), &counts, &energy);
-    let missed = add_success(&mut metrics, file);
-    Ok(RunResult {
-        name: file.scenario.name.clone(),
-        mode: file.scenario.mode,
+    let (trajectory, allocation_counts, energy, timing) = rec.finish(started);
+    Ok(LoopRun {
         trajectory,
-        metrics,
         failure,
-        missed,
-        allocation_counts: counts,
+        allocation_counts,
+        energy,
         timing,
     })
 }

@@ -15,11 +15,11 @@ use crate::spatial::{Vec3, Vec6};
 use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
 
 /// Everything the closed loop owns: the plant, the controllers, the allocator and the
-/// per-period buffers. Built by [`ClosedLoop::new`]; stepped by `run::run_scenario`.
+/// per-period buffers. Built by [`ClosedLoop::new`]; stepped by `run::run_loop`.
 pub(crate) struct ClosedLoop<'f> {
     /// The scenario.
     pub file: &'f ScenarioFile,
-    /// The design with the file's current (SPEC §4).
+    /// The design with the file's current (docs/model.md §4).
     pub vehicle: Vehicle,
     /// The physics.
     pub sim: Simulator,

@@ -1,6 +1,6 @@
-//! `[success]`: what a closed-loop run must achieve to count as a success (SPEC §6
+//! `[success]`: what a closed-loop run must achieve to count as a success (docs/model.md §6
 //! "Success"), the criteria and the verdict on a run ([`Missed`]: the first criterion it
-//! missed), as judged by `metrics::success::judge`.
+//! missed), as judged by `outcome::success::judge`.
 //!
 //! ```toml
 //! [success]

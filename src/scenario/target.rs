@@ -1,5 +1,5 @@
 //! What work mode asks of the end effector: the `[setpoint]` pose and the optional
-//! `[reference]`, a time-parametrised path to it (SPEC §5, USM-42; the path law is
+//! `[reference]`, a time-parametrised path to it (docs/model.md §5, USM-42; the path law is
 //! [`crate::control::spline`]).
 //!
 //! ```toml

@@ -11,7 +11,9 @@ use super::schema::{
     is_scenario_table, Axis, AxisSpec, Dist, Doe, Study, Target, GENERATOR_KEYS, MAX_CASES,
 };
 use crate::input::document::Document;
-use crate::input::keypath::{display_pattern, flatten, pattern_allowed, KeyPath, Seg};
+use crate::input::keypath::{
+    display_pattern, flatten, pattern_allowed, KeyPath, KeyPathError, Seg,
+};
 use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
 
 #[derive(Deserialize)]
@@ -288,7 +290,7 @@ fn axis_target(
 pub fn study_target(
     study: &Study,
     name: &str,
-) -> Result<Option<(Target, Option<toml::Value>)>, String> {
+) -> Result<Option<(Target, Option<toml::Value>)>, KeyPathError> {
     let (mut sc, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&study.scenario_full, "", &mut sc, &mut sc_arrays);
     let names = valid_names(
@@ -306,7 +308,7 @@ fn target_of(
     name: &str,
     names: &Names,
     design: &toml::Table,
-) -> Result<Option<(Target, Option<toml::Value>)>, String> {
+) -> Result<Option<(Target, Option<toml::Value>)>, KeyPathError> {
     let path = KeyPath::parse(name)?;
     if path.head() == "design" {
         let mut rest = path.tail();
@@ -340,7 +342,7 @@ fn target_of(
     }
 }
 
-/// `values = [...]`: non-empty, finite.
+/// `values = [...]`: non-empty, finite, strings without control characters.
 fn values_spec(v: &[toml::Value], i: usize, doc: &Document) -> Result<AxisSpec, InputError> {
     if v.is_empty() {
         return Err(doc.err(&format!("axis[{i}].values"), "needs at least one value"));
@@ -350,6 +352,17 @@ fn values_spec(v: &[toml::Value], i: usize, doc: &Document) -> Result<AxisSpec, 
         .position(|x| matches!(x, toml::Value::Float(f) if !f.is_finite()))
     {
         return Err(doc.err(&format!("axis[{i}].values[{j}]"), "must be finite"));
+    }
+    // A string value is a cell of the results' string columns and of the line-based journal.
+    if let Some(j) = v
+        .iter()
+        .position(|x| matches!(x, toml::Value::String(s) if s.chars().any(char::is_control)))
+    {
+        return Err(doc.err(
+            &format!("axis[{i}].values[{j}]"),
+            "a string value may not hold a newline, tab or other control character \
+             (it is a cell of cases.csv and of the resumable journal)",
+        ));
     }
     Ok(AxisSpec::Values(v.to_vec()))
 }

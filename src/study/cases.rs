@@ -104,7 +104,9 @@ fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>
             set(&mut own, &p.0, v.clone(), &a.name)?;
         }
     }
-    method_control(study.mode, own.get("control")).transpose()
+    method_control(study.mode, own.get("control"))
+        .transpose()
+        .map_err(String::from)
 }
 
 /// The hash of a case: its resolved hash, or for a case whose overrides do not apply a hash

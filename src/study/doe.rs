@@ -118,7 +118,8 @@ pub fn expand(study: &Study, shard: Option<(usize, usize)>) -> Result<Vec<Case>,
                 cases,
                 study.axes.len(),
                 derive_seed(study.seed, 0xD0E),
-            )?;
+            )
+            .map_err(|e| e.to_string())?;
             let mut u = vec![0.0; study.axes.len()];
             for id in (0..n).filter(|&id| keep(id)) {
                 sampler.point(id, &mut u);

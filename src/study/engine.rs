@@ -41,6 +41,7 @@ use super::doe::{case_count, expand, Case};
 use super::error::StudyError;
 use super::finish::finish_report;
 use super::journal;
+use super::lock;
 use super::manifest::{
     git_commit, now_rfc3339, read_manifest, write_manifest, AxisInfo, Counts, Manifest,
 };
@@ -51,7 +52,7 @@ use super::records::{
 };
 use super::runner::TIMEOUT;
 use super::schema::Study;
-use super::tune::Tuner;
+use super::tune::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 
@@ -73,6 +74,9 @@ pub struct SweepOptions {
     pub case_timeout: Option<Duration>,
     /// Replace the output of another study in the output directory.
     pub force: bool,
+    /// How cases of a study with `[tune]` are tuned (the optimiser's tuner, wired in by the
+    /// caller); a study with `[tune]` and no hook is refused.
+    pub tuning: Option<TuningHook>,
 }
 
 /// Progress of a sweep, reported after every finished case.
@@ -151,11 +155,21 @@ pub fn run_sweep(
             )));
         }
     }
-    let tuner = Tuner::new(study)?;
+    let tuner = case_tuner(study, opts.tuning)?;
     let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
-    let out = output_dir(study, opts);
-    let _lock = outdir::lock(&out)?;
-    let mut notes = outdir::claim(&out, &study.name, opts.force)?;
+    let out = outdir::resolve(&output_dir(study, opts))?;
+    let owner = outdir::LockOwner {
+        study: &study.hash,
+        resume: opts.resume,
+    };
+    let lock = outdir::lock(&out, &owner)?;
+    let claim = outdir::Claim {
+        study: &study.name,
+        force: opts.force,
+        resume: opts.resume,
+    };
+    let mut notes = outdir::claim(&out, &lock, &claim)?;
+    outdir::record_owned(&out, lock.created, &outdir::SWEEP_FILES)?;
     let partial = out.join(PARTIAL_FILE);
     if opts.resume && !partial.exists() {
         if let Some(done) = already_complete(study, opts, &out, cases.len()) {
@@ -182,7 +196,7 @@ pub fn run_sweep(
         done: &done,
         max: opts.max_cases.unwrap_or(usize::MAX),
         budget: opts.case_timeout,
-        tuner: tuner.as_ref(),
+        tuner: tuner.as_deref(),
     };
     let streamed = stream_cases(&run, &cases, &pool, &mut appender, progress)?;
     let _ = appender.sync();
@@ -235,8 +249,9 @@ pub fn run_sweep(
     write_manifest(&out, &manifest)?;
     if opts.shard.is_none() {
         // Inside the sweep's pool, so the best/worst reruns respect --jobs.
-        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study)));
+        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study), opts.tuning));
         outcome.warnings.extend(w);
+        outdir::record_owned(&out, lock.created, &outdir::SWEEP_FILES)?;
         // Last: a kill before this leaves a journal that --resume completes from.
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
     }
@@ -322,7 +337,7 @@ struct RunSpec<'a> {
     done: &'a HashSet<String>,
     max: usize,
     budget: Option<Duration>,
-    tuner: Option<&'a Tuner>,
+    tuner: Option<&'a dyn CaseTuner>,
 }
 
 /// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs, each within the
@@ -375,7 +390,25 @@ fn stream_cases(
             });
             drop(tx);
         });
-        for msg in rx {
+        // A SIGTERM/SIGINT is acted on between rows: the journal is synced, then the lock
+        // released (see `super::lock`).
+        lock::set_graceful(true);
+        loop {
+            let msg = match rx.recv_timeout(Duration::from_millis(100)) {
+                Ok(m) => m,
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if let Some(sig) = lock::pending_signal() {
+                        let _ = appender.sync();
+                        lock::exit_interrupted(sig);
+                    }
+                    continue;
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            };
+            if let Some(sig) = lock::pending_signal() {
+                let _ = appender.sync();
+                lock::exit_interrupted(sig);
+            }
             match msg {
                 Msg::Resumed(h) => {
                     st.plan_hashes.insert(h);
@@ -390,7 +423,8 @@ fn stream_cases(
                     }
                     if write_error.is_none() {
                         let texts: Vec<String> = row.axes.iter().map(axis_text).collect();
-                        if let Err(e) = appender.append(&row.values(run.study, &texts)) {
+                        let packed = row.packed(run.study);
+                        if let Err(e) = appender.append(&row.values(run.study, &texts, &packed)) {
                             write_error = Some(e.into());
                             cancel.store(true, Ordering::Relaxed);
                         }
@@ -404,6 +438,7 @@ fn stream_cases(
             st.progress.finished = st.progress.ran + st.progress.resumed;
             progress(&st.progress);
         }
+        lock::set_graceful(false);
     });
     match write_error {
         Some(e) => Err(e),
@@ -431,15 +466,9 @@ fn process(
         return Msg::NotRun;
     }
     let row = match resolved {
-        Ok(r) => match run.tuner {
-            None => w.evaluate(study, case, &r, false).0,
-            Some(t) => {
-                let deadline = w.budget.map(|b| Instant::now() + b);
-                t.evaluate(w, study, case, &r, deadline)
-            }
-        },
+        Ok(r) => w.evaluate(study, case, &r, false, run.tuner).0,
         Err(reason) => {
-            let mut row = Row::new(study, case.id, hash, case.values.clone());
+            let mut row = Row::new(case.id, hash, case.values.clone());
             row.end(CaseStatus::Skipped, &reason);
             row
         }

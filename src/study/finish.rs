@@ -11,22 +11,48 @@ use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE}
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
-use super::tune::Tuner;
-use super::worker::Worker;
-use crate::report::{read_csv_typed, write_csv, Table};
+use super::tune::{case_tuner, tuned_columns, TuneError, TuningHook};
+use super::worker::evaluate_resolved;
+use crate::evaluate::{Deadline, Evaluator};
+use crate::report::{read_csv_typed, write_csv, ReportError, Table};
+
+/// Why the best or worst case could not be rerun (a warning of the report, not fatal).
+#[derive(Debug, thiserror::Error)]
+pub enum RerunError {
+    /// Reading the table or writing the trajectory.
+    #[error(transparent)]
+    Report(#[from] ReportError),
+    /// The tuner could not be set up.
+    #[error(transparent)]
+    Study(Box<StudyError>),
+    /// The study's cases could not be planned.
+    #[error("{0}")]
+    Plan(String),
+    /// The table names a case the study does not have.
+    #[error("case id out of range")]
+    CaseId,
+    /// The case's overrides do not apply.
+    #[error("{0}")]
+    Resolve(String),
+    /// The case's tuned values do not apply.
+    #[error(transparent)]
+    Tune(#[from] TuneError),
+}
 
 /// Write the report, rerunning the best and worst cases of dynamic studies for their
-/// trajectories when the study is available. Returns non-fatal warnings.
+/// trajectories when the study is available (at their tuned values through `tuning` for a
+/// study with `[tune]`). Returns non-fatal warnings.
 pub fn finish_report(
     out: &Path,
     table: &Table,
     manifest: &Manifest,
     study: Option<&Study>,
+    tuning: Option<TuningHook>,
 ) -> Vec<String> {
     let mut warnings = Vec::new();
     if let Some(study) = study {
         if study.mode.is_dynamic() {
-            if let Err(e) = rerun_extremes(out, table, manifest, study) {
+            if let Err(e) = rerun_extremes(out, table, manifest, study, tuning) {
                 warnings.push(format!("time series of the best/worst case: {e}"));
             }
         }
@@ -42,33 +68,33 @@ fn rerun_extremes(
     table: &Table,
     manifest: &Manifest,
     study: &Study,
-) -> Result<(), String> {
+    tuning: Option<TuningHook>,
+) -> Result<(), RerunError> {
     let sel = Selection::new(table, manifest);
     let Some((best, worst)) = sel.extremes(table) else {
         return Ok(());
     };
-    let ids = table.i64(CASE_ID).map_err(|e| e.to_string())?;
-    let all = expand(study, None)?;
-    let tuner = Tuner::new(study).map_err(|e| e.to_string())?;
-    let params = study.tune_columns();
-    let tuned = params[..params.len().saturating_sub(2)]
+    let ids = table.i64(CASE_ID)?;
+    let all = expand(study, None).map_err(RerunError::Plan)?;
+    let tuner = case_tuner(study, tuning).map_err(|e| RerunError::Study(Box::new(e)))?;
+    let tuned = tuned_columns(study)
         .iter()
         .map(|c| table.f64(c))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
+        .collect::<Result<Vec<_>, _>>()?;
     // The two reruns are independent: run them side by side.
-    let rerun = |which: Extreme, row: usize| -> Result<(), String> {
+    let rerun = |which: Extreme, row: usize| -> Result<(), RerunError> {
         let id = ids[row] as usize;
-        let case = all.get(id).ok_or("case id out of range")?;
-        let mut r = resolve_case(study, case)?;
+        let case = all.get(id).ok_or(RerunError::CaseId)?;
+        let mut r = resolve_case(study, case).map_err(RerunError::Resolve)?;
         if let Some(t) = &tuner {
             // Rerun at the case's tuned values, as scored.
             let x: Vec<f64> = tuned.iter().map(|c| c[row]).collect();
             r = t.at(study, case, &r, &x)?;
         }
-        let (_, traj) = Worker::new().evaluate(study, case, &r, true);
-        if let Some(t) = traj {
-            write_csv(&t, &out.join(which.trajectory_file())).map_err(|e| e.to_string())?;
+        let mut ev = Evaluator::new();
+        let res = evaluate_resolved(&mut ev, study, case.id, &r, true, Deadline::NONE);
+        if let Some(t) = res.trajectory {
+            write_csv(&t, &out.join(which.trajectory_file()))?;
         }
         Ok(())
     };
@@ -88,7 +114,7 @@ pub fn report(dir: &Path) -> Result<Vec<String>, StudyError> {
         crate::report::read_parquet(&pq)?
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
-        let schema = m.schema().map_err(StudyError::Input)?;
+        let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
     Ok(write_report(dir, &table, &m))

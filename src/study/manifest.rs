@@ -128,14 +128,17 @@ impl Manifest {
             .collect()
     }
 
-    /// The raw schema.
-    pub fn schema(&self) -> Result<Vec<(String, ColumnKind)>, String> {
+    /// The raw schema; a column kind this version does not know is bad input (a manifest of
+    /// another version or edited by hand).
+    pub fn schema(&self) -> Result<Vec<(String, ColumnKind)>, StudyError> {
         self.columns
             .iter()
             .map(|[n, k]| {
-                kind_of(k)
-                    .map(|k| (n.clone(), k))
-                    .ok_or_else(|| format!("unknown column kind `{k}`"))
+                kind_of(k).map(|k| (n.clone(), k)).ok_or_else(|| {
+                    StudyError::Input(format!(
+                        "{MANIFEST_FILE}: column `{n}`: unknown column kind `{k}`"
+                    ))
+                })
             })
             .collect()
     }

@@ -1,26 +1,25 @@
-//! Batch studies (SPEC §7): the study schema, designs of experiments, the parallel sweep
-//! engine with resume and shards, the static configuration-space TCM analysis, and the sweep
-//! report.
+//! Batch studies (docs/model.md §7): the study schema, designs of experiments, the parallel
+//! sweep engine with resume and shards, and the sweep report.
 //!
 //! Modules in dependency order (each uses only modules above it):
 //!
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
-//! - [`runner`]: the single adapter to the scenario module (modes, defaults, one run).
-//! - [`static_tcm`]: `usm-study tcm` — how often `T(q)` is singular over joint space;
-//!   `static_dist`: the distributions (exact quantiles) of its per-sample quantities.
-//! - [`static_table`]: the `[static]` table of study files ↔ [`StaticSpec`].
-//! - [`static_tcm_slice`]: σ_min over 2-D slices of joint space, the most influential joints.
+//! - [`runner`]: the single adapter to the scenario module's settings (modes, defaults).
 //! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
 //! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
 //! - [`parse`]: study files (TOML) → validated [`Study`].
 //! - [`doe`]: grid and sampled designs of experiments → cases.
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
-//! - [`records`]: case status, row, columns of the raw and final tables.
-//! - [`worker`]: one resolved case → one row (design, static analysis, closed-loop run).
-//! - [`tune`]: per-case tuning (`[tune]`): tune a case with the optimiser, score it there.
+//! - [`tune`]: the per-case tuning hook (`[tune]`): the optimiser's tuner reaches the sweep
+//!   through it, handed in by the caller.
+//! - [`records`]: rows (named metrics), columns of the raw and final tables.
+//! - [`worker`]: one resolved case → one row through the case evaluator
+//!   ([`crate::evaluate`]), tuned first through the hook.
 //! - [`manifest`]: the `manifest.json` of an output directory.
-//! - [`outdir`]: the output directory's lock, its ownership by one study, stale temporaries.
+//! - [`lock`]: the output directory's lock (heartbeat, takeover on `--resume`, signals).
+//! - [`outdir`]: the output directory resolved once, kept free of links out, owned by one
+//!   study; the record of the files the tool wrote.
 //! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
@@ -35,6 +34,7 @@ pub mod error;
 pub mod finish;
 pub mod hash;
 pub mod journal;
+pub mod lock;
 pub mod manifest;
 pub mod outdir;
 pub mod parse;
@@ -44,11 +44,6 @@ pub mod runner;
 pub mod schema;
 pub mod selection;
 pub mod shards;
-mod static_dist;
-pub mod static_table;
-pub mod static_tcm;
-mod static_tcm_eval;
-pub mod static_tcm_slice;
 pub mod summary;
 pub mod tune;
 pub mod worker;
@@ -60,4 +55,3 @@ pub use parse::load_study;
 pub use records::CaseStatus;
 pub use schema::{DoeKind, Study};
 pub use shards::merge;
-pub use static_tcm::{analyse, StaticSpec, StaticSummary};

@@ -1,28 +1,37 @@
-//! Ownership of an output directory: one run at a time, one study per directory, nothing
-//! temporary left behind.
+//! Ownership of an output directory: one run at a time ([`super::lock`]), one study per
+//! directory, writes only inside it, deletes only what the tool wrote.
 //!
-//! - [`OutputLock`]: `.usm-study.lock` holds the pid, host and start time of the run writing
-//!   the directory; a second run exits with code 2 naming the holder. A lock whose pid is dead
-//!   on this host (a killed run) is stale and is replaced. The lock is removed when the run
-//!   ends (dropped), also on errors.
-//! - [`claim`]: a directory holding another study's output (its `study.toml` names another
-//!   study) is refused unless `force`, which first removes that study's tables, manifest,
-//!   journal, summary, trajectories and plots (only files this tool writes; nothing else).
-//!   Temporary files of killed runs (`.NAME.tmp-PID`, see `report::atomic_write`) are removed
-//!   and reported.
+//! - [`resolve`]: the output directory is created and resolved once (canonical path); every
+//!   later write goes below that path.
+//! - [`check_contained`]: a symbolic link inside the directory that leads out of it (e.g. a
+//!   `plots/` linked elsewhere) is refused (exit code 2) before anything is written or removed.
+//! - [`OWNED_FILE`] (`.usm-study.files`): the tool's own record of the files it wrote into the
+//!   directory, one relative path a line ([`record_owned`]). `--force` removes only files
+//!   listed there (a directory written by an older version without the record: only the fixed
+//!   names of a sweep output, and only when its `manifest.json` says `usm-study` wrote it);
+//!   a user's own files are never removed, and files named like outputs that the tool did not
+//!   write are refused even with `--force`.
+//! - [`claim`]: a directory holding another study's output is refused unless `--force`; one
+//!   holding finished cases of the same study is refused unless `--resume` (keep them) or
+//!   `--force` (start over). Temporary files of a killed run that held the lock
+//!   (`.NAME.tmp-TOKEN`, its token from its lock file) are removed and reported.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::collections::BTreeSet;
+use std::io::BufRead;
+use std::path::{Component, Path, PathBuf};
+use std::time::SystemTime;
 
 use super::error::StudyError;
-use super::manifest::{now_rfc3339, MANIFEST_FILE};
+use super::manifest::MANIFEST_FILE;
 use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, STUDY_COPY};
 
-/// The lock file's name in an output directory.
-pub const LOCK_FILE: &str = ".usm-study.lock";
+pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE, RELEASED_FILE};
 
-/// Files of a sweep output (besides `plots/`), removed by `--force` for another study.
-const OUTPUT_FILES: [&str; 8] = [
+/// The tool's record of the files it wrote into an output directory.
+pub const OWNED_FILE: &str = ".usm-study.files";
+
+/// Files of a sweep output (besides `plots/`).
+pub const SWEEP_FILES: [&str; 9] = [
     CASES_CSV,
     CASES_PARQUET,
     PARTIAL_FILE,
@@ -31,127 +40,67 @@ const OUTPUT_FILES: [&str; 8] = [
     "summary.md",
     "trajectory_best.csv",
     "trajectory_worst.csv",
+    "report.html",
 ];
 
-/// The held lock of an output directory; removed on drop.
-#[derive(Debug)]
-pub struct OutputLock {
-    path: PathBuf,
-}
+/// Extensions of the files the tool writes (at the top of an output and in `plots/`).
+const OUTPUT_EXTENSIONS: [&str; 8] = [
+    "csv", "parquet", "json", "jsonl", "md", "html", "toml", "svg",
+];
 
-impl Drop for OutputLock {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.path);
-    }
-}
-
-/// Who holds a lock, as written in the lock file (`pid=…`, `host=…`, `since=…` lines).
-#[derive(Clone, Debug, Default, PartialEq)]
-struct Holder {
-    pid: Option<u32>,
-    host: String,
-    since: String,
-}
-
-impl Holder {
-    fn parse(text: &str) -> Holder {
-        let mut h = Holder::default();
-        for line in text.lines() {
-            match line.split_once('=') {
-                Some(("pid", v)) => h.pid = v.trim().parse().ok(),
-                Some(("host", v)) => h.host = v.trim().to_string(),
-                Some(("since", v)) => h.since = v.trim().to_string(),
-                _ => {}
-            }
-        }
-        h
-    }
-
-    /// Whether the holder is certainly gone: same host, and no process with its pid. A lock
-    /// without a readable pid (cut off while being written) is stale too.
-    fn is_stale(&self) -> bool {
-        match self.pid {
-            None => true,
-            Some(pid) => self.host == host_name() && !process_alive(pid),
-        }
-    }
-}
-
-/// This machine's host name (`/proc/sys/kernel/hostname`, else `$HOSTNAME`, else `?`).
-pub fn host_name() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .ok()
-        .map(|s| s.trim().to_string())
-        .filter(|s| !s.is_empty())
-        .or_else(|| std::env::var("HOSTNAME").ok())
-        .unwrap_or_else(|| "?".into())
-}
-
-/// Whether a process `pid` exists on this host (signal 0; a process of another user counts).
-fn process_alive(pid: u32) -> bool {
-    #[cfg(unix)]
-    {
-        let Ok(p) = libc::pid_t::try_from(pid) else {
-            return false;
-        };
-        // SAFETY: signal 0 only checks that `p` exists and may be signalled; nothing is sent.
-        let r = unsafe { libc::kill(p, 0) };
-        r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = pid;
-        true
-    }
-}
-
-/// Take the lock of `dir` (created if missing) for this process. Another live holder is an
-/// input error (exit code 2) naming its pid, host and start; a stale lock is replaced.
-pub fn lock(dir: &Path) -> Result<OutputLock, StudyError> {
+/// Create `dir` if missing and return its canonical path: the one path every later write of
+/// the run goes below.
+pub fn resolve(dir: &Path) -> Result<PathBuf, StudyError> {
     std::fs::create_dir_all(dir).map_err(|e| StudyError::io(dir, e))?;
-    let path = dir.join(LOCK_FILE);
-    // Two attempts: the second after removing a stale lock.
-    for _ in 0..2 {
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&path)
-        {
-            Ok(mut f) => {
-                let text = format!(
-                    "pid={}\nhost={}\nsince={}\n",
-                    std::process::id(),
-                    host_name(),
-                    now_rfc3339()
-                );
-                f.write_all(text.as_bytes())
-                    .and_then(|()| f.sync_all())
-                    .map_err(|e| StudyError::io(&path, e))?;
-                return Ok(OutputLock { path });
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                let holder = Holder::parse(&std::fs::read_to_string(&path).unwrap_or_default());
-                if !holder.is_stale() {
-                    return Err(StudyError::Input(format!(
-                        "{} is in use by another run (pid {}, host {}, since {}; lock file {}): \
-                         wait for it to finish, use another --out, or remove the lock file if \
-                         that run is gone",
-                        dir.display(),
-                        holder.pid.map_or("?".into(), |p| p.to_string()),
-                        holder.host,
-                        holder.since,
-                        path.display()
-                    )));
+    std::fs::canonicalize(dir).map_err(|e| StudyError::io(dir, e))
+}
+
+/// Refuse any symbolic link inside `root` (canonical) whose target is outside it or missing
+/// (a write through it would land outside); links are not followed while looking.
+pub fn check_contained(root: &Path) -> Result<(), StudyError> {
+    let mut stack = vec![(root.to_path_buf(), 0usize)];
+    while let Some((dir, depth)) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let Ok(ft) = e.file_type() else { continue };
+            let p = e.path();
+            if ft.is_symlink() {
+                match std::fs::canonicalize(&p) {
+                    Ok(t) if t.starts_with(root) => {}
+                    target => {
+                        return Err(StudyError::Input(format!(
+                            "{} is a symbolic link leading out of the output directory {} \
+                             (to {}): refusing to write or delete through it; remove the link \
+                             or use another --out",
+                            p.display(),
+                            root.display(),
+                            target.map_or_else(
+                                |_| std::fs::read_link(&p)
+                                    .map_or("?".into(), |t| t.display().to_string()),
+                                |t| t.display().to_string()
+                            )
+                        )))
+                    }
                 }
-                std::fs::remove_file(&path).map_err(|e| StudyError::io(&path, e))?;
+            } else if ft.is_dir() && depth < 3 {
+                stack.push((p, depth + 1));
             }
-            Err(e) => return Err(StudyError::io(&path, e)),
         }
     }
-    Err(StudyError::Input(format!(
-        "{}: could not take the lock (another run keeps replacing it)",
-        path.display()
-    )))
+    Ok(())
+}
+
+/// What a run asks of its output directory in [`claim`].
+#[derive(Clone, Copy, Debug)]
+pub struct Claim<'a> {
+    /// The study's name (recorded in the output's `study.toml`).
+    pub study: &'a str,
+    /// Replace another study's output, or this study's finished cases.
+    pub force: bool,
+    /// Keep this study's finished cases (`--resume`, or a merge).
+    pub resume: bool,
 }
 
 /// The study name recorded in an output directory (its `study.toml` copy), if any.
@@ -161,80 +110,191 @@ fn recorded_study(dir: &Path) -> Option<String> {
     t.get("study")?.get("name")?.as_str().map(str::to_string)
 }
 
-/// Make `dir` (locked by the caller) ready for study `name`: refuse another study's output
-/// unless `force` (which then removes that output's files), and remove temporary files left
-/// by killed runs. Returns notes for the user.
-pub fn claim(dir: &Path, name: &str, force: bool) -> Result<Vec<String>, StudyError> {
-    let mut notes = Vec::new();
-    let other = recorded_study(dir)
-        .filter(|n| n != name)
-        .or_else(|| (!dir.join(STUDY_COPY).exists() && has_output(dir)).then(|| "?".into()));
+/// Make `dir` (canonical, locked by the caller with `lock`) ready for the run `c`: refuse a
+/// symbolic link out of it, another study's output unless `force` (which then removes that
+/// output's own files), this study's finished cases unless `resume` or `force`; remove the
+/// temporaries of the run whose lock `lock` replaced. Returns notes for the user.
+pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Vec<String>, StudyError> {
+    check_contained(dir)?;
+    let mut notes: Vec<String> = lock.takeover.iter().cloned().collect();
+    let recorded = recorded_study(dir);
+    let other = match &recorded {
+        Some(n) if n != c.study => Some(n.clone()),
+        Some(_) => None,
+        None => has_output(dir).then(|| "?".to_string()),
+    };
     if let Some(other) = other {
-        if !force {
+        if !c.force {
             return Err(StudyError::Input(format!(
                 "{} holds the output of another study ({other}); use another --out, or --force \
                  to replace it",
                 dir.display()
             )));
         }
-        let removed = remove_output(dir)?;
+        let removed = remove_owned(dir)?;
         notes.push(format!(
             "--force: removed {removed} files of study {other} from {}",
             dir.display()
         ));
+    } else if recorded.is_some() && !c.resume {
+        if let Some(what) = finished_cases(dir) {
+            if !c.force {
+                return Err(StudyError::Input(format!(
+                    "{} holds {what} of study {}: rerun with --resume to keep them and run the \
+                     rest, or with --force to start over",
+                    dir.display(),
+                    c.study
+                )));
+            }
+            let removed = remove_owned(dir)?;
+            notes.push(format!(
+                "--force: removed {removed} files of the previous run of study {} from {}",
+                c.study,
+                dir.display()
+            ));
+        }
     }
-    let stale = remove_temporaries(dir)? + remove_temporaries(&dir.join("plots"))?;
-    if stale > 0 {
-        notes.push(format!(
-            "removed {stale} temporary files left by an interrupted run in {}",
-            dir.display()
-        ));
+    if let Some(suffix) = lock.replaced.as_ref().and_then(|h| h.temporary_suffix()) {
+        let stale =
+            remove_temporaries(dir, &suffix)? + remove_temporaries(&dir.join("plots"), &suffix)?;
+        if stale > 0 {
+            notes.push(format!(
+                "removed {stale} temporary files left by an interrupted run in {}",
+                dir.display()
+            ));
+        }
+    }
+    let released = dir.join(RELEASED_FILE);
+    if released.exists() {
+        std::fs::remove_file(&released).map_err(|e| StudyError::io(&released, e))?;
     }
     Ok(notes)
 }
 
-/// Whether `dir` holds any file of a sweep output.
-fn has_output(dir: &Path) -> bool {
-    OUTPUT_FILES.iter().any(|f| dir.join(f).exists())
+/// What finished work of a study `dir` holds: journal rows or a final table.
+fn finished_cases(dir: &Path) -> Option<&'static str> {
+    if let Ok(f) = std::fs::File::open(dir.join(PARTIAL_FILE)) {
+        // A header and at least one complete row.
+        let mut lines = std::io::BufReader::new(f).split(b'\n');
+        let complete = |l: Option<std::io::Result<Vec<u8>>>| l.is_some_and(|l| l.is_ok());
+        if complete(lines.next()) && complete(lines.next()) {
+            return Some("finished cases in its journal (cases.partial.csv)");
+        }
+    }
+    dir.join(CASES_CSV)
+        .is_file()
+        .then_some("the finished cases of a complete run (cases.csv)")
 }
 
-/// Remove the files of a sweep output (and the SVGs of `plots/`); their count.
-fn remove_output(dir: &Path) -> Result<usize, StudyError> {
+/// Whether `dir` holds any file named like a sweep output.
+fn has_output(dir: &Path) -> bool {
+    SWEEP_FILES.iter().any(|f| dir.join(f).exists())
+}
+
+/// A relative path of the record that stays inside the directory (`NAME` or `plots/NAME`).
+fn safe_entry(line: &str) -> Option<&str> {
+    let p = Path::new(line);
+    let parts: Vec<Component> = p.components().collect();
+    let plain = parts.iter().all(|c| matches!(c, Component::Normal(_)));
+    (plain && (1..=2).contains(&parts.len())).then_some(line)
+}
+
+/// The record of files the tool wrote into `dir`, if there is one.
+fn read_owned(dir: &Path) -> Option<BTreeSet<String>> {
+    let text = std::fs::read_to_string(dir.join(OWNED_FILE)).ok()?;
+    Some(
+        text.lines()
+            .filter_map(safe_entry)
+            .map(str::to_string)
+            .collect(),
+    )
+}
+
+/// Whether `manifest.json` of `dir` says this tool wrote it.
+fn written_by_us(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join(MANIFEST_FILE))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .is_some_and(|v| v["tool"] == "usm-study")
+}
+
+/// Remove the files the tool wrote into `dir` (its record; see the module documentation) and
+/// refuse files named like outputs that it did not write. Their count.
+fn remove_owned(dir: &Path) -> Result<usize, StudyError> {
+    let owned = match read_owned(dir) {
+        Some(o) => o,
+        None if written_by_us(dir) => SWEEP_FILES.iter().map(|s| s.to_string()).collect(),
+        None => BTreeSet::new(),
+    };
+    let foreign: Vec<&str> = SWEEP_FILES
+        .iter()
+        .copied()
+        .filter(|f| dir.join(f).exists() && !owned.contains(*f))
+        .collect();
+    if !foreign.is_empty() {
+        return Err(StudyError::Input(format!(
+            "{} holds {} that usm-study did not write (not in its record {OWNED_FILE}): \
+             refusing to replace them, even with --force; move them or use another --out",
+            dir.display(),
+            foreign.join(", ")
+        )));
+    }
     let mut n = 0;
-    for f in OUTPUT_FILES {
+    for f in &owned {
         let p = dir.join(f);
-        if p.is_file() {
+        if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file()) {
             std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
             n += 1;
         }
     }
-    let plots = dir.join("plots");
-    if let Ok(entries) = std::fs::read_dir(&plots) {
-        for e in entries.flatten() {
-            let p = e.path();
-            if p.extension().is_some_and(|x| x == "svg") && p.is_file() {
-                std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
-                n += 1;
-            }
-        }
+    let record = dir.join(OWNED_FILE);
+    if record.exists() {
+        std::fs::remove_file(&record).map_err(|e| StudyError::io(&record, e))?;
     }
     Ok(n)
 }
 
-/// Remove the temporary files of `report::atomic_write` (`.NAME.tmp-PID`) in `dir` (under
-/// the directory's lock they belong to dead runs); their count.
-fn remove_temporaries(dir: &Path) -> Result<usize, StudyError> {
+/// Add to `dir`'s record ([`OWNED_FILE`]) the files this run wrote: output files (by
+/// extension) at the top and in `plots/` modified after the run took the lock (`since`,
+/// [`OutputLock::created`]), plus `always` (names the run writes whether or not they exist
+/// yet); entries of the record whose files are gone are dropped.
+pub fn record_owned(dir: &Path, since: SystemTime, always: &[&str]) -> Result<(), StudyError> {
+    let mut owned = read_owned(dir).unwrap_or_default();
+    owned.retain(|f| dir.join(f).exists());
+    owned.extend(always.iter().map(|s| s.to_string()));
+    for (sub, prefix) in [(dir.to_path_buf(), ""), (dir.join("plots"), "plots/")] {
+        for e in std::fs::read_dir(&sub).into_iter().flatten().flatten() {
+            let name = e.file_name().to_string_lossy().to_string();
+            let fresh = e
+                .metadata()
+                .ok()
+                .filter(|m| m.is_file())
+                .and_then(|m| m.modified().ok())
+                .is_some_and(|t| t > since);
+            let ext_ok = Path::new(&name)
+                .extension()
+                .is_some_and(|x| OUTPUT_EXTENSIONS.iter().any(|o| x == *o));
+            if fresh && ext_ok && !name.starts_with('.') {
+                owned.insert(format!("{prefix}{name}"));
+            }
+        }
+    }
+    let text: String = owned.iter().map(|f| format!("{f}\n")).collect();
+    crate::report::atomic_write(&dir.join(OWNED_FILE), text.as_bytes())?;
+    Ok(())
+}
+
+/// Remove the temporary files `.NAME.tmp-SUFFIX` of one dead run in `dir`; their count.
+fn remove_temporaries(dir: &Path, suffix: &str) -> Result<usize, StudyError> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(0);
     };
+    let tail = format!(".tmp-{suffix}");
     let mut n = 0;
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().to_string();
-        let is_tmp = name.starts_with('.')
-            && name
-                .rsplit_once(".tmp-")
-                .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
-        if is_tmp && e.path().is_file() {
+        let is_tmp = name.starts_with('.') && name.ends_with(&tail) && name.len() > tail.len() + 1;
+        if is_tmp && e.file_type().is_ok_and(|t| t.is_file()) {
             std::fs::remove_file(e.path()).map_err(|err| StudyError::io(&e.path(), err))?;
             n += 1;
         }
@@ -246,49 +306,100 @@ fn remove_temporaries(dir: &Path) -> Result<usize, StudyError> {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_second_lock_names_the_holder_and_a_dead_holder_is_replaced() {
-        let d = tempfile::tempdir().unwrap();
-        let held = lock(d.path()).unwrap();
-        let e = lock(d.path()).unwrap_err().to_string();
-        assert!(e.contains(&format!("pid {}", std::process::id())), "{e}");
-        assert!(e.contains("in use by another run"), "{e}");
-        drop(held);
-        assert!(!d.path().join(LOCK_FILE).exists());
-        // A lock of a pid that cannot exist (above the kernel's pid_max) is stale.
-        let text = format!("pid=4194305\nhost={}\nsince=x\n", host_name());
-        std::fs::write(d.path().join(LOCK_FILE), text).unwrap();
-        let held = lock(d.path()).unwrap();
-        drop(held);
-        // Another host's lock is never judged stale from here.
-        std::fs::write(d.path().join(LOCK_FILE), "pid=4194305\nhost=elsewhere\n").unwrap();
-        assert!(lock(d.path()).is_err());
+    fn owner() -> LockOwner<'static> {
+        LockOwner {
+            study: "h",
+            resume: false,
+        }
     }
 
     #[test]
-    fn another_studys_output_needs_force_and_is_then_removed() {
+    fn another_studys_output_needs_force_and_only_its_own_files_go() {
         let d = tempfile::tempdir().unwrap();
-        let p = d.path();
+        let p = &resolve(d.path()).unwrap();
+        std::fs::create_dir(p.join("plots")).unwrap();
+        std::fs::write(p.join("plots/user_diagram.svg"), "<svg/>").unwrap();
+        std::fs::write(p.join("notes.txt"), "mine").unwrap();
+        let l = lock(p, &owner()).unwrap();
+        // File times have the kernel's coarse clock: the run's files come later.
+        std::thread::sleep(std::time::Duration::from_millis(30));
         std::fs::write(p.join(STUDY_COPY), "[study]\nname = \"a\"\n").unwrap();
         std::fs::write(p.join(CASES_CSV), "x\n").unwrap();
-        std::fs::create_dir(p.join("plots")).unwrap();
         std::fs::write(p.join("plots/axis_x.svg"), "<svg/>").unwrap();
-        std::fs::write(p.join("plots/.axis_y.svg.tmp-12"), "").unwrap();
-        std::fs::write(p.join("notes.txt"), "mine").unwrap();
-        assert!(claim(p, "a", false).unwrap().len() == 1); // the temporary file
-        std::fs::write(p.join("plots/.axis_y.svg.tmp-12"), "").unwrap();
-        let e = claim(p, "b", false).unwrap_err().to_string();
+        record_owned(p, l.created, &[]).unwrap();
+        drop(l);
+        let l = lock(p, &owner()).unwrap();
+        let c = |study, force| Claim {
+            study,
+            force,
+            resume: false,
+        };
+        let e = claim(p, &l, &c("b", false)).unwrap_err().to_string();
         assert!(
             e.contains("another study (a)") && e.contains("--force"),
             "{e}"
         );
-        let notes = claim(p, "b", true).unwrap();
+        let e = claim(p, &l, &c("a", false)).unwrap_err().to_string();
+        assert!(e.contains("--resume") && e.contains("--force"), "{e}");
+        let notes = claim(p, &l, &c("b", true)).unwrap();
         assert!(notes[0].contains("removed 3 files of study a"), "{notes:?}");
         assert!(!p.join(CASES_CSV).exists() && !p.join("plots/axis_x.svg").exists());
-        assert!(!p.join("plots/.axis_y.svg.tmp-12").exists());
+        assert!(p.join("notes.txt").exists() && p.join("plots/user_diagram.svg").exists());
+    }
+
+    #[test]
+    fn files_named_like_outputs_but_not_written_by_the_tool_are_refused_even_with_force() {
+        let d = tempfile::tempdir().unwrap();
+        let p = &resolve(d.path()).unwrap();
+        std::fs::write(p.join(MANIFEST_FILE), "{\"mine\": 1}").unwrap();
+        std::fs::write(p.join("summary.md"), "# my notes").unwrap();
+        let l = lock(p, &owner()).unwrap();
+        let c = Claim {
+            study: "b",
+            force: true,
+            resume: false,
+        };
+        let e = claim(p, &l, &c).unwrap_err().to_string();
         assert!(
-            p.join("notes.txt").exists(),
-            "files the tool did not write stay"
+            e.contains("manifest.json, summary.md that usm-study did not write"),
+            "{e}"
         );
+        assert!(p.join("summary.md").exists());
+    }
+
+    #[test]
+    fn a_symlink_out_of_the_output_is_refused_and_only_a_dead_runs_temporaries_go() {
+        let d = tempfile::tempdir().unwrap();
+        let out = resolve(&d.path().join("o")).unwrap();
+        let victim = d.path().join("victim");
+        std::fs::create_dir(&victim).unwrap();
+        std::fs::write(victim.join(".data.tmp-42"), "precious").unwrap();
+        std::os::unix::fs::symlink(&victim, out.join("plots")).unwrap();
+        let e = check_contained(&out).unwrap_err().to_string();
+        assert!(e.contains("symbolic link leading out"), "{e}");
+        std::fs::remove_file(out.join("plots")).unwrap();
+        std::os::unix::fs::symlink(out.join("inside"), out.join("dangling")).unwrap();
+        assert!(
+            check_contained(&out).is_err(),
+            "a dangling link could be created outside"
+        );
+        std::fs::remove_file(out.join("dangling")).unwrap();
+        std::fs::create_dir(out.join("real")).unwrap();
+        std::os::unix::fs::symlink(out.join("real"), out.join("plots")).unwrap();
+        assert!(check_contained(&out).is_ok(), "a link inside is fine");
+        // Temporaries: only those of the dead holder's token.
+        std::fs::write(out.join(".a.csv.tmp-99-ab"), "").unwrap();
+        std::fs::write(out.join(".b.csv.tmp-42"), "").unwrap();
+        let text = format!("pid=4194305\nhost={}\ntoken=99-ab\n", host_name());
+        std::fs::write(out.join(LOCK_FILE), text).unwrap();
+        let l = lock(&out, &owner()).unwrap();
+        let c = Claim {
+            study: "s",
+            force: false,
+            resume: false,
+        };
+        let notes = claim(&out, &l, &c).unwrap();
+        assert!(notes[0].contains("removed 1 temporary"), "{notes:?}");
+        assert!(!out.join(".a.csv.tmp-99-ab").exists() && out.join(".b.csv.tmp-42").exists());
     }
 }

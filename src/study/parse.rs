@@ -13,11 +13,12 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 use super::error::InputError;
 use super::hash::study_hash;
+use super::records::{DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
-use super::static_table::{static_default_table, static_spec, STATIC_TABLE};
+use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
-use crate::input::keypath::{flatten, pattern_allowed};
+use crate::input::keypath::{did_you_mean, flatten, pattern_allowed};
 use crate::input::located::Location;
 use crate::model::design::{load_design_table, parse_design_table};
 
@@ -79,7 +80,7 @@ fn merge_into(base: &mut toml::Table, over: &toml::Table) {
 /// Read and validate a study file.
 pub fn load_study(path: &Path) -> Result<Study, InputError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+    let text = crate::input::document::read_text(path).map_err(|e| InputError {
         at: Location::origin(&origin),
         error: format!("cannot read the study file: {e}"),
     })?;
@@ -181,7 +182,7 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new("results/sweeps").join(&meta.name));
     let hash = study_hash(text, &design);
-    Ok(Study {
+    let study = Study {
         path: path.to_path_buf(),
         text: text.to_string(),
         name: meta.name.clone(),
@@ -203,7 +204,97 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         },
         hash,
         tune: file.tune.clone(),
-    })
+    };
+    check_report(&study, doc)?;
+    Ok(study)
+}
+
+/// Whether `name` is a metric column the cases of `study` report: a design descriptor, a
+/// static `T(q)` metric (with `[static]`), a run metric of the mode (`seg{k}_…` included) or a
+/// per-case tuning column.
+pub fn known_metric(name: &str, study: &Study) -> bool {
+    DESIGN_COLUMNS.contains(&name)
+        || (study.static_enabled && TCM_COLUMNS.contains(&name))
+        || scenario_mode(study.mode)
+            .is_some_and(|m| crate::outcome::run_summary::is_run_metric(m, name))
+        || study.tune_columns().iter().any(|c| c == name)
+}
+
+/// The closed-loop mode of a study mode (`None` for static studies).
+fn scenario_mode(mode: StudyMode) -> Option<crate::scenario::Mode> {
+    match mode {
+        StudyMode::Static => None,
+        StudyMode::Transport => Some(crate::scenario::Mode::Transport),
+        StudyMode::Work => Some(crate::scenario::Mode::Work),
+    }
+}
+
+/// The metric catalogue of a study (see [`known_metric`]), for messages.
+pub fn metric_catalogue(study: &Study) -> Vec<String> {
+    let mut v: Vec<String> = DESIGN_COLUMNS.iter().map(|s| s.to_string()).collect();
+    if study.static_enabled {
+        v.extend(TCM_COLUMNS.iter().map(|s| s.to_string()));
+    }
+    if let Some(m) = scenario_mode(study.mode) {
+        v.extend(crate::outcome::run_summary::metric_catalogue(m));
+    }
+    v.extend(study.tune_columns());
+    v
+}
+
+/// The error for a metric name `name` at `key` that the study's cases do not report: the
+/// mode, a "did you mean" hint when a catalogue name is close, and the catalogue.
+pub fn unknown_metric(name: &str, key: &str, study: &Study, doc: &Document) -> InputError {
+    let catalogue = metric_catalogue(study);
+    if name.is_empty() {
+        return doc.err(
+            key,
+            "is empty: name a metric, or leave the key out for the default",
+        );
+    }
+    doc.err(
+        key,
+        format!(
+            "unknown metric `{name}` for mode \"{}\"{}{}; valid: {}",
+            study.mode,
+            if study.static_enabled {
+                " with [static]"
+            } else {
+                ""
+            },
+            did_you_mean(name, catalogue.iter().map(String::as_str)),
+            catalogue.join(", ")
+        ),
+    )
+}
+
+/// `study.objective`, `study.pareto` and `study.maximise` name metrics the cases report
+/// (otherwise the report would silently rank or plot another metric).
+fn check_report(study: &Study, doc: &Document) -> Result<(), InputError> {
+    let r = &study.report;
+    let named = r
+        .objective
+        .iter()
+        .map(|o| (o, "study.objective".to_string()))
+        .chain(
+            r.pareto
+                .iter()
+                .flatten()
+                .enumerate()
+                .map(|(i, m)| (m, format!("study.pareto[{i}]"))),
+        )
+        .chain(
+            r.maximise
+                .iter()
+                .enumerate()
+                .map(|(i, m)| (m, format!("study.maximise[{i}]"))),
+        );
+    for (name, key) in named {
+        if !known_metric(name, study) {
+            return Err(unknown_metric(name, &key, study, doc));
+        }
+    }
+    Ok(())
 }
 
 /// `study.name` names the output directory: non-empty, letters, digits, `_`, `-` and `.`.

@@ -23,7 +23,7 @@ use crate::report::{
     LabelledPoint, Panel, PanelKind, Series, Table,
 };
 
-/// Units of metric and design columns, by name or by name suffix (SPEC §6 and the design
+/// Units of metric and design columns, by name or by name suffix (docs/model.md §6 and the design
 /// columns); unknown names get no unit.
 const UNITS: [(&str, &str); 23] = [
     ("energy_per_metre", "J/m"),
@@ -66,7 +66,7 @@ pub fn metric_title(name: &str) -> String {
         .find(|(key, _)| name == *key || name.ends_with(key))
         .map(|(_, u)| *u)
         .or_else(|| {
-            // Singular values and condition numbers of the scaled T(q) (SPEC §6).
+            // Singular values and condition numbers of the scaled T(q) (docs/model.md §6).
             (name.contains("sigma_min") || name.contains("kappa")).then_some("scaled, –")
         });
     match unit {

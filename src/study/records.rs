@@ -1,84 +1,25 @@
-//! Result records of a sweep: the case status, the columns of the raw (partial) and final
-//! tables, one finished case as a [`Row`], and the table operations between them (compaction
-//! and the final table with the scenario metrics unpacked).
+//! Result records of a sweep: the columns of the raw (partial) and final tables, one finished
+//! case as a [`Row`] (its metrics by name), and the table operations between them (compaction
+//! and the final table with the journal's run metrics unpacked). The case status and the
+//! design and TCM column names are the evaluator's ([`crate::evaluate`]), re-exported here.
 //!
 //! The text of these tables is the contract with resumed runs, merges and reports: statuses
 //! and column names are written and read only through the items here.
 
 use std::collections::{HashMap, HashSet};
-use std::fmt;
 use std::path::Path;
-use std::str::FromStr;
 
 use super::error::StudyError;
 use super::schema::Study;
+use crate::evaluate::{CaseResult, Metrics};
 use crate::report::{
     format_f64, write_csv_streamed, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
 };
 
-/// How a case ended (the `status` column: `ok`, `unsuccessful`, `failed`, `skipped`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum CaseStatus {
-    /// Every metric was computed and, for a closed-loop run, every `[success]` criterion met:
-    /// the cases a report ranks.
-    Ok,
-    /// The run completed but missed a `[success]` criterion: the reason is
-    /// `criterion: detail`, the criterion id first ([`missed_criterion`]).
-    Unsuccessful,
-    /// The analysis or the run failed (the reason says why; metrics computed so far are kept).
-    Failed,
-    /// The case could not be set up (an override that does not apply, an invalid design).
-    Skipped,
-}
-
-impl CaseStatus {
-    /// Every status, in table order.
-    pub const ALL: [CaseStatus; 4] = [
-        CaseStatus::Ok,
-        CaseStatus::Unsuccessful,
-        CaseStatus::Failed,
-        CaseStatus::Skipped,
-    ];
-
-    /// The text in the `status` column.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            CaseStatus::Ok => "ok",
-            CaseStatus::Unsuccessful => "unsuccessful",
-            CaseStatus::Failed => "failed",
-            CaseStatus::Skipped => "skipped",
-        }
-    }
-
-    /// The status of a `status` cell; `None` for any other text.
-    pub fn parse(s: &str) -> Option<Self> {
-        CaseStatus::ALL.into_iter().find(|c| c.as_str() == s)
-    }
-}
-
-/// The criterion a case with `status` and `reason` missed, for the report: the id before
-/// the first `:` of an `unsuccessful` case's reason; `no_failure` for a `failed` case; `None`
-/// for `ok` and `skipped` cases (a skipped case never ran).
-pub fn missed_criterion(status: CaseStatus, reason: &str) -> Option<&str> {
-    match status {
-        CaseStatus::Unsuccessful => Some(reason.split_once(':').map_or(reason, |x| x.0).trim()),
-        CaseStatus::Failed => Some("no_failure"),
-        CaseStatus::Ok | CaseStatus::Skipped => None,
-    }
-}
-
-impl fmt::Display for CaseStatus {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl FromStr for CaseStatus {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        CaseStatus::parse(s).ok_or_else(|| format!("unknown case status `{s}`"))
-    }
-}
+pub use crate::evaluate::metrics::{
+    DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
+};
+pub use crate::evaluate::{missed_criterion, CaseStatus};
 
 /// Cases by status.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -167,49 +108,6 @@ pub const REASON: &str = "reason";
 /// first and the last two last.
 pub const RAW_HEAD: [&str; 4] = [CASE_ID, HASH, STATUS, REASON];
 
-/// Number of thrusters of the built design.
-pub const DESIGN_THRUSTERS: &str = "design_thrusters";
-/// Fraction of joint configurations with σ_min below the threshold ("how often T is
-/// singular").
-pub const TCM_SINGULAR_FRACTION: &str = "tcm_singular_fraction";
-/// σ_min of the straight configuration `q = 0`.
-pub const TCM_STRAIGHT_SIGMA_MIN: &str = "tcm_straight_sigma_min";
-
-/// Columns describing the built design (always present).
-pub const DESIGN_COLUMNS: [&str; 5] = [
-    "design_bodies",
-    "design_joints",
-    DESIGN_THRUSTERS,
-    "design_length_m",
-    "design_mass_kg",
-];
-
-/// Static TCM metric columns (present when the static analysis runs): the full 6-DOF figures,
-/// then (`…_commanded`) those of the rows the mode's controller commands.
-pub const TCM_COLUMNS: [&str; 21] = [
-    TCM_SINGULAR_FRACTION,
-    "tcm_rank_deficient_fraction",
-    "tcm_sigma_min_min",
-    "tcm_sigma_min_p05",
-    "tcm_sigma_min_p50",
-    "tcm_sigma_min_mean",
-    "tcm_kappa_p50",
-    "tcm_kappa_p95",
-    TCM_STRAIGHT_SIGMA_MIN,
-    "tcm_lost_surge",
-    "tcm_lost_sway",
-    "tcm_lost_heave",
-    "tcm_lost_roll",
-    "tcm_lost_pitch",
-    "tcm_lost_yaw",
-    "tcm_singular_fraction_commanded",
-    "tcm_sigma_min_commanded_min",
-    "tcm_sigma_min_commanded_p05",
-    "tcm_sigma_min_commanded_p50",
-    "tcm_kappa_commanded_p50",
-    "tcm_straight_sigma_min_commanded",
-];
-
 /// Raw column packing the scenario metrics of dynamic modes (`name=value;…`).
 pub const SCENARIO_METRICS_COLUMN: &str = "scenario_metrics";
 
@@ -249,23 +147,21 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
     s
 }
 
-/// Number of design and TCM metric columns of a study's rows.
-pub fn metric_count(study: &Study) -> usize {
-    DESIGN_COLUMNS.len()
-        + if study.static_enabled {
-            TCM_COLUMNS.len()
-        } else {
-            0
-        }
-        + study.tune_columns().len()
+/// The named metric columns of a study's raw rows, in raw-schema order: design, TCM (with
+/// the static analysis) and tuning columns. Every other metric of a row is a run metric,
+/// packed into [`SCENARIO_METRICS_COLUMN`] in the journal.
+pub fn metric_columns(study: &Study) -> Vec<String> {
+    let mut c: Vec<String> = DESIGN_COLUMNS.iter().map(|n| n.to_string()).collect();
+    if study.static_enabled {
+        c.extend(TCM_COLUMNS.iter().map(|n| n.to_string()));
+    }
+    c.extend(study.tune_columns());
+    c
 }
 
 /// Text of a non-numeric axis value.
 pub fn axis_text(v: &toml::Value) -> String {
-    match v {
-        toml::Value::String(s) => s.clone(),
-        other => other.to_string(),
-    }
+    crate::report::fmt_value(v)
 }
 
 fn axis_number(v: &toml::Value) -> f64 {
@@ -281,11 +177,16 @@ pub fn reason_cell(s: &str) -> String {
     s.replace(['\n', '\r'], " ")
 }
 
-/// Scenario metrics packed into one cell: `name=value;…`, with `=`, `;` and white space in
-/// names replaced by `_` and values in the tables' float format.
-pub fn pack_metrics(metrics: &[(String, f64)]) -> String {
+/// The journal's cell of a row's run metrics (those not in `columns`): `name=value;…`, with
+/// `=`, `;` and white space in names replaced by `_` and values in the tables' float format.
+/// It exists only in `cases.partial.csv` (decoded again by [`final_table`]): the journal's
+/// columns are fixed before any case runs, the run metrics are not.
+fn pack_metrics(metrics: &Metrics, columns: &[String]) -> String {
     let mut packed = String::new();
-    for (name, x) in metrics {
+    for (name, x) in metrics
+        .iter()
+        .filter(|(n, _)| !columns.iter().any(|c| c == n))
+    {
         let clean: String = name
             .chars()
             .map(|c| {
@@ -301,7 +202,7 @@ pub fn pack_metrics(metrics: &[(String, f64)]) -> String {
         }
         packed.push_str(&clean);
         packed.push('=');
-        packed.push_str(&format_f64(*x));
+        packed.push_str(&format_f64(x));
     }
     packed
 }
@@ -319,23 +220,33 @@ pub struct Row {
     pub reason: String,
     /// Axis values.
     pub axes: Vec<toml::Value>,
-    /// Design, TCM and tuning columns, in raw-schema order (NaN when not computed).
-    pub metrics: Vec<f64>,
-    /// Packed scenario metrics (see [`pack_metrics`]).
-    pub scenario: String,
+    /// The case's metrics by name (design, TCM, run and tuning metrics; a column the case
+    /// did not compute is NaN).
+    pub metrics: Metrics,
 }
 
 impl Row {
-    /// An `ok` row without metrics (NaN) for case `id` of `study`.
-    pub fn new(study: &Study, id: usize, hash: String, axes: Vec<toml::Value>) -> Self {
+    /// An `ok` row without metrics for case `id`.
+    pub fn new(id: usize, hash: String, axes: Vec<toml::Value>) -> Self {
         Row {
             id,
             hash,
             status: CaseStatus::Ok,
             reason: String::new(),
             axes,
-            metrics: vec![f64::NAN; metric_count(study)],
-            scenario: String::new(),
+            metrics: Metrics::new(),
+        }
+    }
+
+    /// The row of case `id` from its evaluation.
+    pub fn from_result(id: usize, hash: String, axes: Vec<toml::Value>, r: CaseResult) -> Self {
+        Row {
+            id,
+            hash,
+            status: r.status,
+            reason: reason_cell(&r.reason),
+            axes,
+            metrics: r.metrics,
         }
     }
 
@@ -345,8 +256,24 @@ impl Row {
         self.reason = reason_cell(reason);
     }
 
-    /// The cells in raw-schema order; `texts` are the axis values as text.
-    pub fn values<'a>(&'a self, study: &Study, texts: &'a [String]) -> Vec<Value<'a>> {
+    /// The journal's text of the row's run metrics (see [`pack_metrics`]; empty for static
+    /// studies, which have no such column).
+    pub fn packed(&self, study: &Study) -> String {
+        if study.mode.is_dynamic() {
+            pack_metrics(&self.metrics, &metric_columns(study))
+        } else {
+            String::new()
+        }
+    }
+
+    /// The cells in raw-schema order; `texts` are the axis values as text, `packed` is
+    /// [`Row::packed`].
+    pub fn values<'a>(
+        &'a self,
+        study: &Study,
+        texts: &'a [String],
+        packed: &'a str,
+    ) -> Vec<Value<'a>> {
         let mut v: Vec<Value<'a>> = vec![
             Value::I64(self.id as i64),
             Value::Str(&self.hash),
@@ -360,9 +287,13 @@ impl Row {
                 Value::Str(t)
             });
         }
-        v.extend(self.metrics.iter().map(|m| Value::F64(*m)));
+        v.extend(
+            metric_columns(study)
+                .iter()
+                .map(|c| Value::F64(self.metrics.value(c))),
+        );
         if study.mode.is_dynamic() {
-            v.push(Value::Str(&self.scenario));
+            v.push(Value::Str(packed));
         }
         v
     }

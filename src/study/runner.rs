@@ -1,6 +1,5 @@
-//! The ONE adapter between the batch engine and the scenario module (`crate::scenario`).
-//!
-//! Everything the sweep needs from the closed-loop scenarios goes through this file:
+//! The ONE adapter between the batch engine and the scenario module's settings
+//! (`crate::scenario`); running a case is the evaluator's ([`crate::evaluate`]).
 //!
 //! - [`StudyMode`]: the scenario modes a study may name.
 //! - [`default_table`]: every scenario-side key with its default for a mode, shaped like the
@@ -9,39 +8,47 @@
 //!   valid axis names and to reject unknown keys before anything runs.
 //! - [`check_success`]: validate the `[success]` criteria of a scenario-side table.
 //! - [`check_case`]: validate a resolved table against a vehicle without running it.
-//! - [`run_case`] / [`run_case_until`]: run one case of a dynamic mode (`transport`, `work`)
-//!   on a vehicle with the case's fully resolved scenario-side table (same shape, overrides
-//!   applied) and the case seed (the latter within a wall-clock deadline); returns named
-//!   scalar metrics and, when `log` is set, a trajectory table.
-//!
-//! Both delegate to `crate::scenario` (`default_table`, `run_case`); trajectories are turned
-//! into report tables here so that the scenario module stays free of polars.
+//! - [`method_control`]: the full `[control]` table of a transport method.
 
 use std::fmt;
 use std::str::FromStr;
-use std::time::Instant;
 
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
 use crate::model::Vehicle;
-use crate::report::Table;
 use crate::scenario::success::SuccessSpec;
 use crate::scenario::Mode as ScenarioMode;
 
-/// The result of one dynamic case.
-#[derive(Clone, Debug, Default)]
-pub struct CaseOutcome {
-    /// Named scalar metrics, in a stable order. Names must not contain `=` or `;`.
-    pub metrics: Vec<(String, f64)>,
-    /// The trajectory (one row per logged step; a time column named `t` or `time` first),
-    /// when logging was requested.
-    pub trajectory: Option<Table>,
-    /// Why the run stopped early (diverged, …): the case is recorded as `failed` with this
-    /// reason, its metrics are kept.
-    pub failure: Option<String>,
-    /// The first `[success]` criterion a completed run missed, as `criterion: detail` (the
-    /// criterion id first): the case is recorded as `unsuccessful` with this reason.
-    pub missed: Option<String>,
+/// Why the scenario side's defaults or a method's gains could not be produced.
+#[derive(Debug, thiserror::Error)]
+pub enum SettingsError {
+    /// A scenario mode that does not exist.
+    #[error("unknown scenario mode '{name}'; valid: {valid}")]
+    UnknownMode {
+        /// The name given.
+        name: String,
+        /// The valid names, comma separated.
+        valid: String,
+    },
+    /// The scenario module's defaults.
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    /// Parsing the static mode's table.
+    #[error(transparent)]
+    Toml(#[from] toml::de::Error),
+    /// Writing gains back as a table.
+    #[error(transparent)]
+    TomlWrite(#[from] toml::ser::Error),
+    /// Gains that do not parse or validate.
+    #[error(transparent)]
+    Gains(#[from] KeyError),
+}
+
+/// Callers inside fallible steps that report a reason as text (a skipped case's reason).
+impl From<SettingsError> for String {
+    fn from(e: SettingsError) -> String {
+        e.to_string()
+    }
 }
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
@@ -103,14 +110,17 @@ impl fmt::Display for StudyMode {
 }
 
 impl FromStr for StudyMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = SettingsError;
+    fn from_str(s: &str) -> Result<Self, SettingsError> {
         StudyMode::ALL
             .into_iter()
             .find(|m| m.as_str() == s)
             .ok_or_else(|| {
                 let names: Vec<&str> = StudyMode::ALL.iter().map(|m| m.as_str()).collect();
-                format!("unknown scenario mode '{s}'; valid: {}", names.join(", "))
+                SettingsError::UnknownMode {
+                    name: s.to_string(),
+                    valid: names.join(", "),
+                }
             })
     }
 }
@@ -122,57 +132,15 @@ pub fn check_case(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), (Stri
 }
 
 /// The reason of a case stopped by its wall-clock budget starts with this word.
-pub const TIMEOUT: &str = crate::scenario::TIMEOUT;
+pub const TIMEOUT: &str = crate::evaluate::TIMEOUT;
 
 /// Every scenario-side key with its default for `mode` (see the module docs for the shape):
 /// `crate::scenario::default_table` for the dynamic modes.
-pub fn default_table(mode: StudyMode) -> Result<toml::Table, String> {
-    match mode {
-        StudyMode::Static => {
-            toml::from_str("[scenario]\nmode = \"static\"\n").map_err(|e| e.to_string())
-        }
-        StudyMode::Transport => {
-            crate::scenario::default_table(ScenarioMode::Transport).map_err(|e| e.to_string())
-        }
-        StudyMode::Work => {
-            crate::scenario::default_table(ScenarioMode::Work).map_err(|e| e.to_string())
-        }
-    }
-}
-
-/// Run one dynamic case without a time budget: [`run_case_until`] with no deadline.
-pub fn run_case(
-    vehicle: &Vehicle,
-    scenario: &toml::Table,
-    seed: u64,
-    log: bool,
-) -> Result<CaseOutcome, String> {
-    run_case_until(vehicle, scenario, seed, log, None)
-}
-
-/// Run one dynamic case: `scenario` is the resolved scenario-side table, `seed` the case seed,
-/// `log` asks for the trajectory, `deadline` is the case's wall-clock budget (checked before
-/// every control period). An `Err` (invalid settings) is recorded as a failed case with
-/// the message as its reason; a run that stops early (diverges, NaN, the deadline: a
-/// `timeout: …` failure) returns its metrics with `failure` naming the time and the cause.
-pub fn run_case_until(
-    vehicle: &Vehicle,
-    scenario: &toml::Table,
-    seed: u64,
-    log: bool,
-    deadline: Option<Instant>,
-) -> Result<CaseOutcome, String> {
-    let run = crate::scenario::run_case(vehicle, scenario, seed, log, deadline)
-        .map_err(|e| e.to_string())?;
-    let trajectory = match run.trajectory {
-        Some(t) => Some(crate::report::figures::trajectory_table(&t).map_err(|e| e.to_string())?),
-        None => None,
-    };
-    Ok(CaseOutcome {
-        metrics: run.metrics,
-        trajectory,
-        failure: run.failure,
-        missed: run.missed,
+pub fn default_table(mode: StudyMode) -> Result<toml::Table, SettingsError> {
+    Ok(match mode {
+        StudyMode::Static => toml::from_str("[scenario]\nmode = \"static\"\n")?,
+        StudyMode::Transport => crate::scenario::default_table(ScenarioMode::Transport)?,
+        StudyMode::Work => crate::scenario::default_table(ScenarioMode::Work)?,
     })
 }
 
@@ -185,15 +153,15 @@ pub fn run_case_until(
 pub fn method_control(
     mode: StudyMode,
     control: Option<&toml::Value>,
-) -> Option<Result<toml::Table, String>> {
+) -> Option<Result<toml::Table, SettingsError>> {
     let control = control?.as_table()?;
     if mode != StudyMode::Transport || !control.contains_key("method") {
         return None;
     }
     Some(
         deserialize_table::<crate::control::TransportGains>(control, "control")
-            .map_err(|e| e.to_string())
-            .and_then(|g| toml::Table::try_from(&g).map_err(|e| e.to_string())),
+            .map_err(SettingsError::from)
+            .and_then(|g| Ok(toml::Table::try_from(&g)?)),
     )
 }
 

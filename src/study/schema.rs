@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use super::runner::{StudyMode, SCENARIO_TABLES};
-use super::static_table::STATIC_TABLE;
+use crate::evaluate::static_table::STATIC_TABLE;
 use crate::input::keypath::KeyPath;
 use crate::sampling::Sampling;
 
@@ -126,13 +126,24 @@ impl fmt::Display for DoeKind {
     }
 }
 
+/// A `[doe] kind` that is not one of [`DoeKind::ALL`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown kind '{0}'; valid: grid, random, lhs, sobol")]
+pub struct UnknownDoeKind(pub String);
+
+impl From<UnknownDoeKind> for String {
+    fn from(e: UnknownDoeKind) -> String {
+        e.to_string()
+    }
+}
+
 impl FromStr for DoeKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownDoeKind;
+    fn from_str(s: &str) -> Result<Self, UnknownDoeKind> {
         DoeKind::ALL
             .into_iter()
             .find(|k| k.as_str() == s)
-            .ok_or_else(|| format!("unknown kind '{s}'; valid: grid, random, lhs, sobol"))
+            .ok_or_else(|| UnknownDoeKind(s.to_string()))
     }
 }
 
@@ -213,7 +224,8 @@ pub struct Study {
     /// SHA-256 of the study text, the base design and the tool version (hex).
     pub hash: String,
     /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`); validated
-    /// by [`crate::study::tune::Tuner::new`] before any case runs.
+    /// by the tuner wired into the sweep (`crate::optimise::tune::Tuner::new`) before any
+    /// case runs.
     pub tune: Option<toml::Table>,
 }
 

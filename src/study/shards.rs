@@ -1,7 +1,13 @@
 //! Merging shard outputs into one: same study, raw rows concatenated, sorted by case id,
 //! deduplicated by hash; then the final tables, the manifest and the report (under the output
-//! directory's lock, see [`super::outdir`]; the merged output keeps no journal).
+//! directory's lock, see [`super::outdir`]). The merged output keeps no journal of its own; an
+//! input's journal is never removed (also when `--out` is one of the inputs).
+//!
+//! A merge is complete or refused: shards missing, given twice, or of different shard counts
+//! (or outputs that are not shards) are an input error (exit code 2) naming them, unless
+//! `--partial`, which merges what is there with a warning.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use super::error::StudyError;
@@ -10,11 +16,28 @@ use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manife
 use super::outdir;
 use super::parse::load_study;
 use super::records::{compact, write_tables, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use super::tune::TuningHook;
 use crate::report::{read_csv_typed, Table};
 
-/// Merge shard outputs into `out`: check they come from the same study, concatenate their raw
-/// rows, sort by case id, deduplicate by hash, and write the final tables, manifest and report.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), StudyError> {
+/// Options of [`merge`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MergeOptions {
+    /// Merge what is there when shards are missing, duplicated or mismatched (a warning).
+    pub partial: bool,
+    /// Replace another study's output in the output directory (see [`outdir::claim`]).
+    pub force: bool,
+}
+
+/// Merge shard outputs into `out`: check they come from the same study and form one whole set
+/// of shards (unless `opts.partial`), concatenate their raw rows, sort by case id, deduplicate
+/// by hash, and write the final tables, manifest and report (the best/worst reruns of a study
+/// with `[tune]` at their tuned values through `tuning`).
+pub fn merge(
+    dirs: &[PathBuf],
+    out: &Path,
+    opts: MergeOptions,
+    tuning: Option<TuningHook>,
+) -> Result<(Manifest, Vec<String>), StudyError> {
     let start_time = now_rfc3339();
     let first_dir = dirs
         .first()
@@ -25,14 +48,26 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
         .collect::<Result<_, _>>()?;
     let m0 = &manifests[0];
     check_same_study(dirs, &manifests)?;
-    let schema = m0.schema().map_err(StudyError::Input)?;
+    let mut warnings = check_shard_set(dirs, &manifests, opts.partial)?;
+    let schema = m0.schema()?;
     let mut tables = Vec::new();
     for d in dirs {
         tables.push(read_csv_typed(&d.join(PARTIAL_FILE), &schema)?);
     }
     let raw = compact(&Table::concat(&tables)?, None)?;
-    let _lock = outdir::lock(out)?;
-    let mut warnings = outdir::claim(out, &m0.study_name, false)?;
+    let out = &outdir::resolve(out)?;
+    let owner = outdir::LockOwner {
+        study: &m0.study_hash,
+        resume: false,
+    };
+    let lock = outdir::lock(out, &owner)?;
+    let claim = outdir::Claim {
+        study: &m0.study_name,
+        force: opts.force,
+        resume: true,
+    };
+    warnings.extend(outdir::claim(out, &lock, &claim)?);
+    outdir::record_owned(out, lock.created, &outdir::SWEEP_FILES)?;
     let table = write_tables(raw, out)?;
     if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
         std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
@@ -65,11 +100,79 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(Manifest, Vec<String>), St
     let study = load_study(Path::new(&m.study_file))
         .ok()
         .filter(|s| s.hash == m.study_hash);
-    warnings.extend(finish_report(out, &table, &m, study.as_ref()));
-    // The merged rows are in cases.csv: no journal is left behind.
+    warnings.extend(finish_report(out, &table, &m, study.as_ref(), tuning));
+    outdir::record_owned(out, lock.created, &outdir::SWEEP_FILES)?;
+    // The merged rows are in cases.csv: no journal is left behind, unless the output is one
+    // of the inputs (the journal is that shard's raw output).
+    let is_input = dirs
+        .iter()
+        .any(|d| std::fs::canonicalize(d).is_ok_and(|d| d == *out));
     let journal = out.join(PARTIAL_FILE);
-    std::fs::remove_file(&journal).map_err(|e| StudyError::io(&journal, e))?;
+    if !is_input && journal.exists() {
+        std::fs::remove_file(&journal).map_err(|e| StudyError::io(&journal, e))?;
+    }
     Ok((m, warnings))
+}
+
+/// The inputs must be the shards `0..N` of one `N`, each once: else an input error naming the
+/// missing, repeated and mismatched ones, or with `partial` the same as a warning.
+fn check_shard_set(
+    dirs: &[PathBuf],
+    manifests: &[Manifest],
+    partial: bool,
+) -> Result<Vec<String>, StudyError> {
+    let mut problems = Vec::new();
+    let mut counts: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    let mut seen: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    for (d, m) in dirs.iter().zip(manifests) {
+        match m.shard {
+            Some([i, n]) => {
+                counts.entry(n).or_default().push(d.display().to_string());
+                seen.entry(i).or_default().push(d.display().to_string());
+            }
+            None => problems.push(format!("{} is not a shard output", d.display())),
+        }
+    }
+    if counts.len() > 1 {
+        let parts: Vec<String> = counts
+            .iter()
+            .map(|(n, ds)| format!("{} of {n} shards", ds.join(", ")))
+            .collect();
+        problems.push(format!("mismatched shard counts: {}", parts.join("; ")));
+    }
+    for (i, ds) in seen.iter().filter(|(_, ds)| ds.len() > 1) {
+        problems.push(format!(
+            "shard {i} given {} times ({})",
+            ds.len(),
+            ds.join(", ")
+        ));
+    }
+    if let Some((&n, _)) = counts.iter().next_back() {
+        let missing: Vec<String> = (0..n)
+            .filter(|i| !seen.contains_key(i))
+            .map(|i| format!("shard-{i}-of-{n}"))
+            .collect();
+        if !missing.is_empty() {
+            problems.push(format!(
+                "missing {} of {n} shards: {}",
+                missing.len(),
+                missing.join(", ")
+            ));
+        }
+    }
+    if problems.is_empty() {
+        return Ok(Vec::new());
+    }
+    if partial {
+        return Ok(problems
+            .into_iter()
+            .map(|p| format!("--partial: {p}"))
+            .collect());
+    }
+    Err(StudyError::Input(format!(
+        "merge: {}; pass --partial to merge what is there",
+        problems.join("; ")
+    )))
 }
 
 /// Every shard must come from the first one's study and have its columns.
@@ -96,6 +199,18 @@ fn check_same_study(dirs: &[PathBuf], manifests: &[Manifest]) -> Result<(), Stud
     Ok(())
 }
 
+/// The shard directories listed in `file`, one a line (relative ones relative to the file's
+/// directory); blank lines are skipped.
+pub fn read_shard_list(file: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
+    let base = file.parent().unwrap_or(Path::new("."));
+    Ok(text
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| base.join(l))
+        .collect())
+}
+
 /// What a Slurm submission of a study needs besides the study.
 #[derive(Clone, Debug)]
 pub struct SlurmPlan {
@@ -115,6 +230,8 @@ pub struct SlurmPlan {
     pub case_timeout_s: f64,
     /// Job name.
     pub name: String,
+    /// `--force` for the tasks and the merge (replace another study's output).
+    pub force: bool,
 }
 
 impl SlurmPlan {
@@ -124,7 +241,10 @@ impl SlurmPlan {
     }
 }
 
-/// A shell word quoted for bash (`'…'`, with `'` as `'\''`).
+/// The file (in the merged output directory) listing the shard directories for the merge job.
+pub const SHARD_LIST: &str = "shards.txt";
+
+/// A shell word quoted for bash (`'…'`, with `'` as `'\''`): nothing inside is interpreted.
 fn sh_quote(s: &str) -> String {
     format!("'{}'", s.replace('\'', r"'\''"))
 }
@@ -132,50 +252,54 @@ fn sh_quote(s: &str) -> String {
 /// The submission script of a study on Slurm: a job array of [`SlurmPlan::tasks`] tasks, each
 /// `usm-study sweep STUDY --shard slurm` into `OUT/shard-I-of-N` (resuming, so a requeued
 /// task keeps its finished cases), then the merge into `OUT` as a job depending on the whole
-/// array (`afterok`). Run it with `bash`; it prints the two job ids. `SBATCH_*` environment
-/// variables (e.g. `SBATCH_PARTITION`) apply to both jobs as usual.
+/// array (`afterok`), which reads its shards from `OUT/shards.txt`. Run it with `bash`; it
+/// prints the two job ids. `SBATCH_*` environment variables (e.g. `SBATCH_PARTITION`) apply
+/// to both jobs as usual.
+///
+/// No user data is ever interpreted by a shell: the paths are single-quoted assignments of
+/// environment variables (`USM_EXE`, `USM_STUDY`, `USM_OUT`) that the jobs' fixed,
+/// single-quoted command text only expands (`--export=ALL`); the study name appears only as
+/// [`crate::report::file_stem_safe`] text.
 pub fn slurm_script(p: &SlurmPlan) -> String {
     let n = p.tasks();
-    let exe = sh_quote(&p.exe.display().to_string());
-    let study = sh_quote(&p.study.display().to_string());
-    let out = sh_quote(&p.out.display().to_string());
     let time = if p.case_timeout_s > 0.0 {
         let minutes = (p.case_timeout_s * p.cases_per_task as f64 / 60.0).ceil() as u64 + 5;
         format!(" --time={minutes}")
     } else {
         String::new()
     };
-    let shards: Vec<String> = (0..n)
-        .map(|i| format!("\"$OUT\"/shard-{i}-of-{n}"))
-        .collect();
+    let force = if p.force { " --force" } else { "" };
     format!(
         r#"#!/usr/bin/env bash
-# Slurm submission of study `{name}`: {cases} cases in a job array of {n} tasks
+# Slurm submission of study {jname}: {cases} cases in a job array of {n} tasks
 # ({cpt} cases per task), then a merge job after the whole array succeeded.
 # Written by `usm-study sweep --emit-slurm`; run it with bash on a Slurm login node.
+# The paths reach the jobs as environment variables, never as command text.
 set -euo pipefail
-EXE={exe}
-STUDY={study}
-OUT={out}
-mkdir -p "$OUT"
-array=$(sbatch --parsable --job-name={jname}-sweep --array=0-{last} \
-  --cpus-per-task={cpus}{time} --output="$OUT/slurm-%A_%a.log" \
-  --wrap="exec \"$EXE\" sweep \"$STUDY\" --shard slurm --resume --jobs {cpus} \
---case-timeout {timeout} --out \"$OUT/shard-\${{SLURM_ARRAY_TASK_ID}}-of-{n}\"")
+export USM_EXE={exe}
+export USM_STUDY={study}
+export USM_OUT={out}
+mkdir -p -- "$USM_OUT"
+for ((i = 0; i < {n}; i++)); do printf 'shard-%d-of-{n}\n' "$i"; done >"$USM_OUT/{list}"
+array=$(sbatch --parsable --export=ALL --job-name={jname}-sweep --array=0-{last} \
+  --cpus-per-task={cpus}{time} --output="$USM_OUT/slurm-%A_%a.log" \
+  --wrap='exec "$USM_EXE" sweep "$USM_STUDY" --shard slurm --resume{force} --jobs {cpus} --case-timeout {timeout} --out "$USM_OUT/shard-$SLURM_ARRAY_TASK_ID-of-{n}"')
 array=${{array%%;*}}
-merge=$(sbatch --parsable --job-name={jname}-merge --dependency=afterok:"$array" \
-  --output="$OUT/slurm-merge-%j.log" \
-  --wrap="exec \"$EXE\" merge {shards} --out \"$OUT\"")
-echo "array job $array ({n} tasks), merge job ${{merge%%;*}}; merged output in $OUT"
+merge=$(sbatch --parsable --export=ALL --job-name={jname}-merge --dependency=afterok:"$array" \
+  --output="$USM_OUT/slurm-merge-%j.log" \
+  --wrap='exec "$USM_EXE" merge --list "$USM_OUT/{list}" --out "$USM_OUT"{force}')
+printf 'array job %s ({n} tasks), merge job %s; merged output in %s\n' "$array" "${{merge%%;*}}" "$USM_OUT"
 "#,
-        name = p.name,
+        exe = sh_quote(&p.exe.display().to_string()),
+        study = sh_quote(&p.study.display().to_string()),
+        out = sh_quote(&p.out.display().to_string()),
         cases = p.cases,
         cpt = p.cases_per_task,
         jname = crate::report::file_stem_safe(&p.name),
         last = n - 1,
         cpus = p.cpus.max(1),
         timeout = p.case_timeout_s,
-        shards = shards.join(" ").replace('"', "\\\""),
+        list = SHARD_LIST,
     )
 }
 
@@ -184,27 +308,50 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_slurm_script_names_every_shard_once_and_merges_after_the_array() {
+    fn the_slurm_script_quotes_paths_once_and_lists_shards_in_a_file() {
         let p = SlurmPlan {
             exe: "/opt/usm study/usm-study".into(),
-            study: "/w/s.toml".into(),
+            study: "/w/it's $(x).toml".into(),
             out: "/w/out".into(),
             cases: 25,
             cases_per_task: 10,
             cpus: 2,
             case_timeout_s: 600.0,
-            name: "gains".into(),
+            name: "gains\n$(x)".into(),
+            force: true,
         };
         assert_eq!(p.tasks(), 3);
         let s = slurm_script(&p);
-        assert!(s.contains("EXE='/opt/usm study/usm-study'"), "{s}");
+        assert!(
+            s.contains("export USM_EXE='/opt/usm study/usm-study'\n"),
+            "{s}"
+        );
+        assert!(
+            s.contains(r"export USM_STUDY='/w/it'\''s $(x).toml'"),
+            "{s}"
+        );
         assert!(s.contains("--array=0-2 "), "{s}");
         assert!(s.contains("--time=105"), "{s}");
-        assert!(s.contains("--shard slurm --resume --jobs 2"), "{s}");
-        assert!(s.contains("shard-\\${SLURM_ARRAY_TASK_ID}-of-3"), "{s}");
+        assert!(s.contains("--shard slurm --resume --force --jobs 2"), "{s}");
+        assert!(s.contains("shard-$SLURM_ARRAY_TASK_ID-of-3\"')"), "{s}");
         assert!(s.contains("--dependency=afterok:\"$array\""), "{s}");
-        for i in 0..3 {
-            assert_eq!(s.matches(&format!("shard-{i}-of-3")).count(), 1, "{s}");
-        }
+        assert!(s.contains("merge --list \"$USM_OUT/shards.txt\" --out \"$USM_OUT\" --force'"));
+        assert!(s.contains("# Slurm submission of study gains___x_:"), "{s}");
+        assert_eq!(
+            s.matches("$(x)").count(),
+            1,
+            "only inside the quoted study path: {s}"
+        );
+    }
+
+    #[test]
+    fn a_shard_list_is_read_relative_to_its_file() {
+        let d = tempfile::tempdir().unwrap();
+        let f = d.path().join(SHARD_LIST);
+        std::fs::write(&f, "shard-0-of-2\n\nshard-1-of-2\n/abs/x\n").unwrap();
+        let v = read_shard_list(&f).unwrap();
+        assert_eq!(v[0], d.path().join("shard-0-of-2"));
+        assert_eq!(v[1], d.path().join("shard-1-of-2"));
+        assert_eq!(v[2], Path::new("/abs/x"));
     }
 }

@@ -1,178 +1,135 @@
-//! Per-case tuning of a sweep (`[tune]`, `docs/study-format.md`): every case is first tuned —
-//! its own design, its own axis values — by the optimiser ([`crate::optimise::minimise`] over
-//! the case's resolved tables), then scored at the tuned values like any case; its row
-//! carries the tuned values (`tuned.<param>`), the evaluations used (`tune_evaluations`) and
-//! whether the tuned point met every `[[tune.constraint]]` (`tune_feasible`).
+//! The per-case tuning hook of a sweep (`[tune]`, `docs/study-format.md`). The tuner itself
+//! lives with the optimiser (`crate::optimise::tune`); the sweep engine only knows this
+//! interface, handed in by the caller ([`TuningHook`] in `SweepOptions::tuning` and to
+//! [`super::finish::finish_report`]), so `study` never imports `optimise`.
 //!
-//! `[tune]` holds the sections of a problem file (`[[tune.param]]`, `[tune.objective]`,
-//! `[[tune.constraint]]`, `[tune.solver]`; `docs/optimise.md`), read by
-//! [`crate::optimise::problem::parse_spec`] and validated before any case runs. A parameter
-//! without `start` starts from the case's own value of its key (clamped to the bounds), so
-//! an axis over `control.method` starts each method from its own Table III row.
-//!
-//! Determinism: the tuning of a case runs serially (one thread), every evaluation as the
-//! case itself (its seed), so the tuned values and the row depend only on the study and the
-//! case id — identical for any `--jobs` and any sharding. The case's wall-clock budget
-//! (`--case-timeout`) covers tuning and scoring: a run past it fails `timeout`.
+//! A tuned case's row carries the tuned values (`tuned.<param>`), the evaluations used
+//! (`tune_evaluations`) and whether the tuned point met every `[[tune.constraint]]`
+//! (`tune_feasible`), all set by name ([`Tuned::record`]).
 
-use std::time::Instant;
+use std::fmt;
 
 use super::cases::Resolved;
 use super::doe::Case;
-use super::error::InputError;
-use super::records::{metric_count, CaseStatus, Row, TCM_COLUMNS};
-use super::schema::{Study, Target};
-use super::worker::Worker;
-use crate::input::document::Document;
-use crate::input::keypath::get;
-use crate::optimise::evaluate::CaseEvaluator;
-use crate::optimise::history::Record;
-use crate::optimise::problem::parse_spec;
-use crate::optimise::{minimise, Options, Problem, Spec};
+use super::error::{InputError, StudyError};
+use super::schema::{Study, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
+use crate::evaluate::{Deadline, Metrics};
 
-/// A study's validated `[tune]` section.
-#[derive(Clone, Debug)]
-pub struct Tuner {
-    spec: Spec,
-    /// Per parameter: whether `start` is written (otherwise the case's own value).
-    explicit_start: Vec<bool>,
-    /// Whether the tuning objective or constraints read static TCM metrics.
-    static_needed: bool,
+/// Why a case could not be tuned (its row is `failed` with reason `tune: …`).
+#[derive(Debug, thiserror::Error)]
+#[error("tune: {message}")]
+pub struct TuneError {
+    /// What went wrong.
+    pub message: String,
+    /// The underlying error, when there is one.
+    #[source]
+    pub source: Option<Box<dyn std::error::Error + Send + Sync>>,
 }
 
-impl Tuner {
-    /// The tuner of `study`'s `[tune]` section (`None` without one). Every check of a
-    /// problem file applies (`docs/optimise.md`), and: no `[[tune.variant]]` (a case is
-    /// scored in its own scenario), no parameter that is also a sweep axis. Errors name the
-    /// file, the line and the key (`tune.param[1].upper`).
-    pub fn new(study: &Study) -> Result<Option<Tuner>, InputError> {
-        let Some(t) = &study.tune else {
-            return Ok(None);
-        };
-        let doc = Document::parse(&study.text, &study.path.display().to_string())?;
-        if t.contains_key("variant") {
-            return Err(doc.err(
-                "tune.variant",
-                "not allowed in [tune]: each case is tuned and scored in its own scenario",
-            ));
+impl TuneError {
+    /// A tuning error for `source`, its message kept.
+    pub fn from_error(source: impl std::error::Error + Send + Sync + 'static) -> Self {
+        TuneError {
+            message: source.to_string(),
+            source: Some(Box::new(source)),
         }
-        let params = t.get("param").and_then(|p| p.as_array());
-        for (i, p) in params.into_iter().flatten().enumerate() {
-            let name = p.get("name").and_then(|n| n.as_str()).unwrap_or_default();
-            if study.axes.iter().any(|a| a.name == name) {
-                return Err(doc.err(
-                    &format!("tune.param[{i}].name"),
-                    format!("`{name}` is also a sweep axis: tune it or sweep it"),
-                ));
-            }
-        }
-        let spec = parse_spec(&doc, t, "tune", study)?;
-        let explicit_start = params
-            .map(|ps| ps.iter().map(|p| p.get("start").is_some()).collect())
-            .unwrap_or_default();
-        let static_needed = study.static_enabled
-            && spec
-                .metrics()
-                .iter()
-                .any(|m| TCM_COLUMNS.contains(&m.as_str()));
-        Ok(Some(Tuner {
-            spec,
-            explicit_start,
-            static_needed,
-        }))
     }
 
-    /// The problem tuning one case: the study with the case's resolved tables as its base
-    /// and no axes; each parameter without `start` starts from the case's value.
-    fn case_problem(&self, study: &Study, r: &Resolved) -> Problem {
-        let mut cs = study.clone();
-        cs.design = r.design.clone();
-        cs.scenario_full = r.scenario.clone();
-        cs.axes.clear();
-        cs.tune = None;
-        cs.static_enabled = self.static_needed;
-        let mut spec = self.spec.clone();
-        for (p, explicit) in spec.space.params.iter_mut().zip(&self.explicit_start) {
-            if !explicit {
-                if let Some(x) = case_value(&p.target, r) {
-                    p.start = x.clamp(p.lower, p.upper);
-                }
-            }
+    /// A tuning error with a message only.
+    pub fn msg(message: impl Into<String>) -> Self {
+        TuneError {
+            message: message.into(),
+            source: None,
         }
-        Problem { study: cs, spec }
     }
+}
 
-    /// Tune case `case` (resolved as `r`) within `deadline`, then score it at the tuned
-    /// values with `w`: its row, tuned columns filled in. A tuning that cannot run makes
-    /// the case `failed` with a reason starting `tune:`.
-    pub fn evaluate(
+/// A tuned case: its tables at the tuned values and what the tuning found.
+#[derive(Clone, Debug)]
+pub struct Tuned {
+    /// The case's tables at the tuned values (its hash the case's own).
+    pub resolved: Resolved,
+    /// The tuned values, in `[[tune.param]]` order.
+    pub x: Vec<f64>,
+    /// Fresh evaluations the tuning used.
+    pub evaluations: usize,
+    /// Whether the tuned point met every constraint.
+    pub feasible: bool,
+}
+
+impl Tuned {
+    /// Write the tuning columns of `study` into `metrics` by name.
+    pub fn record(&self, study: &Study, metrics: &mut Metrics) {
+        for (c, x) in tuned_columns(study).iter().zip(&self.x) {
+            metrics.set(c, *x);
+        }
+        metrics.set(TUNE_EVALUATIONS, self.evaluations as f64);
+        metrics.set(TUNE_FEASIBLE, f64::from(u8::from(self.feasible)));
+    }
+}
+
+/// The `tuned.<param>` columns of `study`, in `[[tune.param]]` order.
+pub fn tuned_columns(study: &Study) -> Vec<String> {
+    study
+        .tune_columns()
+        .into_iter()
+        .filter(|c| c.starts_with(TUNED_PREFIX))
+        .collect()
+}
+
+/// Tunes the cases of one study.
+pub trait CaseTuner: Sync {
+    /// Tune case `case` (resolved as `r`) within `deadline`: its tables at the tuned values.
+    fn tune(
         &self,
-        w: &mut Worker,
         study: &Study,
         case: &Case,
         r: &Resolved,
-        deadline: Option<Instant>,
-    ) -> Row {
-        let problem = self.case_problem(study, r);
-        let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
-        let quiet = |_: &Record| {};
-        let opts = Options {
-            jobs: 1,
-            journal: None,
-            resume: false,
-            on_record: &quiet,
-        };
-        let failed = |reason: String| {
-            let mut row = Row::new(study, case.id, r.hash.clone(), case.values.clone());
-            row.end(CaseStatus::Failed, &reason);
-            row
-        };
-        let out = match minimise(&problem.spec, &ev, &study.hash, &opts) {
-            Ok(o) => o,
-            Err(e) => return failed(format!("tune: {e}")),
-        };
-        let best = out.best();
-        let mut scored = match ev.resolve(&best.x, 0) {
-            Ok(s) => s,
-            Err(m) => return failed(format!("tune: {m}")),
-        };
-        scored.hash = r.hash.clone();
-        let (mut row, _) = w.evaluate_until(study, case, &scored, false, deadline);
-        let dim = best.x.len();
-        let at = metric_count(study) - dim - 2;
-        row.metrics[at..at + dim].copy_from_slice(&best.x);
-        row.metrics[at + dim] = out.fresh_evaluations() as f64;
-        row.metrics[at + dim + 1] = f64::from(u8::from(best.score.feasible));
-        row
-    }
+        deadline: Deadline,
+    ) -> Result<Tuned, TuneError>;
 
     /// Case `r` at tuned values `x` (in `[[tune.param]]` order, as a row records them): the
     /// report's reruns of the best and worst cases.
-    pub fn at(
+    fn at(
         &self,
         study: &Study,
         case: &Case,
         r: &Resolved,
         x: &[f64],
-    ) -> Result<Resolved, String> {
-        let problem = self.case_problem(study, r);
-        let mut s = CaseEvaluator::new(&problem)
-            .for_case(case.id, None)
-            .resolve(x, 0)?;
-        s.hash = r.hash.clone();
-        Ok(s)
+    ) -> Result<Resolved, TuneError>;
+}
+
+/// The tuner of a study (`None` without `[tune]`); `Err` for a bad `[tune]` section, located.
+pub type TunerFactory = fn(&Study) -> Result<Option<Box<dyn CaseTuner>>, InputError>;
+
+/// How a sweep tunes its cases: the factory the caller wires in (the optimiser's tuner).
+#[derive(Clone, Copy)]
+pub struct TuningHook(pub TunerFactory);
+
+impl TuningHook {
+    /// The tuner of `study` (`None` without `[tune]`).
+    pub fn tuner(&self, study: &Study) -> Result<Option<Box<dyn CaseTuner>>, InputError> {
+        (self.0)(study)
     }
 }
 
-/// The case's value of a parameter's key (a number), if it has one.
-fn case_value(target: &Target, r: &Resolved) -> Option<f64> {
-    let v = match target {
-        Target::Design(p) => get(&r.design, &p.0),
-        Target::Scenario(p) => get(&r.scenario, &p.0),
-    }?;
-    match v {
-        toml::Value::Float(x) => Some(*x),
-        toml::Value::Integer(n) => Some(*n as f64),
-        _ => None,
+impl fmt::Debug for TuningHook {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("TuningHook")
+    }
+}
+
+/// The tuner of `study` through `hook`; `None` without `[tune]`. A study with `[tune]` but
+/// no hook cannot be run as written: refused.
+pub fn case_tuner(
+    study: &Study,
+    hook: Option<TuningHook>,
+) -> Result<Option<Box<dyn CaseTuner>>, StudyError> {
+    match hook {
+        Some(h) => Ok(h.tuner(study)?),
+        None if study.tune.is_some() => Err(StudyError::Other(
+            "the study has a [tune] section but no tuner was wired into the sweep".into(),
+        )),
+        None => Ok(None),
     }
 }

@@ -1,5 +1,5 @@
 //! The paper's gradient-based secondary objectives (USM section IV-A, objectives 2 and 3;
-//! SPEC §5): "maintain good manipulability" and "maintain controllability, i.e. avoid singular
+//! docs/model.md §5): "maintain good manipulability" and "maintain controllability, i.e. avoid singular
 //! thruster configurations", as a joint velocity that climbs the gradient of each measure,
 //! projected into the null space of every higher-priority task ([`super::Srmtp::push_velocity`]):
 //!

@@ -223,7 +223,7 @@ fn thrust_moves_the_vehicle_in_its_direction() {
 
 #[test]
 fn usm_paper_at_rest_has_zero_bias() {
-    // Neutrally buoyant with CG = CB (SPEC §2): at rest in still water nothing acts.
+    // Neutrally buoyant with CG = CB (docs/model.md §2): at rest in still water nothing acts.
     // Weight and buoyancy differ by rounding only (ρ·(m/ρ) vs m): 1e-12 N.
     let v = usm_paper();
     let mut ws = DynWorkspace::new(&v);

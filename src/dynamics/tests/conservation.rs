@@ -57,7 +57,7 @@ pub(super) fn conservation_drift(
 
 #[test]
 fn rigid_free_motion_conserves_energy_and_momentum() {
-    // SPEC §4 invariant, vacuum. RK4 at dt = 1 ms on motions of ~1 rad/s: local error
+    // docs/model.md §4 invariant, vacuum. RK4 at dt = 1 ms on motions of ~1 rad/s: local error
     // ~(ω dt)⁵ ≈ 1e-15 per step, so 1e5 steps stay far below the required 1e-6.
     for v in [usm_paper(), toy(3)] {
         let (de, dp) = conservation_drift(&v, DynOptions::rigid(), RK4_1MS, 11);
@@ -124,7 +124,7 @@ fn drag_never_increases_energy() {
 
 #[test]
 fn uniform_current_is_a_moving_frame() {
-    // Galilean invariance (SPEC §4 current model): in a constant irrotational current ν_c,
+    // Galilean invariance (docs/model.md §4 current model): in a constant irrotational current ν_c,
     // the motion started with V_b + [R_Ibᵀ ν_c; 0] is the current-free motion plus the drift
     // ν_c t (same orientation, joints and relative twist). This holds only if the added-mass
     // force uses V̇_r = V̇ + [ω × v_c; 0]; dropping that term makes this test fail (checked).

@@ -121,7 +121,7 @@ fn c_matrix(v: &Vehicle, ws: &DynWorkspace, s: &Sample, opts: &DynOptions, h: f6
 
 #[test]
 fn m_dot_minus_two_c_is_skew_symmetric() {
-    // SPEC §4: Ṁ − 2C skew-symmetric. The test has two halves:
+    // docs/model.md §4: Ṁ − 2C skew-symmetric. The test has two halves:
     // (1) the implemented bias h(q,ζ) (RNEA, gravity/drag/current off, with and without added
     //     mass) equals C(q,ζ)ζ for the matrix C of `c_matrix` — so h *has* this
     //     factorisation;

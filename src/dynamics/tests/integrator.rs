@@ -77,7 +77,7 @@ fn dopri5_meets_its_tolerance_on_the_servo_closed_form() {
 
 #[test]
 fn dopri5_conserves_energy_and_momentum_without_dissipation() {
-    // SPEC §4 invariants with the adaptive integrator: torque-free joints, rigid and with
+    // docs/model.md §4 invariants with the adaptive integrator: torque-free joints, rigid and with
     // added mass (Kirchhoff), 100 s in 1 s spans at rtol 1e-10: the drift must stay below
     // the 1e-6 the RK4 tests require.
     for opts in [

@@ -1,4 +1,4 @@
-//! Physics tests of the dynamics module (SPEC §4 invariants), on 1–3 body toy models built
+//! Physics tests of the dynamics module (docs/model.md §4 invariants), on 1–3 body toy models built
 //! here and on `usm-paper`.
 
 use super::passes::inertia_to_parent;

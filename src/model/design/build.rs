@@ -209,7 +209,7 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
         None => d.thruster_rule,
         Some(s) => s
             .parse::<ThrusterRule>()
-            .map_err(|m| ctx.schema("generator.thruster_rule", m))?,
+            .map_err(|e| ctx.schema("generator.thruster_rule", e.to_string()))?,
     };
     let spec = GeneratorSpec {
         links: g.links.unwrap_or(d.links),

@@ -1,5 +1,5 @@
 //! Design files (TOML): a [`Vehicle`] described by a preset name, by explicit body / joint /
-//! thruster lists, or by a `[generator]` table (SPEC §2).
+//! thruster lists, or by a `[generator]` table (docs/model.md §2).
 //!
 //! # Forms
 //! A design file uses exactly one of three forms:
@@ -140,7 +140,7 @@ pub fn parse_design_value(value: &toml::Value, origin: &str) -> Result<Vehicle, 
 }
 
 fn read_file(path: &str) -> Result<String, DesignError> {
-    std::fs::read_to_string(path).map_err(|e| {
+    crate::input::document::read_text(std::path::Path::new(path)).map_err(|e| {
         unplaced(
             DesignErrorKind::Io,
             path,

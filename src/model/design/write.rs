@@ -90,7 +90,8 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         o,
         "# usm-study design file, explicit form, of the design {}.\n\
          # Written by `usm-study design show`; save it, edit it and pass the file wherever a\n\
-         # design or preset name is accepted (e.g. `--design my_design.toml`).\n\
+         # design or preset name is accepted (e.g. `usm-study inspect my_design.toml`,\n\
+         # `design = \"my_design.toml\"` in a scenario, `[design] file = \"my_design.toml\"` in a study).\n\
          # Units: SI (m, kg, s, N); angles in degrees only in keys ending in `_deg`.\n\
          # Frames: each body frame has its origin at the body's tail face, x towards the head;\n\
          # joint k joins body k (parent) to body k+1; positions are in the owning body's frame.",
@@ -161,7 +162,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 let _ = writeln!(o, "quadratic = {}", fmat(quadratic, ""));
             }
             Hydro::Manoeuvring(_) => {
-                // Built-in derivative tables (model::nps_auv2) have no design-file form:
+                // Built-in derivative tables (paper::nps_auv2) have no design-file form:
                 // reading this back fails with "unknown hydro kind".
                 let _ = writeln!(o, "kind = \"manoeuvring\"  # built in, not readable");
             }

@@ -14,13 +14,15 @@ pub(super) type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>
 /// The font family of every text element.
 pub(super) const FONT: &str = "sans-serif";
 
+/// A canvas size outside 50..=20000 px on a side.
+#[derive(Debug, thiserror::Error)]
+#[error("size {}×{} px must be within 50..=20000", .0.0, .0.1)]
+pub(super) struct BadSize(pub (u32, u32));
+
 /// `Err` unless both sides of `size` are within 50..=20000 px.
-pub(super) fn check_size(size: (u32, u32)) -> std::result::Result<(), String> {
+pub(super) fn check_size(size: (u32, u32)) -> std::result::Result<(), BadSize> {
     if size.0 < 50 || size.1 < 50 || size.0 > 20_000 || size.1 > 20_000 {
-        return Err(format!(
-            "size {}×{} px must be within 50..=20000",
-            size.0, size.1
-        ));
+        return Err(BadSize(size));
     }
     Ok(())
 }
@@ -31,7 +33,7 @@ pub(super) fn render_to_svg(
     size: (u32, u32),
     title: &str,
     draw: impl FnOnce(&Area<'_>) -> DrawResult,
-) -> Result<String> {
+) -> Result<String, ReportError> {
     let mut buf = String::new();
     {
         let root = SVGBackend::with_string(&mut buf, size).into_drawing_area();

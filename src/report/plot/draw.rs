@@ -20,11 +20,11 @@ use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
 /// A chart with `f64` axes on an SVG canvas.
 type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 use crate::report::atomic::atomic_write;
-use crate::report::error::Result;
+use crate::report::error::{ReportError, Result};
 
 impl Figure {
     /// Renders the figure to an SVG document.
-    pub fn render_svg(&self) -> Result<String> {
+    pub fn render_svg(&self) -> Result<String, ReportError> {
         self.validate()?;
         render_to_svg(self.size, &self.title, |root| draw_figure(self, root))
     }

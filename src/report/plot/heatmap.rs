@@ -134,7 +134,7 @@ impl Heatmap {
     }
 
     fn validate(&self) -> Result<()> {
-        check_size(self.size).map_err(|d| self.invalid(d))?;
+        check_size(self.size).map_err(|e| self.invalid(e.to_string()))?;
         for (axis, c) in [("x", &self.x), ("y", &self.y)] {
             let ok = c.iter().all(|v| v.is_finite() && v.abs() <= LIMIT)
                 && c.windows(2).all(|w| w[0] < w[1]);
@@ -161,7 +161,7 @@ impl Heatmap {
     }
 
     /// Renders the heat map to an SVG document.
-    pub fn render_svg(&self) -> Result<String> {
+    pub fn render_svg(&self) -> Result<String, ReportError> {
         self.validate()?;
         render_to_svg(self.size, &self.title, |root| self.draw(root))
     }

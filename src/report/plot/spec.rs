@@ -228,7 +228,7 @@ impl Figure {
     }
 
     pub(super) fn validate(&self) -> Result<()> {
-        check_size(self.size).map_err(|d| self.invalid(d))?;
+        check_size(self.size).map_err(|e| self.invalid(e.to_string()))?;
         let (rows, cols) = self.grid();
         if rows.saturating_mul(cols) < self.panels.len() {
             return Err(self.invalid(format!(

@@ -1,4 +1,4 @@
-//! The physical sections of a scenario file: `[servo]` (joint servos, SPEC §4), `[thrusters]`
+//! The physical sections of a scenario file: `[servo]` (joint servos, docs/model.md §4), `[thrusters]`
 //! (thruster dynamics) and `[physics]` (which effects act, the current, the time integrator).
 //! Re-exported by [`super`]; their translation into a [`crate::dynamics::SimConfig`] stays
 //! there.
@@ -6,7 +6,7 @@
 use crate::dynamics::{Integrator, ServoModel};
 use serde::{Deserialize, Serialize};
 
-/// `[servo]`: joint servo model (SPEC §4).
+/// `[servo]`: joint servo model (docs/model.md §4).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ServoSpec {

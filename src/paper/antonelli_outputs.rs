@@ -1,6 +1,6 @@
-//! The `paper antonelli` pipeline: Antonelli & Chiaverini's case studies (SPEC §8) —
-//! the kinematic cases 1, 1b and 2 ([`crate::scenario::antonelli`]) on `uvms-planar` and the
-//! dynamic case 3 ([`crate::scenario::antonelli::dynamic`]: the NPS AUV II under current,
+//! The `paper antonelli` pipeline: Antonelli & Chiaverini's case studies (docs/model.md §8) —
+//! the kinematic cases 1, 1b and 2 ([`crate::paper::antonelli`]) on `uvms-planar` and the
+//! dynamic case 3 ([`crate::paper::antonelli::dynamic`]: the NPS AUV II under current,
 //! 3a holding its pose, 3b following case 1's re-orientation). Writes one CSV of time
 //! histories per case (`<case>.csv`), the paper-like figures (`fig*.svg`, see
 //! [`super::antonelli_figures`]) and a `summary.json` of what the paper's text claims, with
@@ -10,17 +10,17 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::error::{create_dir, PipelineError};
 use crate::dynamics::manoeuvring::ManoeuvringKernel;
-use crate::model::nps_auv2::{nps_auv2, nps_auv2_hydro};
 use crate::model::presets::uvms_planar;
-use crate::report::{atomic_write, write_csv, Table};
-use crate::scenario::antonelli::dynamic::{
+use crate::paper::antonelli::dynamic::{
     run_dynamic_case, BaseTrajectory, DynamicCase, DynamicHistory,
 };
-use crate::scenario::antonelli::{
+use crate::paper::antonelli::{
     antonelli_case, run_kinematic_case, AntonelliCase, KinematicHistory, TaskTrace,
 };
+use crate::paper::nps_auv2::{nps_auv2, nps_auv2_hydro};
+use crate::pipeline::error::{create_dir, PipelineError};
+use crate::report::{atomic_write, write_csv, Table};
 use crate::spatial::{cross_force, Se3, Vec3, Vec6};
 
 /// What a kinematic case run shows, in the terms of the paper's text (SI units, rad).

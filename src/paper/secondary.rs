@@ -17,14 +17,14 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::error::{create_dir, PipelineError};
 use crate::control::kinematic::{SecondarySettings, SecondaryTasks};
 use crate::model::Vehicle;
+use crate::outcome::{run_scenario, RunResult};
+use crate::pipeline::error::{create_dir, PipelineError};
 use crate::report::{atomic_write, MarkdownTable};
 use crate::scenario::config::Mode;
 use crate::scenario::{
-    load_table, parse_table, resolve_design, run_scenario, Channel, RunResult, ScenarioError,
-    ScenarioFile,
+    load_table, parse_table, resolve_design, Channel, ScenarioError, ScenarioFile,
 };
 
 /// Simulated time of the transport runs [s] (the turn is commanded at 95 s).

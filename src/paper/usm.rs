@@ -8,13 +8,14 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::error::{create_dir, PipelineError};
 use super::readings::run_readings;
 use super::secondary::run_secondary_comparison;
-use super::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use crate::allocation::Method;
+use crate::outcome::run_scenario;
+use crate::pipeline::error::{create_dir, PipelineError};
+use crate::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
-use crate::scenario::{load_table, parse_table, preset_names, resolve_design, run_scenario};
+use crate::scenario::{load_table, parse_table, preset_names, resolve_design};
 
 /// Metrics shown in the transport comparison table.
 const TRANSPORT_KEYS: [&str; 14] = [

@@ -1,4 +1,4 @@
-//! The kinematic case studies of Antonelli & Chiaverini (1998), section 5 (SPEC §8), on the
+//! The kinematic case studies of Antonelli & Chiaverini (1998), section 5 (docs/model.md §8), on the
 //! planar UVMS preset `uvms-planar`: closed-loop task-priority inverse kinematics (AC-7…9)
 //!
 //! `ζ = J_p^# w_p + (I − J_p^# J_p) J_s^# w_s`, `w_p = ξ̇_p,d + K_p(ξ_p,d − ξ_p)`,
@@ -27,10 +27,10 @@
 
 pub mod dynamic;
 
-use super::ScenarioError;
 use crate::control::{InertialTask, Quintic, Srmtp, TaskInverse, TaskVariable};
 use crate::kinematics::{forward_kinematics, BasePose, KinWorkspace};
 use crate::model::Vehicle;
+use crate::scenario::ScenarioError;
 use crate::spatial::Vec3;
 use nalgebra::UnitQuaternion;
 use serde::Serialize;
@@ -169,7 +169,7 @@ impl TaskTrace {
             .map(|(d, v)| {
                 let e = d - v;
                 if self.heading {
-                    crate::control::wrap_angle(e).abs()
+                    crate::spatial::wrap_angle(e).abs()
                 } else {
                     e.abs()
                 }
@@ -502,7 +502,7 @@ fn record(h: &mut KinematicHistory, r: &Resolver, t: f64, s: &[f64], ds: &[f64],
     let g_ie = crate::control::ee_pose(&base_pose(s), &r.ws.g_be);
     h.ee[0].push(g_ie.p.x);
     h.ee[1].push(g_ie.p.y);
-    h.ee[2].push(crate::control::heading(&g_ie.r));
+    h.ee[2].push(crate::spatial::heading(&g_ie.r));
     h.sigma_s.push(sigma);
     for (level, traces) in [&mut h.primary, &mut h.secondary].into_iter().enumerate() {
         let task = if level == 0 { &r.primary } else { &r.secondary };

@@ -1,9 +1,10 @@
 //! Tests of the static TCM analysis: determinism across threads, the paper design's singular
 //! straight configuration, quantiles, slices and joint influence.
 
+use super::super::slice::{influential_joints, slice_grid};
 use super::*;
 use crate::model::presets::usm_paper;
-use crate::study::static_tcm_slice::{influential_joints, slice_grid};
+use crate::statics::dist::quantile_sorted;
 
 fn run(threads: usize, samples: usize, sampling: Sampling) -> (StaticSummary, Vec<SampleEval>) {
     let spec = StaticSpec {

@@ -1,11 +1,11 @@
-//! Slices of the static TCM analysis (SPEC §6): σ_min over a 2-D grid of two joints (others
+//! Slices of the static TCM analysis (docs/model.md §6): σ_min over a 2-D grid of two joints (others
 //! straight) and the two joints whose bending most restores the TCM.
 
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm::{evaluator, pool, StaticError, StaticSpec};
-use super::static_tcm_eval::Scratch;
+use super::analysis::{evaluator, pool, StaticError, StaticSpec};
+use super::eval::Scratch;
 use crate::model::Vehicle;
 
 /// σ_min over a 2-D slice of joint space: joints `i` and `j` on a `resolution × resolution`

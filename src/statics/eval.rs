@@ -1,4 +1,4 @@
-//! The per-configuration kernel of the static TCM analysis (SPEC §6): forward kinematics,
+//! The per-configuration kernel of the static TCM analysis (docs/model.md §6): forward kinematics,
 //! `T(q)` and the scaled singularity metrics of one joint configuration, full and over the
 //! commanded axes, with per-worker scratch so that nothing allocates per configuration.
 
@@ -12,7 +12,7 @@ use crate::metrics::singularity::{
 };
 use crate::model::Vehicle;
 
-/// The metrics of one joint configuration (SPEC §6), all in N per N of the scaled `T_L`.
+/// The metrics of one joint configuration (docs/model.md §6), all in N per N of the scaled `T_L`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SampleMetrics {
     /// Smallest singular value of the scaled `T_L`, all six rows.
@@ -129,7 +129,9 @@ pub(super) fn map_joint(v: &Vehicle, u: &[f64], q: &mut [f64]) {
 }
 
 /// A local pool of `threads` workers (0: all cores), or none for 1 (inline evaluation).
-pub(super) fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, String> {
+pub(super) fn local_pool(
+    threads: usize,
+) -> Result<Option<rayon::ThreadPool>, rayon::ThreadPoolBuildError> {
     if threads == 1 {
         return Ok(None);
     }
@@ -137,5 +139,4 @@ pub(super) fn local_pool(threads: usize) -> Result<Option<rayon::ThreadPool>, St
         .num_threads(threads)
         .build()
         .map(Some)
-        .map_err(|e| e.to_string())
 }

@@ -28,12 +28,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::error::{create_dir, PipelineError};
 use crate::control::guidance::PathSpec;
 use crate::control::transport::{SurgeLaw, TransportGains, TransportMethod, YawRateSource};
+use crate::outcome::{run_scenario, RunResult};
+use crate::pipeline::error::{create_dir, PipelineError};
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
 use crate::scenario::channels::Pose;
-use crate::scenario::{load_table, parse_table, resolve_design, run_scenario, Channel, RunResult};
+use crate::scenario::{load_table, parse_table, resolve_design, Channel};
 
 /// Simulated time of each readings run [s].
 pub const READINGS_DURATION: f64 = 170.0;

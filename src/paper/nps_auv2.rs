@@ -1,5 +1,5 @@
 //! The NPS AUV II (Healey & Lienard 1993) as a one-body floating base for Antonelli &
-//! Chiaverini's case 3 (SPEC §8): mass, inertia, hydrostatics and manoeuvring derivatives
+//! Chiaverini's case 3 (docs/model.md §8): mass, inertia, hydrostatics and manoeuvring derivatives
 //! from `../shared/data/nps_auv2.toml` (Fossen's MSS `npsauv.m`, commit `6bca7942…`; the
 //! legacy file `VESSELS/npsauv.m` at `b661a212…` for ρ, g and m), driven by six ideal
 //! generalised-force actuators (the paper's `τ_r = B u_r`, AC-2, with `B` invertible).
@@ -23,8 +23,8 @@
 //! convention); `CO` is the hull's centre, 2.65 m ahead of the tail, and the base frame `F_b`
 //! sits there. The derivatives are in SNAME axes (y starboard, z down).
 
-use super::manoeuvring::{CrossFlow, Manoeuvring};
-use super::{Body, Fluid, Hydro, Thruster, Vehicle};
+use crate::model::manoeuvring::{CrossFlow, Manoeuvring};
+use crate::model::{Body, Fluid, Hydro, Thruster, Vehicle};
 use crate::spatial::{Mat3, Mat6, Se3, Vec3, Vec6};
 
 /// Hull length `L` [m] (also the prime-system reference length).
@@ -238,5 +238,58 @@ pub fn nps_auv2() -> Vehicle {
             g: G,
             current: Vec3::zeros(),
         },
+    }
+}
+
+#[cfg(test)]
+mod kernel_tests {
+    //! The manoeuvring kernel on the NPS AUV II data (moved here from `dynamics::manoeuvring`:
+    //! the kernel is core, the vehicle is the paper's).
+    use super::{nps_auv2_hydro, LENGTH, RHO};
+    use crate::dynamics::manoeuvring::ManoeuvringKernel;
+    use crate::spatial::{Se3, Vec6};
+    use proptest::prelude::*;
+
+    fn kernel() -> ManoeuvringKernel {
+        ManoeuvringKernel::new(&nps_auv2_hydro(RHO))
+    }
+
+    /// `v_r` at the body origin for a twist `nu` at CO in SNAME axes.
+    fn at_origin(k: &ManoeuvringKernel, nu: &Vec6) -> Vec6 {
+        Se3::new(k.model.axes, k.model.origin).twist_to_parent(nu)
+    }
+
+    #[test]
+    fn pure_sway_matches_the_mss_expressions() {
+        // u = 0, v = 0.2 m/s (SNAME): X = r2 Xvv v², Z = r2 Zvv v², M = r3 Mvv v², and the
+        // cross-flow −½ρ (L/10)·11·Cdy·Hx·v|v| on Y with no yaw moment (symmetric stations).
+        let k = kernel();
+        let v = 0.2;
+        let nu = Vec6::new(0.0, v, 0.0, 0.0, 0.0, 0.0);
+        let p = k.parts(&at_origin(&k, &nu));
+        let g = Se3::new(k.model.axes, k.model.origin);
+        let back = |w: &Vec6| g.wrench_to_child(w);
+        let (r2, r3) = (0.5 * RHO * LENGTH.powi(2), 0.5 * RHO * LENGTH.powi(3));
+        let prod = back(&p.products);
+        assert!((prod[0] - r2 * 5.3e-2 * v * v).abs() < 1e-9);
+        assert!((prod[2] - r2 * -6.8e-2 * v * v).abs() < 1e-9);
+        assert!((prod[4] - r3 * -2.6e-2 * v * v).abs() < 1e-9);
+        let cf = back(&p.crossflow);
+        let expect = -0.5 * RHO * 0.5 * 0.53 * 1.1 * LENGTH * v * v;
+        assert!((cf[1] - expect).abs() < 1e-9 * expect.abs(), "{}", cf[1]);
+        assert!(cf[5].abs() < 1e-9, "{}", cf[5]);
+    }
+
+    proptest! {
+        #[test]
+        fn resistance_and_crossflow_dissipate(v in proptest::array::uniform6(-2.0f64..2.0)) {
+            // The drag parts never add energy: V_rᵀ F ≤ 0 (the velocity products may: they
+            // are lift terms, linear in the surge speed).
+            let k = kernel();
+            let v = Vec6::from_row_slice(&v);
+            let p = k.parts(&v);
+            prop_assert!(v.dot(&p.resistance) <= 1e-12);
+            prop_assert!(v.dot(&p.crossflow) <= 1e-9);
+        }
     }
 }

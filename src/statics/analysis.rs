@@ -1,4 +1,4 @@
-//! Static configuration-space analysis of the thruster configuration matrix (SPEC §6):
+//! Static configuration-space analysis of the thruster configuration matrix (docs/model.md §6):
 //! "how often is `T(q)` singular" over a seeded distribution of joint configurations.
 //!
 //! Joint configurations are drawn uniformly within the joint limits by a
@@ -27,16 +27,16 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::static_tcm_eval::{local_pool, map_joint, Eval, Scratch};
+use super::eval::{local_pool, map_joint, Eval, Scratch};
 use crate::metrics::singularity::{
     CommandedDofs, SingularityError, AXIS_NAMES, DEFAULT_RANK_REL_TOL, SINGULARITY_THRESHOLD,
 };
 use crate::model::Vehicle;
-use crate::sampling::{Sampler, Sampling};
-use crate::scenario::config::Mode;
+use crate::sampling::{Sampler, SamplerError, Sampling};
+use crate::scenario::Mode;
 
-pub use super::static_dist::{distribution, quantile_sorted, Distribution, QUANTILES};
-pub use super::static_tcm_eval::SampleMetrics;
+use super::dist::{distribution, Distribution};
+use super::eval::SampleMetrics;
 
 /// Samples evaluated per parallel chunk (the unit of progress reporting and of the memory held
 /// for streaming rows).
@@ -67,8 +67,12 @@ pub const DEFAULT_SAMPLING: Sampling = Sampling::Sobol;
 /// Default number of lowest-σ_min configurations kept (`tcm --worst`).
 pub const DEFAULT_WORST: usize = 10;
 
+/// The error a row or text sink stops an analysis with: the sink's own error (an I/O error,
+/// a deadline passed, …), kept as the cause of [`StaticError::Sink`].
+pub type SinkError = Box<dyn std::error::Error + Send + Sync>;
+
 /// Errors of the static analysis (bad settings or a design the metrics cannot score).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum StaticError {
     /// A setting is out of range.
     #[error("static analysis: `{key}` {message}")]
@@ -87,12 +91,15 @@ pub enum StaticError {
         #[source]
         source: SingularityError,
     },
+    /// The sampler cannot cover the joint space (too many joints for Sobol, too many samples).
+    #[error("static analysis: `sampling` {0}")]
+    Sampler(#[source] SamplerError),
     /// The row sink (e.g. a CSV writer) failed.
     #[error("static analysis: writing rows: {0}")]
-    Sink(String),
+    Sink(#[source] SinkError),
     /// The local thread pool could not be built.
     #[error("static analysis: thread pool: {0}")]
-    Threads(String),
+    Threads(#[source] rayon::ThreadPoolBuildError),
 }
 
 /// Settings of a static analysis. [`Default`] gives every setting its documented default;
@@ -139,6 +146,16 @@ impl Default for StaticSpec {
 }
 
 impl StaticSpec {
+    /// Score the base axes `mode`'s default controller commands: sets [`StaticSpec::mode`] and
+    /// [`StaticSpec::commanded`] together (the `tcm` command's `--mode`).
+    pub fn for_mode(self, mode: Mode) -> Self {
+        Self {
+            mode,
+            commanded: mode.default_commanded_dofs(),
+            ..self
+        }
+    }
+
     /// Check the settings; the error names the key that is wrong.
     pub fn validate(&self) -> Result<(), StaticError> {
         let bad = |key, message: String| Err(StaticError::Setting { key, message });
@@ -199,7 +216,7 @@ pub struct SampleEval {
 
 /// The consumer of the per-sample rows of [`analyse`], called in index order with the
 /// sample's index, joint angles [rad] and metrics; an `Err` stops the analysis.
-pub type RowSink<'a> = dyn FnMut(usize, &[f64], &SampleMetrics) -> Result<(), String> + 'a;
+pub type RowSink<'a> = dyn FnMut(usize, &[f64], &SampleMetrics) -> Result<(), SinkError> + 'a;
 
 /// Formats one sample (index, joint angles [rad], metrics) as text appended to the buffer:
 /// run by the workers of [`analyse_text`], so it must not depend on other samples.
@@ -238,7 +255,7 @@ impl<'a> Output<'a, '_> {
 
 /// The consumer of [`analyse_text`]'s formatted rows, in index order; an `Err` stops the
 /// analysis.
-pub type TextSink<'a> = dyn FnMut(&str) -> Result<(), String> + 'a;
+pub type TextSink<'a> = dyn FnMut(&str) -> Result<(), SinkError> + 'a;
 
 /// How often one wrench axis is the lost (weakest) direction.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -301,7 +318,7 @@ pub struct StaticSummary {
     pub straight: SampleEval,
 }
 
-/// Static TCM analysis of `vehicle` (SPEC §6).
+/// Static TCM analysis of `vehicle` (docs/model.md §6).
 ///
 /// Samples `spec.samples` joint configurations uniformly within the joint limits, evaluates
 /// the scaled singularity metrics of `T(q)` for each (all six rows and the commanded ones),
@@ -359,10 +376,7 @@ fn analyse_with(
         });
     }
     let sampler = Sampler::new(spec.sampling, spec.samples, vehicle.n_joints(), spec.seed)
-        .map_err(|message| StaticError::Setting {
-            key: "sampling",
-            message,
-        })?;
+        .map_err(StaticError::Sampler)?;
     let mut scratch = Scratch::new(vehicle);
     let eval = evaluator(vehicle, spec, l, &mut scratch)?;
     scratch.q.fill(0.0);
@@ -661,5 +675,5 @@ fn keep_worst(worst: &mut Vec<SampleEval>, index: usize, q: &[f64], m: SampleMet
 }
 
 #[cfg(test)]
-#[path = "static_tcm_tests.rs"]
+#[path = "analysis_tests.rs"]
 mod tests;

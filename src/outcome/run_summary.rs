@@ -1,16 +1,18 @@
-//! The summary metrics of one closed-loop run (SPEC §6): pure functions of its trajectory,
+//! The summary metrics of one closed-loop run (docs/model.md §6): pure functions of its trajectory,
 //! looked up by [`Channel`], and of the effort and energy integrals the loop accumulated
 //! (at the control and physics rates, not from the log), in a fixed order for the mode — the common effort, energy,
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
 use super::success::judge;
-use super::trajectory::{segment_tracking, settling_time, singularity_exposure, EnergyMetrics};
-use crate::control::wrap_angle;
+use crate::metrics::trajectory::{
+    segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
+};
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
 use crate::scenario::success::Missed;
+use crate::spatial::wrap_angle;
 
 /// Named metrics in the order they are added.
 type Metrics = Vec<(String, f64)>;
@@ -163,7 +165,7 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
     missed
 }
 
-/// Completion, energy and effort (SPEC §6, integrated along the run, not from the log: see
+/// Completion, energy and effort (docs/model.md §6, integrated along the run, not from the log: see
 /// [`EnergyMetrics`]), σ_min of T(q) and allocation outcomes:
 /// - `thruster_energy` [J]: thruster shaft energy by actuator-disk momentum theory with each
 ///   thruster's axial inflow; `thruster_energy_static` [J] the same thrusts at zero inflow
@@ -175,7 +177,7 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 ///   |τ_q,i| among them;
 /// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals;
 /// - `singularity_exposure`, the fraction of time σ_min of the commanded rows `S·T_L` is below
-///   `[metrics] threshold` (the controller's commanded axes, SPEC §6), and
+///   `[metrics] threshold` (the controller's commanded axes, docs/model.md §6), and
 ///   `singularity_exposure_full` the same for all six rows (a straight USM has lost roll, which
 ///   neither of the paper's modes commands, so the full figure measures straightness);
 ///   `sigma_min_min`/`_mean` (all rows) and `sigma_min_commanded_min`/`_mean` over the log;

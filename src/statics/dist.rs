@@ -1,4 +1,4 @@
-//! Distributions of a per-sample quantity of the static TCM analysis (SPEC §6): min, max,
+//! Distributions of a per-sample quantity of the static TCM analysis (docs/model.md §6): min, max,
 //! mean of the finite values and the [`QUANTILES`], exact (from all samples, sorted).
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (SPEC §8), after their
+//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (docs/model.md §8), after their
 //! reference [1] (Antonelli & Chiaverini, ACC 1998, "Singularity-free regulation of UVMS"),
 //! whose law is not restated in the seed and whose text we did not have. We use the
 //! quaternion-based sliding-mode law in the form of Antonelli's later book ("Underwater
@@ -18,7 +18,7 @@
 //! `sign(s)` by a saturation (no chattering: a chattering switch term would add its own
 //! amplitude to the force integrals of Table I), and every gain (the paper gives none).
 
-use super::{check_nonneg, ControlError};
+use crate::control::{check_nonneg, ControlError};
 use crate::kinematics::BasePose;
 use crate::spatial::{quat_error_vec, Vec3, Vec6};
 use nalgebra::UnitQuaternion;

@@ -12,10 +12,10 @@
 
 use std::path::Path;
 
-use super::error::PipelineError;
+use crate::paper::antonelli::dynamic::DynamicHistory;
+use crate::paper::antonelli::{KinematicHistory, TaskTrace};
+use crate::pipeline::error::PipelineError;
 use crate::report::plot::{Colour, Figure, Panel, Series};
-use crate::scenario::antonelli::dynamic::DynamicHistory;
-use crate::scenario::antonelli::{KinematicHistory, TaskTrace};
 
 const TIME: &str = "time [s]";
 

@@ -1,4 +1,4 @@
-//! The verdict on a closed-loop run (SPEC §6 "Success"): its summary metrics judged against
+//! The verdict on a closed-loop run (docs/model.md §6 "Success"): its summary metrics judged against
 //! the scenario's `[success]` criteria ([`SuccessSpec`]), in the order of [`Criterion::ALL`].
 
 use crate::scenario::config::Mode;
@@ -116,7 +116,7 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
 
 #[cfg(test)]
 mod tests {
-    use crate::metrics::success::judge;
+    use crate::outcome::success::judge;
     use crate::scenario::config::Mode;
     use crate::scenario::success::{Criterion, SuccessSpec};
 

@@ -4,9 +4,9 @@
 
 use serde::Deserialize;
 
-use super::static_tcm::StaticSpec;
 use crate::sampling::Sampling;
 use crate::scenario::config::{Mode, ScenarioFile};
+use crate::statics::StaticSpec;
 
 /// The key of the `[static]` table in study files and resolved scenario-side tables.
 pub const STATIC_TABLE: &str = "static";

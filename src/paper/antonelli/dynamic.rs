@@ -1,7 +1,7 @@
-//! Antonelli & Chiaverini's case 3 (SPEC §8): the NPS AUV II with its full 6-DOF dynamic
-//! model ([`crate::model::nps_auv2`], through the crate's floating-base dynamics) under the
+//! Antonelli & Chiaverini's case 3 (docs/model.md §8): the NPS AUV II with its full 6-DOF dynamic
+//! model ([`crate::paper::nps_auv2`], through the crate's floating-base dynamics) under the
 //! constant irrotational current `ν_c = (0.1√2, 0.1√2, 0)` m/s, driven by the sliding-mode
-//! law of [`crate::control::sliding`], for 100 s:
+//! law of [`crate::paper::sliding`], for 100 s:
 //!
 //! - **3a**: the vehicle holds its initial pose (0, 0, ψ = 0): the control forces only
 //!   compensate the current;
@@ -14,19 +14,19 @@
 //! (the control wrench is held over each control period, so the sums are exact).
 //!
 //! Inferred (the paper does not say; overridable in [`DynamicCase`]): the vehicle alone (the
-//! arm's parameters are unknown, SPEC §8), starting at rest; depth, roll and pitch references
+//! arm's parameters are unknown, docs/model.md §8), starting at rest; depth, roll and pitch references
 //! zero; control at 100 Hz with fixed RK4 steps of 10 ms; samples logged at 5 Hz.
 
 use super::KinematicHistory;
-use crate::control::sliding::{
-    sliding_mode_wrench, sliding_variable, PoseReference, SlidingModeGains,
-};
 use crate::dynamics::{
     restoring_generalized, ActuatorCommand, DynWorkspace, Integrator, SimConfig, SimState,
     Simulator,
 };
 use crate::kinematics::BasePose;
-use crate::model::nps_auv2::{actuator_thrusts, nps_auv2};
+use crate::paper::nps_auv2::{actuator_thrusts, nps_auv2};
+use crate::paper::sliding::{
+    sliding_mode_wrench, sliding_variable, PoseReference, SlidingModeGains,
+};
 use crate::scenario::ScenarioError;
 use crate::spatial::{euler_zyx, Vec3, Vec6};
 use nalgebra::UnitQuaternion;
@@ -231,7 +231,7 @@ impl DynamicHistory {
     /// Largest `|ψ_d − ψ|` (wrapped) [rad].
     pub fn max_yaw_error(&self) -> f64 {
         (0..self.t.len())
-            .map(|i| crate::control::wrap_angle(self.reference[2][i] - self.attitude[2][i]).abs())
+            .map(|i| crate::spatial::wrap_angle(self.reference[2][i] - self.attitude[2][i]).abs())
             .fold(0.0, f64::max)
     }
 
@@ -248,7 +248,7 @@ impl DynamicHistory {
         }
         self.reference[0].push(r.position.x);
         self.reference[1].push(r.position.y);
-        self.reference[2].push(crate::control::heading(
+        self.reference[2].push(crate::spatial::heading(
             r.orientation.to_rotation_matrix().matrix(),
         ));
         self.force_norm.push(tau.fixed_rows::<3>(0).norm());

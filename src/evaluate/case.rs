@@ -1,0 +1,299 @@
+//! The one case evaluator: a design and a scenario-side table (with optional overrides on
+//! top), a seed and a deadline in; one [`CaseResult`] out — named metrics, status, reason
+//! (the criterion missed, for an unsuccessful run) and, when asked, the trajectory.
+//!
+//! Phases: build the vehicle (cached by design), record the design columns, run the static
+//! T(q) analysis and the closed-loop scenario as [`Phases`] asks. A panic, an invalid design
+//! or a failed run becomes the result's status and reason (the metrics computed until then
+//! are kept); it never reaches the caller.
+
+use super::deadline::{Deadline, Phase};
+use super::metrics::{design_metrics, tcm_metrics, Metrics, DESIGN_COLUMNS, TCM_COLUMNS};
+use super::static_table::{static_spec, STATIC_TABLE};
+use super::status::{missed_criterion, CaseStatus};
+use crate::input::keypath::{set, Seg, SetError};
+use crate::model::design::parse_design_table;
+use crate::model::Vehicle;
+use crate::report::Table;
+use crate::sampling::derive_seed;
+use crate::statics::{analyse, SinkError, StaticError};
+
+/// Which phases a case runs besides building its design.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Phases {
+    /// The static T(q) analysis (the scenario-side `[static]` table).
+    pub static_analysis: bool,
+    /// The closed-loop scenario (a dynamic mode).
+    pub closed_loop: bool,
+}
+
+/// Which table an override edits.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Side {
+    /// The design table.
+    Design,
+    /// The scenario-side table.
+    Scenario,
+}
+
+/// One edit applied on top of a case's tables before it is evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Override {
+    /// The table edited.
+    pub side: Side,
+    /// The key path inside it.
+    pub path: Vec<Seg>,
+    /// The value written.
+    pub value: toml::Value,
+    /// The key as a user wrote it (for messages).
+    pub shown: String,
+}
+
+/// An override that does not apply to the case's tables (the case is skipped).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{source}")]
+pub struct OverrideError {
+    /// The key as a user wrote it.
+    pub shown: String,
+    /// Why it does not apply (naming the key).
+    #[source]
+    pub source: SetError,
+}
+
+/// Edits applied on top of a case's tables (e.g. a sampled world); empty for a nominal case.
+pub type Overrides = [Override];
+
+/// What to evaluate.
+#[derive(Clone, Copy, Debug)]
+pub struct CaseInput<'a> {
+    /// The design table.
+    pub design: &'a toml::Table,
+    /// A hash of the design table (the vehicle cache key).
+    pub design_hash: &'a str,
+    /// The scenario-side table (with `[static]` when the static analysis runs).
+    pub scenario: &'a toml::Table,
+    /// Edits on top of both tables.
+    pub overrides: &'a Overrides,
+    /// The case seed (`derive_seed(seed, 1)` seeds the static analysis).
+    pub seed: u64,
+    /// The case's wall-clock deadline (closed loop and static analysis).
+    pub deadline: Deadline,
+    /// Which phases run.
+    pub phases: Phases,
+    /// Keep the closed loop's trajectory.
+    pub trajectory: bool,
+    /// How the design is named in messages (`case 3 design`).
+    pub label: &'a str,
+}
+
+/// The result of one case.
+#[derive(Clone, Debug)]
+pub struct CaseResult {
+    /// Named metrics: design columns, static columns, run metrics, in that order.
+    pub metrics: Metrics,
+    /// How the case ended.
+    pub status: CaseStatus,
+    /// Why it was not `ok` (for `unsuccessful`: `criterion: detail`); empty when `ok`.
+    pub reason: String,
+    /// The closed loop's trajectory (when asked for and the run produced one).
+    pub trajectory: Option<Table>,
+}
+
+impl CaseResult {
+    fn new() -> Self {
+        CaseResult {
+            metrics: Metrics::new(),
+            status: CaseStatus::Ok,
+            reason: String::new(),
+            trajectory: None,
+        }
+    }
+
+    fn end(&mut self, status: CaseStatus, reason: impl Into<String>) {
+        self.status = status;
+        self.reason = reason.into();
+    }
+
+    /// Whether every phase ran and every `[success]` criterion was met.
+    pub fn success(&self) -> bool {
+        self.status == CaseStatus::Ok
+    }
+
+    /// The criterion the case missed (`no_failure` for a failed case), see
+    /// [`missed_criterion`].
+    pub fn criterion(&self) -> Option<&str> {
+        missed_criterion(self.status, &self.reason)
+    }
+
+    /// Why the case failed or could not be set up (`None` for `ok` and `unsuccessful`).
+    pub fn failure(&self) -> Option<&str> {
+        matches!(self.status, CaseStatus::Failed | CaseStatus::Skipped).then_some(&*self.reason)
+    }
+}
+
+/// The evaluator: owns the vehicle cache (one entry, so consecutive cases of a design build it
+/// once) and the panic guard. One per thread.
+#[derive(Default)]
+pub struct Evaluator {
+    cache: Option<(String, Vehicle)>,
+}
+
+impl Evaluator {
+    /// An evaluator with an empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Evaluate one case (see the module docs).
+    pub fn evaluate(&mut self, input: &CaseInput<'_>) -> CaseResult {
+        let mut out = CaseResult::new();
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            self.phases(input, &mut out)
+        }));
+        if let Err(p) = result {
+            let msg = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            out.end(CaseStatus::Failed, format!("panic: {msg}"));
+            out.trajectory = None;
+            self.cache = None;
+        }
+        out
+    }
+
+    fn phases(&mut self, input: &CaseInput<'_>, out: &mut CaseResult) {
+        let edited;
+        let (design, scenario) = if input.overrides.is_empty() {
+            (input.design, input.scenario)
+        } else {
+            match apply(input) {
+                Ok(t) => {
+                    edited = t;
+                    (&edited.0, &edited.1)
+                }
+                Err(e) => return out.end(CaseStatus::Skipped, e.to_string()),
+            }
+        };
+        let Some(v) = self.vehicle(input, design, out) else {
+            return;
+        };
+        out.metrics.push_all(&DESIGN_COLUMNS, &design_metrics(v));
+        if input.phases.static_analysis && !static_phase(v, scenario, input, out) {
+            return;
+        }
+        if input.phases.closed_loop {
+            closed_loop(v, scenario, input, out);
+        }
+    }
+
+    /// The case's vehicle, built unless cached; `None` (the case skipped) for an invalid design.
+    fn vehicle(
+        &mut self,
+        input: &CaseInput<'_>,
+        design: &toml::Table,
+        out: &mut CaseResult,
+    ) -> Option<&Vehicle> {
+        let key = cache_key(input);
+        if !matches!(&self.cache, Some((h, _)) if *h == key) {
+            match parse_design_table(design, input.label) {
+                Ok(v) => self.cache = Some((key, v)),
+                Err(e) => {
+                    out.end(CaseStatus::Skipped, format!("invalid design: {e}"));
+                    return None;
+                }
+            }
+        }
+        self.cache.as_ref().map(|(_, v)| v)
+    }
+}
+
+/// The cache key: the design hash, and the design overrides when there are any.
+fn cache_key(input: &CaseInput<'_>) -> String {
+    let mut key = input.design_hash.to_string();
+    for o in input.overrides.iter().filter(|o| o.side == Side::Design) {
+        key.push_str(&format!(";{}={}", o.shown, o.value));
+    }
+    key
+}
+
+/// The case's tables with its overrides applied; `Err` is the reason the case is skipped.
+fn apply(input: &CaseInput<'_>) -> Result<(toml::Table, toml::Table), OverrideError> {
+    let (mut design, mut scenario) = (input.design.clone(), input.scenario.clone());
+    for o in input.overrides {
+        let t = match o.side {
+            Side::Design => &mut design,
+            Side::Scenario => &mut scenario,
+        };
+        set(t, &o.path, o.value.clone(), &o.shown).map_err(|source| OverrideError {
+            shown: o.shown.clone(),
+            source,
+        })?;
+    }
+    Ok((design, scenario))
+}
+
+/// The static analysis into the [`TCM_COLUMNS`]; `false` when the case ended (a `timeout`
+/// once the deadline passed: it is checked for every sample handed over, so after each chunk).
+fn static_phase(
+    v: &Vehicle,
+    scenario: &toml::Table,
+    input: &CaseInput<'_>,
+    out: &mut CaseResult,
+) -> bool {
+    let spec = match static_spec(scenario, derive_seed(input.seed, 1)) {
+        Ok(s) => s,
+        Err(m) => {
+            out.end(CaseStatus::Skipped, m);
+            return false;
+        }
+    };
+    let deadline = input.deadline;
+    let mut on_time =
+        |_: usize, _: &[f64], _: &_| deadline.check(Phase::Static).map_err(SinkError::from);
+    match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
+        Ok(s) => {
+            out.metrics.push_all(&TCM_COLUMNS, &tcm_metrics(&s));
+            true
+        }
+        Err(StaticError::Sink(m)) => {
+            out.end(CaseStatus::Failed, m.to_string());
+            false
+        }
+        Err(e) => {
+            out.end(CaseStatus::Failed, e.to_string());
+            false
+        }
+    }
+}
+
+/// The closed-loop run: its metrics (kept even when it stopped early), its status and, when
+/// asked, its trajectory.
+fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: &mut CaseResult) {
+    let mut sc = scenario.clone();
+    sc.remove(STATIC_TABLE);
+    let deadline = input.deadline.instant();
+    let run = match crate::outcome::run_case(v, &sc, input.seed, input.trajectory, deadline) {
+        Ok(r) => r,
+        Err(e) => return out.end(CaseStatus::Failed, e.to_string()),
+    };
+    let trajectory = match run
+        .trajectory
+        .map(|t| crate::report::figures::trajectory_table(&t))
+    {
+        Some(Err(e)) => return out.end(CaseStatus::Failed, e.to_string()),
+        t => t.and_then(Result::ok),
+    };
+    if let Some(f) = run.failure {
+        out.end(CaseStatus::Failed, f);
+    } else if let Some(m) = run.missed {
+        out.end(CaseStatus::Unsuccessful, m);
+    }
+    out.metrics.extend(run.metrics);
+    out.trajectory = trajectory;
+}
+
+#[cfg(test)]
+#[path = "case_tests.rs"]
+mod tests;

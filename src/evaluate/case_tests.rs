@@ -1,0 +1,118 @@
+//! The case evaluator: statuses, named metrics, overrides, the deadline, the cache.
+
+use std::time::{Duration, Instant};
+
+use super::*;
+use crate::evaluate::{Deadline, DESIGN_COLUMNS, TCM_COLUMNS};
+use crate::input::keypath::Seg;
+
+fn design() -> toml::Table {
+    toml::from_str("preset = \"usm-paper\"\n").unwrap()
+}
+
+fn static_scenario(samples: i64) -> toml::Table {
+    toml::from_str(&format!(
+        "[scenario]\nmode = \"static\"\n[static]\nsamples = {samples}\n"
+    ))
+    .unwrap()
+}
+
+fn input<'a>(
+    design: &'a toml::Table,
+    scenario: &'a toml::Table,
+    overrides: &'a Overrides,
+    deadline: Deadline,
+) -> CaseInput<'a> {
+    CaseInput {
+        design,
+        design_hash: "d",
+        scenario,
+        overrides,
+        seed: 7,
+        deadline,
+        phases: Phases {
+            static_analysis: true,
+            closed_loop: false,
+        },
+        trajectory: false,
+        label: "test design",
+    }
+}
+
+#[test]
+fn a_static_case_has_its_design_and_tcm_metrics_by_name() {
+    let (d, s) = (design(), static_scenario(64));
+    let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
+    assert_eq!(r.status, CaseStatus::Ok, "{}", r.reason);
+    assert!(r.success() && r.criterion().is_none() && r.failure().is_none());
+    assert_eq!(r.metrics.len(), DESIGN_COLUMNS.len() + TCM_COLUMNS.len());
+    assert_eq!(r.metrics.get("design_thrusters"), Some(7.0));
+    assert!(r.metrics.value("tcm_singular_fraction").is_finite());
+    // Same seed, same numbers (a second evaluator: no cache involved).
+    let again = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
+    assert_eq!(again.metrics, r.metrics);
+}
+
+#[test]
+fn an_invalid_design_is_skipped_and_a_bad_override_too() {
+    let bad: toml::Table = toml::from_str("preset = \"no-such-preset\"\n").unwrap();
+    let s = static_scenario(8);
+    let r = Evaluator::new().evaluate(&input(&bad, &s, &[], Deadline::NONE));
+    assert_eq!(r.status, CaseStatus::Skipped);
+    assert!(r.reason.starts_with("invalid design: "), "{}", r.reason);
+    assert!(r.metrics.is_empty());
+    assert_eq!(r.failure(), Some(r.reason.as_str()));
+    let d = design();
+    let o = [Override {
+        side: Side::Design,
+        path: vec![Seg::Key("preset".into()), Seg::Index(3)],
+        value: toml::Value::Integer(1),
+        shown: "design.preset[3]".into(),
+    }];
+    let r = Evaluator::new().evaluate(&input(&d, &s, &o, Deadline::NONE));
+    assert_eq!(r.status, CaseStatus::Skipped);
+    assert!(r.reason.contains("design.preset[3]"), "{}", r.reason);
+}
+
+#[test]
+fn overrides_change_the_case_and_key_the_design_cache() {
+    let (d, s) = (design(), static_scenario(8));
+    let mut ev = Evaluator::new();
+    let nominal = ev.evaluate(&input(&d, &s, &[], Deadline::NONE));
+    let o = [Override {
+        side: Side::Design,
+        path: vec![Seg::Key("preset".into())],
+        value: toml::Value::String("uvms-planar".into()),
+        shown: "design.preset".into(),
+    }];
+    // Same design hash, other design: the cache must not serve the nominal vehicle.
+    let other = ev.evaluate(&input(&d, &s, &o, Deadline::NONE));
+    assert_eq!(other.status, CaseStatus::Ok, "{}", other.reason);
+    assert_ne!(
+        other.metrics.get("design_thrusters"),
+        nominal.metrics.get("design_thrusters")
+    );
+    let so = [Override {
+        side: Side::Scenario,
+        path: vec![Seg::Key("static".into()), Seg::Key("samples".into())],
+        value: toml::Value::Integer(0),
+        shown: "static.samples".into(),
+    }];
+    let r = ev.evaluate(&input(&d, &s, &so, Deadline::NONE));
+    assert_ne!(r.status, CaseStatus::Ok, "0 samples must not pass");
+}
+
+#[test]
+fn a_passed_deadline_stops_the_static_analysis_with_the_sweeps_message() {
+    let (d, s) = (design(), static_scenario(20_000));
+    let past = Deadline::at(Instant::now() - Duration::from_millis(1));
+    let r = Evaluator::new().evaluate(&input(&d, &s, &[], past));
+    assert_eq!(r.status, CaseStatus::Failed);
+    assert_eq!(
+        r.reason,
+        "timeout: the case's wall-clock budget ran out in the static analysis"
+    );
+    assert_eq!(r.criterion(), Some("no_failure"));
+    // The design columns computed before the deadline are kept.
+    assert_eq!(r.metrics.len(), DESIGN_COLUMNS.len());
+}

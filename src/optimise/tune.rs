@@ -1,0 +1,170 @@
+//! Per-case tuning of a sweep (`[tune]`, `docs/study-format.md`): every case is first tuned —
+//! its own design, its own axis values — by the optimiser ([`minimise`] over the case's
+//! resolved tables), then scored at the tuned values like any case. The sweep reaches this
+//! tuner through its hook ([`HOOK`], a [`TuningHook`] the caller hands to the sweep, the
+//! merge and the report): `study` never imports `optimise`.
+//!
+//! `[tune]` holds the sections of a problem file (`[[tune.param]]`, `[tune.objective]`,
+//! `[[tune.constraint]]`, `[tune.solver]`; `docs/optimise.md`), read by
+//! [`super::problem::parse_spec`] and validated before any case runs. A parameter without
+//! `start` starts from the case's own value of its key (clamped to the bounds), so an axis
+//! over `control.method` starts each method from its own Table III row.
+//!
+//! Determinism: the tuning of a case runs serially (one thread), every evaluation as the
+//! case itself (its seed), so the tuned values and the row depend only on the study and the
+//! case id — identical for any `--jobs` and any sharding. The case's [`Deadline`]
+//! (`--case-timeout`) covers tuning and scoring: a run past it fails `timeout`.
+
+use super::evaluate::CaseEvaluator;
+use super::history::Record;
+use super::problem::parse_spec;
+use super::{minimise, Options, Problem, Spec};
+use crate::evaluate::{Deadline, TCM_COLUMNS};
+use crate::input::document::Document;
+use crate::input::keypath::get;
+use crate::study::cases::Resolved;
+use crate::study::doe::Case;
+use crate::study::error::InputError;
+use crate::study::schema::{Study, Target};
+use crate::study::tune::{CaseTuner, TuneError, Tuned, TuningHook};
+
+/// The hook wiring this tuner into sweeps, merges and reports.
+pub const HOOK: TuningHook = TuningHook(boxed);
+
+fn boxed(study: &Study) -> Result<Option<Box<dyn CaseTuner>>, InputError> {
+    Ok(Tuner::new(study)?.map(|t| Box::new(t) as Box<dyn CaseTuner>))
+}
+
+/// A study's validated `[tune]` section.
+#[derive(Clone, Debug)]
+pub struct Tuner {
+    spec: Spec,
+    /// Per parameter: whether `start` is written (otherwise the case's own value).
+    explicit_start: Vec<bool>,
+    /// Whether the tuning objective or constraints read static TCM metrics.
+    static_needed: bool,
+}
+
+impl Tuner {
+    /// The tuner of `study`'s `[tune]` section (`None` without one). Every check of a
+    /// problem file applies (`docs/optimise.md`), and: no `[[tune.variant]]` (a case is
+    /// scored in its own scenario), no parameter that is also a sweep axis. Errors name the
+    /// file, the line and the key (`tune.param[1].upper`).
+    pub fn new(study: &Study) -> Result<Option<Tuner>, InputError> {
+        let Some(t) = &study.tune else {
+            return Ok(None);
+        };
+        let doc = Document::parse(&study.text, &study.path.display().to_string())?;
+        if t.contains_key("variant") {
+            return Err(doc.err(
+                "tune.variant",
+                "not allowed in [tune]: each case is tuned and scored in its own scenario",
+            ));
+        }
+        let params = t.get("param").and_then(|p| p.as_array());
+        for (i, p) in params.into_iter().flatten().enumerate() {
+            let name = p.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+            if study.axes.iter().any(|a| a.name == name) {
+                return Err(doc.err(
+                    &format!("tune.param[{i}].name"),
+                    format!("`{name}` is also a sweep axis: tune it or sweep it"),
+                ));
+            }
+        }
+        let spec = parse_spec(&doc, t, "tune", study)?;
+        let explicit_start = params
+            .map(|ps| ps.iter().map(|p| p.get("start").is_some()).collect())
+            .unwrap_or_default();
+        let static_needed = study.static_enabled
+            && spec
+                .metrics()
+                .iter()
+                .any(|m| TCM_COLUMNS.contains(&m.as_str()));
+        Ok(Some(Tuner {
+            spec,
+            explicit_start,
+            static_needed,
+        }))
+    }
+
+    /// The problem tuning one case: the study with the case's resolved tables as its base
+    /// and no axes; each parameter without `start` starts from the case's value.
+    fn case_problem(&self, study: &Study, r: &Resolved) -> Problem {
+        let mut cs = study.clone();
+        cs.design = r.design.clone();
+        cs.scenario_full = r.scenario.clone();
+        cs.axes.clear();
+        cs.tune = None;
+        cs.static_enabled = self.static_needed;
+        let mut spec = self.spec.clone();
+        for (p, explicit) in spec.space.params.iter_mut().zip(&self.explicit_start) {
+            if !explicit {
+                if let Some(x) = case_value(&p.target, r) {
+                    p.start = x.clamp(p.lower, p.upper);
+                }
+            }
+        }
+        Problem { study: cs, spec }
+    }
+}
+
+impl CaseTuner for Tuner {
+    /// Tune case `case` (resolved as `r`) within `deadline`: the case at the best point.
+    fn tune(
+        &self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        deadline: Deadline,
+    ) -> Result<Tuned, TuneError> {
+        let problem = self.case_problem(study, r);
+        let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
+        let quiet = |_: &Record| {};
+        let opts = Options {
+            jobs: 1,
+            journal: None,
+            resume: false,
+            on_record: &quiet,
+        };
+        let out =
+            minimise(&problem.spec, &ev, &study.hash, &opts).map_err(TuneError::from_error)?;
+        let best = out.best();
+        let mut resolved = ev.resolve(&best.x, 0).map_err(TuneError::from_error)?;
+        resolved.hash = r.hash.clone();
+        Ok(Tuned {
+            resolved,
+            x: best.x.clone(),
+            evaluations: out.fresh_evaluations(),
+            feasible: best.score.feasible,
+        })
+    }
+
+    fn at(
+        &self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        x: &[f64],
+    ) -> Result<Resolved, TuneError> {
+        let problem = self.case_problem(study, r);
+        let mut s = CaseEvaluator::new(&problem)
+            .for_case(case.id, Deadline::NONE)
+            .resolve(x, 0)
+            .map_err(TuneError::from_error)?;
+        s.hash = r.hash.clone();
+        Ok(s)
+    }
+}
+
+/// The case's value of a parameter's key (a number), if it has one.
+fn case_value(target: &Target, r: &Resolved) -> Option<f64> {
+    let v = match target {
+        Target::Design(p) => get(&r.design, &p.0),
+        Target::Scenario(p) => get(&r.scenario, &p.0),
+    }?;
+    match v {
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::Integer(n) => Some(*n as f64),
+        _ => None,
+    }
+}

@@ -1,0 +1,126 @@
+//! One closed-loop run and its outcome: the loop of [`crate::scenario::run_loop`], then the
+//! run's summary metrics ([`super::run_summary`]) and its `[success]` judgement
+//! ([`super::success`]).
+
+use super::run_summary::{add_success, run_summary};
+use crate::model::Vehicle;
+use crate::scenario::channels::Trajectory;
+use crate::scenario::config::{Mode, ScenarioFile};
+use crate::scenario::success::Missed;
+use crate::scenario::{
+    parse_table, run_loop, AllocationCounts, ScenarioError, Source, Timing, TIMEOUT,
+};
+use std::time::Instant;
+
+/// The outcome of one run: the trajectory up to the end (or the failure), the metrics, and
+/// the failure if the run stopped early.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// Scenario name.
+    pub name: String,
+    /// Mode.
+    pub mode: Mode,
+    /// Logged time series.
+    pub trajectory: Trajectory,
+    /// Metrics (name, value), in a fixed order for the mode; SI units.
+    pub metrics: Vec<(String, f64)>,
+    /// Why the run stopped early, if it did: (simulation time [s], cause).
+    pub failure: Option<(f64, String)>,
+    /// The first `[success]` criterion the run missed; `None` for a successful run (metric
+    /// `success` = 1).
+    pub missed: Option<Missed>,
+    /// Allocation outcomes.
+    pub allocation_counts: AllocationCounts,
+    /// Wall-clock breakdown.
+    pub timing: Timing,
+}
+
+impl RunResult {
+    /// A metric by name.
+    pub fn metric(&self, name: &str) -> Option<f64> {
+        self.metrics
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, x)| *x)
+    }
+}
+
+/// Run a scenario on a vehicle. Never panics on bad input: settings problems return
+/// [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges, NaN,
+/// singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
+pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, ScenarioError> {
+    run_scenario_until(v, file, None)
+}
+
+/// [`run_scenario`] with a wall-clock `deadline` ([`crate::scenario::run_loop`]): a run still
+/// going at the deadline stops there with the failure cause [`TIMEOUT`] (the metrics and
+/// trajectory up to then are kept, as for any failure).
+pub fn run_scenario_until(
+    v: &Vehicle,
+    file: &ScenarioFile,
+    deadline: Option<Instant>,
+) -> Result<RunResult, ScenarioError> {
+    let run = run_loop(v, file, deadline)?;
+    let failed = run.failure.is_some();
+    let mut metrics = run_summary(
+        file,
+        &run.trajectory,
+        failed,
+        &run.allocation_counts,
+        &run.energy,
+    );
+    let missed = add_success(&mut metrics, file);
+    Ok(RunResult {
+        name: file.scenario.name.clone(),
+        mode: file.scenario.mode,
+        trajectory: run.trajectory,
+        metrics,
+        failure: run.failure,
+        missed,
+        allocation_counts: run.allocation_counts,
+        timing: run.timing,
+    })
+}
+
+/// One case of a sweep: the scenario-side table (overrides applied) run on `vehicle`.
+#[derive(Clone, Debug)]
+pub struct CaseRun {
+    /// Named metrics in a fixed order (see [`RunResult::metrics`]); a run that stopped
+    /// early has `completed = 0`.
+    pub metrics: Vec<(String, f64)>,
+    /// The trajectory, when asked for.
+    pub trajectory: Option<Trajectory>,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<String>,
+    /// The first success criterion the run missed, as `criterion: detail`
+    /// ([`crate::scenario::success::Missed`]; `no_failure` for a run that stopped early); `None` when it met
+    /// them all.
+    pub missed: Option<String>,
+}
+
+/// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
+/// runs are deterministic). A run still going at `deadline` stops with a failure starting
+/// with [`TIMEOUT`] (`timeout: …`).
+pub fn run_case(
+    vehicle: &Vehicle,
+    scenario: &toml::Table,
+    seed: u64,
+    log: bool,
+    deadline: Option<std::time::Instant>,
+) -> Result<CaseRun, ScenarioError> {
+    let _ = seed;
+    let f = parse_table(scenario, &Source::unplaced("scenario"))?;
+    let r = run_scenario_until(vehicle, &f, deadline)?;
+    Ok(CaseRun {
+        metrics: r.metrics,
+        trajectory: if log { Some(r.trajectory) } else { None },
+        failure: r.failure.map(|(t, c)| {
+            if c == TIMEOUT {
+                format!("{TIMEOUT}: the case's wall-clock budget ran out at t = {t:.3} s")
+            } else {
+                format!("run stopped at t = {t:.3} s: {c}")
+            }
+        }),
+        missed: r.missed.map(|m| m.to_string()),
+    })
+}

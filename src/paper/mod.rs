@@ -1,0 +1,21 @@
+//! The paper reproductions, above the core: nothing below this room imports it.
+//!
+//! - [`usm`]: the USM paper's simulations (`usm-study paper`), their files and comparison
+//!   tables; [`readings`]: transport mode under every reading of the paper's open choices;
+//!   [`secondary`]: the paper's secondary objectives on and off;
+//! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies 1, 1b, 2 and
+//!   ([`antonelli::dynamic`]) case 3 on the NPS AUV II ([`nps_auv2`]) under the sliding-mode
+//!   base control ([`sliding`]); [`antonelli_outputs`]: `paper antonelli` and the
+//!   `simulate antonelli-*` presets, their CSVs and summary; [`antonelli_figures`]: their
+//!   figures.
+//!
+//! The formulation these reproduce is `docs/model.md` (AC-nn, USM-nn).
+
+pub mod antonelli;
+pub mod antonelli_figures;
+pub mod antonelli_outputs;
+pub mod nps_auv2;
+pub mod readings;
+pub mod secondary;
+pub mod sliding;
+pub mod usm;
