@@ -1,4 +1,4 @@
-//! O(n) recursive forward and hybrid dynamics of the floating-base chain (SPEC §4, issue 23):
+//! O(n) recursive forward and hybrid dynamics of the floating-base chain (docs/model.md §4, issue 23):
 //! the articulated-body algorithm (Featherstone, *Rigid Body Dynamics Algorithms*, §7.3 and
 //! §9.2 for the floating base; Pinocchio's `aba.hxx`) with each body's added-mass spatial
 //! inertia in its articulated inertia, and the hybrid dynamics of the ideal servos without
@@ -263,7 +263,7 @@ pub fn solve_hybrid_on(ws: &mut DynWorkspace, q_ext: &[f64], qdd: &[f64]) -> Res
     check_finite("joint_torques", &ws.joint_torque)
 }
 
-/// Hybrid dynamics (SPEC §4, ideal servos) in O(n): [`hybrid_terms`] then
+/// Hybrid dynamics (docs/model.md §4, ideal servos) in O(n): [`hybrid_terms`] then
 /// [`solve_hybrid_on`]; the same results as [`hybrid_dynamics`](super::hybrid_dynamics).
 #[allow(clippy::too_many_arguments)]
 pub fn hybrid_dynamics_on(
