@@ -1,5 +1,7 @@
 //! Benchmarks of the dynamics core on `usm-paper` (docs/model.md §4): mass matrix (CRBA), bias
-//! forces (RNEA), forward and hybrid dynamics, one RK4 step with full hydrodynamics, and one
+//! forces (RNEA), forward and hybrid dynamics by the dense route (CRBA + Cholesky) and by
+//! the O(n) route the simulator uses (articulated-body forward dynamics, O(n) hybrid
+//! dynamics: its terms and its solve), one RK4 step with full hydrodynamics, and one
 //! 50 ms control period advanced by the adaptive Dormand–Prince integrator.
 //!
 //! Group `whole_run`: a whole closed-loop run of the presets `transport-method1` (140 s,
@@ -17,8 +19,9 @@ use common::ALLOCS;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::sync::atomic::Ordering;
 use usm_study::dynamics::{
-    bias, dynamics_terms, forward_dynamics, hybrid_dynamics, mass_matrix, solve_forward,
-    ActuatorCommand, DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
+    bias, dynamics_terms, forward_dynamics, forward_dynamics_aba, hybrid_dynamics,
+    hybrid_dynamics_on, hybrid_terms, mass_matrix, solve_forward, solve_hybrid_on, ActuatorCommand,
+    DynOptions, DynWorkspace, Integrator, SimConfig, SimState, Simulator,
 };
 use usm_study::kinematics::BasePose;
 use usm_study::model::presets::usm_paper;
@@ -119,12 +122,77 @@ fn bench_dynamics(c: &mut Criterion) {
             hybrid_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
         })
     });
+    c.bench_function("forward_dynamics_aba", |b| {
+        b.iter(|| {
+            forward_dynamics_aba(
+                &v,
+                &mut ws,
+                &pose,
+                black_box(&q),
+                black_box(&zeta),
+                &tau,
+                &opts,
+            )
+            .unwrap()
+        })
+    });
+    c.bench_function("hybrid_terms_on", |b| {
+        b.iter(|| hybrid_terms(&v, &mut ws, &pose, black_box(&q), black_box(&zeta), &opts))
+    });
+    hybrid_terms(&v, &mut ws, &pose, &q, &zeta, &opts);
+    c.bench_function("solve_hybrid_on", |b| {
+        b.iter(|| solve_hybrid_on(&mut ws, black_box(&tau), &qdd).unwrap())
+    });
+    c.bench_function("hybrid_dynamics_on", |b| {
+        b.iter(|| {
+            hybrid_dynamics_on(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
     c.bench_function("rk4_step_full_hydro", |b| {
         b.iter(|| sim.step(1e-3, black_box(&cmd)).unwrap())
     });
     c.bench_function("dopri5_control_period_50ms", |b| {
         b.iter(|| adaptive.advance(0.05, black_box(&cmd)).unwrap())
     });
+}
+
+/// Scaling: the dense and the O(n) routes on the generated 9-link design (17 bodies, 16
+/// joints, 22 DOF), full hydrodynamics with current.
+fn bench_scaling(c: &mut Criterion) {
+    let spec = usm_study::model::generator::GeneratorSpec {
+        links: 9,
+        ..Default::default()
+    };
+    let mut v = spec.build("gen9").unwrap();
+    v.fluid.current = Vec3::new(0.2, 0.1, 0.0);
+    let opts = DynOptions::full();
+    let n = v.n_joints();
+    let pose = state().0;
+    let q: Vec<f64> = (0..n).map(|k| 0.3 * ((k as f64) * 1.3).sin()).collect();
+    let zeta: Vec<f64> = (0..6 + n).map(|k| 0.2 * ((k as f64) * 0.7).cos()).collect();
+    let tau: Vec<f64> = (0..6 + n).map(|k| k as f64 - 6.0).collect();
+    let qdd: Vec<f64> = (0..n).map(|k| 0.1 * k as f64).collect();
+    let mut ws = DynWorkspace::new(&v);
+    let mut g = c.benchmark_group("gen9");
+    g.bench_function("forward_dynamics", |b| {
+        b.iter(|| forward_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &opts).unwrap())
+    });
+    g.bench_function("forward_dynamics_aba", |b| {
+        b.iter(|| {
+            forward_dynamics_aba(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &opts).unwrap()
+        })
+    });
+    g.bench_function("hybrid_dynamics", |b| {
+        b.iter(|| {
+            hybrid_dynamics(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    g.bench_function("hybrid_dynamics_on", |b| {
+        b.iter(|| {
+            hybrid_dynamics_on(&v, &mut ws, &pose, black_box(&q), &zeta, &tau, &qdd, &opts).unwrap()
+        })
+    });
+    g.finish();
 }
 
 fn bench_whole_run(c: &mut Criterion) {
@@ -145,5 +213,5 @@ fn bench_whole_run(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_dynamics, bench_whole_run);
+criterion_group!(benches, bench_dynamics, bench_scaling, bench_whole_run);
 criterion_main!(benches);

@@ -64,7 +64,7 @@ fn bias_after_position(
         orientation_pass(ws, pose);
     }
     forward_pass(v, ws, zeta, None);
-    body_forces(v, ws, opts);
+    body_forces(v, ws, opts, true);
     let mut out = std::mem::take(&mut ws.bias);
     backward_pass(v, ws, &mut out);
     ws.bias = out;
@@ -105,7 +105,7 @@ pub fn inverse_dynamics(
         orientation_pass(ws, pose);
     }
     forward_pass(v, ws, zeta, Some(zeta_dot));
-    body_forces(v, ws, opts);
+    body_forces(v, ws, opts, true);
     backward_pass(v, ws, tau);
 }
 

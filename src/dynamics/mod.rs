@@ -16,6 +16,9 @@
 //! - [`workspace`]: the [`DynWorkspace`] (per-body inertias, kernels and every buffer);
 //! - `passes`: the staged passes (CRBA, Newton–Euler forward pass, body wrenches, backward
 //!   pass) after the one position pass, [`crate::kinematics::forward_kinematics`];
+//! - [`aba`]: the O(n) forward dynamics (articulated-body algorithm with the added mass in
+//!   the articulated inertias) and the O(n) hybrid dynamics of the ideal servos — what the
+//!   [`Simulator`] evaluates;
 //! - [`algorithms`]: composite-rigid-body mass matrix ([`mass_matrix`]), recursive
 //!   Newton–Euler bias forces ([`bias`]) and inverse dynamics, forward and hybrid dynamics,
 //!   energy and momentum;
@@ -31,6 +34,7 @@
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
 
+pub mod aba;
 pub mod algorithms;
 pub(crate) mod cholesky;
 pub mod config;
@@ -46,6 +50,7 @@ pub mod workspace;
 #[cfg(test)]
 mod tests;
 
+pub use aba::{forward_dynamics_aba, hybrid_dynamics_on, hybrid_terms, solve_hybrid_on};
 pub use algorithms::{
     bias, damping_generalized, dynamics_terms, forward_dynamics, hybrid_dynamics, inverse_dynamics,
     kinetic_energy, mass_matrix, restoring_generalized, solve_forward, solve_hybrid,

@@ -53,21 +53,8 @@ pub(super) fn inertia_to_parent(g: &Se3, i: &Mat6) -> Mat6 {
 /// twist and the joint twists `S_k` (in `F_b`) give `M_11 = Ic_0`, `M_1,k = Ic_{k+1} S_k`,
 /// `M_l,k = S_lᵀ Ic_{k+1} S_k` for `l ≤ k` — exactly `Σ J_g,iᵀ I_i J_g,i` (USM-22).
 pub(super) fn crba(ws: &mut DynWorkspace, added_mass: bool) {
-    let nb = ws.kin.g_up.len();
-    let n = nb - 1;
-    for i in (0..nb).rev() {
-        let inertia = if added_mass {
-            &ws.i_tot[i]
-        } else {
-            &ws.i_rb[i]
-        };
-        let ib = inertia_to_parent(&ws.kin.g_b[i], inertia);
-        ws.composite[i] = if i + 1 < nb {
-            ib + ws.composite[i + 1]
-        } else {
-            ib
-        };
-    }
+    let n = ws.kin.g_up.len() - 1;
+    composites(ws, added_mass);
     let mass = &mut ws.mass;
     let ic0 = &ws.composite[0];
     // Rotated blocks R A Rᵀ are symmetric only to rounding: symmetrise M_11 exactly.
@@ -90,6 +77,25 @@ pub(super) fn crba(ws: &mut DynWorkspace, added_mass: bool) {
             mass[(6 + l, 6 + k)] = x;
             mass[(6 + k, 6 + l)] = x;
         }
+    }
+}
+
+/// The composite inertias `Ic_i = Σ_{j≥i} I^b_j` of the chain in `F_b` into `ws.composite`
+/// (the first half of [`crba`]; with or without added mass).
+pub(super) fn composites(ws: &mut DynWorkspace, added_mass: bool) {
+    let nb = ws.kin.g_up.len();
+    for i in (0..nb).rev() {
+        let inertia = if added_mass {
+            &ws.i_tot[i]
+        } else {
+            &ws.i_rb[i]
+        };
+        let ib = inertia_to_parent(&ws.kin.g_b[i], inertia);
+        ws.composite[i] = if i + 1 < nb {
+            ib + ws.composite[i + 1]
+        } else {
+            ib
+        };
     }
 }
 
@@ -178,11 +184,18 @@ pub(super) fn uses_current(v: &Vehicle, opts: &DynOptions) -> bool {
 /// uniform current are the current-free dynamics seen from a frame drifting with the current
 /// (tested). `V_r ×* (M_A V_r)` is Fossen's `C_A(ν_r) ν_r` (the Kirchhoff term), left out
 /// for bodies whose manoeuvring derivatives hold it ([`super::hydro::DampingKernel::kirchhoff`]).
-pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions) {
+///
+/// With `with_accel` false the acceleration terms `I a_i` are left out (`a_i = 0`): the
+/// velocity-dependent and external part that the articulated-body algorithms propagate.
+pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions, with_accel: bool) {
     let current = uses_current(v, opts);
     for i in 0..ws.twist.len() {
         let vi = ws.twist[i];
-        let ai = ws.accel[i];
+        let ai = if with_accel {
+            ws.accel[i]
+        } else {
+            Vec6::zeros()
+        };
         let vc = if current {
             body_current(v, ws, opts, i)
         } else {
@@ -191,7 +204,11 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions)
         let vr = relative_twist(&vi, &vc);
         let mut f;
         if opts.added_mass {
-            f = ws.i_tot[i] * ai;
+            f = if with_accel {
+                ws.i_tot[i] * ai
+            } else {
+                Vec6::zeros()
+            };
             if !ws.damping[i].kirchhoff() {
                 // Manoeuvring derivatives carry the added mass's velocity forces themselves.
                 f += cross_force(&vi, &(ws.i_rb[i] * vi));
@@ -208,8 +225,10 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions)
             } else {
                 f += cross_force(&vi, &(ws.i_tot[i] * vi));
             }
-        } else {
+        } else if with_accel {
             f = ws.i_rb[i] * ai + cross_force(&vi, &(ws.i_rb[i] * vi));
+        } else {
+            f = cross_force(&vi, &(ws.i_rb[i] * vi));
         }
         if opts.drag {
             f -= ws.damping[i].wrench(&vr);

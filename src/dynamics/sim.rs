@@ -22,10 +22,20 @@
 //! [`Simulator::step`] is one classical RK4 step. [`Simulator::advance`] integrates over a
 //! span (a control period, commands held) with the configured [`Integrator`]: fixed RK4
 //! steps, or Dormand–Prince 5(4) with error control (`integrator`), restarted at each span
-//! start because the held command jumps there. After a Dormand–Prince span, `M` and `h` of
-//! the last (FSAL) evaluation are those of the end state, so
-//! [`Simulator::base_control_terms`] and the first stage of the next span reuse them
-//! instead of recomputing the dynamics terms.
+//! start because the held command jumps there.
+//!
+//! # Dynamics per stage (O(n))
+//! Ideal servos evaluate the O(n) hybrid dynamics of [`super::aba`]: composite inertias,
+//! `M_11`, the columns `Ic_{k+1} S_k` and the bias `h` by Newton–Euler
+//! ([`hybrid_terms`](super::hybrid_terms)), then the base acceleration and the recovered
+//! torques through the composite inertias ([`solve_hybrid_on`](super::solve_hybrid_on));
+//! no joint block of `M`, no dense solve. PD servos and passive joints evaluate the
+//! articulated-body forward dynamics ([`forward_dynamics_aba`](super::forward_dynamics_aba),
+//! the added mass in the articulated inertias). Both equal the CRBA + Cholesky route to
+//! 1e-12 (tests). The generalised thrust is summed from the tip in O(n + m). After a
+//! Dormand–Prince span with ideal servos, the hybrid terms of the last (FSAL) evaluation are
+//! those of the end state, so [`Simulator::base_control_terms`] and the first stage of the
+//! next span reuse them instead of recomputing them.
 //!
 //! # Thrusters
 //! The commanded thrust is held over a step (zero-order hold) and first saturated to
@@ -36,14 +46,13 @@
 //! state saturated to `[u_min, u_max]` in every model. Thrust enters as the generalised force
 //! `J_g,iᵀ F_j` of each thruster's wrench on its body (base rows `T(q) u`, USM-25/26).
 
-use super::algorithms::{
-    dynamics_terms, kinetic_energy, solve_forward, solve_hybrid, spatial_momentum,
-};
+use super::aba::{aba_after_position, hybrid_terms, solve_hybrid_on};
+use super::algorithms::{kinetic_energy, spatial_momentum};
 use super::config::{config_err, Integrator, ServoModel, SimConfig, ThrusterModel};
 use super::integrator::{rk4_step, Dopri5, Quadrature, StepStats, Tolerance};
 use super::thruster_lag::ThrusterDyn;
 use super::{check_finite, DynError, DynWorkspace, SimError};
-use crate::kinematics::{generalized_thrust_map, BasePose};
+use crate::kinematics::{thruster_column, BasePose};
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};
 use nalgebra::{Matrix6, Quaternion, UnitQuaternion, Vector6};
@@ -138,7 +147,8 @@ pub struct Simulator {
     joint_work: f64,
     /// Peak |τ_q| [N·m] over the step boundaries evaluated since the simulator was built.
     joint_torque_peak: f64,
-    /// `ws.mass` and `ws.bias` hold `M` and `h` of the current state.
+    /// The workspace holds the hybrid terms ([`hybrid_terms`]: `M_11` in the base block of
+    /// `ws.mass`, `h` in `ws.bias`, the composite inertias) of the current state.
     terms_fresh: bool,
     u_cmd: Vec<f64>,
     u_act: Vec<f64>,
@@ -301,20 +311,22 @@ impl Simulator {
         self.stats
     }
 
-    /// The dynamics workspace (holds `M` and `h` of the last evaluation).
+    /// The dynamics workspace (holds the quantities of the last evaluation: with ideal
+    /// servos `M_11` in the base block of `ws.mass` and `h` in `ws.bias`; the full `M` is not
+    /// formed).
     pub fn workspace(&self) -> &DynWorkspace {
         &self.ws
     }
 
     /// `M_11(q)` and `h_1 = n(R_Ib, q, ζ)` (USM-33/34: the base block of the mass matrix and
     /// the base rows of the bias forces, both in `F_b`) at the current state, with the
-    /// simulator's options. Reuses `M` and `h` when the workspace already holds them for the
+    /// simulator's options (O(n): [`hybrid_terms`], no joint block). Reuses them when the workspace already holds them for the
     /// current state (after a Dormand–Prince span or a previous call).
     pub fn base_control_terms(&mut self) -> Result<(Matrix6<f64>, Vector6<f64>), SimError> {
         self.check_state()?;
         if !self.terms_fresh {
             self.load_zeta();
-            dynamics_terms(
+            hybrid_terms(
                 &self.vehicle,
                 &mut self.ws,
                 &self.state.pose,
@@ -501,8 +513,9 @@ impl Simulator {
                     .map_err(fail)?;
                 stats.steps += counts.steps;
                 stats.rejected += counts.rejected;
-                // The last evaluation was at the end state: M and h stay valid for it.
-                *terms_fresh = true;
+                // The last evaluation was at the end state: with ideal servos, the terms of
+                // the hybrid dynamics (M_11, h) stay valid for it; the ABA forms none.
+                *terms_fresh = matches!(cfg.servo, ServoModel::SecondOrder { .. });
             }
         }
         self.unpack_state(t0 + span, work)
@@ -594,20 +607,14 @@ fn eval_stage(
     let zeta = &x[JOINTS + n..work_index(n)];
     check_finite("joint_angles", q)?;
     check_finite("generalized_velocity", zeta)?;
-    if !terms_ready {
-        dynamics_terms(v, ws, &pose, q, zeta, &cfg.options);
+    let hybrid = matches!(cfg.servo, ServoModel::SecondOrder { .. });
+    if hybrid && !terms_ready {
+        hybrid_terms(v, ws, &pose, q, zeta, &cfg.options);
+    } else if !hybrid {
+        // The ABA runs the position pass itself; the thrust needs it first.
+        crate::kinematics::forward_kinematics(v, q, &mut ws.kin);
     }
-
-    // Generalised thrust force Q = Σ_j (J_g,iᵀ F_j) u_j.
-    q_gen.fill(0.0);
-    if !u_act.is_empty() {
-        generalized_thrust_map(v, &ws.kin, &mut ws.thrust_map);
-        for (j, u) in u_act.iter().enumerate() {
-            for (r, g) in q_gen.iter_mut().enumerate() {
-                *g += ws.thrust_map[(r, j)] * u;
-            }
-        }
-    }
+    generalized_thrust(v, ws, u_act, q_gen);
     let qd = &zeta[6..];
     match cfg.servo {
         ServoModel::SecondOrder { omega_n, zeta: z } => {
@@ -615,7 +622,7 @@ fn eval_stage(
             for k in 0..n {
                 qdd[k] = w2 * (cmd.joint_ref[k] - q[k]) - 2.0 * z * omega_n * qd[k];
             }
-            solve_hybrid(ws, q_gen, qdd)?;
+            solve_hybrid_on(ws, q_gen, qdd)?;
         }
         ServoModel::TorquePd {
             kp,
@@ -628,11 +635,11 @@ fn eval_stage(
                 ws.joint_torque[k] = tau;
                 q_gen[6 + k] += tau;
             }
-            solve_forward(ws, q_gen)?;
+            aba_after_position(v, ws, &pose, zeta, q_gen, &cfg.options)?;
         }
         ServoModel::Passive => {
             ws.joint_torque.fill(0.0);
-            solve_forward(ws, q_gen)?;
+            aba_after_position(v, ws, &pose, zeta, q_gen, &cfg.options)?;
         }
     }
 
@@ -654,4 +661,24 @@ fn eval_stage(
         *d = t * w;
     }
     Ok(())
+}
+
+/// Generalised thrust force `Q = Σ_j J_g,iᵀ F_j u_j` (6+n) into `q_gen`, in O(n + m): the
+/// base rows are `Σ_j B_j u_j` (`B_j` thruster `j`'s unit wrench in `F_b`, USM-25) and joint
+/// `k`'s row is `S_k · Σ_{j on bodies > k} B_j u_j`, summed from the tip. Needs the position
+/// pass in `ws.kin`.
+fn generalized_thrust(v: &Vehicle, ws: &mut DynWorkspace, u_act: &[f64], q_gen: &mut [f64]) {
+    let body = &mut ws.thrust_body;
+    body.fill(Vec6::zeros());
+    for (j, u) in u_act.iter().enumerate() {
+        body[v.thrusters[j].body] += thruster_column(v, &ws.kin, j) * *u;
+    }
+    let n = v.n_joints();
+    let mut sum = body[n];
+    for k in (0..n).rev() {
+        // Joint k moves bodies k+1 …: `sum` holds their thrust.
+        q_gen[6 + k] = ws.kin.joint_twist_b[k].dot(&sum);
+        sum += body[k];
+    }
+    q_gen[..6].copy_from_slice(sum.as_slice());
 }

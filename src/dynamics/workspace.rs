@@ -58,9 +58,21 @@ pub struct DynWorkspace {
     pub zeta_dot: Vec<f64>,
     /// Joint torques recovered by [`hybrid_dynamics`](super::hybrid_dynamics) [N·m].
     pub joint_torque: Vec<f64>,
-    /// Generalised thrust map (6+n)×n_thrusters (column `j`: `J_g,iᵀ F_j` of a unit thrust of
-    /// thruster `j` on body `i`), for the simulator.
-    pub thrust_map: Mat<f64>,
+    /// Articulated-body inertias `I^A_i` (body frames) of the O(n) forward dynamics.
+    pub(super) art_inertia: Vec<Mat6>,
+    /// Velocity-product accelerations `c_i = V_i × s_i q̇_k` (body frames, ABA).
+    pub(super) vp_accel: Vec<Vec6>,
+    /// `U_i = I^A_i s_i` of body `i`'s joint (ABA).
+    pub(super) aba_u: Vec<Vec6>,
+    /// `1 / D_i = 1 / (s_iᵀ I^A_i s_i)` (ABA).
+    pub(super) aba_dinv: Vec<f64>,
+    /// `u_i = τ_k − s_iᵀ p^A_i` (ABA).
+    pub(super) aba_force: Vec<f64>,
+    /// `F_k = Ic_{k+1} S_k` in `F_b`, one per joint (the composite-inertia columns of the
+    /// O(n) hybrid dynamics).
+    pub(super) comp_twist: Vec<Vec6>,
+    /// Thrust wrench of each body in `F_b` (the simulator's O(n + m) generalised thrust).
+    pub(super) thrust_body: Vec<Vec6>,
     /// Cholesky factor scratch, column-major lower triangle (`cholesky::factor`).
     pub(super) chol: Vec<f64>,
     /// Right-hand-side scratch (6+n).
@@ -97,7 +109,13 @@ impl DynWorkspace {
             bias: vec![0.0; nv],
             zeta_dot: vec![0.0; nv],
             joint_torque: vec![0.0; v.n_joints()],
-            thrust_map: Mat::zeros(nv, v.n_thrusters()),
+            art_inertia: vec![Mat6::zeros(); nb],
+            vp_accel: vec![Vec6::zeros(); nb],
+            aba_u: vec![Vec6::zeros(); nb],
+            aba_dinv: vec![0.0; nb],
+            aba_force: vec![0.0; nb],
+            comp_twist: vec![Vec6::zeros(); v.n_joints()],
+            thrust_body: vec![Vec6::zeros(); nb],
             chol: vec![0.0; nv * nv],
             rhs: vec![0.0; nv],
         }

@@ -194,6 +194,7 @@ fn potential_energy(v: &Vehicle, pose: &BasePose, q: &[f64]) -> f64 {
         .sum()
 }
 
+mod aba;
 mod actuators;
 mod conservation;
 mod equations;
