@@ -6,15 +6,14 @@
 
 use super::*;
 use crate::model::generator::GeneratorSpec;
-use crate::model::nps_auv2::nps_auv2;
 use crate::model::presets::uvms_planar;
 
-/// Every preset design: the toys, `usm-paper`, `uvms-planar`, NPS AUV II and the generated
-/// 3–9 link designs (2N−1 bodies, 2N−2 joints), each in a current.
+/// Every preset design of the core: the toys, `usm-paper`, `uvms-planar` and the generated
+/// 3–9 link designs (2N−1 bodies, 2N−2 joints), each in a current. (NPS AUV II lives in the
+/// `paper` room above this one; it is a single body, where both routes are the same 6×6 solve.)
 fn all_designs() -> Vec<Vehicle> {
     let mut out = models();
     out.push(uvms_planar());
-    out.push(nps_auv2());
     for links in 3..=9 {
         let spec = GeneratorSpec {
             links,
