@@ -245,7 +245,11 @@ fn a_scenario_name_cannot_lead_the_output_out_of_its_root() {
         .unwrap();
     // Refused since issue 21 (a name is a single safe path component), naming file, line, key.
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("s.toml:3:1: scenario.name"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("s.toml:3:1: scenario.name"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!d.path().join("out").exists());
     assert!(!d.path().parent().unwrap().join("escaped").exists());
 }
