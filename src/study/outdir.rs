@@ -171,19 +171,17 @@ pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Vec<String>, St
     Ok(notes)
 }
 
-/// What finished work of a study `dir` holds: journal rows or a final table.
+/// What finished work of a study `dir` holds that a rerun would lose: the rows of an
+/// interrupted run's journal. A complete run's tables (cases.csv) are not counted: the same
+/// study file recomputes them bit for bit, and the README's main command reruns the study into
+/// its committed reference output.
 fn finished_cases(dir: &Path) -> Option<&'static str> {
-    if let Ok(f) = std::fs::File::open(dir.join(PARTIAL_FILE)) {
-        // A header and at least one complete row.
-        let mut lines = std::io::BufReader::new(f).split(b'\n');
-        let complete = |l: Option<std::io::Result<Vec<u8>>>| l.is_some_and(|l| l.is_ok());
-        if complete(lines.next()) && complete(lines.next()) {
-            return Some("finished cases in its journal (cases.partial.csv)");
-        }
-    }
-    dir.join(CASES_CSV)
-        .is_file()
-        .then_some("the finished cases of a complete run (cases.csv)")
+    let f = std::fs::File::open(dir.join(PARTIAL_FILE)).ok()?;
+    // A header and at least one complete row.
+    let mut lines = std::io::BufReader::new(f).split(b'\n');
+    let complete = |l: Option<std::io::Result<Vec<u8>>>| l.is_some_and(|l| l.is_ok());
+    (complete(lines.next()) && complete(lines.next()))
+        .then_some("finished cases in its journal (cases.partial.csv)")
 }
 
 /// Whether `dir` holds any file named like a sweep output.
@@ -325,6 +323,7 @@ mod tests {
         std::thread::sleep(std::time::Duration::from_millis(30));
         std::fs::write(p.join(STUDY_COPY), "[study]\nname = \"a\"\n").unwrap();
         std::fs::write(p.join(CASES_CSV), "x\n").unwrap();
+        std::fs::write(p.join(PARTIAL_FILE), "id\n0\n").unwrap();
         std::fs::write(p.join("plots/axis_x.svg"), "<svg/>").unwrap();
         record_owned(p, l.created, &[]).unwrap();
         drop(l);
@@ -342,7 +341,7 @@ mod tests {
         let e = claim(p, &l, &c("a", false)).unwrap_err().to_string();
         assert!(e.contains("--resume") && e.contains("--force"), "{e}");
         let notes = claim(p, &l, &c("b", true)).unwrap();
-        assert!(notes[0].contains("removed 3 files of study a"), "{notes:?}");
+        assert!(notes[0].contains("removed 4 files of study a"), "{notes:?}");
         assert!(!p.join(CASES_CSV).exists() && !p.join("plots/axis_x.svg").exists());
         assert!(p.join("notes.txt").exists() && p.join("plots/user_diagram.svg").exists());
     }
