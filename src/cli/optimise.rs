@@ -7,7 +7,7 @@
 //! problem-file errors are reported before any evaluation.
 
 use super::progress::Progress;
-use anyhow::{anyhow, bail};
+use anyhow::bail;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -44,7 +44,7 @@ pub struct OptimiseArgs {
 /// Refuse an output directory that a link leads out of, that holds a sweep's output, or the
 /// optimisation of another problem (its `manifest.json` names it).
 fn check_output(out: &Path, problem: &str) -> anyhow::Result<()> {
-    outdir::check_contained(out).map_err(|e| anyhow!(e.to_string()))?;
+    outdir::check_contained(out)?;
     let sweep_files = [
         "cases.csv",
         "cases.parquet",
@@ -90,15 +90,14 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
     create_dir(&out)?;
     // The same lock and output checks as `sweep`: one run per directory, no link out of it,
     // no other output mixed in.
-    let out = outdir::resolve(&out).map_err(|e| anyhow!(e.to_string()))?;
+    let out = outdir::resolve(&out)?;
     let lock = outdir::lock(
         &out,
         &outdir::LockOwner {
             study: &s.hash,
             resume: a.resume,
         },
-    )
-    .map_err(|e| anyhow!(e.to_string()))?;
+    )?;
     if let Some(t) = &lock.takeover {
         eprintln!("[optimise] {t}");
     }
@@ -177,8 +176,7 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
         out.join(BEST_FILE).display()
     );
     super::sweep::review("optimise", &out)?;
-    outdir::record_owned(&out, lock.created, &["report.html"])
-        .map_err(|e| anyhow!(e.to_string()))?;
+    outdir::record_owned(&out, lock.created, &["report.html"])?;
     drop(lock);
     Ok(if b.score.feasible {
         ExitCode::SUCCESS

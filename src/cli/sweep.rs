@@ -85,8 +85,7 @@ fn emit_slurm(a: &SweepArgs, study: &usm_study::study::Study, file: &Path) -> an
         name: study.name.clone(),
         force: a.force,
     };
-    usm_study::report::atomic_write(file, slurm_script(&plan).as_bytes())
-        .map_err(|e| anyhow!(e.to_string()))?;
+    usm_study::report::atomic_write(file, slurm_script(&plan).as_bytes())?;
     eprintln!(
         "[sweep] wrote {}: {} array tasks of {} cases, merged into {}; submit with `bash {}`",
         file.display(),
@@ -119,21 +118,32 @@ pub enum ShardArg {
     Slurm,
 }
 
-fn parse_shard(s: &str) -> Result<ShardArg, String> {
+/// A `--shard` value that is neither `I/N` with `0 <= I < N` nor `slurm`.
+#[derive(Debug, thiserror::Error)]
+enum ShardArgError {
+    #[error("expected I/N (e.g. 0/4) or `slurm`, got '{0}'")]
+    Form(String),
+    #[error("'{0}' is not a non-negative integer")]
+    NotIndex(String),
+    #[error("shard {0}/{1}: need 0 <= I < N")]
+    Range(usize, usize),
+}
+
+fn parse_shard(s: &str) -> Result<ShardArg, ShardArgError> {
     if s == "slurm" {
         return Ok(ShardArg::Slurm);
     }
     let (i, n) = s
         .split_once('/')
-        .ok_or_else(|| format!("expected I/N (e.g. 0/4) or `slurm`, got '{s}'"))?;
+        .ok_or_else(|| ShardArgError::Form(s.to_string()))?;
     let p = |x: &str| {
         x.trim()
             .parse::<usize>()
-            .map_err(|_| format!("'{x}' is not a non-negative integer"))
+            .map_err(|_| ShardArgError::NotIndex(x.to_string()))
     };
     let (i, n) = (p(i)?, p(n)?);
     if n == 0 || i >= n {
-        return Err(format!("shard {i}/{n}: need 0 <= I < N"));
+        return Err(ShardArgError::Range(i, n));
     }
     Ok(ShardArg::Fixed(i, n))
 }
@@ -158,15 +168,16 @@ fn slurm_shard() -> anyhow::Result<(usize, usize)> {
     Ok((i, count))
 }
 
+/// A study error with its causes (the command line prints the chain on one line).
 fn study_err(e: StudyError) -> anyhow::Error {
-    anyhow!(e.to_string())
+    anyhow::Error::new(e)
 }
 
 /// Run `usm-study sweep`.
 pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
-    let study = load_study(&a.study).map_err(|e| anyhow!(e.to_string()))?;
+    let study = load_study(&a.study)?;
     // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
-    Tuner::new(&study).map_err(|e| anyhow!(e.to_string()))?;
+    Tuner::new(&study)?;
     let shard = match &a.shard {
         None => None,
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),

@@ -245,7 +245,7 @@ fn static_phase(
     let spec = match static_spec(scenario, derive_seed(input.seed, 1)) {
         Ok(s) => s,
         Err(m) => {
-            out.end(CaseStatus::Skipped, m);
+            out.end(CaseStatus::Skipped, m.to_string());
             return false;
         }
     };

@@ -69,15 +69,15 @@ fn commanded_in(scenario: &toml::Table, mode: Mode) -> crate::metrics::singulari
 /// fallback threshold), seeded with `seed`. The commanded axes are those of `static.mode`
 /// (default: the study's closed-loop mode, else transport). No configurations are kept
 /// (`worst = 0`): sweeps record only the aggregate metrics.
-pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, String> {
+pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, StaticTableError> {
     let t = scenario
         .get(STATIC_TABLE)
         .cloned()
         .unwrap_or(toml::Value::Table(toml::Table::new()));
-    let f = StaticFile::deserialize(t).map_err(|e| format!("[static]: {}", e.message().trim()))?;
+    let f = StaticFile::deserialize(t).map_err(StaticTableError::Table)?;
     let d = StaticSpec::default();
     let sampling: Sampling = match &f.sampling {
-        Some(s) => s.parse().map_err(|m| format!("static.sampling: {m}"))?,
+        Some(s) => s.parse().map_err(StaticTableError::Sampling)?,
         None => d.sampling,
     };
     let metrics_l = scenario
@@ -105,16 +105,38 @@ pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, Stri
         mode,
         commanded: commanded_in(scenario, mode),
     };
-    spec.validate().map_err(|e| e.to_string())?;
+    spec.validate().map_err(StaticTableError::Setting)?;
     if spec.samples > MAX_CASE_SAMPLES {
-        return Err(format!(
-            "static.samples: {} samples per case would keep {:.1} GB of per-sample values \
-             (σ_min and κ, for exact quantiles); at most {MAX_CASE_SAMPLES} per case",
-            spec.samples,
-            spec.samples as f64 * 16.0 / 1e9
-        ));
+        return Err(StaticTableError::TooManySamples {
+            samples: spec.samples,
+        });
     }
     Ok(spec)
+}
+
+/// Why a `[static]` table does not give static-analysis settings (the study parser places it
+/// at the table's line; a sweep case whose overrides break it is skipped with this reason).
+#[derive(Debug, thiserror::Error)]
+pub enum StaticTableError {
+    /// The table does not deserialise (an unknown key, a wrong type).
+    #[error("[static]: {}", .0.message().trim())]
+    Table(#[source] toml::de::Error),
+    /// `static.sampling` names no sampling method.
+    #[error("static.sampling: {0}")]
+    Sampling(#[source] crate::sampling::UnknownSampling),
+    /// A setting is out of range.
+    #[error("{0}")]
+    Setting(#[source] crate::statics::StaticError),
+    /// More samples per case than a worker may keep.
+    #[error(
+        "static.samples: {samples} samples per case would keep {:.1} GB of per-sample values \
+         (σ_min and κ, for exact quantiles); at most {MAX_CASE_SAMPLES} per case",
+        *samples as f64 * 16.0 / 1e9
+    )]
+    TooManySamples {
+        /// The samples asked for.
+        samples: usize,
+    },
 }
 
 /// Most static samples of one sweep case: 16 bytes each are kept (σ_min and κ), 160 MB at the

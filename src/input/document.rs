@@ -255,7 +255,7 @@ pub const MAX_INPUT_BYTES: u64 = 16 << 20;
 /// before reading when the file is larger than [`MAX_INPUT_BYTES`], and after reading that many
 /// bytes from anything that is not a regular file (`/dev/zero`, a FIFO): an input file never
 /// fills memory. The error names the limit.
-pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+pub fn read_text(path: &std::path::Path) -> Result<String, std::io::Error> {
     use std::io::Read;
     let file = std::fs::File::open(path)?;
     let meta = file.metadata()?;

@@ -120,7 +120,7 @@ impl<'a> CaseEvaluator<'a> {
                 values,
             },
         )
-        .map_err(ResolveError)
+        .map_err(|e| ResolveError(e.to_string()))
     }
 
     /// Run one resolved case (with its trajectory when `log`) through the case evaluator.

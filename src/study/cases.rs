@@ -3,10 +3,10 @@
 
 use super::doe::Case;
 use super::hash::{case_hashes, unresolved_case_hash};
-use super::runner::method_control;
+use super::runner::{method_control, SettingsError};
 use super::schema::{Study, Target};
-use crate::input::keypath::{set, Seg};
-use crate::model::design::{parse_design_table, thrusters_to_toml};
+use crate::input::keypath::{set, Seg, SetError};
+use crate::model::design::{parse_design_table, thrusters_to_toml, DesignError};
 use crate::sampling::derive_seed;
 
 /// A case with every override applied.
@@ -24,9 +24,23 @@ pub struct Resolved {
     pub design_hash: String,
 }
 
+/// Why a case's overrides do not apply to the study's tables: the reason the case is skipped.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    /// An axis value cannot be set (an index beyond an array, a value of the wrong shape).
+    #[error(transparent)]
+    Set(#[from] SetError),
+    /// The generator cannot build the design whose thrusters the case edits.
+    #[error("{0}")]
+    Design(#[source] DesignError),
+    /// The case's `control.method` gives no valid `[control]` table.
+    #[error(transparent)]
+    Control(#[from] SettingsError),
+}
+
 /// Apply a case's overrides to the study's tables. `Err` is the reason the case is skipped
 /// (an index beyond an array, a design the generator cannot build for thruster overrides).
-pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
+pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
     let mut design = study.design.clone();
     let mut scenario = study.scenario_full.clone();
     let mut thruster_edits = Vec::new();
@@ -44,7 +58,7 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
     }
     if !thruster_edits.is_empty() && study.generator && !design.contains_key("thruster") {
         // Write the generated thrusters out so that they can be edited one by one.
-        let v = parse_design_table(&design, "generated design").map_err(|e| e.to_string())?;
+        let v = parse_design_table(&design, "generated design").map_err(CaseError::Design)?;
         design.insert("thruster".into(), thrusters_to_toml(&v));
     }
     for (a, p, v) in thruster_edits {
@@ -79,7 +93,7 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, String> {
 /// its method's Table III row, with the study's own `[control]` keys and the case's other
 /// `control.…` values on top ([`method_control`]); `None` without such an axis (the study's
 /// own method was resolved when the file was parsed).
-fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>, String> {
+fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>, CaseError> {
     let on_control = |t: &Target| match t {
         Target::Scenario(p) => matches!(p.0.first(), Some(Seg::Key(k)) if k == "control"),
         Target::Design(_) => false,
@@ -104,14 +118,12 @@ fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>
             set(&mut own, &p.0, v.clone(), &a.name)?;
         }
     }
-    method_control(study.mode, own.get("control"))
-        .transpose()
-        .map_err(String::from)
+    Ok(method_control(study.mode, own.get("control")).transpose()?)
 }
 
 /// The hash of a case: its resolved hash, or for a case whose overrides do not apply a hash
 /// of the study, the id and the axis values.
-pub fn case_hash(study: &Study, case: &Case, resolved: &Result<Resolved, String>) -> String {
+pub fn case_hash(study: &Study, case: &Case, resolved: &Result<Resolved, CaseError>) -> String {
     match resolved {
         Ok(r) => r.hash.clone(),
         Err(_) => unresolved_case_hash(&study.hash, case.id, &case.values),

@@ -295,11 +295,14 @@ impl SweepOutcome {
 
 /// The partial file, created (or, with `resume`, opened) with the raw schema, and the hashes
 /// of the cases already in it.
+/// The hashes of the cases a journal already holds (skipped on `--resume`).
+type DoneHashes = HashSet<String>;
+
 fn open_partial(
     partial: &Path,
     schema: &[(String, ColumnKind)],
     resume: bool,
-) -> Result<(CsvAppender, HashSet<String>), StudyError> {
+) -> Result<(CsvAppender, DoneHashes), StudyError> {
     let mut done: HashSet<String> = HashSet::new();
     if !resume {
         return Ok((CsvAppender::create(partial, schema)?, done));
@@ -469,7 +472,7 @@ fn process(
         Ok(r) => w.evaluate(study, case, &r, false, run.tuner).0,
         Err(reason) => {
             let mut row = Row::new(case.id, hash, case.values.clone());
-            row.end(CaseStatus::Skipped, &reason);
+            row.end(CaseStatus::Skipped, &reason.to_string());
             row
         }
     };

@@ -21,17 +21,21 @@ pub enum StudyError {
     #[error(transparent)]
     Report(#[from] crate::report::ReportError),
     /// File system.
-    #[error("{path}: {message}", path = .path.display())]
+    #[error("{path}: {source}", path = .path.display())]
     Io {
         /// The path concerned.
         path: PathBuf,
         /// What went wrong.
-        message: String,
+        #[source]
+        source: std::io::Error,
     },
     /// Anything else.
     #[error("{0}")]
     Other(String),
 }
+
+/// Messages for the user that a step returns beside its result (notes, warnings), one a line.
+pub type Notes = Vec<String>;
 
 impl StudyError {
     /// Whether this is bad input (study file or command line).
@@ -43,7 +47,7 @@ impl StudyError {
     pub(crate) fn io(path: &Path, e: std::io::Error) -> Self {
         StudyError::Io {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            source: e,
         }
     }
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::cases::resolve_case;
 use super::doe::expand;
-use super::error::StudyError;
+use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
 use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::schema::Study;
@@ -85,7 +85,7 @@ fn rerun_extremes(
     let rerun = |which: Extreme, row: usize| -> Result<(), RerunError> {
         let id = ids[row] as usize;
         let case = all.get(id).ok_or(RerunError::CaseId)?;
-        let mut r = resolve_case(study, case).map_err(RerunError::Resolve)?;
+        let mut r = resolve_case(study, case).map_err(|e| RerunError::Resolve(e.to_string()))?;
         if let Some(t) = &tuner {
             // Rerun at the case's tuned values, as scored.
             let x: Vec<f64> = tuned.iter().map(|c| c[row]).collect();
@@ -107,7 +107,7 @@ fn rerun_extremes(
 
 /// Regenerate `summary.md` and the plots of an output directory from `cases.parquet` (or
 /// `cases.csv`) and `manifest.json`.
-pub fn report(dir: &Path) -> Result<Vec<String>, StudyError> {
+pub fn report(dir: &Path) -> Result<Notes, StudyError> {
     let m = read_manifest(dir)?;
     let pq = dir.join(CASES_PARQUET);
     let table = if pq.is_file() {

@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use super::error::StudyError;
+use super::error::{Notes, StudyError};
 use super::records::{CaseStatus, HASH, STATUS};
 use crate::report::{atomic_write, ColumnKind};
 
@@ -71,7 +71,7 @@ fn check_line(line: &str, schema: &[(String, ColumnKind)]) -> Option<String> {
 /// Check the journal at `path` (whose first line is the header of `schema`, checked by the
 /// caller's appender): drop its malformed complete lines, rewriting the file, and return one
 /// warning per dropped line (`FILE:LINE: why; the case runs again`). A missing file is fine.
-pub fn repair(path: &Path, schema: &[(String, ColumnKind)]) -> Result<Vec<String>, StudyError> {
+pub fn repair(path: &Path, schema: &[(String, ColumnKind)]) -> Result<Notes, StudyError> {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),

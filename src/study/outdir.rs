@@ -21,7 +21,7 @@ use std::io::BufRead;
 use std::path::{Component, Path, PathBuf};
 use std::time::SystemTime;
 
-use super::error::StudyError;
+use super::error::{Notes, StudyError};
 use super::manifest::MANIFEST_FILE;
 use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, STUDY_COPY};
 
@@ -114,7 +114,7 @@ fn recorded_study(dir: &Path) -> Option<String> {
 /// symbolic link out of it, another study's output unless `force` (which then removes that
 /// output's own files), this study's finished cases unless `resume` or `force`; remove the
 /// temporaries of the run whose lock `lock` replaced. Returns notes for the user.
-pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Vec<String>, StudyError> {
+pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Notes, StudyError> {
     check_contained(dir)?;
     let mut notes: Vec<String> = lock.takeover.iter().cloned().collect();
     let recorded = recorded_study(dir);

@@ -455,7 +455,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     // Static settings of the base must parse.
     if static_enabled {
         if let Err(m) = static_spec(&reference, 0) {
-            return Err(doc.err(STATIC_TABLE, m));
+            return Err(doc.err(STATIC_TABLE, m.to_string()));
         }
     }
     Ok(ScenarioSide {

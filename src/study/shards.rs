@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use super::error::StudyError;
+use super::error::{Notes, StudyError};
 use super::finish::finish_report;
 use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manifest};
 use super::outdir;
@@ -37,7 +37,7 @@ pub fn merge(
     out: &Path,
     opts: MergeOptions,
     tuning: Option<TuningHook>,
-) -> Result<(Manifest, Vec<String>), StudyError> {
+) -> Result<(Manifest, Notes), StudyError> {
     let start_time = now_rfc3339();
     let first_dir = dirs
         .first()
@@ -120,7 +120,7 @@ fn check_shard_set(
     dirs: &[PathBuf],
     manifests: &[Manifest],
     partial: bool,
-) -> Result<Vec<String>, StudyError> {
+) -> Result<Notes, StudyError> {
     let mut problems = Vec::new();
     let mut counts: BTreeMap<usize, Vec<String>> = BTreeMap::new();
     let mut seen: BTreeMap<usize, Vec<String>> = BTreeMap::new();
