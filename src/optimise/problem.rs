@@ -17,10 +17,10 @@ use super::space::{Param, Scale, Space};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::join_key;
 use crate::input::located::{InputError, Located, Location};
+use crate::study::axes::overlaps;
 use crate::study::axes::study_target;
 pub use crate::study::parse::metric_catalogue;
 use crate::study::parse::{known_metric, parse_study_table, unknown_metric};
-use crate::study::schema::Target;
 use crate::study::Study;
 
 /// The optimiser's top-level sections of a problem file (removed before the study part is
@@ -303,19 +303,6 @@ pub fn parse_spec(
     })
 }
 
-/// Whether two targets set the same key, or one a key inside the other
-/// (`control.weights` and `control.weights[2]`).
-fn same_key(a: &Target, b: &Target) -> bool {
-    let (pa, pb) = match (a, b) {
-        (Target::Design(x), Target::Design(y)) | (Target::Scenario(x), Target::Scenario(y)) => {
-            (x, y)
-        }
-        _ => return false,
-    };
-    let n = pa.0.len().min(pb.0.len());
-    pa.0[..n] == pb.0[..n]
-}
-
 /// No parameter may set a key a sweep axis of the study sets (under any alias, e.g.
 /// `design.longitudinal_offset` and `design.generator.longitudinal_offset`): the tuned value
 /// would silently replace the axis value the case is labelled with.
@@ -326,7 +313,7 @@ fn check_axis_aliases(
     doc: &Document,
 ) -> Result<(), InputError> {
     for (i, p) in params.iter().enumerate() {
-        if let Some(a) = study.axes.iter().find(|a| same_key(&a.target, &p.target)) {
+        if let Some(a) = study.axes.iter().find(|a| overlaps(&a.target, &p.target)) {
             return Err(doc.err(
                 &format!("{at}[{i}].name"),
                 format!(
@@ -355,7 +342,7 @@ fn check_variant_params(
             let Some((target, _)) = study_target(study, path).ok().flatten() else {
                 continue; // parse_variants has refused it
             };
-            if let Some(p) = params.iter().find(|p| same_key(&p.target, &target)) {
+            if let Some(p) = params.iter().find(|p| overlaps(&p.target, &target)) {
                 return Err(doc.err(
                     &format!("{at}[{i}].set"),
                     format!(

@@ -207,7 +207,7 @@ const MAX_PLAN_BYTES: f64 = 4.0e9;
 
 /// Whether two axis targets set the same parameter: equal paths, or one inside the other
 /// (`design.thruster[2].position` and `design.thruster[2].position[0]`).
-fn overlaps(a: &Target, b: &Target) -> bool {
+pub(crate) fn overlaps(a: &Target, b: &Target) -> bool {
     let (pa, pb) = match (a, b) {
         (Target::Design(x), Target::Design(y)) | (Target::Scenario(x), Target::Scenario(y)) => {
             (x, y)
