@@ -34,4 +34,5 @@ pub mod scenario;
 pub mod spatial;
 pub mod state;
 pub mod statics;
+pub mod stats;
 pub mod study;

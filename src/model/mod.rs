@@ -10,6 +10,7 @@ pub mod design;
 pub mod generator;
 pub mod manoeuvring;
 pub mod presets;
+pub mod world;
 
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};
 use nalgebra::Vector6;
@@ -69,6 +70,9 @@ pub enum Hydro {
         strips: usize,
         /// Ratio of axial added mass to body mass (paper: 0.1).
         axial_added_mass_ratio: f64,
+        /// Factor on the whole added-mass matrix of the formulas above (1 = the paper's
+        /// formulas; an uncertain world's `hydro.added_mass_scale`, docs/assumptions.md).
+        added_mass_scale: f64,
     },
     /// Hydrodynamic derivatives in matrix form about the body frame's origin:
     /// added mass `M_A` (6×6, symmetric PSD), linear damping `D_l` and quadratic damping
@@ -99,6 +103,7 @@ impl Hydro {
             linear_damping: [1.0, 1.0, 1.0, 0.05, 0.05, 0.05],
             strips: 5,
             axial_added_mass_ratio: 0.1,
+            added_mass_scale: 1.0,
         }
     }
 }
@@ -162,12 +167,17 @@ impl Body {
         match &self.hydro {
             Hydro::Cylinder {
                 axial_added_mass_ratio,
+                added_mass_scale,
                 ..
             } => {
                 let (r, l) = (self.radius, self.length);
                 let lat = PI * rho * r * r * l;
                 let rot = PI * rho * r * r * l * l * l / 12.0;
-                let d = Vector6::new(axial_added_mass_ratio * self.mass, lat, lat, 0.0, rot, rot);
+                let mut d =
+                    Vector6::new(axial_added_mass_ratio * self.mass, lat, lat, 0.0, rot, rot);
+                if *added_mass_scale != 1.0 {
+                    d *= *added_mass_scale;
+                }
                 // Paper formulas hold about the geometric centre; move to the frame origin.
                 Se3::from_translation(self.centre()).inertia_to_parent(&Mat6::from_diagonal(&d))
             }
@@ -356,8 +366,14 @@ impl Vehicle {
                     linear_damping,
                     strips,
                     axial_added_mass_ratio,
+                    added_mass_scale,
                 } => {
-                    for (name, v) in [("cd_x", cd_x), ("cd_y", cd_y), ("cd_z", cd_z)] {
+                    for (name, v) in [
+                        ("cd_x", cd_x),
+                        ("cd_y", cd_y),
+                        ("cd_z", cd_z),
+                        ("added_mass_scale", added_mass_scale),
+                    ] {
                         if !v.is_finite() || *v < 0.0 {
                             return Err(ModelError::new(
                                 k(&format!("hydro.{name}")),

@@ -22,6 +22,7 @@ use super::{minimise, Options, Problem, Spec};
 use crate::evaluate::{Deadline, TCM_COLUMNS};
 use crate::input::document::Document;
 use crate::input::keypath::get;
+use crate::sampling::{derive_seed, Sampler, Sampling};
 use crate::study::cases::Resolved;
 use crate::study::doe::Case;
 use crate::study::error::InputError;
@@ -43,7 +44,19 @@ pub struct Tuner {
     explicit_start: Vec<bool>,
     /// Whether the tuning objective or constraints read static TCM metrics.
     static_needed: bool,
+    /// Independent tuning starts (`[tune] starts`, default 1): the case's own start, then
+    /// Sobol points of the box, each with an equal share of the evaluation budget.
+    starts: usize,
 }
+
+/// Most independent tuning starts.
+pub const MAX_STARTS: usize = 16;
+
+/// Seed stream of the tuning starts' Sobol points (shared by every case).
+const STARTS_STREAM: u64 = 0x5354_4152_5453; // "STARTS"
+
+/// A parameter within this fraction of the unit box from a bound counts as on the bound.
+pub const BOUND_TOLERANCE: f64 = 1e-3;
 
 impl Tuner {
     /// The tuner of `study`'s `[tune]` section (`None` without one). Every check of a
@@ -71,7 +84,27 @@ impl Tuner {
                 ));
             }
         }
-        let spec = parse_spec(&doc, t, "tune", study)?;
+        let mut t = t.clone();
+        let starts = match t.remove("starts") {
+            None => 1,
+            Some(toml::Value::Integer(n)) if (1..=MAX_STARTS as i64).contains(&n) => n as usize,
+            Some(v) => {
+                return Err(doc.err(
+                    "tune.starts",
+                    format!("must be an integer from 1 to {MAX_STARTS}, got {v}"),
+                ))
+            }
+        };
+        let spec = parse_spec(&doc, &t, "tune", study)?;
+        if spec.solver.max_evals / starts < 2 {
+            return Err(doc.err(
+                "tune.starts",
+                format!(
+                    "{starts} starts leave fewer than 2 evaluations each of tune.solver.max_evals = {}",
+                    spec.solver.max_evals
+                ),
+            ));
+        }
         let explicit_start = params
             .map(|ps| ps.iter().map(|p| p.get("start").is_some()).collect())
             .unwrap_or_default();
@@ -84,6 +117,7 @@ impl Tuner {
             spec,
             explicit_start,
             static_needed,
+            starts,
         }))
     }
 
@@ -119,6 +153,7 @@ impl CaseTuner for Tuner {
     ) -> Result<Tuned, TuneError> {
         let problem = self.case_problem(study, r);
         let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
+        let mut spec = problem.spec.clone();
         let quiet = |_: &Record| {};
         let opts = Options {
             jobs: 1,
@@ -126,16 +161,55 @@ impl CaseTuner for Tuner {
             resume: false,
             on_record: &quiet,
         };
-        let out =
-            minimise(&problem.spec, &ev, &study.hash, &opts).map_err(TuneError::from_error)?;
-        let best = out.best();
+        let d = spec.space.dim();
+        let sobol = Sampler::new(
+            Sampling::Sobol,
+            self.starts.max(2),
+            d,
+            derive_seed(study.seed, STARTS_STREAM),
+        )
+        .map_err(TuneError::from_error)?;
+        spec.solver.max_evals = self.spec.solver.max_evals / self.starts;
+        let (mut best, mut bests, mut curve, mut evaluations) = (None, Vec::new(), Vec::new(), 0);
+        for k in 0..self.starts {
+            if k > 0 {
+                let mut u = vec![0.0; d];
+                sobol.point(k - 1, &mut u);
+                for (p, u) in spec.space.params.iter_mut().zip(&u) {
+                    p.start = p.value(*u);
+                }
+            }
+            let out = minimise(&spec, &ev, &study.hash, &opts).map_err(TuneError::from_error)?;
+            evaluations += out.fresh_evaluations();
+            best_so_far(&out.records, &mut curve);
+            let b = out.best().clone();
+            bests.push(if b.score.feasible {
+                b.score.objective
+            } else {
+                f64::NAN
+            });
+            if best
+                .as_ref()
+                .is_none_or(|x: &Record| b.score.better_than(&x.score))
+            {
+                best = Some(b);
+            }
+        }
+        let best = best.ok_or_else(|| TuneError::msg("no tuning start ran"))?;
         let mut resolved = ev.resolve(&best.x, 0).map_err(TuneError::from_error)?;
         resolved.hash = r.hash.clone();
         Ok(Tuned {
             resolved,
             x: best.x.clone(),
-            evaluations: out.fresh_evaluations(),
+            evaluations,
             feasible: best.score.feasible,
+            noise: relative_spread(&bests),
+            bound_hits: best
+                .u
+                .iter()
+                .filter(|u| **u <= BOUND_TOLERANCE || **u >= 1.0 - BOUND_TOLERANCE)
+                .count(),
+            curve,
         })
     }
 
@@ -154,6 +228,32 @@ impl CaseTuner for Tuner {
         s.hash = r.hash.clone();
         Ok(s)
     }
+}
+
+/// Append the best feasible objective so far after each fresh evaluation of `records` to
+/// `curve` (NaN until one is feasible); a later start carries the earlier starts' best on.
+fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
+    let mut best = curve.last().copied().unwrap_or(f64::NAN);
+    for r in records.iter().filter(|r| !r.repeat) {
+        if r.score.feasible && !(r.score.objective >= best) {
+            best = r.score.objective;
+        }
+        curve.push(best);
+    }
+}
+
+/// Relative spread `(max − min) / |min|` of the finite values (NaN with fewer than two).
+fn relative_spread(xs: &[f64]) -> f64 {
+    let f: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
+    if f.len() < 2 {
+        return f64::NAN;
+    }
+    let (lo, hi) = f
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(*x), b.max(*x))
+        });
+    (hi - lo) / lo.abs()
 }
 
 /// The case's value of a parameter's key (a number), if it has one.

@@ -54,7 +54,7 @@ use crate::input::located::{fmt_exact, KeyError};
 use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
-pub use physics::{PhysicsSpec, ServoSpec, ThrusterSpec};
+pub use physics::{HydroScaleSpec, PhysicsSpec, ServoSpec, ThrusterSpec, SCALE_KEYS};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -347,6 +347,9 @@ pub struct ScenarioFile {
     /// Physical effects.
     #[serde(default)]
     pub physics: PhysicsSpec,
+    /// Whole-design hydrodynamic scale factors (uncertain worlds).
+    #[serde(default)]
+    pub hydro: HydroScaleSpec,
     /// Metric settings.
     #[serde(default)]
     pub metrics: MetricsSpec,
@@ -482,7 +485,7 @@ impl ScenarioFile {
                 added_mass: p.added_mass,
                 drag: p.drag,
                 restoring: p.restoring,
-                current: p.current.iter().any(|c| *c != 0.0),
+                current: p.total_current().iter().any(|c| *c != 0.0),
             },
             servo,
             thruster,
@@ -513,6 +516,14 @@ impl ScenarioFile {
         finite("initial.yaw_deg", &[self.initial.yaw_deg])?;
         finite("initial.joint_angles_deg", &self.initial.joint_angles_deg)?;
         finite("physics.current", &self.physics.current)?;
+        finite(
+            "physics.current_speed",
+            &[self.physics.current_speed, self.physics.current_direction],
+        )?;
+        self.hydro
+            .scales(self.thrusters.limit_scale)
+            .validate(&SCALE_KEYS)
+            .map_err(|e| KeyError::new(e.key, e.message))?;
         match self.scenario.mode {
             Mode::Transport if self.path.is_none() => {
                 return Err(KeyError::new("path", "transport mode needs a [path] table"))

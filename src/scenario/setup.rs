@@ -3,7 +3,7 @@
 //! every buffer the loop needs once, so that no time step allocates.
 
 use super::channels::check_log_size;
-use super::config::ScenarioFile;
+use super::config::{ScenarioFile, SCALE_KEYS};
 use super::controller::{Command, ModeController};
 use super::error::ScenarioError;
 use crate::allocation::{Allocation, Allocator};
@@ -93,7 +93,10 @@ impl<'f> ClosedLoop<'f> {
         let s = &file.scenario;
         check_log_size(file, v).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let mut vehicle = v.clone();
-        vehicle.fluid.current = Vec3::from(file.physics.current);
+        vehicle.fluid.current = Vec3::from(file.physics.total_current());
+        vehicle
+            .apply_scales(&file.hydro.scales(file.thrusters.limit_scale), &SCALE_KEYS)
+            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
         let v = &vehicle;
         let n_thrusters = v.n_thrusters();
         if n_thrusters == 0 {

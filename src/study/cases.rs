@@ -68,12 +68,21 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
         scenario.insert("control".into(), toml::Value::Table(c));
     }
     let seed = derive_seed(study.seed, case.id as u64);
-    let (hash, design_hash) = match &study.tune {
-        None => case_hashes(&design, &scenario, seed),
-        Some(t) => {
-            // A case is tuned by the study's `[tune]`: its row depends on it.
+    let (hash, design_hash) = match (&study.tune, study.robust_table.is_empty()) {
+        (None, true) => case_hashes(&design, &scenario, seed),
+        (t, _) => {
+            // A case is tuned by the study's `[tune]` and meets its worlds and validation
+            // variants: its row depends on them.
             let mut hashed = scenario.clone();
-            hashed.insert("tune".into(), toml::Value::Table(t.clone()));
+            if let Some(t) = t {
+                hashed.insert("tune".into(), toml::Value::Table(t.clone()));
+            }
+            if !study.robust_table.is_empty() {
+                hashed.insert(
+                    "robust".into(),
+                    toml::Value::Table(study.robust_table.clone()),
+                );
+            }
             (
                 case_hashes(&design, &hashed, seed).0,
                 case_hashes(&design, &scenario, seed).1,

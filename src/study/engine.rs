@@ -50,6 +50,7 @@ use super::records::{
     axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH,
     PARTIAL_FILE, STUDY_COPY,
 };
+use super::robust::RobustInfo;
 use super::runner::TIMEOUT;
 use super::schema::Study;
 use super::tune::{case_tuner, CaseTuner, TuningHook};
@@ -222,7 +223,7 @@ pub fn run_sweep(
         &read_csv_typed(&partial, &schema)?,
         Some(&streamed.plan_hashes),
     )?;
-    let table = write_tables(raw, &out)?;
+    let table = write_tables(raw, &out, RobustInfo::of(study).as_ref())?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;
@@ -520,5 +521,7 @@ fn sweep_manifest(
             })
             .collect(),
         report: study.report.clone(),
+        robust: RobustInfo::of(study),
+        ledger: None,
     }
 }

@@ -116,6 +116,13 @@ pub struct Manifest {
     pub axes: Vec<AxisInfo>,
     /// Report settings.
     pub report: ReportSettings,
+    /// The uncertain worlds and the ranking rule (studies with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robust: Option<super::robust::RobustInfo>,
+    /// The assumption ledger: every inferred model parameter with its value, source and
+    /// range (studies with `[uncertainty]`; docs/assumptions.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ledger: Option<serde_json::Value>,
 }
 
 impl Manifest {

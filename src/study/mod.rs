@@ -9,6 +9,8 @@
 //! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
 //! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
 //! - [`parse`]: study files (TOML) → validated [`Study`].
+//! - [`uncertainty`]: `[uncertainty]` and `[[validate]]`: uncertain parameters, the worlds
+//!   every case meets (common random numbers), ranking settings, validation variants.
 //! - [`doe`]: grid and sampled designs of experiments → cases.
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
 //! - [`tune`]: the per-case tuning hook (`[tune]`): the optimiser's tuner reaches the sweep
@@ -16,12 +18,17 @@
 //! - [`records`]: rows (named metrics), columns of the raw and final tables.
 //! - [`worker`]: one resolved case → one row through the case evaluator
 //!   ([`crate::evaluate`]), tuned first through the hook.
+//! - [`worlds`]: one case in the study's worlds and validation variants (summaries over
+//!   worlds, success probability, the paired per-world values).
+//! - [`robust`]: the study-level view of the worlds: `worlds.csv`, ranking columns, the
+//!   paired verdict.
 //! - [`manifest`]: the `manifest.json` of an output directory.
 //! - [`lock`]: the output directory's lock (heartbeat, takeover on `--resume`, signals).
 //! - [`outdir`]: the output directory resolved once, kept free of links out, owned by one
 //!   study; the record of the files the tool wrote.
 //! - [`journal`]: the journal (`cases.partial.csv`) checked before `--resume` trusts it.
-//! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots).
+//! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots);
+//!   [`summary_robust`]: its verdict and sections over uncertain worlds.
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
 //! - [`engine`]: running, resuming and sharding a sweep.
 //! - [`shards`]: merging shard outputs.
@@ -40,13 +47,17 @@ pub mod outdir;
 pub mod parse;
 pub mod plots;
 pub mod records;
+pub mod robust;
 pub mod runner;
 pub mod schema;
 pub mod selection;
 pub mod shards;
 pub mod summary;
+pub mod summary_robust;
 pub mod tune;
+pub mod uncertainty;
 pub mod worker;
+pub mod worlds;
 
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use error::{InputError, StudyError};

@@ -16,6 +16,7 @@ use super::hash::study_hash;
 use super::records::{DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
+use super::uncertainty::{parse_uncertainty, parse_variants};
 use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{did_you_mean, flatten, pattern_allowed};
@@ -45,6 +46,9 @@ struct StudyFile {
     axis: Option<Vec<AxisFile>>,
     doe: Option<DoeFile>,
     tune: Option<toml::Table>,
+    hydro: Option<toml::Table>,
+    uncertainty: Option<toml::Table>,
+    validate: Option<Vec<toml::Table>>,
 }
 
 #[derive(Deserialize)]
@@ -204,8 +208,25 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         },
         hash,
         tune: file.tune.clone(),
+        uncertainty: None,
+        validate: Vec::new(),
+        robust_table: toml::Table::new(),
     };
     check_report(&study, doc)?;
+    let mut study = study;
+    study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
+    study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
+    if let Some(u) = &file.uncertainty {
+        study
+            .robust_table
+            .insert("uncertainty".into(), toml::Value::Table(u.clone()));
+    }
+    if let Some(v) = &file.validate {
+        let list = v.iter().cloned().map(toml::Value::Table).collect();
+        study
+            .robust_table
+            .insert("validate".into(), toml::Value::Array(list));
+    }
     Ok(study)
 }
 
@@ -409,6 +430,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("reference", &file.reference),
         ("servo", &file.servo),
         ("thrusters", &file.thrusters),
+        ("hydro", &file.hydro),
         ("success", &file.success),
     ] {
         if let Some(t) = t {

@@ -365,9 +365,26 @@ pub fn final_table(raw: Table) -> Result<Table, StudyError> {
 
 /// Write compacted raw rows to the partial file of `out` and the final table to
 /// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table (built from `raw`'s columns).
-pub fn write_tables(raw: Table, out: &Path) -> Result<Table, StudyError> {
+///
+/// With uncertain worlds (`robust`), the per-world columns move to
+/// [`super::robust::WORLDS_CSV`] and the ranking columns are added
+/// ([`super::robust::add_rank_columns`]).
+pub fn write_tables(
+    raw: Table,
+    out: &Path,
+    robust: Option<&super::robust::RobustInfo>,
+) -> Result<Table, StudyError> {
     write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
-    let table = final_table(raw)?;
+    let mut table = final_table(raw)?;
+    if let Some(curves) = super::robust::split_tuning(&mut table) {
+        write_csv_streamed(&curves, &out.join(super::robust::TUNING_CSV))?;
+    }
+    if let Some(info) = robust {
+        if let Some(worlds) = super::robust::split_worlds(&mut table, info) {
+            write_csv_streamed(&worlds, &out.join(super::robust::WORLDS_CSV))?;
+            super::robust::add_rank_columns(&mut table, &worlds, info);
+        }
+    }
     write_csv_streamed(&table, &out.join(CASES_CSV))?;
     write_parquet(&table, &out.join(CASES_PARQUET))?;
     Ok(table)

@@ -53,8 +53,9 @@ impl From<SettingsError> for String {
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
 /// `[static]`); must cover the top-level keys of [`default_table`].
-pub const SCENARIO_TABLES: [&str; 13] = [
+pub const SCENARIO_TABLES: [&str; 14] = [
     "scenario",
+    "hydro",
     "control",
     "base_control",
     "allocation",

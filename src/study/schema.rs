@@ -227,18 +227,33 @@ pub struct Study {
     /// by the tuner wired into the sweep (`crate::optimise::tune::Tuner::new`) before any
     /// case runs.
     pub tune: Option<toml::Table>,
+    /// The `[uncertainty]` section: worlds every case meets (issue 22).
+    pub uncertainty: Option<super::uncertainty::Uncertainty>,
+    /// The `[[validate]]` variants, scored at the tuned values.
+    pub validate: Vec<super::uncertainty::Variant>,
+    /// `[uncertainty]` and `[[validate]]` as written (part of every case hash: a row
+    /// depends on them); empty without them.
+    pub robust_table: toml::Table,
 }
 
 /// Column of a tuned study's rows: fresh evaluations the case's tuning used.
 pub const TUNE_EVALUATIONS: &str = "tune_evaluations";
 /// Column of a tuned study's rows: 1 when the tuned point met every `[[tune.constraint]]`.
 pub const TUNE_FEASIBLE: &str = "tune_feasible";
+/// Column of a tuned study's rows: relative spread of the tuned objective across the
+/// independent tuning starts (`[tune] starts`), the tuning noise.
+pub const TUNE_NOISE: &str = "tune_noise";
+/// Column of a tuned study's rows: tuned parameters on a bound of their box.
+pub const TUNE_BOUND_HITS: &str = "tune_bound_hits";
+/// Prefix of a row's best-so-far tuning curve (`tune_curve.<k>`), moved to `tuning.csv`.
+pub const TUNE_CURVE_PREFIX: &str = "tune_curve.";
 /// Prefix of the tuned-value columns (`tuned.control.k_psi`).
 pub const TUNED_PREFIX: &str = "tuned.";
 
 impl Study {
     /// The columns per-case tuning adds to every row: `tuned.<param>` for each
-    /// `[[tune.param]]` in file order, then [`TUNE_EVALUATIONS`] and [`TUNE_FEASIBLE`]
+    /// `[[tune.param]]` in file order, then [`TUNE_EVALUATIONS`], [`TUNE_FEASIBLE`],
+    /// [`TUNE_NOISE`] and [`TUNE_BOUND_HITS`]
     /// (none without `[tune]`).
     pub fn tune_columns(&self) -> Vec<String> {
         let Some(t) = &self.tune else {
@@ -253,6 +268,8 @@ impl Study {
             .collect();
         cols.push(TUNE_EVALUATIONS.into());
         cols.push(TUNE_FEASIBLE.into());
+        cols.push(TUNE_NOISE.into());
+        cols.push(TUNE_BOUND_HITS.into());
         cols
     }
 }

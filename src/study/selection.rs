@@ -39,6 +39,36 @@ pub const ENERGY_PER_METRE: &str = "energy_per_metre";
 /// The 0/1 success metric of a closed-loop run (1 on every ranked case).
 pub const SUCCESS: &str = "success";
 
+/// Whether larger is better for `metric` by default: conditioning (σ_min) and run outcomes
+/// (completion, success, convergence, progress) and their summaries over worlds
+/// (`…_mean`, `…_p05`, …), `success_probability` and `p_best`. Study files add their own with
+/// `study.maximise`.
+pub fn larger_is_better(metric: &str) -> bool {
+    let m = metric;
+    m.starts_with("tcm_sigma_min")
+        || m.starts_with(TCM_STRAIGHT_SIGMA_MIN)
+        || m.starts_with("sigma_min")
+        || [
+            "completed",
+            SUCCESS,
+            "converged",
+            "segments_reached",
+            "simulated_time",
+            "path_progress",
+        ]
+        .iter()
+        .any(|b| {
+            m == *b
+                || m.strip_prefix(b)
+                    .is_some_and(|r| r != "_std" && WORLD_SUFFIXES.contains(&r))
+        })
+        || m == "success_probability"
+        || m == "p_best"
+}
+
+/// Suffixes of a metric's summary over worlds (`energy_per_metre_mean`, …).
+pub const WORLD_SUFFIXES: [&str; 5] = ["_mean", "_std", "_p05", "_p95", "_worst"];
+
 /// Which metrics the report looks at and in which direction.
 pub struct Selection {
     /// Every metric column (f64, not an axis).
@@ -67,20 +97,7 @@ impl Selection {
         let has = |n: &str| metrics.iter().any(|m| m == n);
         let mut maximise: HashSet<String> = manifest.report.maximise.iter().cloned().collect();
         for m in &metrics {
-            // Larger is better for conditioning (σ_min) and for run outcomes.
-            if m.starts_with("tcm_sigma_min")
-                || m.starts_with(TCM_STRAIGHT_SIGMA_MIN)
-                || m.starts_with("sigma_min")
-                || matches!(
-                    m.as_str(),
-                    "completed"
-                        | SUCCESS
-                        | "converged"
-                        | "segments_reached"
-                        | "simulated_time"
-                        | "path_progress"
-                )
-            {
+            if larger_is_better(m) {
                 maximise.insert(m.clone());
             }
         }

@@ -19,6 +19,7 @@ use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
+use super::summary_robust::Robust;
 use crate::report::{fmt_short, MarkdownTable, Table};
 
 /// What every section of the summary reads.
@@ -70,8 +71,12 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         axes: m.axes.iter().map(|a| a.name.as_str()).collect(),
         key,
     };
-    let mut md = header_section(&c, m);
-    tune_section(&c, &mut md);
+    let robust = Robust::load(dir, table, m);
+    let mut md = header_section(&c, m, robust.as_ref().map(Robust::verdict_line));
+    if let Some(r) = &robust {
+        md.push_str(&r.sections(&plots, &mut warnings));
+    }
+    tune_section(&c, &mut md, robust.is_some());
     best_section(&c, &mut md);
     effects_section(&c, &mut md);
     if let Some(f) = c.sel.front(table, &c.ok_rows) {
@@ -142,9 +147,12 @@ fn detail(s: CaseStatus, reason: &str) -> &str {
 }
 
 /// Title, description, counts and the objective.
-fn header_section(c: &Ctx, m: &Manifest) -> String {
+fn header_section(c: &Ctx, m: &Manifest, verdict: Option<String>) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# Sweep `{}`\n", m.study_name);
+    if let Some(v) = verdict {
+        let _ = writeln!(md, "{v}\n");
+    }
     if !m.description.is_empty() {
         let _ = writeln!(md, "{}\n", m.description.trim());
     }
@@ -197,7 +205,7 @@ fn header_section(c: &Ctx, m: &Manifest) -> String {
 
 /// With per-case tuning (`[tune]`): how many cases tuning made feasible and successful, and
 /// the winner at tuned values (the best successful case by the objective) with its values.
-fn tune_section(c: &Ctx, md: &mut String) {
+fn tune_section(c: &Ctx, md: &mut String, robust: bool) {
     let (Ok(feasible), Ok(evals)) = (c.table.f64(TUNE_FEASIBLE), c.table.f64(TUNE_EVALUATIONS))
     else {
         return;
@@ -249,7 +257,12 @@ fn tune_section(c: &Ctx, md: &mut String) {
         .collect();
     let _ = writeln!(
         md,
-        "**Winner at tuned values** by `{o}`: case #{} ({}), `{o}` = {}, tuned {}.\n",
+        "**{}** by `{o}`: case #{} ({}), `{o}` = {}, tuned {}.\n",
+        if robust {
+            "Best in the nominal world at tuned values (the verdict above is over the worlds)"
+        } else {
+            "Winner at tuned values"
+        },
         c.ids[best],
         axes.join(", "),
         cell_text(c.table, o, best),

@@ -12,7 +12,10 @@ use std::fmt;
 use super::cases::Resolved;
 use super::doe::Case;
 use super::error::{InputError, StudyError};
-use super::schema::{Study, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
+use super::schema::{
+    Study, TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_CURVE_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE,
+    TUNE_NOISE,
+};
 use crate::evaluate::{Deadline, Metrics};
 
 /// Why a case could not be tuned (its row is `failed` with reason `tune: …`).
@@ -55,6 +58,14 @@ pub struct Tuned {
     pub evaluations: usize,
     /// Whether the tuned point met every constraint.
     pub feasible: bool,
+    /// Relative spread of the best feasible objective across independent tuning starts
+    /// (`[tune] starts`; NaN with one start or fewer than two feasible): the tuning noise.
+    pub noise: f64,
+    /// Tuned parameters on a bound of their box (within 0.1 % of its width).
+    pub bound_hits: usize,
+    /// Best feasible tuning objective after each fresh evaluation (relative to the start
+    /// point's scale; NaN before the first feasible point).
+    pub curve: Vec<f64>,
 }
 
 impl Tuned {
@@ -65,6 +76,11 @@ impl Tuned {
         }
         metrics.set(TUNE_EVALUATIONS, self.evaluations as f64);
         metrics.set(TUNE_FEASIBLE, f64::from(u8::from(self.feasible)));
+        metrics.set(TUNE_NOISE, self.noise);
+        metrics.set(TUNE_BOUND_HITS, self.bound_hits as f64);
+        for (k, x) in self.curve.iter().enumerate() {
+            metrics.push(format!("{TUNE_CURVE_PREFIX}{k}"), *x);
+        }
     }
 }
 

@@ -15,6 +15,7 @@ use super::doe::Case;
 use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
+use super::worlds::score_worlds;
 use crate::evaluate::{CaseInput, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
 use crate::report::Table;
 
@@ -72,6 +73,39 @@ impl Worker {
         }
     }
 
+    /// Score a case that ran (at its tuned values `r`) in the study's worlds and validation
+    /// variants ([`score_worlds`]); a timeout there fails the case.
+    fn robust(
+        &mut self,
+        study: &Study,
+        id: usize,
+        r: &Resolved,
+        deadline: Deadline,
+        res: &mut CaseResult,
+    ) {
+        let robust = study.uncertainty.is_some() || !study.validate.is_empty();
+        if !robust || matches!(res.status, CaseStatus::Failed | CaseStatus::Skipped) {
+            return;
+        }
+        let worlds = study
+            .uncertainty
+            .as_ref()
+            .map(|u| u.sample(study.seed))
+            .unwrap_or_default();
+        if let Err(e) = score_worlds(
+            &mut self.evaluator,
+            study,
+            &worlds,
+            id,
+            r,
+            deadline,
+            &mut res.metrics,
+        ) {
+            res.status = CaseStatus::Failed;
+            res.reason = e.to_string();
+        }
+    }
+
     /// Evaluate a resolved case; returns the row and (with `log`) the trajectory. With a
     /// `tuner`, the case is tuned first and scored at its tuned values (a tuning that cannot
     /// run makes the case `failed` with a reason starting `tune:`).
@@ -88,6 +122,7 @@ impl Worker {
             |res: CaseResult| Row::from_result(case.id, r.hash.clone(), case.values.clone(), res);
         let Some(t) = tuner else {
             let mut res = evaluate_resolved(&mut self.evaluator, study, case.id, r, log, deadline);
+            self.robust(study, case.id, r, deadline, &mut res);
             let traj = res.trajectory.take();
             return (row(res), traj);
         };
@@ -102,6 +137,7 @@ impl Worker {
                     deadline,
                 );
                 tuned.record(study, &mut res.metrics);
+                self.robust(study, case.id, &tuned.resolved, deadline, &mut res);
                 let traj = res.trajectory.take();
                 (row(res), traj)
             }

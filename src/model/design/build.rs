@@ -383,6 +383,7 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
         ("linear_damping", h.linear_damping.is_some()),
         ("strips", h.strips.is_some()),
         ("axial_added_mass_ratio", h.axial_added_mass_ratio.is_some()),
+        ("added_mass_scale", h.added_mass_scale.is_some()),
     ];
     let coefficient_keys = [
         ("added_mass", h.added_mass.is_some()),
@@ -405,6 +406,7 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
                 linear_damping,
                 strips,
                 axial_added_mass_ratio,
+                added_mass_scale,
             } = Hydro::cylinder(0.1, 1.0)
             else {
                 return Err(ctx.schema(&key("kind"), "internal: cylinder defaults"));
@@ -423,6 +425,7 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
                 linear_damping: h.linear_damping.unwrap_or(linear_damping),
                 strips,
                 axial_added_mass_ratio: h.axial_added_mass_ratio.unwrap_or(axial_added_mass_ratio),
+                added_mass_scale: h.added_mass_scale.unwrap_or(added_mass_scale),
             })
         }
         "coefficients" => {

@@ -29,7 +29,7 @@
 //!   and `cb` [3] [m] (default: the centre `(l/2, 0, 0)`), `volume` [m³] (default `πr²l`) or
 //!   `neutral = true` (volume `m/ρ`), `inertia` [3][3] [kg·m²] about the CG (default solid
 //!   cylinder), and `[body.hydro]` with `kind = "cylinder"` (`cd_x`, `cd_y`, `cd_z`,
-//!   `linear_damping` [6], `strips`, `axial_added_mass_ratio`; defaults of
+//!   `linear_damping` [6], `strips`, `axial_added_mass_ratio`, `added_mass_scale`; defaults of
 //!   `Hydro::cylinder(0.1, 1.0)`) or `kind = "coefficients"` (`added_mass` [6][6] required,
 //!   `linear` and `quadratic` [6][6] default zero). Without `[body.hydro]`: the cylinder model
 //!   with its defaults.

@@ -54,6 +54,7 @@ pub(super) struct HydroSpec {
     pub(super) linear_damping: Option<[f64; 6]>,
     pub(super) strips: Option<usize>,
     pub(super) axial_added_mass_ratio: Option<f64>,
+    pub(super) added_mass_scale: Option<f64>,
     pub(super) added_mass: Option<[[f64; 6]; 6]>,
     pub(super) linear: Option<[[f64; 6]; 6]>,
     pub(super) quadratic: Option<[[f64; 6]; 6]>,

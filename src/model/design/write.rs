@@ -138,6 +138,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 linear_damping,
                 strips,
                 axial_added_mass_ratio,
+                added_mass_scale,
             } => {
                 let _ = writeln!(o, "kind = \"cylinder\"");
                 let _ = writeln!(o, "cd_x = {}", fnum(*cd_x));
@@ -150,6 +151,9 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                     "axial_added_mass_ratio = {}",
                     fnum(*axial_added_mass_ratio)
                 );
+                if *added_mass_scale != 1.0 {
+                    let _ = writeln!(o, "added_mass_scale = {}", fnum(*added_mass_scale));
+                }
             }
             Hydro::Coefficients {
                 added_mass,

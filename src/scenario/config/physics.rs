@@ -47,6 +47,9 @@ pub struct ThrusterSpec {
     pub time_constant: f64,
     /// Rate limit [N/s] for `rate` (0 = each thruster's own).
     pub rate_limit: f64,
+    /// Factor on every thruster's thrust limits (derating; > 0, nominal 1): an uncertain
+    /// world's key (docs/assumptions.md).
+    pub limit_scale: f64,
 }
 
 impl Default for ThrusterSpec {
@@ -55,6 +58,74 @@ impl Default for ThrusterSpec {
             model: "ideal".into(),
             time_constant: 0.0,
             rate_limit: 0.0,
+            limit_scale: 1.0,
+        }
+    }
+}
+
+impl PhysicsSpec {
+    /// The current in the inertial frame [m/s]: `current` plus the horizontal current of
+    /// `current_speed` towards `current_direction`.
+    pub fn total_current(&self) -> [f64; 3] {
+        let mut c = self.current;
+        if self.current_speed != 0.0 {
+            let a = self.current_direction.to_radians();
+            c[0] += self.current_speed * a.cos();
+            c[1] += self.current_speed * a.sin();
+        }
+        c
+    }
+}
+
+/// `[hydro]`: whole-design scale factors of the hydrodynamics and buoyancy (an uncertain
+/// world's keys; docs/assumptions.md). Nominal values change nothing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HydroScaleSpec {
+    /// Factor on every body's linear damping (≥ 0).
+    pub linear_damping_scale: f64,
+    /// Factor on the roll entry of the linear damping, on top (≥ 0).
+    pub roll_damping_scale: f64,
+    /// Factor on the quadratic drag coefficients (≥ 0).
+    pub drag_scale: f64,
+    /// Factor on the added mass (≥ 0).
+    pub added_mass_scale: f64,
+    /// Relative buoyancy offset: displaced volumes × (1 + offset) (> −1).
+    pub buoyancy_offset: f64,
+}
+
+impl Default for HydroScaleSpec {
+    fn default() -> Self {
+        Self {
+            linear_damping_scale: 1.0,
+            roll_damping_scale: 1.0,
+            drag_scale: 1.0,
+            added_mass_scale: 1.0,
+            buoyancy_offset: 0.0,
+        }
+    }
+}
+
+/// The study keys of the scale factors, for error messages.
+pub const SCALE_KEYS: crate::model::world::ScaleKeys = crate::model::world::ScaleKeys {
+    linear_damping: "hydro.linear_damping_scale",
+    roll_damping: "hydro.roll_damping_scale",
+    drag: "hydro.drag_scale",
+    added_mass: "hydro.added_mass_scale",
+    buoyancy_offset: "hydro.buoyancy_offset",
+    thrust_limit: "thrusters.limit_scale",
+};
+
+impl HydroScaleSpec {
+    /// The model scales of this section with the thrust-limit factor of `[thrusters]`.
+    pub fn scales(&self, limit_scale: f64) -> crate::model::world::ModelScales {
+        crate::model::world::ModelScales {
+            linear_damping: self.linear_damping_scale,
+            roll_damping: self.roll_damping_scale,
+            drag: self.drag_scale,
+            added_mass: self.added_mass_scale,
+            buoyancy_offset: self.buoyancy_offset,
+            thrust_limit: limit_scale,
         }
     }
 }
@@ -77,6 +148,10 @@ pub struct PhysicsSpec {
     pub restoring: bool,
     /// Constant irrotational current, inertial frame [m/s].
     pub current: [f64; 3],
+    /// Speed [m/s] of a horizontal current added to `current` (an uncertain world's key).
+    pub current_speed: f64,
+    /// Direction [deg] of that current: the angle from inertial +x towards +y.
+    pub current_direction: f64,
     /// Time integrator: `"dopri5"` (adaptive Dormand–Prince 5(4), the default) or `"rk4"`
     /// (fixed steps of `scenario.dt`); see [`Integrator`].
     pub integrator: String,
@@ -93,6 +168,8 @@ impl Default for PhysicsSpec {
             drag: true,
             restoring: true,
             current: [0.0; 3],
+            current_speed: 0.0,
+            current_direction: 0.0,
             integrator: "dopri5".into(),
             rtol: DOPRI5_DEFAULT.0,
             atol: DOPRI5_DEFAULT.1,

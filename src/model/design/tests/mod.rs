@@ -109,6 +109,7 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 linear_damping,
                 strips,
                 axial_added_mass_ratio,
+                added_mass_scale,
             },
             Hydro::Cylinder {
                 cd_x: cx,
@@ -117,11 +118,13 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 linear_damping: ld,
                 strips: s,
                 axial_added_mass_ratio: ar,
+                added_mass_scale: ams,
             },
         ) => {
             nums(&k("cd"), &[*cd_x, *cd_y, *cd_z], &[*cx, *cy, *cz], tol)?;
             nums(&k("linear_damping"), linear_damping, ld, tol)?;
             num(&k("axial"), *axial_added_mass_ratio, *ar, tol)?;
+            num(&k("added_mass_scale"), *added_mass_scale, *ams, tol)?;
             if strips != s {
                 return Err(k("strips"));
             }

@@ -1,0 +1,241 @@
+//! Whole-design scale factors of an uncertain world (issue 22; docs/assumptions.md): the
+//! inferred and measured-with-error quantities of a design scaled together, so that an
+//! uncertainty study can ask "what if the linear damping we inferred is twice too large?"
+//! without editing every body.
+//!
+//! The nominal scales ([`ModelScales::default`]) change nothing, bit for bit.
+
+use super::{Hydro, ModelError, Vehicle};
+
+/// Scale factors applied to every body and thruster of a design (dimensionless).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelScales {
+    /// Factor on all six linear-damping entries of every body (cylinder `linear_damping`,
+    /// coefficient `D_l`). Nominal 1.
+    pub linear_damping: f64,
+    /// Factor on the roll entry of the linear damping, on top of `linear_damping`. Nominal 1.
+    pub roll_damping: f64,
+    /// Factor on the quadratic drag (cylinder `cd_x`, `cd_y`, `cd_z`; coefficient `D_q`).
+    /// Nominal 1.
+    pub drag: f64,
+    /// Factor on the added-mass matrix `M_A` of every body. Nominal 1.
+    pub added_mass: f64,
+    /// Relative buoyancy offset δ: every displaced volume × (1 + δ). Nominal 0.
+    pub buoyancy_offset: f64,
+    /// Factor on every thrust limit `u_min`, `u_max` (derating). Nominal 1.
+    pub thrust_limit: f64,
+}
+
+impl Default for ModelScales {
+    fn default() -> Self {
+        Self {
+            linear_damping: 1.0,
+            roll_damping: 1.0,
+            drag: 1.0,
+            added_mass: 1.0,
+            buoyancy_offset: 0.0,
+            thrust_limit: 1.0,
+        }
+    }
+}
+
+impl ModelScales {
+    /// Whether the scales leave the hydrodynamics untouched.
+    fn hydro_nominal(&self) -> bool {
+        self.linear_damping == 1.0
+            && self.roll_damping == 1.0
+            && self.drag == 1.0
+            && self.added_mass == 1.0
+    }
+
+    /// Check the factors: finite, the damping, drag and added-mass factors ≥ 0, the thrust
+    /// factor > 0 and the buoyancy offset > −1. `key` names the offending factor as given.
+    pub fn validate(&self, keys: &ScaleKeys) -> Result<(), ModelError> {
+        for (k, v) in [
+            (keys.linear_damping, self.linear_damping),
+            (keys.roll_damping, self.roll_damping),
+            (keys.drag, self.drag),
+            (keys.added_mass, self.added_mass),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(ModelError::new(
+                    k,
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
+        }
+        if !self.thrust_limit.is_finite() || self.thrust_limit <= 0.0 {
+            return Err(ModelError::new(
+                keys.thrust_limit,
+                format!("must be finite and > 0, got {}", self.thrust_limit),
+            ));
+        }
+        if !self.buoyancy_offset.is_finite() || self.buoyancy_offset <= -1.0 {
+            return Err(ModelError::new(
+                keys.buoyancy_offset,
+                format!("must be finite and > -1, got {}", self.buoyancy_offset),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The names under which the scale factors are given (for error messages).
+#[derive(Clone, Copy, Debug)]
+pub struct ScaleKeys {
+    /// Name of [`ModelScales::linear_damping`].
+    pub linear_damping: &'static str,
+    /// Name of [`ModelScales::roll_damping`].
+    pub roll_damping: &'static str,
+    /// Name of [`ModelScales::drag`].
+    pub drag: &'static str,
+    /// Name of [`ModelScales::added_mass`].
+    pub added_mass: &'static str,
+    /// Name of [`ModelScales::buoyancy_offset`].
+    pub buoyancy_offset: &'static str,
+    /// Name of [`ModelScales::thrust_limit`].
+    pub thrust_limit: &'static str,
+}
+
+impl Vehicle {
+    /// Apply whole-design scale factors in place (see [`ModelScales`]). Nominal factors leave
+    /// the vehicle bit-identical. Bodies described by manoeuvring derivatives take no
+    /// hydrodynamic factor (their tables are measured as a whole): a non-nominal one is an
+    /// error at `body[i].hydro`.
+    pub fn apply_scales(&mut self, s: &ModelScales, keys: &ScaleKeys) -> Result<(), ModelError> {
+        s.validate(keys)?;
+        for (i, b) in self.bodies.iter_mut().enumerate() {
+            if s.buoyancy_offset != 0.0 {
+                b.volume *= 1.0 + s.buoyancy_offset;
+            }
+            if s.hydro_nominal() {
+                continue;
+            }
+            match &mut b.hydro {
+                Hydro::Cylinder {
+                    cd_x,
+                    cd_y,
+                    cd_z,
+                    linear_damping,
+                    added_mass_scale,
+                    ..
+                } => {
+                    for d in linear_damping.iter_mut() {
+                        *d *= s.linear_damping;
+                    }
+                    linear_damping[3] *= s.roll_damping;
+                    for c in [cd_x, cd_y, cd_z] {
+                        *c *= s.drag;
+                    }
+                    *added_mass_scale *= s.added_mass;
+                }
+                Hydro::Coefficients {
+                    added_mass,
+                    linear,
+                    quadratic,
+                } => {
+                    *linear *= s.linear_damping;
+                    linear[(3, 3)] *= s.roll_damping;
+                    *quadratic *= s.drag;
+                    *added_mass *= s.added_mass;
+                }
+                Hydro::Manoeuvring(_) => {
+                    return Err(ModelError::new(
+                        format!("body[{i}].hydro"),
+                        "the hydrodynamic scale factors (damping, drag, added mass) do not \
+                         apply to a hull given by manoeuvring derivatives",
+                    ))
+                }
+            }
+        }
+        if s.thrust_limit != 1.0 {
+            for t in &mut self.thrusters {
+                t.u_min *= s.thrust_limit;
+                t.u_max *= s.thrust_limit;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets;
+
+    const KEYS: ScaleKeys = ScaleKeys {
+        linear_damping: "ld",
+        roll_damping: "rd",
+        drag: "drag",
+        added_mass: "am",
+        buoyancy_offset: "bo",
+        thrust_limit: "tl",
+    };
+
+    #[test]
+    fn nominal_scales_change_nothing() {
+        let v0 = presets::usm_paper();
+        let mut v = v0.clone();
+        v.apply_scales(&ModelScales::default(), &KEYS).unwrap();
+        assert_eq!(v, v0);
+    }
+
+    #[test]
+    fn scales_reach_every_body_and_thruster() {
+        let v0 = presets::usm_paper();
+        let mut v = v0.clone();
+        let s = ModelScales {
+            linear_damping: 2.0,
+            roll_damping: 3.0,
+            drag: 0.5,
+            added_mass: 1.5,
+            buoyancy_offset: 0.01,
+            thrust_limit: 0.8,
+        };
+        v.apply_scales(&s, &KEYS).unwrap();
+        for (b, b0) in v.bodies.iter().zip(&v0.bodies) {
+            let (
+                Hydro::Cylinder {
+                    cd_x,
+                    linear_damping,
+                    ..
+                },
+                Hydro::Cylinder {
+                    cd_x: cd_x0,
+                    linear_damping: ld0,
+                    ..
+                },
+            ) = (&b.hydro, &b0.hydro)
+            else {
+                panic!("usm-paper bodies are cylinders");
+            };
+            assert_eq!(linear_damping[0], 2.0 * ld0[0]);
+            assert_eq!(linear_damping[3], 6.0 * ld0[3]);
+            assert_eq!(linear_damping[4], 2.0 * ld0[4]);
+            assert_eq!(*cd_x, 0.5 * cd_x0);
+            let (ma, ma0) = (b.added_mass(1026.0), b0.added_mass(1026.0));
+            assert!((ma - 1.5 * ma0).abs().max() <= 1e-12 * ma0.abs().max());
+            assert_eq!(b.volume, b0.volume * 1.01);
+        }
+        for (t, t0) in v.thrusters.iter().zip(&v0.thrusters) {
+            assert_eq!(t.u_max, 0.8 * t0.u_max);
+            assert_eq!(t.u_min, 0.8 * t0.u_min);
+        }
+        assert!(v.validate().is_ok());
+    }
+
+    #[test]
+    fn bad_factors_are_named() {
+        let mut v = presets::usm_paper();
+        let s = ModelScales {
+            thrust_limit: 0.0,
+            ..ModelScales::default()
+        };
+        assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "tl");
+        let s = ModelScales {
+            drag: f64::NAN,
+            ..ModelScales::default()
+        };
+        assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "drag");
+    }
+}

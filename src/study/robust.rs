@@ -1,0 +1,380 @@
+//! The study-level view of uncertain worlds (issue 22): what `manifest.json` records about
+//! them ([`RobustInfo`]), the per-world columns of the rows moved to `worlds.csv`
+//! ([`split_worlds`]), the ranking columns `p_best`, `rank_p05`, `rank_p50`, `rank_p95`
+//! ([`add_rank_columns`]) and the paired verdict the summary opens with ([`study_verdict`]).
+//!
+//! A case is ranked only when it ran and its `success_probability` reaches the study's
+//! `min_success_probability`; ranks and `p_best` are among the ranked cases, world by world
+//! (docs/statistics.md).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::records::{CaseStatus, CASE_ID, STATUS};
+use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
+use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use super::uncertainty::{Uncertainty, WorldSampling};
+use super::worlds::{SUCCESS_PROBABILITY, WORLD_PREFIX};
+use crate::report::{Column, ColumnData, Table};
+use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
+
+/// The per-world table of a study output (long format: one row per case and world).
+pub const WORLDS_CSV: &str = "worlds.csv";
+/// Column of the ranking: fraction of worlds in which the case is best.
+pub const P_BEST: &str = "p_best";
+/// Rank columns (5 %, 50 %, 95 % quantiles over the worlds).
+pub const RANK_COLUMNS: [&str; 3] = ["rank_p05", "rank_p50", "rank_p95"];
+/// The best-so-far tuning curves of a tuned study (long format: case, evaluation, best).
+pub const TUNING_CSV: &str = "tuning.csv";
+
+/// An uncertain parameter as the manifest records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParamInfo {
+    /// Its key.
+    pub name: String,
+    /// Its distribution, as text.
+    pub distribution: String,
+}
+
+/// What `manifest.json` records of a study's worlds and ranking rule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobustInfo {
+    /// Worlds each case met (besides the nominal one).
+    pub worlds: usize,
+    /// How they were drawn (`sobol`, `lhs`, `random`, `saltelli`).
+    pub sampling: String,
+    /// The uncertain parameters.
+    pub params: Vec<ParamInfo>,
+    /// Each world's parameter values (numbers; a `choice` of text by its index), by world.
+    pub world_values: Vec<Vec<f64>>,
+    /// Metrics summarised over worlds; the first is the ranking objective.
+    pub metrics: Vec<String>,
+    /// Least success probability of a ranked case.
+    pub min_success_probability: f64,
+    /// Fraction of paired worlds a winner must win.
+    pub confidence: f64,
+    /// Relative margin called a tie.
+    pub equivalence: f64,
+    /// The validation variants' names.
+    pub validate: Vec<String>,
+}
+
+impl RobustInfo {
+    /// The record of `study`'s `[uncertainty]` (`None` without it).
+    pub fn of(study: &Study) -> Option<RobustInfo> {
+        let u: &Uncertainty = study.uncertainty.as_ref()?;
+        let world_values = u
+            .sample(study.seed)
+            .iter()
+            .map(|w| {
+                w.values
+                    .iter()
+                    .zip(&u.params)
+                    .map(|(v, p)| numeric(v, &p.dist))
+                    .collect()
+            })
+            .collect();
+        Some(RobustInfo {
+            worlds: u.n_worlds(),
+            sampling: match u.sampling {
+                WorldSampling::Saltelli => "saltelli".into(),
+                WorldSampling::Points(s) => s.to_string(),
+            },
+            params: u
+                .params
+                .iter()
+                .map(|p| ParamInfo {
+                    name: p.name.clone(),
+                    distribution: p.dist.range_text(),
+                })
+                .collect(),
+            world_values,
+            metrics: u.metrics.clone(),
+            min_success_probability: u.min_success_probability,
+            confidence: u.confidence,
+            equivalence: u.equivalence,
+            validate: study.validate.iter().map(|v| v.name.clone()).collect(),
+        })
+    }
+
+    /// The ranking objective.
+    pub fn objective(&self) -> &str {
+        &self.metrics[0]
+    }
+}
+
+/// A world value as a number: numbers as they are, a choice of text or booleans by index.
+fn numeric(v: &toml::Value, d: &super::uncertainty::WorldDist) -> f64 {
+    match v {
+        toml::Value::Float(x) => *x,
+        toml::Value::Integer(i) => *i as f64,
+        _ => match d {
+            super::uncertainty::WorldDist::Choice(c) => {
+                c.iter().position(|x| x == v).map_or(f64::NAN, |i| i as f64)
+            }
+            _ => f64::NAN,
+        },
+    }
+}
+
+/// Move the per-world columns (`world.<k>.<metric>`) out of `table` into a long table
+/// `world`, `case_id`, the parameter values, then each metric; `None` when there are none.
+pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
+    let mut per: BTreeMap<(usize, String), Vec<f64>> = BTreeMap::new();
+    let mut kept = Vec::with_capacity(table.columns.len());
+    for c in std::mem::take(&mut table.columns) {
+        let parsed = c.name.strip_prefix(WORLD_PREFIX).and_then(|rest| {
+            let (k, m) = rest.split_once('.')?;
+            Some((k.parse::<usize>().ok()?, m.to_string()))
+        });
+        match (parsed, &c.data) {
+            (Some(key), ColumnData::F64(v)) => {
+                per.insert(key, v.clone());
+            }
+            _ => kept.push(c),
+        }
+    }
+    table.columns = kept;
+    if per.is_empty() {
+        return None;
+    }
+    let ids = table.i64(CASE_ID).ok()?.to_vec();
+    let n_worlds = per.keys().map(|(k, _)| k + 1).max().unwrap_or(0);
+    let mut metric_names: Vec<String> = info.metrics.clone();
+    metric_names.push(SUCCESS.into());
+    let rows = n_worlds * ids.len();
+    let mut world_col = Vec::with_capacity(rows);
+    let mut case_col = Vec::with_capacity(rows);
+    let mut params: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); info.params.len()];
+    let mut metrics: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); metric_names.len()];
+    for k in 0..n_worlds {
+        for (r, id) in ids.iter().enumerate() {
+            world_col.push(k as i64);
+            case_col.push(*id);
+            for (j, p) in params.iter_mut().enumerate() {
+                p.push(
+                    info.world_values
+                        .get(k)
+                        .and_then(|w| w.get(j))
+                        .copied()
+                        .unwrap_or(f64::NAN),
+                );
+            }
+            for (m, col) in metric_names.iter().zip(metrics.iter_mut()) {
+                col.push(per.get(&(k, m.clone())).map_or(f64::NAN, |v| v[r]));
+            }
+        }
+    }
+    let mut cols = vec![
+        Column {
+            name: "world".into(),
+            data: ColumnData::I64(world_col),
+        },
+        Column {
+            name: CASE_ID.into(),
+            data: ColumnData::I64(case_col),
+        },
+    ];
+    for (p, v) in info.params.iter().zip(params) {
+        cols.push(Column {
+            name: p.name.clone(),
+            data: ColumnData::F64(v),
+        });
+    }
+    for (m, v) in metric_names.into_iter().zip(metrics) {
+        cols.push(Column {
+            name: m,
+            data: ColumnData::F64(v),
+        });
+    }
+    Table::from_columns(cols).ok()
+}
+
+/// Move the best-so-far tuning curves (`tune_curve.<k>`) out of `table` into a long table
+/// `case_id`, `evaluation`, `best` (rows past a case's last evaluation left out); `None`
+/// when there are none.
+pub fn split_tuning(table: &mut Table) -> Option<Table> {
+    let mut curves: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+    let mut kept = Vec::with_capacity(table.columns.len());
+    for c in std::mem::take(&mut table.columns) {
+        let k = c
+            .name
+            .strip_prefix(TUNE_CURVE_PREFIX)
+            .and_then(|k| k.parse::<usize>().ok());
+        match (k, &c.data) {
+            (Some(k), ColumnData::F64(v)) => {
+                curves.insert(k, v.clone());
+            }
+            _ => kept.push(c),
+        }
+    }
+    table.columns = kept;
+    if curves.is_empty() {
+        return None;
+    }
+    let ids = table.i64(CASE_ID).ok()?.to_vec();
+    let (mut case, mut eval, mut best) = (Vec::new(), Vec::new(), Vec::new());
+    for (r, id) in ids.iter().enumerate() {
+        for (k, v) in &curves {
+            // A curve shorter than the longest reads NaN past its end: not a row.
+            if r < v.len() && !(v[r].is_nan() && curves.range(k..).all(|(_, w)| w[r].is_nan())) {
+                case.push(*id);
+                eval.push(*k as i64 + 1);
+                best.push(v[r]);
+            }
+        }
+    }
+    Table::new()
+        .with(CASE_ID, ColumnData::I64(case))
+        .and_then(|t| t.with("evaluation", ColumnData::I64(eval)))
+        .and_then(|t| t.with("best", ColumnData::F64(best)))
+        .ok()
+}
+
+/// The paired data of the ranking: per case of `table` (in row order), its objective (as
+/// ranked: smaller is better) and success in each world, and whether it is ranked.
+pub struct Paired {
+    /// `obj[c][w]`.
+    pub obj: Vec<Vec<f64>>,
+    /// `ok[c][w]`.
+    pub ok: Vec<Vec<bool>>,
+    /// Whether case `c` is ranked.
+    pub eligible: Vec<bool>,
+}
+
+/// The paired data of `table`'s cases from `worlds` (see [`Paired`]).
+pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired> {
+    let objective = info.objective();
+    let ids = table.i64(CASE_ID).ok()?;
+    let status = table.str(STATUS).ok()?;
+    let p = table.f64(SUCCESS_PROBABILITY).ok()?;
+    let row_of: BTreeMap<i64, usize> = ids.iter().enumerate().map(|(r, id)| (*id, r)).collect();
+    let n_worlds = worlds
+        .i64("world")
+        .ok()?
+        .iter()
+        .max()
+        .map_or(0, |m| *m as usize + 1);
+    let mut obj = vec![vec![f64::NAN; n_worlds]; ids.len()];
+    let mut ok = vec![vec![false; n_worlds]; ids.len()];
+    let (wc, cc) = (worlds.i64("world").ok()?, worlds.i64(CASE_ID).ok()?);
+    let (wo, ws) = (worlds.f64(objective).ok()?, worlds.f64(SUCCESS).ok()?);
+    let sign = if larger_is_better(objective) {
+        -1.0
+    } else {
+        1.0
+    };
+    let magnitude = BY_MAGNITUDE.contains(&objective);
+    for i in 0..wc.len() {
+        let Some(&r) = row_of.get(&cc[i]) else {
+            continue;
+        };
+        let x = if magnitude { wo[i].abs() } else { wo[i] };
+        obj[r][wc[i] as usize] = sign * x;
+        ok[r][wc[i] as usize] = ws[i] == 1.0;
+    }
+    let eligible = (0..ids.len())
+        .map(|r| {
+            matches!(
+                CaseStatus::parse(&status[r]),
+                Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
+            ) && p[r] >= info.min_success_probability
+        })
+        .collect();
+    Some(Paired { obj, ok, eligible })
+}
+
+/// Add `p_best` and the rank quantiles (NaN for unranked cases) before `status`.
+pub fn add_rank_columns(table: &mut Table, worlds: &Table, info: &RobustInfo) {
+    let Some(pd) = paired(table, worlds, info) else {
+        return;
+    };
+    let idx: Vec<usize> = (0..pd.eligible.len()).filter(|&c| pd.eligible[c]).collect();
+    let obj: Vec<Vec<f64>> = idx.iter().map(|&c| pd.obj[c].clone()).collect();
+    let ok: Vec<Vec<bool>> = idx.iter().map(|&c| pd.ok[c].clone()).collect();
+    let stats = rank_stats(&obj, &ok);
+    let n = table.n_rows();
+    let mut cols = vec![vec![f64::NAN; n]; 4];
+    for (s, &c) in stats.iter().zip(&idx) {
+        for (col, x) in cols
+            .iter_mut()
+            .zip([s.p_best, s.rank_p05, s.rank_p50, s.rank_p95])
+        {
+            col[c] = x;
+        }
+    }
+    let at = table
+        .columns
+        .iter()
+        .position(|c| c.name == STATUS)
+        .unwrap_or(table.columns.len());
+    for (name, v) in [P_BEST, RANK_COLUMNS[0], RANK_COLUMNS[1], RANK_COLUMNS[2]]
+        .into_iter()
+        .zip(cols)
+        .rev()
+    {
+        table.columns.insert(
+            at,
+            Column {
+                name: name.into(),
+                data: ColumnData::F64(v),
+            },
+        );
+    }
+}
+
+/// The verdict of a study's output, in terms of its table's rows, with the noise used.
+pub struct StudyVerdict {
+    /// The verdict (case indices are rows of the table).
+    pub verdict: Verdict,
+    /// Median relative tuning noise of the ranked cases (0 without tuning restarts).
+    pub noise: f64,
+    /// Cases not ranked for a success probability below the requirement.
+    pub below_requirement: usize,
+    /// Cases ranked.
+    pub ranked: usize,
+}
+
+/// The paired verdict of `table` (rows) with `worlds` under `info`'s rule, the tuning noise
+/// (median `tune_noise` of the ranked cases) counted as a tie margin.
+pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<StudyVerdict> {
+    let pd = paired(table, worlds, info)?;
+    let mut noise: Vec<f64> = table
+        .f64(TUNE_NOISE)
+        .map(|v| {
+            v.iter()
+                .zip(&pd.eligible)
+                .filter(|(x, e)| **e && x.is_finite())
+                .map(|(x, _)| *x)
+                .collect()
+        })
+        .unwrap_or_default();
+    noise.sort_by(f64::total_cmp);
+    let noise = if noise.is_empty() {
+        0.0
+    } else {
+        crate::stats::describe::quantile_sorted(&noise, 0.5)
+    };
+    let settings = VerdictSettings {
+        confidence: info.confidence,
+        equivalence: info.equivalence,
+        noise,
+    };
+    let status = table.str(STATUS).ok()?;
+    let below_requirement = (0..pd.eligible.len())
+        .filter(|&r| {
+            !pd.eligible[r]
+                && matches!(
+                    CaseStatus::parse(&status[r]),
+                    Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
+                )
+        })
+        .count();
+    Some(StudyVerdict {
+        verdict: verdict(&pd.obj, &pd.ok, &pd.eligible, &settings),
+        noise,
+        below_requirement,
+        ranked: pd.eligible.iter().filter(|e| **e).count(),
+    })
+}

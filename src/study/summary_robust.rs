@@ -1,0 +1,490 @@
+//! The parts of `summary.md` a study with uncertain worlds adds (issue 22): the verdict it
+//! opens with ("Winner: #N …" or "Statistically tied: #a, #b, …"), the ranking over the
+//! paired worlds with its rank-interval plot, tuning adequacy (tuning noise beside the top
+//! margin, bound hits), the sensitivity of each tracked metric to the uncertain parameters
+//! (pooled SRRC, or Sobol indices with a Saltelli design) with tornado plots, and the
+//! held-out validation gaps. Everything is read from the output directory (`cases`,
+//! `worlds.csv`, `manifest.json`), so `usm-study report` regenerates it.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::manifest::Manifest;
+use super::records::CASE_ID;
+use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
+use super::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
+use super::selection::cell_text;
+use super::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
+use crate::report::plot::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
+use crate::report::{fmt_short, read_csv, MarkdownTable, Table};
+use crate::stats::ranking::Verdict;
+use crate::stats::sobol::{sobol_indices, SaltelliDesign};
+use crate::stats::srrc::srrc;
+
+/// Most designs listed in the ranking table and drawn in the rank-interval plot.
+const TOP: usize = 12;
+
+/// What the robust sections read.
+pub struct Robust<'a> {
+    table: &'a Table,
+    info: &'a RobustInfo,
+    worlds: Table,
+    verdict: StudyVerdict,
+    ids: Vec<i64>,
+    axes: Vec<&'a str>,
+}
+
+impl<'a> Robust<'a> {
+    /// The robust view of an output directory (`None` without worlds).
+    pub fn load(dir: &Path, table: &'a Table, m: &'a Manifest) -> Option<Robust<'a>> {
+        let info = m.robust.as_ref()?;
+        let worlds = read_csv(&dir.join(WORLDS_CSV)).ok()?;
+        let verdict = study_verdict(table, &worlds, info)?;
+        Some(Robust {
+            table,
+            info,
+            worlds,
+            verdict,
+            ids: table.i64(CASE_ID).ok()?.to_vec(),
+            axes: m.axes.iter().map(|a| a.name.as_str()).collect(),
+        })
+    }
+
+    fn label(&self, r: usize) -> String {
+        let axes: Vec<String> = self
+            .axes
+            .iter()
+            .map(|a| cell_text(self.table, a, r))
+            .collect();
+        format!("#{} ({})", self.ids[r], axes.join(", "))
+    }
+
+    fn pct(x: f64) -> String {
+        if x.is_finite() {
+            format!("{:.2} %", 100.0 * x)
+        } else {
+            "–".into()
+        }
+    }
+
+    /// The line the summary opens with.
+    pub fn verdict_line(&self) -> String {
+        let v = &self.verdict;
+        let n = self.info.worlds;
+        let o = self.info.objective();
+        let noise = format!(
+            "median tuning noise {}; tie margin max(equivalence {}, noise)",
+            Self::pct(v.noise),
+            Self::pct(self.info.equivalence)
+        );
+        match &v.verdict {
+            Verdict::Winner {
+                leader,
+                runner_up,
+                p_beats,
+                margin,
+            } if leader == runner_up => format!(
+                "**Winner: {}** — the only design ranked (success probability ≥ {}) over {n} \
+                 worlds by `{o}`.",
+                self.label(*leader),
+                self.info.min_success_probability
+            ),
+            Verdict::Winner {
+                leader,
+                runner_up,
+                p_beats,
+                margin,
+            } => format!(
+                "**Winner: {}** by `{o}` — beats every other ranked design in ≥ {:.0} % of {n} \
+                 paired worlds; runner-up {}: beaten in {:.0} % of the worlds, median margin {} \
+                 ({noise}).",
+                self.label(*leader),
+                100.0 * self.info.confidence,
+                self.label(*runner_up),
+                100.0 * p_beats,
+                Self::pct(*margin)
+            ),
+            Verdict::Tied { leader, tied } => {
+                let list: Vec<String> = std::iter::once(format!("#{}", self.ids[*leader]))
+                    .chain(
+                        tied.iter()
+                            .take(TOP)
+                            .map(|c| format!("#{}", self.ids[c.case])),
+                    )
+                    .collect();
+                let margins: Vec<String> = tied
+                    .iter()
+                    .take(5)
+                    .map(|c| {
+                        format!(
+                            "#{} {} (beaten in {:.0} % of worlds)",
+                            self.ids[c.case],
+                            Self::pct(c.margin),
+                            100.0 * c.p_beats
+                        )
+                    })
+                    .collect();
+                format!(
+                    "**Statistically tied: {}{}** by `{o}` over {n} paired worlds — no design \
+                     beats all others in ≥ {:.0} % of the worlds. Leader {}; median margins \
+                     behind it: {} ({noise}).",
+                    list.join(", "),
+                    if tied.len() > TOP { ", …" } else { "" },
+                    100.0 * self.info.confidence,
+                    self.label(*leader),
+                    margins.join("; ")
+                )
+            }
+            Verdict::NoneEligible => format!(
+                "**No winner: no design reaches the required success probability {}** over {n} \
+                 worlds.",
+                self.info.min_success_probability
+            ),
+        }
+    }
+
+    /// The ranking, tuning-adequacy, sensitivity and validation sections; plots into
+    /// `plots`.
+    pub fn sections(&self, plots: &Path, warnings: &mut Vec<String>) -> String {
+        let mut md = String::new();
+        self.ranking_section(&mut md, plots, warnings);
+        self.tuning_section(&mut md);
+        self.sensitivity_section(&mut md, plots, warnings);
+        self.validation_section(&mut md);
+        md
+    }
+
+    fn col(&self, name: &str) -> Vec<f64> {
+        self.table
+            .f64(name)
+            .map(<[f64]>::to_vec)
+            .unwrap_or_else(|_| vec![f64::NAN; self.table.n_rows()])
+    }
+
+    /// Ranked rows by decreasing `p_best`, then increasing mean objective.
+    fn ranked_rows(&self) -> Vec<usize> {
+        let p = self.col(P_BEST);
+        let mean = self.col(&format!("{}_mean", self.info.objective()));
+        let mut rows: Vec<usize> = (0..self.table.n_rows())
+            .filter(|&r| p[r].is_finite())
+            .collect();
+        rows.sort_by(|&a, &b| p[b].total_cmp(&p[a]).then(mean[a].total_cmp(&mean[b])));
+        rows
+    }
+
+    fn ranking_section(&self, md: &mut String, plots: &Path, warnings: &mut Vec<String>) {
+        let o = self.info.objective();
+        let params: Vec<String> = self
+            .info
+            .params
+            .iter()
+            .map(|p| format!("`{}` {}", p.name, p.distribution))
+            .collect();
+        let _ = writeln!(
+            md,
+            "## Ranking over {} uncertain worlds\n",
+            self.info.worlds
+        );
+        let _ = writeln!(
+            md,
+            "Every design met the same {} worlds ({} sampling; common random numbers, so \
+             comparisons are paired): {}. The nominal world is reported apart (the plain \
+             metric columns). **{} designs are ranked**; {} ran but are not ranked because \
+             their success probability is below {} (`{SUCCESS_PROBABILITY}`: fraction of \
+             worlds meeting every `[success]` criterion).\n",
+            self.info.worlds,
+            self.info.sampling,
+            params.join(", "),
+            self.verdict.ranked,
+            self.verdict.below_requirement,
+            self.info.min_success_probability
+        );
+        let rows = self.ranked_rows();
+        let mut t = MarkdownTable::new(
+            [
+                "case",
+                P_BEST,
+                "rank 5–95 %",
+                &format!("{o} (nominal)"),
+                "mean",
+                "p05",
+                "p95",
+                "worst",
+                SUCCESS_PROBABILITY,
+            ]
+            .into_iter()
+            .chain(self.axes.iter().copied()),
+        );
+        let cells = |m: &str, r: usize| cell_text(self.table, m, r);
+        for &r in rows.iter().take(TOP) {
+            let mut cells_row = vec![
+                format!("#{}", self.ids[r]),
+                cells(P_BEST, r),
+                format!(
+                    "{}–{}",
+                    cells(RANK_COLUMNS[0], r),
+                    cells(RANK_COLUMNS[2], r)
+                ),
+                cells(o, r),
+            ];
+            for s in ["mean", "p05", "p95", "worst"] {
+                cells_row.push(cells(&format!("{o}_{s}"), r));
+            }
+            cells_row.push(cells(SUCCESS_PROBABILITY, r));
+            cells_row.extend(self.axes.iter().map(|a| cell_text(self.table, a, r)));
+            t.row(cells_row);
+        }
+        let _ = writeln!(md, "{}", t.finish());
+        let (p05, p50, p95) = (
+            self.col(RANK_COLUMNS[0]),
+            self.col(RANK_COLUMNS[1]),
+            self.col(RANK_COLUMNS[2]),
+        );
+        let leader = match &self.verdict.verdict {
+            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
+            Verdict::NoneEligible => None,
+        };
+        let rank_rows: Vec<RankRow> = rows
+            .iter()
+            .take(TOP)
+            .map(|&r| RankRow {
+                label: self.label(r),
+                p05: p05[r],
+                p50: p50[r],
+                p95: p95[r],
+                highlight: Some(r) == leader,
+            })
+            .collect();
+        if !rank_rows.is_empty() {
+            let title = format!(
+                "Rank of each design by {o} over {} worlds (5–95 %)",
+                self.info.worlds
+            );
+            match rank_interval_svg(&title, &rank_rows, self.verdict.ranked) {
+                Ok(svg) => {
+                    write_plot(plots, "rank_intervals.svg", &svg, warnings);
+                    let _ = writeln!(md, "![rank intervals](plots/rank_intervals.svg)\n");
+                }
+                Err(e) => warnings.push(format!("rank_intervals.svg: {e}")),
+            }
+        }
+    }
+
+    fn tuning_section(&self, md: &mut String) {
+        let noise = self.col(TUNE_NOISE);
+        if noise.iter().all(|x| x.is_nan()) && self.table.f64(TUNE_BOUND_HITS).is_err() {
+            return;
+        }
+        let _ = writeln!(md, "## Tuning adequacy\n");
+        let top_margin = match &self.verdict.verdict {
+            Verdict::Winner { margin, .. } => *margin,
+            Verdict::Tied { tied, .. } => tied.first().map_or(f64::NAN, |c| c.margin),
+            Verdict::NoneEligible => f64::NAN,
+        };
+        let _ = writeln!(
+            md,
+            "Median tuning noise (relative spread of the tuned `{}` across independent tuning \
+             starts, ranked designs): **{}**, beside a median margin of **{}** between the \
+             leader and the closest design. A margin inside the tuning noise is a tie: a \
+             winner is named only beyond both the noise and the equivalence margin.\n",
+            self.info.objective(),
+            Self::pct(self.verdict.noise),
+            Self::pct(top_margin)
+        );
+        if let Ok(hits) = self.table.f64(TUNE_BOUND_HITS) {
+            let n_params = self
+                .table
+                .columns
+                .iter()
+                .filter(|c| c.name.starts_with(TUNED_PREFIX))
+                .count();
+            let tuned = hits.iter().filter(|x| x.is_finite()).count();
+            let total: f64 = hits.iter().filter(|x| x.is_finite()).sum();
+            let _ = writeln!(
+                md,
+                "Bound hits: {total:.0} of {} tuned gains ({tuned} designs × {n_params}) ended \
+                 within 0.1 % of a bound of their box (`{TUNE_BOUND_HITS}`): a bound that \
+                 binds says the box, not the design, decided. Best-so-far curves of every \
+                 design: `tuning.csv`.\n",
+                tuned * n_params
+            );
+        }
+    }
+
+    /// Per tracked metric: the sensitivity rows (name, value, lo, hi) and the method.
+    fn sensitivity(&self, metric: &str) -> Option<(Vec<TornadoRow>, &'static str)> {
+        let eligible: Vec<i64> = {
+            let p = self.col(P_BEST);
+            (0..self.table.n_rows())
+                .filter(|&r| p[r].is_finite())
+                .map(|r| self.ids[r])
+                .collect()
+        };
+        let case = self.worlds.i64(CASE_ID).ok()?;
+        let world = self.worlds.i64("world").ok()?;
+        let y = self.worlds.f64(metric).ok()?;
+        let d = self.info.params.len();
+        let mut per_case: BTreeMap<i64, Vec<(usize, f64)>> = BTreeMap::new();
+        for i in 0..case.len() {
+            if eligible.binary_search(&case[i]).is_ok() || eligible.contains(&case[i]) {
+                per_case
+                    .entry(case[i])
+                    .or_default()
+                    .push((world[i] as usize, y[i]));
+            }
+        }
+        if self.info.sampling == "saltelli" {
+            let design = SaltelliDesign {
+                n: self.info.worlds / (d + 2),
+                d,
+            };
+            let mut all: Vec<Vec<crate::stats::sobol::SobolIndex>> = Vec::new();
+            for (id, v) in &per_case {
+                let mut ys = vec![f64::NAN; self.info.worlds];
+                for (w, x) in v {
+                    if *w < ys.len() {
+                        ys[*w] = *x;
+                    }
+                }
+                all.push(sobol_indices(&design, &ys, 200, *id as u64));
+            }
+            let med = |f: &dyn Fn(&crate::stats::sobol::SobolIndex) -> f64, j: usize| {
+                let mut v: Vec<f64> = all
+                    .iter()
+                    .map(|s| f(&s[j]))
+                    .filter(|x| x.is_finite())
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                crate::stats::describe::quantile_sorted(&v, 0.5)
+            };
+            let rows = (0..d)
+                .map(|j| TornadoRow {
+                    name: self.info.params[j].name.clone(),
+                    value: med(&|s| s.total, j),
+                    lo: med(&|s| s.total_lo, j),
+                    hi: med(&|s| s.total_hi, j),
+                })
+                .collect();
+            return Some((rows, "Sobol total index (median over ranked designs)"));
+        }
+        let (mut xs, mut ys) = (Vec::new(), Vec::new());
+        for v in per_case.values() {
+            let finite: Vec<f64> = v
+                .iter()
+                .map(|(_, x)| *x)
+                .filter(|x| x.is_finite())
+                .collect();
+            if finite.is_empty() {
+                continue;
+            }
+            let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+            for (w, x) in v {
+                let Some(p) = self.info.world_values.get(*w) else {
+                    continue;
+                };
+                if x.is_finite() && mean != 0.0 {
+                    xs.push(p.clone());
+                    ys.push(x / mean);
+                }
+            }
+        }
+        if ys.len() < d + 2 {
+            return None;
+        }
+        let s = srrc(&xs, &ys);
+        let rows = (0..d)
+            .map(|j| TornadoRow {
+                name: self.info.params[j].name.clone(),
+                value: s.coef[j],
+                lo: f64::NAN,
+                hi: f64::NAN,
+            })
+            .collect();
+        Some((
+            rows,
+            "SRRC (pooled over ranked designs, each design's values relative to its mean)",
+        ))
+    }
+
+    fn sensitivity_section(&self, md: &mut String, plots: &Path, warnings: &mut Vec<String>) {
+        let _ = writeln!(
+            md,
+            "## Sensitivity: which uncertain parameters drive each metric\n"
+        );
+        for m in &self.info.metrics {
+            let Some((mut rows, method)) = self.sensitivity(m) else {
+                continue;
+            };
+            rows.sort_by(|a, b| b.value.abs().total_cmp(&a.value.abs()));
+            let _ = writeln!(md, "### `{m}` — {method}\n");
+            let mut t = MarkdownTable::new(["rank", "parameter", "index", "95 % interval"]);
+            for (i, r) in rows.iter().enumerate() {
+                t.row([
+                    (i + 1).to_string(),
+                    format!("`{}`", r.name),
+                    fmt_short(r.value),
+                    if r.lo.is_finite() {
+                        format!("{} … {}", fmt_short(r.lo), fmt_short(r.hi))
+                    } else {
+                        "–".into()
+                    },
+                ]);
+            }
+            let _ = writeln!(md, "{}", t.finish());
+            let file = format!("tornado_{}.svg", crate::report::file_stem_safe(m));
+            match tornado_svg(&format!("What drives {m}"), method, &rows) {
+                Ok(svg) => {
+                    write_plot(plots, &file, &svg, warnings);
+                    let _ = writeln!(md, "![tornado {m}](plots/{file})\n");
+                }
+                Err(e) => warnings.push(format!("{file}: {e}")),
+            }
+        }
+    }
+
+    fn validation_section(&self, md: &mut String) {
+        if self.info.validate.is_empty() {
+            return;
+        }
+        let o = self.info.objective();
+        let _ = writeln!(md, "## Held-out validation\n");
+        let _ = writeln!(
+            md,
+            "Each design at its tuned values in scenario variants not used in tuning; gap = \
+             relative change of `{o}` from the nominal run (median over ranked designs; the \
+             leader's own in the last column).\n"
+        );
+        let leader = match &self.verdict.verdict {
+            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
+            Verdict::NoneEligible => None,
+        };
+        let p = self.col(P_BEST);
+        let mut t = MarkdownTable::new(["variant", "median gap", "successful", "leader's gap"]);
+        for v in &self.info.validate {
+            let gap = self.col(&format!("{VALIDATE_PREFIX}{v}.gap"));
+            let ok = self.col(&format!("{VALIDATE_PREFIX}{v}.success"));
+            let rows: Vec<usize> = (0..gap.len()).filter(|&r| p[r].is_finite()).collect();
+            let mut g: Vec<f64> = rows
+                .iter()
+                .map(|&r| gap[r])
+                .filter(|x| x.is_finite())
+                .collect();
+            g.sort_by(f64::total_cmp);
+            let n_ok = rows.iter().filter(|&&r| ok[r] == 1.0).count();
+            t.row([
+                format!("`{v}`"),
+                Self::pct(crate::stats::describe::quantile_sorted(&g, 0.5)),
+                format!("{n_ok} of {}", rows.len()),
+                leader.map_or("–".into(), |l| Self::pct(gap[l])),
+            ]);
+        }
+        let _ = writeln!(md, "{}", t.finish());
+    }
+}
+
+fn write_plot(dir: &Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
+    if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
+        warnings.push(format!("{name}: {e}"));
+    }
+}

@@ -1,0 +1,165 @@
+//! One case in its uncertain worlds and validation variants (issue 22): after the nominal
+//! run (at the case's tuned values), the case meets every world of the study's
+//! `[uncertainty]` ([`super::uncertainty`], the same worlds for every case) and every
+//! `[[validate]]` variant, and its row gains
+//!
+//! - per tracked metric `m`: `m_mean`, `m_std`, `m_p05`, `m_p95`, `m_worst` over the worlds
+//!   (worst by the metric's direction, [`larger_is_better`]); `success_probability`;
+//! - per world `k`: `world.<k>.<m>` and `world.<k>.success`, which the final tables move to
+//!   `worlds.csv` (the paired data of the ranking, [`super::robust`]);
+//! - per variant `v`: `validate.<v>.<objective>`, `validate.<v>.success` and
+//!   `validate.<v>.gap` (relative change of the objective from the nominal run).
+
+use super::cases::Resolved;
+use super::records::CaseStatus;
+use super::schema::Study;
+use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use super::uncertainty::{apply, World};
+use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
+use crate::stats::describe::describe;
+
+/// Prefix of the per-world columns of a row (`world.<k>.<metric>`).
+pub const WORLD_PREFIX: &str = "world.";
+/// Fraction of worlds in which the case met every `[success]` criterion.
+pub const SUCCESS_PROBABILITY: &str = "success_probability";
+/// Prefix of the validation columns (`validate.<name>.<metric>`).
+pub const VALIDATE_PREFIX: &str = "validate.";
+
+/// Run `r` (closed loop only) with `evaluator`.
+fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -> CaseResult {
+    evaluator.evaluate(&CaseInput {
+        design: &r.design,
+        design_hash: &r.design_hash,
+        scenario: &r.scenario,
+        overrides: &[],
+        seed: r.seed,
+        deadline,
+        phases: Phases {
+            static_analysis: false,
+            closed_loop: true,
+        },
+        trajectory: false,
+        label: &format!("case {id} design"),
+    })
+}
+
+/// The value of `metric` over worlds that is worst for it.
+fn worst(metric: &str, xs: &[f64]) -> f64 {
+    let finite = xs.iter().copied().filter(|x| x.is_finite());
+    if larger_is_better(metric) {
+        finite.fold(f64::NAN, f64::min)
+    } else if BY_MAGNITUDE.contains(&metric) {
+        finite
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .unwrap_or(f64::NAN)
+    } else {
+        finite.fold(f64::NAN, f64::max)
+    }
+}
+
+/// Why scoring a case in its worlds stopped: its wall-clock budget ran out.
+#[derive(Debug, thiserror::Error)]
+#[error("{TIMEOUT} in world {world} (the case's wall-clock budget)")]
+pub struct WorldTimeout {
+    /// The world being run.
+    pub world: usize,
+}
+
+/// Score resolved case `r` (at its tuned values) in `worlds` and the study's validation
+/// variants; the columns are added to `metrics` (see the module docs). A world whose
+/// overrides do not apply or whose run fails counts as unsuccessful with NaN metrics.
+pub fn score_worlds(
+    evaluator: &mut Evaluator,
+    study: &Study,
+    worlds: &[World],
+    id: usize,
+    r: &Resolved,
+    deadline: Deadline,
+    metrics: &mut Metrics,
+) -> Result<(), WorldTimeout> {
+    if let Some(u) = &study.uncertainty {
+        let mut values: Vec<Vec<f64>> = vec![Vec::with_capacity(worlds.len()); u.metrics.len()];
+        let mut successes = 0usize;
+        for w in worlds {
+            let overrides = u
+                .params
+                .iter()
+                .zip(&w.values)
+                .map(|(p, v)| (p.name.as_str(), &p.target, v));
+            let (ok, m) = match apply(r, overrides) {
+                Ok(rw) => {
+                    let res = run(evaluator, &rw, id, deadline);
+                    if res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT) {
+                        return Err(WorldTimeout { world: w.index });
+                    }
+                    (res.status == CaseStatus::Ok, res.metrics)
+                }
+                Err(_) => (false, Metrics::new()),
+            };
+            successes += usize::from(ok);
+            for (name, col) in u.metrics.iter().zip(values.iter_mut()) {
+                let x = m.value(name);
+                col.push(x);
+                metrics.push(format!("{WORLD_PREFIX}{}.{name}", w.index), x);
+            }
+            metrics.push(
+                format!("{WORLD_PREFIX}{}.{SUCCESS}", w.index),
+                f64::from(u8::from(ok)),
+            );
+        }
+        for (name, xs) in u.metrics.iter().zip(&values) {
+            let d = describe(xs);
+            for (suffix, x) in [
+                ("mean", d.mean),
+                ("std", d.std),
+                ("p05", d.p05),
+                ("p95", d.p95),
+                ("worst", worst(name, xs)),
+            ] {
+                metrics.set(&format!("{name}_{suffix}"), x);
+            }
+        }
+        let p = if worlds.is_empty() {
+            f64::NAN
+        } else {
+            successes as f64 / worlds.len() as f64
+        };
+        metrics.set(SUCCESS_PROBABILITY, p);
+    }
+    score_variants(evaluator, study, id, r, deadline, metrics)
+}
+
+/// The validation columns of `r` (see the module docs).
+fn score_variants(
+    evaluator: &mut Evaluator,
+    study: &Study,
+    id: usize,
+    r: &Resolved,
+    deadline: Deadline,
+    metrics: &mut Metrics,
+) -> Result<(), WorldTimeout> {
+    let objective = study
+        .uncertainty
+        .as_ref()
+        .map(|u| u.objective().to_string())
+        .unwrap_or_else(|| super::selection::ENERGY_PER_METRE.to_string());
+    let nominal = metrics.value(&objective);
+    for v in &study.validate {
+        let overrides = v.set.iter().map(|(n, t, x)| (n.as_str(), t, x));
+        let (ok, x) = match apply(r, overrides) {
+            Ok(rv) => {
+                let res = run(evaluator, &rv, id, deadline);
+                if res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT) {
+                    return Err(WorldTimeout { world: usize::MAX });
+                }
+                (res.status == CaseStatus::Ok, res.metrics.value(&objective))
+            }
+            Err(_) => (false, f64::NAN),
+        };
+        let col = |m: &str| format!("{VALIDATE_PREFIX}{}.{m}", v.name);
+        metrics.set(&col(&objective), x);
+        metrics.set(&col(SUCCESS), f64::from(u8::from(ok)));
+        metrics.set(&col("gap"), (x - nominal) / nominal.abs());
+    }
+    Ok(())
+}
