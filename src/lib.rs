@@ -11,7 +11,9 @@
 //! dynamics, the control laws and the scenario loop, a run's [`outcome`] is judged above it, and
 //! results flow out to reports ([`report`]) through the static analysis ([`statics`]), the
 //! sweep ([`study`]), the optimiser ([`optimise`]) and the output pipelines ([`pipeline`]); the
-//! paper reproductions ([`paper`]) sit on top. The command-line interface is the binary's own
+//! paper reproductions ([`paper`]) sit on top. Decisions under uncertainty (quantiles over
+//! worlds, Sobol indices, paired rankings and the winner-or-tie verdict) rest on the pure
+//! kernels of [`stats`]. The command-line interface is the binary's own
 //! (`src/cli/`), not part of this library.
 
 #![warn(missing_docs)]

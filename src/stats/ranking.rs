@@ -1,0 +1,309 @@
+//! Paired ranking of cases over common worlds, and the winner-or-tie verdict.
+//!
+//! Inputs are `obj[c][w]`, case c's objective in world w (smaller is better: callers negate
+//! maximised objectives), and `ok[c][w]`, whether case c met its success criteria in world w.
+//! Every case meets the same worlds (common random numbers), so comparisons are paired world by
+//! world. A case whose objective is not finite in a world counts as failed there. Rows longer
+//! than the shortest one are read up to its length.
+
+use super::describe::quantile_sorted;
+
+/// How a case ranks among all cases over the worlds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RankStats {
+    /// Mean over worlds of `[successful and best] / (number of cases tied for best)`: two
+    /// identical best cases get 0.5 each. A world where no case succeeds counts for nobody, so
+    /// the values of all cases sum to at most 1.
+    pub p_best: f64,
+    /// 5 % quantile of the case's rank over the worlds ([`quantile_sorted`]).
+    pub rank_p05: f64,
+    /// Median rank.
+    pub rank_p50: f64,
+    /// 95 % quantile of the rank.
+    pub rank_p95: f64,
+    /// Mean rank.
+    pub rank_mean: f64,
+}
+
+/// The number of worlds every row has (the shortest row's length; 0 without rows).
+fn worlds(obj: &[Vec<f64>], ok: &[Vec<bool>]) -> usize {
+    obj.iter()
+        .map(Vec::len)
+        .chain(ok.iter().map(Vec::len))
+        .min()
+        .unwrap_or(0)
+}
+
+/// Whether case `c` succeeded in world `w` with a finite objective.
+fn success(obj: &[Vec<f64>], ok: &[Vec<bool>], c: usize, w: usize) -> bool {
+    ok[c][w] && obj[c][w].is_finite()
+}
+
+/// Per case, its [`RankStats`] over the worlds. In each world a case's rank is 1 + the number
+/// of cases strictly better: a successful case is better than another with a smaller
+/// objective and better than any failed case; failed cases tie behind all successful ones.
+/// Ranks lie in `1..=C` for C cases. With no worlds every field is NaN. Cases beyond
+/// `min(obj.len(), ok.len())` are not ranked.
+pub fn rank_stats(obj: &[Vec<f64>], ok: &[Vec<bool>]) -> Vec<RankStats> {
+    let cases = obj.len().min(ok.len());
+    let (obj, ok) = (&obj[..cases], &ok[..cases]);
+    let nw = worlds(obj, ok);
+    let mut ranks = vec![Vec::with_capacity(nw); cases];
+    let mut p_best = vec![0.0; cases];
+    let mut good: Vec<f64> = Vec::with_capacity(cases);
+    for w in 0..nw {
+        good.clear();
+        good.extend(
+            (0..cases)
+                .filter(|&c| success(obj, ok, c, w))
+                .map(|c| obj[c][w]),
+        );
+        good.sort_by(f64::total_cmp);
+        let best = good.first().copied();
+        let tied = good.iter().take_while(|&&v| Some(v) == best).count();
+        for c in 0..cases {
+            let rank = if success(obj, ok, c, w) {
+                let v = obj[c][w];
+                if Some(v) == best {
+                    p_best[c] += 1.0 / tied as f64;
+                }
+                1 + good.partition_point(|&g| g < v)
+            } else {
+                1 + good.len()
+            };
+            ranks[c].push(rank as f64);
+        }
+    }
+    ranks
+        .into_iter()
+        .zip(p_best)
+        .map(|(mut r, pb)| {
+            r.sort_by(f64::total_cmp);
+            let n = r.len() as f64;
+            RankStats {
+                p_best: pb / n,
+                rank_p05: quantile_sorted(&r, 0.05),
+                rank_p50: quantile_sorted(&r, 0.5),
+                rank_p95: quantile_sorted(&r, 0.95),
+                rank_mean: r.iter().sum::<f64>() / n,
+            }
+        })
+        .collect()
+}
+
+/// The rule of [`verdict`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VerdictSettings {
+    /// Fraction of paired worlds in which the leader must beat a case to be called better
+    /// than it (default 0.95).
+    pub confidence: f64,
+    /// Relative margin below which a difference in one world is a tie (default 0.01).
+    pub equivalence: f64,
+    /// Relative tuning noise (e.g. the median spread of tuned objectives across restarts;
+    /// default 0): differences inside it are ties too.
+    pub noise: f64,
+}
+
+impl Default for VerdictSettings {
+    fn default() -> Self {
+        VerdictSettings {
+            confidence: 0.95,
+            equivalence: 0.01,
+            noise: 0.0,
+        }
+    }
+}
+
+/// A [`VerdictSettings`] field out of its range.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum VerdictSettingsError {
+    /// `confidence` must lie in (0, 1].
+    #[error("confidence must be in (0, 1], got {0}")]
+    Confidence(f64),
+    /// `equivalence` must be finite and ≥ 0.
+    #[error("equivalence must be a finite relative margin ≥ 0, got {0}")]
+    Equivalence(f64),
+    /// `noise` must be finite and ≥ 0.
+    #[error("noise must be a finite relative spread ≥ 0, got {0}")]
+    Noise(f64),
+}
+
+impl VerdictSettings {
+    /// Checks every field's range (callers locate the error in their file).
+    pub fn validate(&self) -> Result<(), VerdictSettingsError> {
+        if !(self.confidence > 0.0 && self.confidence <= 1.0) {
+            return Err(VerdictSettingsError::Confidence(self.confidence));
+        }
+        if !(self.equivalence.is_finite() && self.equivalence >= 0.0) {
+            return Err(VerdictSettingsError::Equivalence(self.equivalence));
+        }
+        if !(self.noise.is_finite() && self.noise >= 0.0) {
+            return Err(VerdictSettingsError::Noise(self.noise));
+        }
+        Ok(())
+    }
+}
+
+/// How the leader compares with one other case.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contender {
+    /// The case's index.
+    pub case: usize,
+    /// Fraction of all worlds in which the leader succeeds and beats this case (the case fails,
+    /// or the leader is better by more than the relative margin δ).
+    pub p_beats: f64,
+    /// Median over the worlds where both succeed of `(obj_c − obj_L) / |obj_L|` (NaN when
+    /// there is no such world).
+    pub margin: f64,
+}
+
+/// The answer of [`verdict`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    /// The leader beats every other eligible case in at least `confidence` of the worlds.
+    Winner {
+        /// The winning case.
+        leader: usize,
+        /// The other eligible case with the smallest margin; the leader itself when it is the
+        /// only eligible case.
+        runner_up: usize,
+        /// The leader's `p_beats` against the runner-up (1 when alone).
+        p_beats: f64,
+        /// The leader's margin over the runner-up (NaN when alone).
+        margin: f64,
+    },
+    /// Some eligible cases are not beaten with the required confidence.
+    Tied {
+        /// The case with the lowest mean objective.
+        leader: usize,
+        /// Every other eligible case the leader does not beat with confidence, by increasing
+        /// margin (NaN margins last, then by index).
+        tied: Vec<Contender>,
+    },
+    /// No case is eligible.
+    NoneEligible,
+}
+
+/// Mean objective of case `c` over the worlds where it succeeds (NaN when it never does).
+fn mean_success(obj: &[Vec<f64>], ok: &[Vec<bool>], c: usize, nw: usize) -> f64 {
+    let v: Vec<f64> = (0..nw)
+        .filter(|&w| success(obj, ok, c, w))
+        .map(|w| obj[c][w])
+        .collect();
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+}
+
+/// Compares leader `l` with case `c` (see [`Contender`]), δ the relative tie margin.
+fn contend(
+    obj: &[Vec<f64>],
+    ok: &[Vec<bool>],
+    l: usize,
+    c: usize,
+    nw: usize,
+    delta: f64,
+) -> Contender {
+    let mut beats = 0usize;
+    let mut rel = Vec::with_capacity(nw);
+    for w in 0..nw {
+        if !success(obj, ok, l, w) {
+            continue;
+        }
+        let (ol, oc) = (obj[l][w], obj[c][w]);
+        if !success(obj, ok, c, w) {
+            beats += 1;
+            continue;
+        }
+        if ol < oc - delta * ol.abs() {
+            beats += 1;
+        }
+        let r = (oc - ol) / ol.abs();
+        if !r.is_nan() {
+            rel.push(r);
+        }
+    }
+    rel.sort_by(f64::total_cmp);
+    Contender {
+        case: c,
+        p_beats: if nw == 0 {
+            0.0
+        } else {
+            beats as f64 / nw as f64
+        },
+        margin: quantile_sorted(&rel, 0.5),
+    }
+}
+
+/// Orders contenders by increasing margin, NaN margins last, then by case index.
+fn by_margin(a: &Contender, b: &Contender) -> std::cmp::Ordering {
+    a.margin
+        .is_nan()
+        .cmp(&b.margin.is_nan())
+        .then(a.margin.total_cmp(&b.margin))
+        .then(a.case.cmp(&b.case))
+}
+
+/// Names a winner only when the data support it.
+///
+/// The leader is the eligible case (`eligible[c]`; missing entries count as not eligible) with
+/// the lowest mean objective over the worlds where it succeeds (cases that never succeed come
+/// last; ties go to the lower index). For every other eligible case c, `p_beats` is the
+/// fraction of worlds in which the leader succeeds and either c fails or
+/// `obj_L < obj_c − δ·|obj_L|`, with `δ = max(equivalence, noise)`; `margin` is the median
+/// relative difference where both succeed ([`Contender`]). The leader is a
+/// [`Verdict::Winner`] iff its `p_beats` against every other eligible case is at least
+/// `confidence`; the runner-up is then the case with the smallest margin. A single eligible
+/// case is a winner over itself: `runner_up = leader`, `p_beats = 1`, `margin = NaN`.
+/// Otherwise the verdict is [`Verdict::Tied`] with the cases not beaten.
+pub fn verdict(
+    obj: &[Vec<f64>],
+    ok: &[Vec<bool>],
+    eligible: &[bool],
+    s: &VerdictSettings,
+) -> Verdict {
+    let cases = obj.len().min(ok.len()).min(eligible.len());
+    let nw = worlds(&obj[..cases], &ok[..cases]);
+    let candidates: Vec<(usize, f64)> = (0..cases)
+        .filter(|&c| eligible[c])
+        .map(|c| (c, mean_success(obj, ok, c, nw)))
+        .collect();
+    let Some(&(leader, _)) = candidates.iter().min_by(|a, b| {
+        a.1.is_nan()
+            .cmp(&b.1.is_nan())
+            .then(a.1.total_cmp(&b.1))
+            .then(a.0.cmp(&b.0))
+    }) else {
+        return Verdict::NoneEligible;
+    };
+    let delta = s.equivalence.max(s.noise);
+    let mut others: Vec<Contender> = candidates
+        .iter()
+        .filter(|&&(c, _)| c != leader)
+        .map(|&(c, _)| contend(obj, ok, leader, c, nw, delta))
+        .collect();
+    others.sort_by(by_margin);
+    if others.iter().all(|c| c.p_beats >= s.confidence) {
+        return match others.first() {
+            Some(r) => Verdict::Winner {
+                leader,
+                runner_up: r.case,
+                p_beats: r.p_beats,
+                margin: r.margin,
+            },
+            None => Verdict::Winner {
+                leader,
+                runner_up: leader,
+                p_beats: 1.0,
+                margin: f64::NAN,
+            },
+        };
+    }
+    others.retain(|c| c.p_beats < s.confidence);
+    Verdict::Tied {
+        leader,
+        tied: others,
+    }
+}
