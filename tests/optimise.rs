@@ -402,3 +402,63 @@ fn the_metric_catalogue_names_every_metric_a_run_reports() {
         assert!(!is_run_metric(mode, "no_such_metric"));
     }
 }
+
+/// A problem file with `[uncertainty]` (issue 22 item 4): every variant meets every world
+/// (`calm/w0` …), the objective combines by CVaR, and a chance constraint on
+/// `success_probability` is judged once over the worlds, not in each.
+#[test]
+fn uncertain_worlds_make_a_robust_problem_with_cvar_and_a_chance_constraint() {
+    let text = SMALL
+        .replace("combine = \"worst\"", "combine = \"cvar\"\nalpha = 0.5")
+        .replace("max_evals = 16", "max_evals = 6")
+        + r#"
+[[constraint]]
+metric = "success_probability"
+op = ">="
+value = 0.5
+
+[uncertainty]
+worlds = 3
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.0, high = 2.0 }
+"#;
+    let p = parse_problem(&text, Path::new("robust.toml")).unwrap();
+    let names: Vec<&str> = p.spec.variants.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "calm/w0",
+            "calm/w1",
+            "calm/w2",
+            "current/w0",
+            "current/w1",
+            "current/w2"
+        ]
+    );
+    // The same world values under both variants (common random numbers).
+    let world = |i: usize| p.spec.variants[i].set.last().unwrap().clone();
+    assert_eq!(world(0), world(3));
+    assert_ne!(world(0), world(1));
+    assert!(p.spec.metrics().contains(&"success".to_string()));
+    let chance = p.spec.constraints.last().unwrap();
+    assert!(chance.chance);
+    let o = run(&p, &options(2)).unwrap();
+    assert_eq!(o.records[0].metrics.len(), 6);
+    // CVaR with α = 0.5 over 6 scenarios: the mean of the worst 3 scenario objectives.
+    let s = &o.scorer;
+    let mut js: Vec<f64> = o.records[0]
+        .metrics
+        .iter()
+        .map(|m| s.scenario_objective(m))
+        .collect();
+    js.sort_by(|a, b| b.total_cmp(a));
+    let expected = (js[0] + js[1] + js[2]) / 3.0;
+    assert!((o.records[0].score.objective - expected).abs() <= 1e-12 * expected.abs());
+
+    let bad = text.replace("alpha = 0.5", "alpha = 1.5");
+    let e = parse_problem(&bad, Path::new("robust.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("objective.alpha"), "{e}");
+}

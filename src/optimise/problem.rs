@@ -28,14 +28,21 @@ use crate::study::Study;
 pub const SPEC_KEYS: [&str; 5] = ["param", "variant", "objective", "constraint", "solver"];
 
 /// How the objectives of several scenarios ([`Variant`]s) are combined.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Combine {
     /// The mean of the scenarios' objectives.
     Mean,
     /// The largest (worst) of the scenarios' objectives.
     Worst,
+    /// Conditional value at risk: the mean of the worst `⌈α·n⌉` of the n scenarios'
+    /// objectives (`objective.alpha`, 0 < α ≤ 1; α = 1 is the mean, α → 0 the worst).
+    Cvar(f64),
 }
+
+/// The chance-constraint metric: the fraction of scenarios (worlds) whose run met every
+/// `[success]` criterion (`success == 1`), compared once over all scenarios.
+pub const SUCCESS_PROBABILITY: &str = "success_probability";
 
 /// One weighted term of the objective: `weight · metric / scale`, the scale being the
 /// metric's |value| at the start point (see [`Objective::normalise`]).
@@ -95,6 +102,21 @@ pub struct Constraint {
     pub value: f64,
     /// Slack of `==` (default 1e-9·max(1, |value|)).
     pub tolerance: f64,
+    /// A chance constraint ([`SUCCESS_PROBABILITY`]): compared once over the scenarios,
+    /// not in each.
+    pub chance: bool,
+}
+
+impl Constraint {
+    /// The metric an evaluation must report for this constraint (`success` for a chance
+    /// constraint).
+    pub fn column(&self) -> &str {
+        if self.chance {
+            "success"
+        } else {
+            &self.metric
+        }
+    }
 }
 
 /// One scenario of a robust objective: key paths set on top of the parameters.
@@ -130,10 +152,11 @@ impl Spec {
             .terms
             .iter()
             .map(|t| &t.metric)
-            .chain(self.constraints.iter().map(|c| &c.metric));
+            .map(String::as_str)
+            .chain(self.constraints.iter().map(Constraint::column));
         for n in names {
-            if !out.contains(n) {
-                out.push(n.clone());
+            if !out.iter().any(|o| o == n) {
+                out.push(n.to_string());
             }
         }
         out
@@ -181,6 +204,7 @@ struct VariantFile {
 struct ObjectiveFile {
     term: Vec<TermFile>,
     combine: Option<String>,
+    alpha: Option<f64>,
     normalise: Option<bool>,
 }
 
@@ -283,6 +307,12 @@ pub fn parse_spec(
         doc,
     )?;
     check_variant_params(&variants, &list, &key("variant"), study, doc)?;
+    // A problem file's `[uncertainty]`: every scenario in every world (robust optimisation;
+    // per-case tuning of sweeps tunes in the nominal world and meets the worlds after).
+    let variants = match (&study.uncertainty, prefix.is_empty()) {
+        (Some(u), true) => in_worlds(variants, u, study.seed),
+        _ => variants,
+    };
     let objective = parse_objective(&file.objective, &key("objective"), study, doc)?;
     let mut constraints = Vec::new();
     for (i, c) in file.constraint.unwrap_or_default().iter().enumerate() {
@@ -446,6 +476,36 @@ fn parse_param(
     })
 }
 
+/// Each scenario of `variants` in each world of `u` (named `w<k>`, or `<variant>/w<k>`).
+fn in_worlds(
+    variants: Vec<Variant>,
+    u: &crate::study::uncertainty::Uncertainty,
+    seed: u64,
+) -> Vec<Variant> {
+    let worlds = u.sample(seed);
+    let mut out = Vec::with_capacity(variants.len() * worlds.len());
+    for v in &variants {
+        for w in &worlds {
+            let mut set = v.set.clone();
+            set.extend(
+                u.params
+                    .iter()
+                    .zip(&w.values)
+                    .map(|(p, x)| (p.name.clone(), x.clone())),
+            );
+            out.push(Variant {
+                name: if v.name.is_empty() {
+                    format!("w{}", w.index)
+                } else {
+                    format!("{}/w{}", v.name, w.index)
+                },
+                set,
+            });
+        }
+    }
+    out
+}
+
 fn parse_variants(
     files: Vec<VariantFile>,
     at: &str,
@@ -525,13 +585,31 @@ fn parse_objective(
     let combine = match o.combine.as_deref().unwrap_or("mean") {
         "mean" => Combine::Mean,
         "worst" => Combine::Worst,
+        "cvar" => match o.alpha {
+            Some(a) if a > 0.0 && a <= 1.0 => Combine::Cvar(a),
+            Some(a) => {
+                return Err(doc.err(
+                    &format!("{at}.alpha"),
+                    format!("must be in (0, 1], got {a}"),
+                ))
+            }
+            None => {
+                return Err(doc.err(
+                    &format!("{at}.alpha"),
+                    "combine = \"cvar\" needs alpha: the fraction of worst scenarios averaged",
+                ))
+            }
+        },
         other => {
             return Err(doc.err(
                 &format!("{at}.combine"),
-                format!("unknown combination `{other}`; valid: mean, worst"),
+                format!("unknown combination `{other}`; valid: mean, worst, cvar"),
             ))
         }
     };
+    if o.alpha.is_some() && !matches!(combine, Combine::Cvar(_)) {
+        return Err(doc.err(&format!("{at}.alpha"), "only with combine = \"cvar\""));
+    }
     Ok(Objective {
         terms,
         combine,
@@ -545,7 +623,17 @@ fn parse_constraint(
     study: &Study,
     doc: &Document,
 ) -> Result<Constraint, InputError> {
-    check_metric(&c.metric, &format!("{at}.metric"), study, doc)?;
+    let chance = c.metric == SUCCESS_PROBABILITY;
+    if chance {
+        if !study.mode.is_dynamic() {
+            return Err(doc.err(
+                &format!("{at}.metric"),
+                "success_probability needs a closed-loop mode",
+            ));
+        }
+    } else {
+        check_metric(&c.metric, &format!("{at}.metric"), study, doc)?;
+    }
     let op = match c.op.as_str() {
         "<=" => Op::Le,
         ">=" => Op::Ge,
@@ -569,5 +657,6 @@ fn parse_constraint(
         op,
         value: c.value,
         tolerance,
+        chance,
     })
 }

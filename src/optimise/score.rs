@@ -107,7 +107,7 @@ impl Scorer {
             objective: objective.clone(),
             constraints: constraints.to_vec(),
             term_columns,
-            constraint_columns: constraints.iter().map(|c| col(&c.metric)).collect(),
+            constraint_columns: constraints.iter().map(|c| col(c.column())).collect(),
             scales,
         }
     }
@@ -157,22 +157,36 @@ impl Scorer {
         let js = per_scenario.iter().map(|m| self.scenario_objective(m));
         let objective = match self.objective.combine {
             Combine::Mean => js.sum::<f64>() / per_scenario.len().max(1) as f64,
-            Combine::Worst => js.fold(f64::NEG_INFINITY, |a, j| {
-                if a.is_nan() || j.is_nan() {
-                    f64::NAN
-                } else {
-                    a.max(j)
-                }
-            }),
+            Combine::Worst => worst_of(js),
+            Combine::Cvar(alpha) => cvar(js.collect(), alpha),
         };
         let mut violation: f64 = per_scenario
             .iter()
             .map(|m| {
                 (0..self.constraints.len())
+                    .filter(|&k| !self.constraints[k].chance)
                     .map(|k| self.constraint_violation(k, m))
                     .sum::<f64>()
             })
             .sum();
+        for (k, c) in self
+            .constraints
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.chance)
+        {
+            let col = self.constraint_columns[k];
+            let met = per_scenario
+                .iter()
+                .filter(|m| m.get(col).copied() == Some(1.0))
+                .count();
+            let p = met as f64 / per_scenario.len().max(1) as f64;
+            violation += match c.op {
+                Op::Le => (p - c.value).max(0.0),
+                Op::Ge => (c.value - p).max(0.0),
+                Op::Eq => ((p - c.value).abs() - c.tolerance).max(0.0),
+            };
+        }
         if objective.is_nan() {
             violation += NAN_VIOLATION;
         }
@@ -182,6 +196,28 @@ impl Scorer {
             feasible: violation == 0.0,
         }
     }
+}
+
+/// The largest value (NaN when any is NaN).
+fn worst_of(js: impl Iterator<Item = f64>) -> f64 {
+    js.fold(f64::NEG_INFINITY, |a, j| {
+        if a.is_nan() || j.is_nan() {
+            f64::NAN
+        } else {
+            a.max(j)
+        }
+    })
+}
+
+/// Conditional value at risk: the mean of the largest `⌈alpha·n⌉` values (NaN when any is
+/// NaN).
+pub fn cvar(mut js: Vec<f64>, alpha: f64) -> f64 {
+    if js.iter().any(|j| j.is_nan()) || js.is_empty() {
+        return f64::NAN;
+    }
+    js.sort_by(|a, b| b.total_cmp(a));
+    let k = ((alpha * js.len() as f64).ceil() as usize).clamp(1, js.len());
+    js[..k].iter().sum::<f64>() / k as f64
 }
 
 /// Mean of column `c` over the rows (NaN when a row lacks it or any value is NaN).
@@ -204,6 +240,15 @@ mod tests {
             violation: if feasible { 0.0 } else { v + 1e-9 },
             feasible,
         })
+    }
+
+    #[test]
+    fn cvar_is_the_mean_of_the_worst_fraction() {
+        let js = vec![1.0, 5.0, 2.0, 4.0, 3.0];
+        assert_eq!(cvar(js.clone(), 1.0), 3.0);
+        assert_eq!(cvar(js.clone(), 0.4), 4.5);
+        assert_eq!(cvar(js.clone(), 0.01), 5.0);
+        assert!(cvar(vec![1.0, f64::NAN], 0.5).is_nan());
     }
 
     proptest! {

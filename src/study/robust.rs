@@ -328,8 +328,10 @@ pub fn add_rank_columns(table: &mut Table, worlds: &Table, info: &RobustInfo) {
 pub struct StudyVerdict {
     /// The verdict (case indices are rows of the table).
     pub verdict: Verdict,
-    /// Median relative tuning noise of the ranked cases (0 without tuning restarts).
+    /// Median relative tuning noise of the ranked cases (0 without tuning starts to compare).
     pub noise: f64,
+    /// Whether the tuning noise was measured (a study with `[tune] starts` ≥ 2).
+    pub noise_measured: bool,
     /// Cases not ranked for a success probability below the requirement.
     pub below_requirement: usize,
     /// Cases ranked.
@@ -351,6 +353,7 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
         })
         .unwrap_or_default();
     noise.sort_by(f64::total_cmp);
+    let noise_measured = !noise.is_empty();
     let noise = if noise.is_empty() {
         0.0
     } else {
@@ -374,6 +377,7 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
     Some(StudyVerdict {
         verdict: verdict(&pd.obj, &pd.ok, &pd.eligible, &settings),
         noise,
+        noise_measured,
         below_requirement,
         ranked: pd.eligible.iter().filter(|e| **e).count(),
     })

@@ -73,11 +73,18 @@ impl<'a> Robust<'a> {
         let v = &self.verdict;
         let n = self.info.worlds;
         let o = self.info.objective();
-        let noise = format!(
-            "median tuning noise {}; tie margin max(equivalence {}, noise)",
-            Self::pct(v.noise),
-            Self::pct(self.info.equivalence)
-        );
+        let noise = if v.noise_measured {
+            format!(
+                "median tuning noise {}; tie margin max(equivalence {}, noise)",
+                Self::pct(v.noise),
+                Self::pct(self.info.equivalence)
+            )
+        } else {
+            format!(
+                "tuning noise not measured; tie margin: equivalence {}",
+                Self::pct(self.info.equivalence)
+            )
+        };
         match &v.verdict {
             Verdict::Winner {
                 leader,

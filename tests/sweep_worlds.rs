@@ -1,0 +1,239 @@
+//! Uncertain worlds in sweeps (issue 22): the verdict a summary opens with, and common random
+//! numbers.
+//!
+//! Small transport studies (3 links, a 45 s run, four worlds over the linear-damping scale and
+//! a weak current) whose cases differ only in `metrics.efficiency`, which divides the thruster
+//! energy and nothing else: a known margin in energy per metre that is the same in every world.
+//! - a 10 % margin names the winner; a 0.1 % margin (inside the 1 % equivalence margin) is a
+//!   tie; two cases differing only in a key no metric depends on are tied with `p_best` 0.5;
+//! - `worlds.csv` and `cases.csv` are identical for `--jobs 1` and `--jobs 2`, for two shards
+//!   merged, and for an interrupted run resumed: every case meets the same worlds.
+
+mod common;
+
+use std::path::Path;
+
+use common::{arg, run, stderr, sweep, write};
+
+const BASE: &str = r#"[study]
+name = "tiny_worlds"
+seed = 11
+
+[design.generator]
+links = 3
+link_length = 0.6
+thrust_limit = 40.0
+
+[scenario]
+mode = "transport"
+duration = 45.0
+
+[allocation]
+method = "pinv"
+lambda = 0.1
+
+[success]
+# 45 s: the vehicle converges to the path (3 m off at the start), not yet fully settled.
+cross_track_bound = 1.0
+
+[uncertainty]
+worlds = 4
+sampling = "sobol"
+
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.5, high = 1.5 }
+
+[[uncertainty.param]]
+name = "physics.current_speed"
+distribution = { kind = "uniform", low = 0.0, high = 0.02 }
+
+[[validate]]
+name = "late_turn"
+set = { "initial.position[1]" = 2.0 }
+"#;
+
+fn study(dir: &Path, name: &str, axis: &str) -> std::path::PathBuf {
+    write(dir, name, &format!("{BASE}\n{axis}"))
+}
+
+fn summary(out: &Path) -> String {
+    std::fs::read_to_string(out.join("summary.md")).unwrap()
+}
+
+/// The first line after the title of `summary.md`.
+fn verdict(out: &Path) -> String {
+    summary(out)
+        .lines()
+        .skip(1)
+        .find(|l| !l.is_empty())
+        .unwrap_or_default()
+        .to_string()
+}
+
+fn column(out: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let c = head
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("{name}: {head:?}"));
+    lines
+        .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+        .collect()
+}
+
+fn ok(o: &std::process::Output) {
+    assert!(o.status.success(), "{}", stderr(o));
+}
+
+#[test]
+fn a_ten_percent_margin_names_the_winner_and_a_tenth_of_a_percent_is_a_tie() {
+    let dir = tempfile::tempdir().unwrap();
+    let wide = study(
+        dir.path(),
+        "wide.toml",
+        "[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.55]\n",
+    );
+    let out = dir.path().join("wide");
+    ok(&sweep(&wide, &out, &["--jobs", "2"]));
+    let v = verdict(&out);
+    assert!(v.starts_with("**Winner: #1"), "{v}");
+    assert_eq!(column(&out, "p_best"), vec![0.0, 1.0]);
+    assert_eq!(column(&out, "success_probability"), vec![1.0, 1.0]);
+    // The margin is the same in every world: 0.55 / 0.5 − 1 = 10 %.
+    let m = column(&out, "energy_per_metre_mean");
+    assert!((m[0] / m[1] - 1.1).abs() < 1e-9, "{m:?}");
+    for c in [
+        "energy_per_metre_p05",
+        "energy_per_metre_p95",
+        "energy_per_metre_worst",
+    ] {
+        let x = column(&out, c);
+        assert!(x.iter().all(|x| x.is_finite()), "{c}: {x:?}");
+    }
+    let gap = column(&out, "validate.late_turn.gap");
+    assert!(gap.iter().all(|g| g.is_finite()), "{gap:?}");
+
+    let narrow = study(
+        dir.path(),
+        "narrow.toml",
+        "[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.5005]\n",
+    );
+    let out = dir.path().join("narrow");
+    ok(&sweep(&narrow, &out, &["--jobs", "2"]));
+    let v = verdict(&out);
+    assert!(v.starts_with("**Statistically tied: #1, #0"), "{v}");
+    // Paired worlds: the 0.1 % better case is best in every world, yet not a winner.
+    assert_eq!(column(&out, "p_best"), vec![0.0, 1.0]);
+}
+
+#[test]
+fn cases_differing_in_a_key_no_metric_reads_are_tied_never_a_winner() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "same.toml",
+        "[[axis]]\nname = \"metrics.divergence_distance\"\nvalues = [50.0, 60.0]\n",
+    );
+    let out = dir.path().join("same");
+    ok(&sweep(&s, &out, &["--jobs", "2"]));
+    let v = verdict(&out);
+    assert!(v.starts_with("**Statistically tied: #0, #1"), "{v}");
+    assert_eq!(column(&out, "p_best"), vec![0.5, 0.5]);
+    let s = summary(&out);
+    assert!(s.contains("## Ranking over 4 uncertain worlds"), "{s}");
+    assert!(s.contains("## Sensitivity"), "{s}");
+    assert!(s.contains("## Held-out validation"), "{s}");
+}
+
+#[test]
+fn every_case_meets_the_same_worlds_for_any_jobs_shards_and_resume() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "s.toml",
+        "[[axis]]\nname = \"design.links\"\nvalues = [3, 4]\n\n[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.6]\n",
+    );
+    let read = |out: &Path, f: &str| std::fs::read(out.join(f)).unwrap();
+    let j1 = dir.path().join("j1");
+    let j2 = dir.path().join("j2");
+    ok(&sweep(&s, &j1, &["--jobs", "1"]));
+    ok(&sweep(&s, &j2, &["--jobs", "2"]));
+    for f in ["worlds.csv", "cases.csv"] {
+        assert!(
+            read(&j1, f) == read(&j2, f),
+            "{f} differs between --jobs 1 and 2"
+        );
+    }
+    // The parameter values of a world are the same for every case.
+    let w = std::fs::read_to_string(j1.join("worlds.csv")).unwrap();
+    let mut by_world: std::collections::BTreeMap<String, String> = Default::default();
+    for l in w.lines().skip(1) {
+        let c: Vec<&str> = l.split(',').collect();
+        let params = format!("{},{}", c[2], c[3]);
+        let prev = by_world
+            .entry(c[0].to_string())
+            .or_insert_with(|| params.clone());
+        assert_eq!(*prev, params, "world {} differs between cases", c[0]);
+    }
+    assert_eq!(by_world.len(), 4);
+
+    let (a, b, merged) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("m"),
+    );
+    ok(&sweep(&s, &a, &["--shard", "0/2"]));
+    ok(&sweep(&s, &b, &["--shard", "1/2"]));
+    ok(&run(&["merge", arg(&a), arg(&b), "--out", arg(&merged)]));
+    for f in ["worlds.csv", "cases.csv"] {
+        assert!(
+            read(&j1, f) == read(&merged, f),
+            "{f} differs after a shard merge"
+        );
+    }
+
+    let res = dir.path().join("res");
+    ok(&sweep(&s, &res, &["--jobs", "1", "--max-cases", "1"]));
+    ok(&sweep(&s, &res, &["--jobs", "2", "--resume"]));
+    for f in ["worlds.csv", "cases.csv"] {
+        assert!(read(&j1, f) == read(&res, f), "{f} differs after a resume");
+    }
+}
+
+#[test]
+fn bad_uncertainty_sections_exit_2_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let axis = "[[axis]]\nname = \"design.links\"\nvalues = [3]\n";
+    for (edit, key) in [
+        (
+            (
+                "hydro.linear_damping_scale\"",
+                "hydro.linear_damping_scael\"",
+            ),
+            "uncertainty.param[0].name",
+        ),
+        (
+            (
+                "kind = \"uniform\", low = 0.5",
+                "kind = \"gamma\", low = 0.5",
+            ),
+            "kind",
+        ),
+        (("worlds = 4", "worlds = 1"), "uncertainty.worlds"),
+        (("low = 0.0, high = 0.02", "low = 0.0, mean = 0.02"), "mean"),
+        (
+            ("name = \"late_turn\"", "name = \"late turn\""),
+            "validate[0].name",
+        ),
+    ] {
+        let text = format!("{BASE}\n{axis}").replacen(edit.0, edit.1, 1);
+        let p = write(dir.path(), "bad.toml", &text);
+        let o = run(&["sweep", arg(&p), "--out", arg(&dir.path().join("bad"))]);
+        assert_eq!(o.status.code(), Some(2), "{edit:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("bad.toml:") && e.contains(key), "{edit:?}: {e}");
+    }
+}
