@@ -111,6 +111,16 @@ fn referenced_cases(md: &str) -> Vec<i64> {
     out
 }
 
+/// The verdict line of a summary: the first paragraph after its title when it opens with
+/// `**Winner:`, `**Statistically tied:` or `**No winner`.
+fn verdict_line(md: &str) -> Option<&str> {
+    let first = md.lines().skip(1).find(|l| !l.trim().is_empty())?;
+    ["**Winner:", "**Statistically tied:", "**No winner"]
+        .iter()
+        .any(|p| first.starts_with(p))
+        .then_some(first)
+}
+
 /// One drawn design: the cases that share it and its SVG.
 struct Drawing {
     cases: Vec<i64>,
@@ -334,7 +344,9 @@ impl Page<'_> {
              <h1>Design review: <code>{t}</code></h1>",
             t = escape(&title)
         );
+        self.verdict_section(&mut h);
         self.study_section(&mut h);
+        self.ledger_section(&mut h);
         self.success_section(&mut h);
         self.designs_section(&mut h);
         self.tables_section(&mut h);
@@ -342,6 +354,46 @@ impl Page<'_> {
         self.manifest_section(&mut h);
         h.push_str("</body>\n</html>\n");
         h
+    }
+
+    /// The answer first: the verdict line `summary.md` opens with over uncertain worlds
+    /// ("Winner: …" or "Statistically tied: …"), when it has one.
+    fn verdict_section(&self, h: &mut String) {
+        let Some(line) = self.summary.and_then(verdict_line) else {
+            return;
+        };
+        let _ = writeln!(
+            h,
+            "<section id=\"verdict\">\n<h2>Verdict</h2>\n{}</section>",
+            markdown_to_html(line, 0, &|id| self.link(id))
+        );
+    }
+
+    /// The assumption ledger of the manifest (studies with uncertain worlds): every
+    /// inferred model parameter, its value, its source and the range used for it.
+    fn ledger_section(&self, h: &mut String) {
+        let Some(rows) = self.manifest.and_then(|m| m["ledger"].as_array()) else {
+            return;
+        };
+        h.push_str(
+            "<section id=\"ledger\">\n<h2>Assumption ledger</h2>\n<p>Model parameters that \
+             are inferred rather than taken from a source, with the range the uncertain worlds \
+             use (docs/assumptions.md).</p>\n<table class=\"r-kv\">\n<tr><th>parameter</th>\
+             <th>value</th><th>source</th><th>key</th><th>range</th></tr>\n",
+        );
+        for r in rows {
+            let cell = |k: &str| escape(&json_text(&r[k]));
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td><code>{}</code></td><td>{}</td></tr>",
+                cell("name"),
+                cell("value"),
+                cell("source"),
+                cell("key"),
+                cell("range")
+            );
+        }
+        h.push_str("</table>\n</section>\n");
     }
 
     /// Description, parameters and counts from the manifest.
