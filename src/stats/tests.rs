@@ -237,6 +237,14 @@ fn sobol_indices_drop_non_finite_base_samples() {
     assert!(sobol_indices(&design, &vec![1.0; 256], 10, 1)[1]
         .total
         .is_nan());
+    // Constant at A and B but not at AB: still NaN, not infinite.
+    let flat_ab: Vec<f64> = (0..256)
+        .map(|k| if k % 4 < 2 { 1.0 } else { k as f64 })
+        .collect();
+    let s = sobol_indices(&design, &flat_ab, 10, 1);
+    assert!(s
+        .iter()
+        .all(|i| i.first.is_nan() && i.total.is_nan() && i.first_lo.is_nan()));
     let mut all_nan = y.clone();
     all_nan.iter_mut().skip(4).for_each(|v| *v = f64::NAN);
     assert!(sobol_indices(&design, &all_nan, 10, 1)[0].first.is_nan());
