@@ -192,7 +192,8 @@ impl Outputs {
 /// `S_i = mean(f(B)·(f(AB_i) − f(A))) / V` (Saltelli et al. 2010) and
 /// `ST_i = mean((f(A) − f(AB_i))²) / (2V)` (Jansen 1999). A base sample with any non-finite
 /// output is dropped entirely. The indices are NaN when fewer than two base samples remain,
-/// when the outputs at `A` and `B` do not vary (`V = 0`), or when `y.len()` does not match the design.
+/// when the outputs at `A` and `B` do not vary (`V = 0`), or when `y.len()` does not match
+/// the design.
 pub fn sobol_indices(
     design: &SaltelliDesign,
     y: &[f64],

@@ -182,8 +182,15 @@ fn sobol_indices_of_ishigami_match_the_closed_form() {
     let s = sobol_indices(&design, &y, 200, 7);
     assert_eq!(s.len(), 3);
     for (i, (idx, (first, total))) in s.iter().zip(exact).enumerate() {
-        eprintln!("S{0} = {1:.4} [{2:.4}, {3:.4}] (exact {first:.4}), ST{0} = {4:.4} [{5:.4}, {6:.4}] (exact {total:.4})",
-            i + 1, idx.first, idx.first_lo, idx.first_hi, idx.total, idx.total_lo, idx.total_hi);
+        let show = |v: f64, lo: f64, hi: f64, exact: f64| {
+            format!("{v:.4} [{lo:.4}, {hi:.4}] (exact {exact:.4})")
+        };
+        eprintln!(
+            "S{0} = {1}, ST{0} = {2}",
+            i + 1,
+            show(idx.first, idx.first_lo, idx.first_hi, first),
+            show(idx.total, idx.total_lo, idx.total_hi, total)
+        );
         assert!(
             close(idx.first, first, 0.02),
             "S{}: {} vs {first}",
