@@ -2,12 +2,12 @@
 //! inputs, deterministic (sorted copies, seeded generators, no hashing), independent of thread
 //! count.
 //!
-//! - [`describe`]: quantiles (numpy's default, R type 7) and a NaN-ignoring summary
-//!   ([`Describe`]) of one metric over worlds;
+//! - [`describe`](mod@describe): quantiles (numpy's default, R type 7) and a NaN-ignoring
+//!   summary ([`Describe`]) of one metric over worlds;
 //! - [`normal`]: the standard normal distribution ([`normal::cdf`], [`normal::inv_cdf`]);
 //! - [`sobol`]: Saltelli designs ([`SaltelliDesign`]) and first-order / total Sobol indices
 //!   with percentile-bootstrap intervals ([`sobol_indices`]);
-//! - [`srrc`]: standardised (rank) regression coefficients ([`srrc()`], [`src()`]);
+//! - [`srrc`](mod@srrc): standardised (rank) regression coefficients ([`srrc()`], [`src()`]);
 //! - [`ranking`]: paired ranking of cases over common worlds ([`rank_stats`]) and the
 //!   winner-or-tie verdict ([`verdict`]).
 //!

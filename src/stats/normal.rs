@@ -1,5 +1,9 @@
 //! The standard normal distribution: [`cdf`] and its inverse [`inv_cdf`].
 
+// AS 241's coefficients are kept with their published digits (more than an f64 holds), so
+// that they can be checked against the paper line by line.
+#![allow(clippy::excessive_precision)]
+
 /// Φ(x), the standard normal distribution function, as `erfc(−x/√2)/2` (musl's `erfc` through
 /// the `libm` crate: accurate to a few ulp, also far in the lower tail). NaN gives NaN.
 pub fn cdf(x: f64) -> f64 {

@@ -113,9 +113,7 @@ fn failures_are_beaten_and_never_lead() {
     let obj = vec![vec![100.0; worlds], vec![100.0; worlds], vec![90.0; worlds]];
     let mut ok = all_ok(3, worlds);
     // Case 1 matches the leader but fails in half the worlds: beaten exactly there.
-    for w in 0..5 {
-        ok[1][w] = false;
-    }
+    ok[1][..5].fill(false);
     // Case 2 is better but never succeeds: it cannot lead.
     ok[2] = vec![false; worlds];
     let s = VerdictSettings::default();

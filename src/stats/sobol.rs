@@ -164,6 +164,12 @@ impl Outputs {
             })
             .sum::<f64>()
             / (2.0 * m);
+        if !(var > 0.0 && var.is_finite()) {
+            // No variance at A and B: the indices are undefined (not ±∞).
+            first.fill(f64::NAN);
+            total.fill(f64::NAN);
+            return;
+        }
         for i in 0..self.d {
             let (mut s1, mut st) = (0.0, 0.0);
             for &j in rows {
@@ -186,7 +192,8 @@ impl Outputs {
 /// `S_i = mean(f(B)·(f(AB_i) − f(A))) / V` (Saltelli et al. 2010) and
 /// `ST_i = mean((f(A) − f(AB_i))²) / (2V)` (Jansen 1999). A base sample with any non-finite
 /// output is dropped entirely. The indices are NaN when fewer than two base samples remain,
-/// when the output does not vary (`V = 0`), or when `y.len()` does not match the design.
+/// when the outputs at `A` and `B` do not vary (`V = 0`), or when `y.len()` does not match
+/// the design.
 pub fn sobol_indices(
     design: &SaltelliDesign,
     y: &[f64],

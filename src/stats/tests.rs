@@ -182,8 +182,15 @@ fn sobol_indices_of_ishigami_match_the_closed_form() {
     let s = sobol_indices(&design, &y, 200, 7);
     assert_eq!(s.len(), 3);
     for (i, (idx, (first, total))) in s.iter().zip(exact).enumerate() {
-        eprintln!("S{0} = {1:.4} [{2:.4}, {3:.4}] (exact {first:.4}), ST{0} = {4:.4} [{5:.4}, {6:.4}] (exact {total:.4})",
-            i + 1, idx.first, idx.first_lo, idx.first_hi, idx.total, idx.total_lo, idx.total_hi);
+        let show = |v: f64, lo: f64, hi: f64, exact: f64| {
+            format!("{v:.4} [{lo:.4}, {hi:.4}] (exact {exact:.4})")
+        };
+        eprintln!(
+            "S{0} = {1}, ST{0} = {2}",
+            i + 1,
+            show(idx.first, idx.first_lo, idx.first_hi, first),
+            show(idx.total, idx.total_lo, idx.total_hi, total)
+        );
         assert!(
             close(idx.first, first, 0.02),
             "S{}: {} vs {first}",
@@ -237,6 +244,14 @@ fn sobol_indices_drop_non_finite_base_samples() {
     assert!(sobol_indices(&design, &vec![1.0; 256], 10, 1)[1]
         .total
         .is_nan());
+    // Constant at A and B but not at AB: still NaN, not infinite.
+    let flat_ab: Vec<f64> = (0..256)
+        .map(|k| if k % 4 < 2 { 1.0 } else { k as f64 })
+        .collect();
+    let s = sobol_indices(&design, &flat_ab, 10, 1);
+    assert!(s
+        .iter()
+        .all(|i| i.first.is_nan() && i.total.is_nan() && i.first_lo.is_nan()));
     let mut all_nan = y.clone();
     all_nan.iter_mut().skip(4).for_each(|v| *v = f64::NAN);
     assert!(sobol_indices(&design, &all_nan, 10, 1)[0].first.is_nan());

@@ -2,7 +2,8 @@
 //!
 //! A [`Figure`] is a grid of [`Panel`]s, each holding [`Series`] of `(x, y)` data drawn as
 //! lines, markers or bars. [`histogram`] and [`scatter_labelled`] build common figures;
-//! [`Heatmap`] draws a grid of cells with a colour bar.
+//! [`Heatmap`] draws a grid of cells with a colour bar; [`tornado_svg`] and
+//! [`rank_interval_svg`] draw sensitivity measures and rank intervals over uncertain worlds.
 //!
 //! Rendering rules, whatever the input:
 //! - non-finite values (NaN, ±inf) are skipped; a line breaks at them;
@@ -22,10 +23,12 @@ mod draw;
 mod heatmap;
 mod labels;
 mod spec;
+mod uncertainty;
 
 pub use charts::{histogram, scatter_labelled, LabelledPoint};
 pub use heatmap::{heatmap, ColourScale, Heatmap};
 pub use spec::{Colour, Figure, LineStyle, Panel, PanelKind, Series};
+pub use uncertainty::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
 
 #[cfg(test)]
 mod tests;

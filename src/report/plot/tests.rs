@@ -287,3 +287,139 @@ fn crowded_point_labels_get_leader_lines() {
     let svg = fig.render_svg().unwrap();
     assert!(svg.contains("stroke=\"#787878\""), "no leader line");
 }
+
+fn tornado_rows() -> Vec<TornadoRow> {
+    let row = |name: &str, value: f64, lo: f64, hi: f64| TornadoRow {
+        name: name.to_owned(),
+        value,
+        lo,
+        hi,
+    };
+    vec![
+        row("hydro.drag_scale", 0.12, 0.05, 0.2),
+        row("hydro.linear_damping_scale", -0.81, -0.9, -0.7),
+        row("current <speed> & dir", 0.45, f64::NAN, f64::NAN),
+        row("start.offset", f64::NAN, f64::NAN, f64::NAN),
+    ]
+}
+
+#[test]
+fn tornado_chart_sorts_by_magnitude_and_draws_whiskers() {
+    let rows = tornado_rows();
+    let svg = tornado_svg("Drivers of energy per metre", "SRRC [-]", &rows).unwrap();
+    assert_well_formed(&svg);
+    assert_eq!(
+        svg,
+        tornado_svg("Drivers of energy per metre", "SRRC [-]", &rows).unwrap()
+    );
+    for l in [
+        "Drivers of energy per metre",
+        "SRRC [-]",
+        "hydro.linear_damping_scale",
+        "hydro.drag_scale",
+        "current &lt;speed&gt; &amp; dir",
+        "start.offset (n/a)",
+    ] {
+        assert!(svg.contains(l), "missing {l}");
+    }
+    assert!(!svg.contains("NaN"));
+    // Rows from the top by decreasing |value|: the labels appear in that order.
+    let at = |l: &str| svg.find(l).unwrap();
+    assert!(at("linear_damping") < at("current") && at("current") < at("drag_scale"));
+    assert!(at("drag_scale") < at("start.offset"));
+    // Three bars (blue positive, orange negative); whiskers with two caps on the two rows
+    // with a finite interval only.
+    assert_eq!(svg.matches("fill=\"#1F77B4\"").count(), 2);
+    assert_eq!(svg.matches("fill=\"#FF7F0E\"").count(), 1);
+    assert_eq!(svg.matches("stroke-width=\"2\"").count(), 6);
+    // Sobol indices in [0, 1] render too; a lone row and an all-NaN row as well.
+    let sobol: Vec<TornadoRow> = ["a", "b"]
+        .iter()
+        .zip([0.6, 0.02])
+        .map(|(n, v)| TornadoRow {
+            name: n.to_string(),
+            value: v,
+            lo: v - 0.01,
+            hi: v + 0.01,
+        })
+        .collect();
+    assert_well_formed(&tornado_svg("S", "first-order index [-]", &sobol).unwrap());
+    let nan = tornado_svg("n", "x", &rows[3..]).unwrap();
+    assert_well_formed(&nan);
+    assert!(!nan.contains("NaN"));
+}
+
+#[test]
+fn rank_intervals_mark_medians_and_highlight() {
+    let row = |label: &str, p: (f64, f64, f64), highlight: bool| RankRow {
+        label: label.to_owned(),
+        p05: p.0,
+        p50: p.1,
+        p95: p.2,
+        highlight,
+    };
+    let rows = vec![
+        row("#44 ends/3/0.14", (1.0, 1.0, 2.0), true),
+        row("#12 paper/5/0.06", (1.0, 2.0, 4.0), false),
+        row("#7 mid/4/0.10", (2.0, 3.5, 5.0), false),
+        row("#3 never ranked", (f64::NAN, f64::NAN, f64::NAN), false),
+    ];
+    let svg = rank_interval_svg("Rank over 16 worlds", &rows, 5).unwrap();
+    assert_well_formed(&svg);
+    assert_eq!(
+        svg,
+        rank_interval_svg("Rank over 16 worlds", &rows, 5).unwrap()
+    );
+    for l in [
+        "Rank over 16 worlds",
+        "#44 ends/3/0.14",
+        "#12 paper/5/0.06",
+        "#3 never ranked",
+        "1 = best",
+    ] {
+        assert!(svg.contains(l), "missing {l}");
+    }
+    assert!(!svg.contains("NaN"));
+    // Three medians, one of them in the accent colour.
+    assert_eq!(svg.matches("<circle").count(), 3);
+    assert_eq!(svg.matches("fill=\"#FF7F0E\"").count(), 1);
+    // One design alone and out-of-range ranks still render.
+    let one = rank_interval_svg("one", &[row("only", (0.0, 1.0, 9.0), true)], 1).unwrap();
+    assert_well_formed(&one);
+}
+
+#[test]
+fn uncertainty_charts_refuse_empty_input() {
+    for e in [
+        tornado_svg("t", "m", &[]),
+        rank_interval_svg("r", &[], 3),
+        rank_interval_svg(
+            "r",
+            &[RankRow {
+                label: "a".into(),
+                p05: 1.0,
+                p50: 1.0,
+                p95: 1.0,
+                highlight: false,
+            }],
+            0,
+        ),
+    ] {
+        match e {
+            Err(ReportError::InvalidFigure { detail, .. }) => assert!(!detail.is_empty()),
+            other => panic!("expected InvalidFigure, got {other:?}"),
+        }
+    }
+    let many: Vec<TornadoRow> = (0..1000)
+        .map(|i| TornadoRow {
+            name: format!("p{i}"),
+            value: 0.1,
+            lo: f64::NAN,
+            hi: f64::NAN,
+        })
+        .collect();
+    assert!(matches!(
+        tornado_svg("big", "m", &many),
+        Err(ReportError::InvalidFigure { .. })
+    ));
+}
