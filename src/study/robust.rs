@@ -15,8 +15,9 @@ use super::records::{CaseStatus, CASE_ID, STATUS};
 use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
 use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::uncertainty::{Uncertainty, WorldSampling};
-use super::worlds::{SUCCESS_PROBABILITY, WORLD_PREFIX};
+use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
 use crate::report::{Column, ColumnData, Table};
+use crate::scenario::success::Criterion;
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
 
 /// The per-world table of a study output (long format: one row per case and world).
@@ -188,6 +189,19 @@ pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
             data: ColumnData::F64(v),
         });
     }
+    let missed: Vec<String> = (0..n_worlds)
+        .flat_map(|k| (0..ids.len()).map(move |r| (k, r)))
+        .map(|(k, r)| {
+            per.get(&(k, MISSED.to_string()))
+                .and_then(|v| v[r].is_finite().then(|| v[r] as usize))
+                .and_then(|i| Criterion::ALL.get(i))
+                .map_or(String::new(), |c| c.as_str().to_string())
+        })
+        .collect();
+    cols.push(Column {
+        name: MISSED.into(),
+        data: ColumnData::Str(missed),
+    });
     Table::from_columns(cols).ok()
 }
 

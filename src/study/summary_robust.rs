@@ -180,6 +180,31 @@ impl<'a> Robust<'a> {
         rows
     }
 
+    /// The rows the sensitivity and validation sections describe: the ranked designs, or
+    /// every design that ran in its worlds when none is ranked.
+    fn scope(&self) -> Vec<usize> {
+        let p = self.col(P_BEST);
+        let ranked: Vec<usize> = (0..self.table.n_rows())
+            .filter(|&r| p[r].is_finite())
+            .collect();
+        if !ranked.is_empty() {
+            return ranked;
+        }
+        let sp = self.col(SUCCESS_PROBABILITY);
+        (0..self.table.n_rows())
+            .filter(|&r| sp[r].is_finite())
+            .collect()
+    }
+
+    /// "ranked designs" or "designs that ran" for the rows of [`Robust::scope`].
+    fn scope_text(&self) -> &'static str {
+        if self.verdict.ranked > 0 {
+            "ranked designs"
+        } else {
+            "designs that ran (none is ranked)"
+        }
+    }
+
     fn ranking_section(&self, md: &mut String, plots: &Path, warnings: &mut Vec<String>) {
         let o = self.info.objective();
         let params: Vec<String> = self
@@ -207,6 +232,21 @@ impl<'a> Robust<'a> {
             self.verdict.below_requirement,
             self.info.min_success_probability
         );
+        if let Ok(missed) = self.worlds.str(super::worlds::MISSED) {
+            let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+            for m in missed.iter().filter(|m| !m.is_empty()) {
+                *counts.entry(m.as_str()).or_default() += 1;
+            }
+            if !counts.is_empty() {
+                let list: Vec<String> = counts.iter().map(|(c, n)| format!("`{c}` {n}")).collect();
+                let _ = writeln!(
+                    md,
+                    "Runs that missed a `[success]` criterion, by the first criterion missed \
+                     (all designs × worlds, `worlds.csv` column `missed`): {}.\n",
+                    list.join(", ")
+                );
+            }
+        }
         let rows = self.ranked_rows();
         let mut t = MarkdownTable::new(
             [
@@ -321,20 +361,14 @@ impl<'a> Robust<'a> {
 
     /// Per tracked metric: the sensitivity rows (name, value, lo, hi) and the method.
     fn sensitivity(&self, metric: &str) -> Option<(Vec<TornadoRow>, &'static str)> {
-        let eligible: Vec<i64> = {
-            let p = self.col(P_BEST);
-            (0..self.table.n_rows())
-                .filter(|&r| p[r].is_finite())
-                .map(|r| self.ids[r])
-                .collect()
-        };
+        let eligible: Vec<i64> = self.scope().into_iter().map(|r| self.ids[r]).collect();
         let case = self.worlds.i64(CASE_ID).ok()?;
         let world = self.worlds.i64("world").ok()?;
         let y = self.worlds.f64(metric).ok()?;
         let d = self.info.params.len();
         let mut per_case: BTreeMap<i64, Vec<(usize, f64)>> = BTreeMap::new();
         for i in 0..case.len() {
-            if eligible.binary_search(&case[i]).is_ok() || eligible.contains(&case[i]) {
+            if eligible.contains(&case[i]) {
                 per_case
                     .entry(case[i])
                     .or_default()
@@ -373,7 +407,7 @@ impl<'a> Robust<'a> {
                     hi: med(&|s| s.total_hi, j),
                 })
                 .collect();
-            return Some((rows, "Sobol total index (median over ranked designs)"));
+            return Some((rows, "Sobol total index (median over the designs)"));
         }
         let (mut xs, mut ys) = (Vec::new(), Vec::new());
         for v in per_case.values() {
@@ -424,7 +458,7 @@ impl<'a> Robust<'a> {
                 continue;
             };
             rows.sort_by(|a, b| b.value.abs().total_cmp(&a.value.abs()));
-            let _ = writeln!(md, "### `{m}` — {method}\n");
+            let _ = writeln!(md, "### `{m}` — {method}; {}\n", self.scope_text());
             let mut t = MarkdownTable::new(["rank", "parameter", "index", "95 % interval"]);
             for (i, r) in rows.iter().enumerate() {
                 t.row([
@@ -459,19 +493,20 @@ impl<'a> Robust<'a> {
         let _ = writeln!(
             md,
             "Each design at its tuned values in scenario variants not used in tuning; gap = \
-             relative change of `{o}` from the nominal run (median over ranked designs; the \
-             leader's own in the last column).\n"
+             relative change of `{o}` from the nominal run (median over the {}; the \
+             leader's own in the last column).\n",
+            self.scope_text()
         );
         let leader = match &self.verdict.verdict {
             Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
             Verdict::NoneEligible => None,
         };
-        let p = self.col(P_BEST);
+        let scope = self.scope();
         let mut t = MarkdownTable::new(["variant", "median gap", "successful", "leader's gap"]);
         for v in &self.info.validate {
             let gap = self.col(&format!("{VALIDATE_PREFIX}{v}.gap"));
             let ok = self.col(&format!("{VALIDATE_PREFIX}{v}.success"));
-            let rows: Vec<usize> = (0..gap.len()).filter(|&r| p[r].is_finite()).collect();
+            let rows = &scope;
             let mut g: Vec<f64> = rows
                 .iter()
                 .map(|&r| gap[r])

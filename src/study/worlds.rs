@@ -11,11 +11,12 @@
 //!   `validate.<v>.gap` (relative change of the objective from the nominal run).
 
 use super::cases::Resolved;
-use super::records::CaseStatus;
+use super::records::{missed_criterion, CaseStatus};
 use super::schema::Study;
 use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::uncertainty::{apply, World};
 use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
+use crate::scenario::success::Criterion;
 use crate::stats::describe::describe;
 
 /// Prefix of the per-world columns of a row (`world.<k>.<metric>`).
@@ -24,6 +25,18 @@ pub const WORLD_PREFIX: &str = "world.";
 pub const SUCCESS_PROBABILITY: &str = "success_probability";
 /// Prefix of the validation columns (`validate.<name>.<metric>`).
 pub const VALIDATE_PREFIX: &str = "validate.";
+
+/// Per-world column: the first `[success]` criterion the run missed, as its index in
+/// [`Criterion::ALL`] (NaN when it met all); `worlds.csv` writes its id.
+pub const MISSED: &str = "missed";
+
+/// The index of `c` in [`Criterion::ALL`].
+fn criterion_index(c: Criterion) -> f64 {
+    Criterion::ALL
+        .iter()
+        .position(|x| *x == c)
+        .map_or(f64::NAN, |i| i as f64)
+}
 
 /// Run `r` (closed loop only) with `evaluator`.
 fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -> CaseResult {
@@ -86,16 +99,20 @@ pub fn score_worlds(
                 .iter()
                 .zip(&w.values)
                 .map(|(p, v)| (p.name.as_str(), &p.target, v));
-            let (ok, m) = match apply(r, overrides) {
+            let (ok, m, missed) = match apply(r, overrides) {
                 Ok(rw) => {
                     let res = run(evaluator, &rw, id, deadline);
                     if res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT) {
                         return Err(WorldTimeout { world: w.index });
                     }
-                    (res.status == CaseStatus::Ok, res.metrics)
+                    let missed = missed_criterion(res.status, &res.reason)
+                        .and_then(Criterion::parse)
+                        .map_or(f64::NAN, criterion_index);
+                    (res.status == CaseStatus::Ok, res.metrics, missed)
                 }
-                Err(_) => (false, Metrics::new()),
+                Err(_) => (false, Metrics::new(), criterion_index(Criterion::NoFailure)),
             };
+            metrics.push(format!("{WORLD_PREFIX}{}.{MISSED}", w.index), missed);
             successes += usize::from(ok);
             for (name, col) in u.metrics.iter().zip(values.iter_mut()) {
                 let x = m.value(name);
