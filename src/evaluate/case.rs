@@ -273,8 +273,8 @@ fn static_phase(
 fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: &mut CaseResult) {
     let mut sc = scenario.clone();
     sc.remove(STATIC_TABLE);
-    let deadline = input.deadline.instant();
-    let run = match crate::outcome::run_case(v, &sc, input.seed, input.trajectory, deadline) {
+    let stop = input.deadline.stop();
+    let run = match crate::outcome::run_case(v, &sc, input.seed, input.trajectory, stop) {
         Ok(r) => r,
         Err(e) => return out.end(CaseStatus::Failed, e.to_string()),
     };

@@ -7,12 +7,15 @@
 
 use std::time::{Duration, Instant};
 
+use crate::scenario::Stop;
+
 /// The word a timed-out case's reason starts with (`timeout: …`).
 pub const TIMEOUT: &str = crate::scenario::TIMEOUT;
 
-/// A wall-clock deadline, or none (unlimited).
+/// A wall-clock deadline, or none (unlimited). It holds the closed loop's [`Stop`] (the
+/// scenario room's form of the same instant), which [`Deadline::stop`] hands out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Deadline(Option<Instant>);
+pub struct Deadline(Stop);
 
 /// The phase a deadline ran out in (its message names it).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,26 +46,26 @@ fn where_(p: &Phase) -> String {
 
 impl Deadline {
     /// No deadline.
-    pub const NONE: Deadline = Deadline(None);
+    pub const NONE: Deadline = Deadline(Stop::NEVER);
 
     /// `budget` from now (`None`: no deadline).
     pub fn after(budget: Option<Duration>) -> Self {
-        Deadline(budget.map(|b| Instant::now() + b))
+        Deadline(budget.map_or(Stop::NEVER, |b| Stop::at(Instant::now() + b)))
     }
 
     /// The deadline at `instant`.
     pub fn at(instant: Instant) -> Self {
-        Deadline(Some(instant))
+        Deadline(Stop::at(instant))
     }
 
-    /// The instant, if there is one (what the closed loop checks).
-    pub fn instant(self) -> Option<Instant> {
+    /// The closed loop's [`Stop`] at this deadline (never, without one).
+    pub fn stop(self) -> Stop {
         self.0
     }
 
     /// Whether the deadline has passed (never, without one).
     pub fn passed(self) -> bool {
-        self.0.is_some_and(|d| Instant::now() >= d)
+        self.0.due()
     }
 
     /// `Err` naming `phase` once the deadline has passed.
@@ -86,6 +89,12 @@ mod tests {
         assert_eq!(Deadline::after(None), Deadline::NONE);
         let past = Deadline::at(Instant::now() - Duration::from_millis(1));
         assert!(past.passed());
+        // The closed loop's stop is the same instant.
+        assert!(past.stop().due());
+        assert_eq!(Deadline::NONE.stop(), Stop::NEVER);
+        assert!(!Deadline::after(Some(Duration::from_secs(3600)))
+            .stop()
+            .due());
         assert!(Deadline::after(Some(Duration::from_secs(3600)))
             .check(Phase::Static)
             .is_ok());

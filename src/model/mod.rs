@@ -8,6 +8,7 @@
 
 pub mod design;
 pub mod generator;
+pub mod ledger;
 pub mod manoeuvring;
 pub mod presets;
 pub mod world;

@@ -17,13 +17,14 @@ pub enum OptimiseError {
     Journal(#[from] JournalError),
     /// A line could not be appended to the journal (the first such error of the run).
     #[error("journal: {0}")]
-    JournalWrite(String),
+    JournalWrite(#[source] JournalError),
     /// The thread pool could not be built.
     #[error("building the thread pool: {0}")]
     Pool(#[from] rayon::ThreadPoolBuildError),
-    /// The start point could not be evaluated.
+    /// The start point could not be evaluated (the solver framework's error: an evaluation
+    /// budget of zero).
     #[error("evaluating the start point: {0}")]
-    Start(String),
+    Start(#[source] Box<dyn std::error::Error + Send + Sync>),
 }
 
 /// How to run an optimisation.
@@ -117,7 +118,7 @@ pub fn minimise<E: Evaluator>(
     );
     search
         .start(|m| Scorer::new(&spec.objective, &spec.constraints, ev.metrics(), m))
-        .map_err(|e| OptimiseError::Start(e.to_string()))?;
+        .map_err(|e| OptimiseError::Start(e.into()))?;
     let stops = run_solver(&search, &spec.solver);
     let (records, journal_error) = search.finish();
     if let Some(e) = journal_error {

@@ -14,15 +14,15 @@ use super::problem::Problem;
 use super::search::Evaluator;
 use crate::evaluate::{self as case_eval, CaseInput, CaseResult, Deadline, Metrics, Phases};
 use crate::study::axes::study_target;
-use crate::study::cases::{resolve_case, Resolved};
+use crate::study::cases::{resolve_case, CaseError, Resolved};
 use crate::study::doe::Case;
 use crate::study::schema::{Axis, AxisSpec, Study};
 
 /// A point's parameters could not be applied to the study's tables (an index beyond an
 /// array, a design the generator cannot build).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 #[error("{0}")]
-pub struct ResolveError(pub String);
+pub struct ResolveError(#[source] pub CaseError);
 
 /// The evaluator of a problem file's points.
 pub struct CaseEvaluator<'a> {
@@ -120,7 +120,7 @@ impl<'a> CaseEvaluator<'a> {
                 values,
             },
         )
-        .map_err(|e| ResolveError(e.to_string()))
+        .map_err(ResolveError)
     }
 
     /// Run one resolved case (with its trajectory when `log`) through the case evaluator.

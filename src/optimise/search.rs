@@ -32,7 +32,7 @@ use argmin::solver::quasinewton::LBFGS;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
-use super::history::{Evaluation, Journal, Record};
+use super::history::{Evaluation, Journal, JournalError, Record};
 use super::problem::{Method, SolverSettings};
 use super::score::{Score, Scorer};
 use super::space::Space;
@@ -66,7 +66,7 @@ struct SearchState {
     exhausted: bool,
     run: usize,
     journal: Option<Journal>,
-    journal_error: Option<String>,
+    journal_error: Option<JournalError>,
 }
 
 /// The cost function the solvers see (see the module docs).
@@ -205,7 +205,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
         for (&i, e) in todo.iter().zip(done) {
             if let Some(j) = st.journal.as_mut() {
                 if let Err(err) = j.append(&plan[i].x, &e) {
-                    st.journal_error.get_or_insert(err.to_string());
+                    st.journal_error.get_or_insert(err);
                 }
             }
             st.memo.insert(plan[i].key.clone(), e);
@@ -251,7 +251,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
     }
 
     /// The records so far, the number of fresh evaluations, and any journal write error.
-    pub fn finish(self) -> (Vec<Record>, Option<String>) {
+    pub fn finish(self) -> (Vec<Record>, Option<JournalError>) {
         let st = self.state.into_inner().unwrap_or_else(|e| e.into_inner());
         (st.records, st.journal_error)
     }

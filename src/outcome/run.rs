@@ -8,9 +8,8 @@ use crate::scenario::channels::Trajectory;
 use crate::scenario::config::{Mode, ScenarioFile};
 use crate::scenario::success::Missed;
 use crate::scenario::{
-    parse_table, run_loop, AllocationCounts, ScenarioError, Source, Timing, TIMEOUT,
+    parse_table, run_loop, AllocationCounts, ScenarioError, Source, Stop, Timing, TIMEOUT,
 };
-use std::time::Instant;
 
 /// The outcome of one run: the trajectory up to the end (or the failure), the metrics, and
 /// the failure if the run stopped early.
@@ -46,21 +45,21 @@ impl RunResult {
 }
 
 /// Run a scenario on a vehicle. Never panics on bad input: settings problems return
-/// [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges, NaN,
+/// a [`ScenarioError`] before anything runs; a run that fails (diverges, NaN,
 /// singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
 pub fn run_scenario(v: &Vehicle, file: &ScenarioFile) -> Result<RunResult, ScenarioError> {
-    run_scenario_until(v, file, None)
+    run_scenario_until(v, file, Stop::NEVER)
 }
 
-/// [`run_scenario`] with a wall-clock `deadline` ([`crate::scenario::run_loop`]): a run still
-/// going at the deadline stops there with the failure cause [`TIMEOUT`] (the metrics and
+/// [`run_scenario`] with a wall-clock [`Stop`] ([`crate::scenario::run_loop`]): a run still
+/// going when it is due stops there with the failure cause [`TIMEOUT`] (the metrics and
 /// trajectory up to then are kept, as for any failure).
 pub fn run_scenario_until(
     v: &Vehicle,
     file: &ScenarioFile,
-    deadline: Option<Instant>,
+    stop: Stop,
 ) -> Result<RunResult, ScenarioError> {
-    let run = run_loop(v, file, deadline)?;
+    let run = run_loop(v, file, stop)?;
     let failed = run.failure.is_some();
     let mut metrics = run_summary(
         file,
@@ -99,18 +98,18 @@ pub struct CaseRun {
 }
 
 /// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
-/// runs are deterministic). A run still going at `deadline` stops with a failure starting
-/// with [`TIMEOUT`] (`timeout: …`).
+/// runs are deterministic). A run still going when `stop` is due stops with a failure
+/// starting with [`TIMEOUT`] (`timeout: …`).
 pub fn run_case(
     vehicle: &Vehicle,
     scenario: &toml::Table,
     seed: u64,
     log: bool,
-    deadline: Option<std::time::Instant>,
+    stop: Stop,
 ) -> Result<CaseRun, ScenarioError> {
     let _ = seed;
     let f = parse_table(scenario, &Source::unplaced("scenario"))?;
-    let r = run_scenario_until(vehicle, &f, deadline)?;
+    let r = run_scenario_until(vehicle, &f, stop)?;
     Ok(CaseRun {
         metrics: r.metrics,
         trajectory: if log { Some(r.trajectory) } else { None },

@@ -296,7 +296,7 @@ impl Resolver {
             &self.gains[level],
             &mut self.w[..m],
         )
-        .map_err(invalid)
+        .map_err(ScenarioError::from)
     }
 
     /// AC-7 at state `s`, time `t`: writes `ṡ` into `ds`; returns `σ_min(J_s N_p)` when
@@ -315,8 +315,7 @@ impl Resolver {
         self.rate(0, t)?;
         let m = self.primary.dim();
         self.srmtp
-            .push_task(self.primary.jacobian(), &self.w[..m], exact)
-            .map_err(invalid)?;
+            .push_task(self.primary.jacobian(), &self.w[..m], exact)?;
         let sigma = if measure {
             self.srmtp
                 .projected_singular_value(self.secondary.jacobian())
@@ -326,8 +325,7 @@ impl Resolver {
         self.rate(1, t)?;
         let m = self.secondary.dim();
         self.srmtp
-            .push_task(self.secondary.jacobian(), &self.w[..m], exact)
-            .map_err(invalid)?;
+            .push_task(self.secondary.jacobian(), &self.w[..m], exact)?;
         let z = self.srmtp.zeta();
         let (c, sn) = (s[2].cos(), s[2].sin());
         ds[0] = c * z[0] - sn * z[1];
@@ -338,34 +336,33 @@ impl Resolver {
     }
 }
 
-fn invalid(e: impl std::fmt::Display) -> ScenarioError {
-    ScenarioError::Invalid(e.to_string())
-}
-
 impl KinematicCase {
     /// Check the settings against a chain of `n` joints: one initial angle per joint,
     /// positive times and sampling, finite non-negative gains, finite targets.
     pub fn validate(&self, n: usize) -> Result<(), ScenarioError> {
-        let bad = |m: String| Err(ScenarioError::Invalid(format!("{}: {m}", self.name)));
+        let bad = |e: ScenarioError| Err(e.in_case(&self.name));
         if self.q0.len() != n {
-            return bad(format!(
-                "q0 has {} angles, the design {n} joints",
-                self.q0.len()
-            ));
+            return bad(ScenarioError::JointCount {
+                key: "q0",
+                found: self.q0.len(),
+                joints: n,
+            });
         }
         let positive = [self.ramp, self.duration, self.dt];
         if positive.iter().any(|x| !x.is_finite() || *x <= 0.0) || self.record_every == 0 {
-            return bad("ramp, duration, dt and record_every must be > 0".into());
+            return bad(ScenarioError::Rule(
+                "ramp, duration, dt and record_every must be > 0",
+            ));
         }
         let rows = self.primary.iter().chain(&self.secondary);
         if rows.clone().any(|r| !r.gain.is_finite() || r.gain < 0.0) {
-            return bad("task gains must be finite and >= 0".into());
+            return bad(ScenarioError::Rule("task gains must be finite and >= 0"));
         }
         if rows
             .clone()
             .any(|r| r.target.is_some_and(|x| !x.is_finite()))
         {
-            return bad("task targets must be finite".into());
+            return bad(ScenarioError::Rule("task targets must be finite"));
         }
         Ok(())
     }
@@ -386,10 +383,10 @@ fn trace(task: &InertialTask) -> Vec<TaskTrace> {
 fn build(v: &Vehicle, case: &KinematicCase) -> Result<Resolver, ScenarioError> {
     let n = v.n_joints();
     let vars = |rows: &[TaskRow]| rows.iter().map(|r| r.variable).collect::<Vec<_>>();
-    let primary = InertialTask::new(&vars(&case.primary), n).map_err(invalid)?;
-    let secondary = InertialTask::new(&vars(&case.secondary), n).map_err(invalid)?;
+    let primary = InertialTask::new(&vars(&case.primary), n)?;
+    let secondary = InertialTask::new(&vars(&case.secondary), n)?;
     let max_rows = primary.dim() + secondary.dim();
-    let srmtp = Srmtp::new(6 + n, max_rows, &planar_weights(n), 0.0).map_err(invalid)?;
+    let srmtp = Srmtp::new(6 + n, max_rows, &planar_weights(n), 0.0)?;
     let gains = |rows: &[TaskRow]| rows.iter().map(|r| r.gain).collect::<Vec<_>>();
     let mut r = Resolver {
         n,
@@ -413,8 +410,7 @@ fn build(v: &Vehicle, case: &KinematicCase) -> Result<Resolver, ScenarioError> {
             .iter()
             .zip(task.value())
             .map(|(row, &x0)| Quintic::new(x0, row.target.unwrap_or(x0), case.ramp))
-            .collect::<Result<_, _>>()
-            .map_err(invalid)?;
+            .collect::<Result<_, _>>()?;
     }
     Ok(r)
 }

@@ -151,7 +151,7 @@ pub fn secondary_profile(
         file.commanded(),
         file.char_length(v),
     )
-    .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    .map_err(ScenarioError::from)?;
     let qs = r.trajectory.indexed(Channel::Q);
     let mut q = vec![0.0; qs.len()];
     let (mut sigma, mut manip) = (Vec::new(), Vec::new());

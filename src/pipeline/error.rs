@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use crate::dynamics::DynError;
 use crate::metrics::singularity::SingularityError;
 use crate::model::design::DesignError;
+use crate::optimise::evaluate::ResolveError;
 use crate::report::ReportError;
 use crate::scenario::ScenarioError;
 use crate::statics::StaticError;
@@ -19,6 +20,9 @@ pub enum PipelineError {
     /// A scenario could not be loaded, or its run could not start.
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// An optimised point's parameters could not be applied to the problem's tables.
+    #[error(transparent)]
+    Resolve(#[from] ResolveError),
     /// The static analysis of `T(q)` failed.
     #[error(transparent)]
     Static(#[from] StaticError),

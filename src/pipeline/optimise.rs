@@ -120,9 +120,7 @@ pub fn case_file_text(problem: &Problem, r: &Resolved, x: &[f64]) -> Result<Stri
         t.insert("design".into(), toml::Value::Table(r.design.clone()));
         toml::to_string(&t)
     };
-    let body = body.map_err(|e| {
-        PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(e.to_string()))
-    })?;
+    let body = body.map_err(crate::scenario::ScenarioError::Serialize)?;
     Ok(format!("{head}\n{body}"))
 }
 
@@ -133,9 +131,7 @@ fn write_best_files(
     out: &Path,
 ) -> Result<(), PipelineError> {
     for v in 0..problem.spec.variants.len() {
-        let r = ev.resolve(x, v).map_err(|m| {
-            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
-        })?;
+        let r = ev.resolve(x, v)?;
         let text = case_file_text(problem, &r, x)?;
         atomic_write(&out.join(best_file_name(problem, v)), text.as_bytes())?;
     }
@@ -364,9 +360,7 @@ fn runs_figure(
     };
     let mut figs = Vec::new();
     for (label, r) in [("start", o.start()), ("best", o.best())] {
-        let resolved = ev.resolve(&r.x, 0).map_err(|m| {
-            PipelineError::Scenario(crate::scenario::ScenarioError::Invalid(m.to_string()))
-        })?;
+        let resolved = ev.resolve(&r.x, 0)?;
         let run = ev.run_case(&resolved, true);
         let vehicle = parse_design_table(&resolved.design, "optimised design")?;
         let yaw: Vec<usize> = yaw_joint_mask(&vehicle)

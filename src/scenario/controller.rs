@@ -115,7 +115,7 @@ fn secondary_tasks(v: &Vehicle, file: &ScenarioFile) -> Result<SecondaryTasks, S
         file.commanded(),
         file.char_length(v),
     )
-    .map_err(|e| ScenarioError::Invalid(e.to_string()))
+    .map_err(ScenarioError::from)
 }
 
 impl ModeController {
@@ -129,17 +129,17 @@ impl ModeController {
         q0: &[f64],
         base0: &BasePose,
     ) -> Result<Self, ScenarioError> {
-        let invalid = ScenarioError::Invalid;
+        let control = |source| ScenarioError::Control {
+            prefix: "control.",
+            source,
+        };
         Ok(match gains {
             ModeGains::Transport(g) => {
-                let path = file
-                    .path
-                    .clone()
-                    .ok_or_else(|| invalid("path: transport mode needs a [path] table".into()))?;
-                let mut law = Box::new(
-                    TransportController::new(v, g, &path)
-                        .map_err(|e| invalid(format!("control.{e}")))?,
-                );
+                let path = file.path.clone().ok_or(ScenarioError::MissingTable {
+                    table: "path",
+                    mode: "transport",
+                })?;
+                let mut law = Box::new(TransportController::new(v, g, &path).map_err(control)?);
                 if file.secondary.enabled() {
                     law.set_secondary(secondary_tasks(v, file)?);
                 }
@@ -150,11 +150,11 @@ impl ModeController {
                 }
             }
             ModeGains::Work(g) => {
-                let sp = file.setpoint.as_ref().ok_or_else(|| {
-                    invalid("setpoint: work mode needs a [setpoint] table".into())
+                let sp = file.setpoint.as_ref().ok_or(ScenarioError::MissingTable {
+                    table: "setpoint",
+                    mode: "work",
                 })?;
-                let mut law =
-                    WorkController::new(v, &g).map_err(|e| invalid(format!("control.{e}")))?;
+                let mut law = WorkController::new(v, &g).map_err(control)?;
                 law.reset(q0);
                 if file.secondary.enabled() {
                     law.set_secondary(secondary_tasks(v, file)?);
@@ -176,10 +176,12 @@ impl ModeController {
                         let [x, y, z] = sp.position;
                         let end = [x, y, z, r[0], r[1], r[2]];
                         let via = spec.via_points();
-                        Some(Box::new(
-                            PoseReference::new(start, end, spec.duration, &via)
-                                .map_err(|e| invalid(e.to_string()))?,
-                        ))
+                        Some(Box::new(PoseReference::new(
+                            start,
+                            end,
+                            spec.duration,
+                            &via,
+                        )?))
                     }
                     None => None,
                 };

@@ -42,7 +42,7 @@ pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
-pub use run::{run_loop, LoopRun, TIMEOUT};
+pub use run::{run_loop, LoopRun, Stop, TIMEOUT};
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::KeyError;
@@ -228,9 +228,9 @@ impl Source {
     }
 
     /// `e` placed in this scenario's document (file, line, column, key) as a
-    /// [`ScenarioError::Invalid`].
+    /// [`ScenarioError::Input`].
     pub fn invalid(&self, e: KeyError) -> ScenarioError {
-        ScenarioError::Invalid(self.doc.place(e).to_string())
+        ScenarioError::Input(self.doc.place(e))
     }
 }
 
@@ -238,8 +238,11 @@ impl Source {
 pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     let path = Path::new(arg);
     let (text, dir) = if path.is_file() {
-        let text = crate::input::document::read_text(path)
-            .map_err(|e| ScenarioError::Invalid(format!("{arg}: {e}")))?;
+        let text =
+            crate::input::document::read_text(path).map_err(|source| ScenarioError::Read {
+                origin: arg.to_string(),
+                source,
+            })?;
         (
             text,
             Some(path.parent().map(Path::to_path_buf).unwrap_or_default()),
@@ -247,10 +250,10 @@ pub fn load_table(arg: &str) -> Result<(toml::Table, Source), ScenarioError> {
     } else if let Some(t) = preset_text(arg) {
         (t, None)
     } else {
-        return Err(ScenarioError::Invalid(format!(
-            "{arg}: no such scenario file, and not a preset (presets: {})",
-            preset_names().join(", ")
-        )));
+        return Err(ScenarioError::NotFound {
+            name: arg.to_string(),
+            presets: preset_names(),
+        });
     };
     parse_source(&text, arg, dir)
 }
@@ -269,7 +272,7 @@ fn parse_source(
     origin: &str,
     dir: Option<PathBuf>,
 ) -> Result<(toml::Table, Source), ScenarioError> {
-    let invalid = |e| ScenarioError::Invalid(format!("{e}"));
+    let invalid = ScenarioError::Input;
     let doc = match dir {
         Some(_) => Document::parse(text, origin),
         None => Document::parse_generated(text, origin),
@@ -296,8 +299,7 @@ pub fn parse_table(table: &toml::Table, src: &Source) -> Result<ScenarioFile, Sc
 /// or a file relative to the scenario's directory), checked against the scenario's gains.
 pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, ScenarioError> {
     let v = if let Some(t) = &file.design {
-        parse_design_table(t, &format!("{} [design]", src.origin))
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?
+        parse_design_table(t, &format!("{} [design]", src.origin)).map_err(ScenarioError::Design)?
     } else {
         let d = &file.scenario.design;
         let rel = src.dir.join(d);
@@ -306,7 +308,7 @@ pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, Scen
         } else {
             d.clone()
         };
-        load_design(&arg).map_err(|e| ScenarioError::Invalid(e.to_string()))?
+        load_design(&arg).map_err(ScenarioError::Design)?
     };
     file.check_design(&v).map_err(|e| src.invalid(e))?;
     check_log_size(file, &v).map_err(|e| src.invalid(e))?;
@@ -324,16 +326,15 @@ pub fn default_table(mode: Mode) -> Result<toml::Table, ScenarioError> {
     let text = preset_text(preset).unwrap_or_default();
     let (table, src) = parse_source(&text, preset, None)?;
     let f = parse_table(&table, &src)?;
-    let mut full = toml::Table::try_from(&f).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    let mut full = toml::Table::try_from(&f).map_err(ScenarioError::Serialize)?;
     // Write the mode's gains out in full (the file may give only a few keys).
     let gains = match f.mode_gains().map_err(|e| src.invalid(e))? {
         config::ModeGains::Transport(g) => toml::Table::try_from(&g),
         config::ModeGains::Work(g) => toml::Table::try_from(&g),
     }
-    .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    .map_err(ScenarioError::Serialize)?;
     full.insert("control".into(), toml::Value::Table(gains));
-    let base =
-        toml::Table::try_from(f.base_gains()).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+    let base = toml::Table::try_from(f.base_gains()).map_err(ScenarioError::Serialize)?;
     full.insert("base_control".into(), toml::Value::Table(base));
     full.remove("design");
     Ok(full)
@@ -352,6 +353,9 @@ pub fn check_table(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), KeyE
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::control::ControlError;
+    use crate::dynamics::SimError;
+    use std::error::Error as _;
 
     #[test]
     fn presets_parse_and_default_tables_are_complete() {
@@ -511,5 +515,79 @@ mod tests {
             e.starts_with("work-setpoint: scenario.duration: must be"),
             "{e}"
         );
+    }
+
+    /// The scenario `name` with `edit` applied to its table, and its design.
+    fn scenario(name: &str, edit: impl FnOnce(&mut toml::Table)) -> (ScenarioFile, Vehicle) {
+        let (mut t, src) = load_table(name).unwrap();
+        edit(&mut t);
+        let f = parse_table(&t, &src).unwrap();
+        let v = resolve_design(&f, &src).unwrap();
+        (f, v)
+    }
+
+    #[test]
+    fn an_unknown_scenario_is_not_found_and_the_presets_are_named() {
+        let e = load_table("no-such-scenario").unwrap_err();
+        assert!(matches!(&e, ScenarioError::NotFound { name, .. } if name == "no-such-scenario"));
+        assert!(e.to_string().starts_with(
+            "no-such-scenario: no such scenario file, and not a preset (presets: transport-method1, "
+        ));
+    }
+
+    #[test]
+    fn setup_errors_are_typed_and_read_as_before() {
+        let (f, v) = scenario("work-setpoint", |t| {
+            let initial = t.entry("initial").or_insert(toml::Table::new().into());
+            initial.as_table_mut().unwrap().insert(
+                "joint_angles_deg".into(),
+                toml::Value::Array(vec![toml::Value::Float(0.0)]),
+            );
+        });
+        let e = run_loop(&v, &f, Stop::NEVER).unwrap_err();
+        assert!(matches!(
+            e,
+            ScenarioError::JointCount { found: 1, joints, .. } if joints == v.n_joints()
+        ));
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "initial.joint_angles_deg has 1 entries, the design has {} joints",
+                v.n_joints()
+            )
+        );
+        let (f, mut v) = scenario("transport-method2", |_| {});
+        v.thrusters.clear();
+        let e = run_loop(&v, &f, Stop::NEVER).unwrap_err();
+        assert!(matches!(e, ScenarioError::NoThrusters));
+        assert_eq!(
+            e.to_string(),
+            "design: a closed-loop scenario needs at least one thruster"
+        );
+    }
+
+    #[test]
+    fn causes_are_sources_and_the_text_keeps_the_prefix_and_the_case() {
+        let e = ScenarioError::Control {
+            prefix: "control.",
+            source: ControlError::new("transport.k_psi", "must be > 0"),
+        };
+        assert_eq!(e.to_string(), "control.transport.k_psi: must be > 0");
+        let cause = e.source().unwrap().downcast_ref::<ControlError>().unwrap();
+        assert_eq!(cause.key, "transport.k_psi");
+        let e = ScenarioError::from(SimError {
+            time: 0.0,
+            quantity: "mass_matrix".into(),
+            message: "is singular".into(),
+        })
+        .in_case("case 3");
+        assert_eq!(
+            e.to_string(),
+            "case 3: mass_matrix is singular at t = 0.000000 s"
+        );
+        let inner = e.source().unwrap();
+        let inner = inner.downcast_ref::<Box<ScenarioError>>().unwrap();
+        assert!(matches!(**inner, ScenarioError::Sim(_)));
+        assert!(inner.source().unwrap().downcast_ref::<SimError>().is_some());
     }
 }

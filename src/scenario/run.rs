@@ -140,25 +140,46 @@ impl ClosedLoop<'_> {
 /// The failure cause of a run stopped by its wall-clock deadline ([`run_loop`]).
 pub const TIMEOUT: &str = "timeout";
 
+/// When a closed-loop run must stop on the wall clock: at an instant, or never. [`run_loop`]
+/// checks it cooperatively before every control period; a run still going when it is
+/// [`due`](Stop::due) stops there with the failure cause [`TIMEOUT`] and keeps its trajectory
+/// up to then. A case's `crate::evaluate::Deadline` hands one out (`Deadline::stop`), so that
+/// the loop does not depend on the evaluator that budgets it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stop {
+    at: Option<Instant>,
+}
+
+impl Stop {
+    /// Never stop on the wall clock: the run goes to the end of the scenario (or its failure).
+    pub const NEVER: Stop = Stop { at: None };
+
+    /// Stop at `instant`.
+    pub fn at(instant: Instant) -> Stop {
+        Stop { at: Some(instant) }
+    }
+
+    /// Whether the stop time has passed (never for [`Stop::NEVER`]).
+    pub fn due(self) -> bool {
+        self.at.is_some_and(|d| Instant::now() >= d)
+    }
+}
+
 /// Run the closed loop of a scenario on a vehicle. Never panics on bad input: settings
-/// problems return [`ScenarioError::Invalid`] before anything runs; a run that fails (diverges,
+/// problems return a [`ScenarioError`] before anything runs; a run that fails (diverges,
 /// NaN, singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
 ///
-/// A wall-clock `deadline` is checked cooperatively before every control period: a run still
-/// going at the deadline stops there with the failure cause [`TIMEOUT`] (the trajectory up to
+/// The wall-clock [`Stop`] is checked cooperatively before every control period: a run still
+/// going when it is due stops there with the failure cause [`TIMEOUT`] (the trajectory up to
 /// then is kept, as for any failure). A control period is bounded in work: at most
 /// `MAX_SUBSTEPS` (1e5) RK4 steps (`scenario.control_dt / dt`, checked by validation) or
 /// `MAX_STEPS_PER_SPAN` (1e5) Dormand–Prince trials.
-pub fn run_loop(
-    v: &Vehicle,
-    file: &ScenarioFile,
-    deadline: Option<Instant>,
-) -> Result<LoopRun, ScenarioError> {
+pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun, ScenarioError> {
     let started = Instant::now();
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
     let failure = (0..=lp.n_control).find_map(|k| {
-        if deadline.is_some_and(|d| Instant::now() >= d) {
+        if stop.due() {
             return Some((k as f64 * file.scenario.control_dt, TIMEOUT.to_string()));
         }
         let period_started = Instant::now();

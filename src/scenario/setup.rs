@@ -52,10 +52,11 @@ fn initial_state(v: &Vehicle, file: &ScenarioFile) -> Result<SimState, ScenarioE
         UnitQuaternion::from_axis_angle(&Vector3::z_axis(), file.initial.yaw_deg.to_radians());
     if !file.initial.joint_angles_deg.is_empty() {
         if file.initial.joint_angles_deg.len() != n_joints {
-            return Err(ScenarioError::Invalid(format!(
-                "initial.joint_angles_deg has {} entries, the design has {n_joints} joints",
-                file.initial.joint_angles_deg.len()
-            )));
+            return Err(ScenarioError::JointCount {
+                key: "initial.joint_angles_deg",
+                found: file.initial.joint_angles_deg.len(),
+                joints: n_joints,
+            });
         }
         for (q, d) in st
             .joint_angles
@@ -82,16 +83,16 @@ fn allocator(v: &Vehicle, file: &ScenarioFile) -> Result<Allocator, ScenarioErro
         &spec.weights_for(n_thrusters),
         spec.settings(n_thrusters),
     )
-    .map_err(|e| ScenarioError::Invalid(format!("allocation: {e}")))
+    .map_err(ScenarioError::Allocation)
 }
 
 impl<'f> ClosedLoop<'f> {
-    /// Set up a run of `file` on `v`. Settings problems are [`ScenarioError::Invalid`].
+    /// Set up a run of `file` on `v`; a settings problem is the [`ScenarioError`] of the
+    /// check that found it.
     pub fn new(v: &Vehicle, file: &'f ScenarioFile) -> Result<Self, ScenarioError> {
-        file.validate()
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+        file.validate()?;
         let s = &file.scenario;
-        check_log_size(file, v).map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+        check_log_size(file, v)?;
         let mut vehicle = v.clone();
         vehicle.fluid.current = Vec3::from(file.physics.total_current());
         vehicle
@@ -100,23 +101,16 @@ impl<'f> ClosedLoop<'f> {
         let v = &vehicle;
         let n_thrusters = v.n_thrusters();
         if n_thrusters == 0 {
-            return Err(ScenarioError::Invalid(
-                "design: a closed-loop scenario needs at least one thruster".into(),
-            ));
+            return Err(ScenarioError::NoThrusters);
         }
-        let mut sim = Simulator::new(
-            v,
-            file.sim_config()
-                .map_err(|e| ScenarioError::Invalid(e.to_string()))?,
-        )
-        .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
-        sim.set_state(initial_state(v, file)?)
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
-        let gains = file
-            .mode_gains()
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
-        let base_ctl = DynamicController::new(file.base_gains())
-            .map_err(|e| ScenarioError::Invalid(format!("base_control.{e}")))?;
+        let mut sim = Simulator::new(v, file.sim_config()?)?;
+        sim.set_state(initial_state(v, file)?)?;
+        let gains = file.mode_gains()?;
+        let base_ctl =
+            DynamicController::new(file.base_gains()).map_err(|source| ScenarioError::Control {
+                prefix: "base_control.",
+                source,
+            })?;
         let q0 = sim.state().joint_angles.clone();
         let mode = ModeController::new(v, file, gains, &q0, &sim.state().pose)?;
         let allocator = allocator(v, file)?;

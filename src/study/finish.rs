@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::cases::resolve_case;
+use super::cases::{resolve_case, CaseError};
 use super::doe::expand;
 use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
@@ -33,7 +33,7 @@ pub enum RerunError {
     CaseId,
     /// The case's overrides do not apply.
     #[error("{0}")]
-    Resolve(String),
+    Resolve(#[source] CaseError),
     /// The case's tuned values do not apply.
     #[error(transparent)]
     Tune(#[from] TuneError),
@@ -85,7 +85,7 @@ fn rerun_extremes(
     let rerun = |which: Extreme, row: usize| -> Result<(), RerunError> {
         let id = ids[row] as usize;
         let case = all.get(id).ok_or(RerunError::CaseId)?;
-        let mut r = resolve_case(study, case).map_err(|e| RerunError::Resolve(e.to_string()))?;
+        let mut r = resolve_case(study, case).map_err(RerunError::Resolve)?;
         if let Some(t) = &tuner {
             // Rerun at the case's tuned values, as scored.
             let x: Vec<f64> = tuned.iter().map(|c| c[row]).collect();

@@ -152,20 +152,22 @@ impl DynamicCase {
 
     /// Positive finite times, `log_every ≥ 1`, finite current, valid gains.
     pub fn validate(&self) -> Result<(), ScenarioError> {
-        let bad = |m: String| Err(ScenarioError::Invalid(format!("{}: {m}", self.name)));
+        let bad = |e: ScenarioError| Err(e.in_case(&self.name));
         if ![self.duration, self.control_dt]
             .iter()
             .all(|x| x.is_finite() && *x > 0.0)
             || self.log_every == 0
         {
-            return bad("duration, control_dt and log_every must be > 0".into());
+            return bad(ScenarioError::Rule(
+                "duration, control_dt and log_every must be > 0",
+            ));
         }
         if !self.current.iter().all(|x| x.is_finite()) {
-            return bad("current must be finite".into());
+            return bad(ScenarioError::Rule("current must be finite"));
         }
         self.gains
             .validate()
-            .map_err(|e| ScenarioError::Invalid(format!("{}: {e}", self.name)))
+            .map_err(|e| ScenarioError::from(e).in_case(&self.name))
     }
 }
 
@@ -276,8 +278,7 @@ pub fn run_dynamic_case(
         },
         ..SimConfig::default()
     };
-    let sim_err =
-        |e: crate::dynamics::SimError| ScenarioError::Invalid(format!("{}: {e}", case.name));
+    let sim_err = |e: crate::dynamics::SimError| ScenarioError::Sim(e).in_case(&case.name);
     let mut sim = Simulator::new(&v, cfg).map_err(sim_err)?;
     let r0 = reference.reference(0.0);
     let mut state = SimState::rest(&v);
