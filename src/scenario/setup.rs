@@ -10,6 +10,7 @@ use crate::allocation::{Allocation, Allocator};
 use crate::control::dynamic::DynamicController;
 use crate::dynamics::{SimState, Simulator};
 use crate::kinematics::KinWorkspace;
+use crate::input::located::KeyError;
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};
 use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
@@ -97,7 +98,7 @@ impl<'f> ClosedLoop<'f> {
         vehicle.fluid.current = Vec3::from(file.physics.total_current());
         vehicle
             .apply_scales(&file.hydro.scales(file.thrusters.limit_scale), &SCALE_KEYS)
-            .map_err(|e| ScenarioError::Invalid(e.to_string()))?;
+            .map_err(|e| ScenarioError::Key(KeyError::new(e.key, e.message)))?;
         let v = &vehicle;
         let n_thrusters = v.n_thrusters();
         if n_thrusters == 0 {
