@@ -74,6 +74,14 @@ pub enum SamplerError {
     },
 }
 
+/// The message of a [`SamplerError`], for callers that report a reason as text (as
+/// `From<SetError> for String`).
+impl From<SamplerError> for String {
+    fn from(e: SamplerError) -> String {
+        e.to_string()
+    }
+}
+
 /// Mix a seed with a stream index (SplitMix64 finaliser): a stable, well-spread derived seed.
 pub fn derive_seed(seed: u64, stream: u64) -> u64 {
     let mut z = seed ^ stream.wrapping_mul(0x9E37_79B9_7F4A_7C15);

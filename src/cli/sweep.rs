@@ -198,7 +198,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         tuning: Some(TUNING),
     };
     if a.dry_run {
-        let cases = expand(&study, shard).map_err(|e| anyhow!(e))?;
+        let cases = expand(&study, shard)?;
         println!(
             "study {} ({} mode{}): {} cases{}, output {}",
             study.name,

@@ -8,7 +8,7 @@
 //! Case `i` is a pure function of `(study, i)`.
 
 use super::schema::{Axis, AxisSpec, Dist, Doe, Study};
-use crate::sampling::{derive_seed, Sampler};
+use crate::sampling::{derive_seed, Sampler, SamplerError};
 
 /// One case: its id and one value per axis (in axis order).
 #[derive(Clone, Debug, PartialEq)]
@@ -95,7 +95,7 @@ pub fn case_count(study: &Study) -> usize {
 }
 
 /// Expands the study's cases (ids `0..case_count`); for shards, only ids `≡ index (mod count)`.
-pub fn expand(study: &Study, shard: Option<(usize, usize)>) -> Result<Vec<Case>, String> {
+pub fn expand(study: &Study, shard: Option<(usize, usize)>) -> Result<Vec<Case>, SamplerError> {
     let n = case_count(study);
     let keep = |id: usize| shard.is_none_or(|(i, k)| id % k == i);
     let mut out = Vec::new();
@@ -118,8 +118,7 @@ pub fn expand(study: &Study, shard: Option<(usize, usize)>) -> Result<Vec<Case>,
                 cases,
                 study.axes.len(),
                 derive_seed(study.seed, 0xD0E),
-            )
-            .map_err(|e| e.to_string())?;
+            )?;
             let mut u = vec![0.0; study.axes.len()];
             for id in (0..n).filter(|&id| keep(id)) {
                 sampler.point(id, &mut u);

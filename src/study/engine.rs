@@ -157,7 +157,7 @@ pub fn run_sweep(
         }
     }
     let tuner = case_tuner(study, opts.tuning)?;
-    let cases = expand(study, opts.shard).map_err(StudyError::Input)?;
+    let cases = expand(study, opts.shard)?;
     let out = outdir::resolve(&output_dir(study, opts))?;
     let owner = outdir::LockOwner {
         study: &study.hash,
@@ -191,7 +191,7 @@ pub fn run_sweep(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
         .build()
-        .map_err(|e| StudyError::Other(format!("thread pool: {e}")))?;
+        .map_err(StudyError::Pool)?;
     let run = RunSpec {
         study,
         done: &done,

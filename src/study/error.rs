@@ -29,6 +29,15 @@ pub enum StudyError {
         #[source]
         source: std::io::Error,
     },
+    /// The study's cases cannot be sampled (too many axes for Sobol, too many cases).
+    #[error("{0}")]
+    Plan(#[from] crate::sampling::SamplerError),
+    /// The sweep's thread pool could not be built.
+    #[error("thread pool: {0}")]
+    Pool(#[source] rayon::ThreadPoolBuildError),
+    /// The study has a `[tune]` section but the caller wired no tuner into the sweep.
+    #[error("the study has a [tune] section but no tuner was wired into the sweep")]
+    NoTuner,
     /// Anything else.
     #[error("{0}")]
     Other(String),
@@ -40,7 +49,10 @@ pub type Notes = Vec<String>;
 impl StudyError {
     /// Whether this is bad input (study file or command line).
     pub fn is_input(&self) -> bool {
-        matches!(self, StudyError::Study(_) | StudyError::Input(_))
+        matches!(
+            self,
+            StudyError::Study(_) | StudyError::Input(_) | StudyError::Plan(_)
+        )
     }
 
     /// A file-system error at `path`.

@@ -27,7 +27,7 @@ pub enum RerunError {
     Study(Box<StudyError>),
     /// The study's cases could not be planned.
     #[error("{0}")]
-    Plan(String),
+    Plan(#[source] crate::sampling::SamplerError),
     /// The table names a case the study does not have.
     #[error("case id out of range")]
     CaseId,

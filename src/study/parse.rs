@@ -20,7 +20,7 @@ use super::uncertainty::{parse_uncertainty, parse_variants};
 use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{did_you_mean, flatten, pattern_allowed};
-use crate::input::located::Location;
+use crate::input::located::{KeyError, Location};
 use crate::model::design::{load_design_table, parse_design_table};
 
 #[derive(Deserialize)]
@@ -380,7 +380,7 @@ fn check_base_scenario(
     };
     let mut sc = reference.clone();
     sc.remove(STATIC_TABLE);
-    let Err((key, message)) = runner::check_case(&v, &sc) else {
+    let Err(KeyError { key, message }) = runner::check_case(&v, &sc) else {
         return Ok(());
     };
     let swept = axes.iter().any(|a| match &a.target {

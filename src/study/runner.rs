@@ -127,9 +127,9 @@ impl FromStr for StudyMode {
 }
 
 /// Check a resolved scenario-side table of a dynamic mode against `vehicle` without running
-/// it (schema, settings, gains against the design, log size): `Err((key, message))`.
-pub fn check_case(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), (String, String)> {
-    crate::scenario::check_table(vehicle, scenario).map_err(|e| (e.key.clone(), e.message.clone()))
+/// it (schema, settings, gains against the design, log size); the error names the key.
+pub fn check_case(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), KeyError> {
+    crate::scenario::check_table(vehicle, scenario)
 }
 
 /// The reason of a case stopped by its wall-clock budget starts with this word.

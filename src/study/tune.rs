@@ -143,9 +143,7 @@ pub fn case_tuner(
 ) -> Result<Option<Box<dyn CaseTuner>>, StudyError> {
     match hook {
         Some(h) => Ok(h.tuner(study)?),
-        None if study.tune.is_some() => Err(StudyError::Other(
-            "the study has a [tune] section but no tuner was wired into the sweep".into(),
-        )),
+        None if study.tune.is_some() => Err(StudyError::NoTuner),
         None => Ok(None),
     }
 }
