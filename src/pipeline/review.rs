@@ -383,14 +383,28 @@ impl Page<'_> {
         );
         for r in rows {
             let cell = |k: &str| escape(&json_text(&r[k]));
+            let source = format!(
+                "{}: {}",
+                json_text(&r["source"]["kind"]),
+                json_text(&r["source"]["text"])
+            );
+            let range = match (&r["study_range"], &r["range"]) {
+                (serde_json::Value::String(s), _) => format!("this study: {s}"),
+                (_, serde_json::Value::Array(a)) if a.len() == 2 => format!(
+                    "held nominal here (ledger range {} … {})",
+                    json_text(&a[0]),
+                    json_text(&a[1])
+                ),
+                _ => "–".into(),
+            };
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td><code>{}</code></td><td>{}</td></tr>",
                 cell("name"),
                 cell("value"),
-                cell("source"),
+                escape(&source),
                 cell("key"),
-                cell("range")
+                escape(&range)
             );
         }
         h.push_str("</table>\n</section>\n");

@@ -522,6 +522,6 @@ fn sweep_manifest(
             .collect(),
         report: study.report.clone(),
         robust: RobustInfo::of(study),
-        ledger: None,
+        ledger: super::robust::study_ledger(study),
     }
 }

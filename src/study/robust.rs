@@ -105,6 +105,24 @@ impl RobustInfo {
     }
 }
 
+/// The assumption ledger ([`crate::model::ledger`]) as `manifest.json` records it for a study
+/// with `[uncertainty]`: every entry, plus `study_range`, the distribution this study gives
+/// its key (null when the study holds it at its nominal value).
+pub fn study_ledger(study: &Study) -> Option<serde_json::Value> {
+    let u = study.uncertainty.as_ref()?;
+    let mut v = crate::model::ledger::ledger_json();
+    for e in v.as_array_mut()? {
+        let key = e["key"].as_str().unwrap_or_default().to_string();
+        let used = u
+            .params
+            .iter()
+            .find(|p| !key.is_empty() && p.name == key)
+            .map(|p| p.dist.range_text());
+        e["study_range"] = used.map_or(serde_json::Value::Null, serde_json::Value::String);
+    }
+    Some(v)
+}
+
 /// A world value as a number: numbers as they are, a choice of text or booleans by index.
 fn numeric(v: &toml::Value, d: &super::uncertainty::WorldDist) -> f64 {
     match v {

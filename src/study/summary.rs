@@ -74,7 +74,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     let robust = Robust::load(dir, table, m);
     let mut md = header_section(&c, m, robust.as_ref().map(Robust::verdict_line));
     if let Some(r) = &robust {
-        md.push_str(&r.sections(&plots, &mut warnings));
+        md.push_str(&r.sections(dir, &plots, &mut warnings));
     }
     tune_section(&c, &mut md, robust.is_some());
     best_section(&c, &mut md);

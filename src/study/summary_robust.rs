@@ -18,6 +18,7 @@ use super::selection::cell_text;
 use super::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
 use crate::report::plot::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
 use crate::report::{fmt_short, read_csv, MarkdownTable, Table};
+use crate::report::{Colour, Figure, Panel, Series};
 use crate::stats::ranking::Verdict;
 use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
@@ -153,10 +154,13 @@ impl<'a> Robust<'a> {
 
     /// The ranking, tuning-adequacy, sensitivity and validation sections; plots into
     /// `plots`.
-    pub fn sections(&self, plots: &Path, warnings: &mut Vec<String>) -> String {
+    pub fn sections(&self, dir: &Path, plots: &Path, warnings: &mut Vec<String>) -> String {
         let mut md = String::new();
         self.ranking_section(&mut md, plots, warnings);
         self.tuning_section(&mut md);
+        if self.tuning_curves(dir, plots, warnings) {
+            let _ = writeln!(md, "![tuning curves](plots/tuning_curves.svg)\n");
+        }
         self.sensitivity_section(&mut md, plots, warnings);
         self.validation_section(&mut md);
         md
@@ -318,6 +322,52 @@ impl<'a> Robust<'a> {
         }
     }
 
+    /// Every design's best-so-far tuning curve (`tuning.csv`) relative to its final value, one
+    /// faint line each: how many runs the tuning needed, and whether it had settled.
+    fn tuning_curves(&self, dir: &Path, plots: &Path, warnings: &mut Vec<String>) -> bool {
+        let Ok(t) = read_csv(&dir.join(super::robust::TUNING_CSV)) else {
+            return false;
+        };
+        let (Ok(case), Ok(eval), Ok(best)) = (t.i64(CASE_ID), t.i64("evaluation"), t.f64("best"))
+        else {
+            return false;
+        };
+        let mut curves: BTreeMap<i64, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+        for i in 0..case.len() {
+            let c = curves.entry(case[i]).or_default();
+            c.0.push(eval[i] as f64);
+            c.1.push(best[i]);
+        }
+        let mut panel = Panel::new(
+            "best-so-far tuning objective / final value",
+            "tuning run",
+            "best so far / final",
+        );
+        for (k, (x, y)) in curves.values().enumerate() {
+            let last = y
+                .iter()
+                .rev()
+                .copied()
+                .find(|v| v.is_finite())
+                .unwrap_or(f64::NAN);
+            let rel: Vec<f64> = y.iter().map(|v| v / last).collect();
+            panel.series.push(
+                Series::new(if k == 0 { "one design each" } else { "" }, x.clone(), rel)
+                    .colour(Colour::Palette(0)),
+            );
+        }
+        let mut fig = Figure::new("Per-design tuning: best so far");
+        fig.panels.push(panel);
+        fig.size = (720, 420);
+        match fig.write_svg(&plots.join("tuning_curves.svg")) {
+            Ok(()) => true,
+            Err(e) => {
+                warnings.push(format!("tuning_curves.svg: {e}"));
+                false
+            }
+        }
+    }
+
     fn tuning_section(&self, md: &mut String) {
         let noise = self.col(TUNE_NOISE);
         if noise.iter().all(|x| x.is_nan()) && self.table.f64(TUNE_BOUND_HITS).is_err() {
@@ -409,7 +459,9 @@ impl<'a> Robust<'a> {
                 .collect();
             return Some((rows, "Sobol total index (median over the designs)"));
         }
-        let (mut xs, mut ys) = (Vec::new(), Vec::new());
+        // Each design's values relative to its own mean, grouped by world (the bootstrap
+        // resamples worlds, the unit the parameters vary over).
+        let mut by_world: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         for v in per_case.values() {
             let finite: Vec<f64> = v
                 .iter()
@@ -421,30 +473,82 @@ impl<'a> Robust<'a> {
             }
             let mean = finite.iter().sum::<f64>() / finite.len() as f64;
             for (w, x) in v {
-                let Some(p) = self.info.world_values.get(*w) else {
-                    continue;
-                };
-                if x.is_finite() && mean != 0.0 {
-                    xs.push(p.clone());
-                    ys.push(x / mean);
+                if x.is_finite() && mean != 0.0 && *w < self.info.world_values.len() {
+                    by_world.entry(*w).or_default().push(x / mean);
                 }
             }
         }
-        if ys.len() < d + 2 {
+        // Per world, the mean over the designs: the parameters vary only from world to world.
+        let worlds: Vec<usize> = by_world.keys().copied().collect();
+        let ybar: Vec<f64> = worlds
+            .iter()
+            .map(|w| by_world[w].iter().sum::<f64>() / by_world[w].len() as f64)
+            .collect();
+        let x: Vec<Vec<f64>> = worlds
+            .iter()
+            .map(|&w| self.info.world_values[w].clone())
+            .collect();
+        let n = worlds.len();
+        if n < 4 {
             return None;
         }
-        let s = srrc(&xs, &ys);
+        if n >= 3 * (d + 1) {
+            // Enough worlds for a joint fit: SRRC, 95 % bootstrap over worlds.
+            let coef = srrc(&x, &ybar).coef;
+            let mut rng = crate::sampling::rng_for(0x5352_5243, 0); // "SRRC"
+            let boots: Vec<Vec<f64>> = (0..200)
+                .map(|_| {
+                    let pick: Vec<usize> = (0..n)
+                        .map(|_| rand::Rng::random_range(&mut rng, 0..n))
+                        .collect();
+                    let xs: Vec<Vec<f64>> = pick.iter().map(|&i| x[i].clone()).collect();
+                    let ys: Vec<f64> = pick.iter().map(|&i| ybar[i]).collect();
+                    srrc(&xs, &ys).coef
+                })
+                .collect();
+            let rows = (0..d)
+                .map(|j| {
+                    let mut v: Vec<f64> = boots
+                        .iter()
+                        .map(|b| b[j])
+                        .filter(|x| x.is_finite())
+                        .collect();
+                    v.sort_by(f64::total_cmp);
+                    TornadoRow {
+                        name: self.info.params[j].name.clone(),
+                        value: coef[j],
+                        lo: crate::stats::describe::quantile_sorted(&v, 0.025),
+                        hi: crate::stats::describe::quantile_sorted(&v, 0.975),
+                    }
+                })
+                .collect();
+            return Some((
+                rows,
+                "SRRC of the per-world mean over the designs (each design relative to its \
+                 mean); 95 % bootstrap over worlds",
+            ));
+        }
+        // Fewer worlds than a joint fit of every parameter needs: each parameter's Spearman
+        // rank correlation with the per-world mean (the SRRC of a one-parameter fit; the
+        // space-filling worlds keep the parameters nearly uncorrelated), 95 % Fisher interval.
+        let half = 1.96 / ((n - 3) as f64).sqrt();
         let rows = (0..d)
-            .map(|j| TornadoRow {
-                name: self.info.params[j].name.clone(),
-                value: s.coef[j],
-                lo: f64::NAN,
-                hi: f64::NAN,
+            .map(|j| {
+                let col: Vec<Vec<f64>> = x.iter().map(|r| vec![r[j]]).collect();
+                let rho = srrc(&col, &ybar).coef[0];
+                let z = rho.clamp(-0.999_999, 0.999_999).atanh();
+                TornadoRow {
+                    name: self.info.params[j].name.clone(),
+                    value: rho,
+                    lo: (z - half).tanh(),
+                    hi: (z + half).tanh(),
+                }
             })
             .collect();
         Some((
             rows,
-            "SRRC (pooled over ranked designs, each design's values relative to its mean)",
+            "Spearman rank correlation with the per-world mean over the designs (each design \
+             relative to its mean; too few worlds for a joint SRRC fit); 95 % Fisher interval",
         ))
     }
 
