@@ -411,7 +411,13 @@ impl<'a> Robust<'a> {
 
     /// Per tracked metric: the sensitivity rows (name, value, lo, hi) and the method.
     fn sensitivity(&self, metric: &str) -> Option<(Vec<TornadoRow>, &'static str)> {
-        let eligible: Vec<i64> = self.scope().into_iter().map(|r| self.ids[r]).collect();
+        // Every design that ran in its worlds (ranked or not): how the world moves a metric
+        // is a question about the model, not about the winners.
+        let sp = self.col(SUCCESS_PROBABILITY);
+        let eligible: Vec<i64> = (0..self.table.n_rows())
+            .filter(|&r| sp[r].is_finite())
+            .map(|r| self.ids[r])
+            .collect();
         let case = self.worlds.i64(CASE_ID).ok()?;
         let world = self.worlds.i64("world").ok()?;
         let y = self.worlds.f64(metric).ok()?;
@@ -562,7 +568,7 @@ impl<'a> Robust<'a> {
                 continue;
             };
             rows.sort_by(|a, b| b.value.abs().total_cmp(&a.value.abs()));
-            let _ = writeln!(md, "### `{m}` — {method}; {}\n", self.scope_text());
+            let _ = writeln!(md, "### `{m}` — {method}; every design that ran\n");
             let mut t = MarkdownTable::new(["rank", "parameter", "index", "95 % interval"]);
             for (i, r) in rows.iter().enumerate() {
                 t.row([
