@@ -479,7 +479,7 @@ fn parse_param(
 /// Each scenario of `variants` in each world of `u` (named `w<k>`, or `<variant>/w<k>`).
 fn in_worlds(
     variants: Vec<Variant>,
-    u: &crate::study::uncertainty::Uncertainty,
+    u: &crate::study::schema::Uncertainty,
     seed: u64,
 ) -> Vec<Variant> {
     let worlds = u.sample(seed);

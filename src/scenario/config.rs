@@ -515,13 +515,9 @@ impl ScenarioFile {
         finite("initial.position", &self.initial.position)?;
         finite("initial.yaw_deg", &[self.initial.yaw_deg])?;
         finite("initial.joint_angles_deg", &self.initial.joint_angles_deg)?;
-        finite("physics.current", &self.physics.current)?;
-        finite(
-            "physics.current_speed",
-            &[self.physics.current_speed, self.physics.current_direction],
-        )?;
-        self.hydro
-            .scales(self.thrusters.limit_scale)
+        finite("physics.current", &self.physics.total_current())?;
+        let scales = self.hydro.scales(self.thrusters.limit_scale);
+        scales
             .validate(&SCALE_KEYS)
             .map_err(|e| KeyError::new(e.key, e.message))?;
         match self.scenario.mode {

@@ -138,3 +138,26 @@ pub fn case_hash(study: &Study, case: &Case, resolved: &Result<Resolved, CaseErr
         Err(_) => unresolved_case_hash(&study.hash, case.id, &case.values),
     }
 }
+
+/// Case `r` with overrides applied (a world's values, a validation variant's keys): new
+/// tables and a new design hash (the vehicle cache key), the case hash and seed unchanged.
+pub fn apply_overrides<'a>(
+    r: &Resolved,
+    overrides: impl IntoIterator<Item = (&'a str, &'a Target, &'a toml::Value)>,
+) -> Result<Resolved, SetError> {
+    let mut out = r.clone();
+    let mut design_changed = false;
+    for (name, target, value) in overrides {
+        match target {
+            Target::Design(p) => {
+                set(&mut out.design, &p.0, value.clone(), name)?;
+                design_changed = true;
+            }
+            Target::Scenario(p) => set(&mut out.scenario, &p.0, value.clone(), name)?,
+        }
+    }
+    if design_changed {
+        out.design_hash = case_hashes(&out.design, &out.scenario, out.seed).1;
+    }
+    Ok(out)
+}

@@ -47,10 +47,9 @@ use super::manifest::{
 };
 use super::outdir;
 use super::records::{
-    axis_text, compact, raw_schema, write_tables, CaseStatus, Row, StatusCounts, HASH,
-    PARTIAL_FILE, STUDY_COPY,
+    axis_text, compact, raw_schema, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE, STUDY_COPY,
 };
-use super::robust::RobustInfo;
+use super::robust::{write_tables, RobustInfo};
 use super::runner::TIMEOUT;
 use super::schema::Study;
 use super::tune::{case_tuner, CaseTuner, TuningHook};

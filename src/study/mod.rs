@@ -35,6 +35,8 @@
 
 pub mod axes;
 pub mod cases;
+pub mod catalogue;
+pub mod directions;
 pub mod doe;
 pub mod engine;
 pub mod error;

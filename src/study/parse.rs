@@ -11,15 +11,15 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::axes::{parse_axes, valid_names, AxisFile};
+pub use super::catalogue::{known_metric, metric_catalogue, unknown_metric};
 use super::error::InputError;
 use super::hash::study_hash;
-use super::records::{DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
 use super::uncertainty::{parse_uncertainty, parse_variants};
 use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
 use crate::input::document::{deserialize_table, Document};
-use crate::input::keypath::{did_you_mean, flatten, pattern_allowed};
+use crate::input::keypath::{flatten, pattern_allowed};
 use crate::input::located::{KeyError, Location};
 use crate::model::design::{load_design_table, parse_design_table};
 
@@ -228,65 +228,6 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
             .insert("validate".into(), toml::Value::Array(list));
     }
     Ok(study)
-}
-
-/// Whether `name` is a metric column the cases of `study` report: a design descriptor, a
-/// static `T(q)` metric (with `[static]`), a run metric of the mode (`seg{k}_…` included) or a
-/// per-case tuning column.
-pub fn known_metric(name: &str, study: &Study) -> bool {
-    DESIGN_COLUMNS.contains(&name)
-        || (study.static_enabled && TCM_COLUMNS.contains(&name))
-        || scenario_mode(study.mode)
-            .is_some_and(|m| crate::outcome::run_summary::is_run_metric(m, name))
-        || study.tune_columns().iter().any(|c| c == name)
-}
-
-/// The closed-loop mode of a study mode (`None` for static studies).
-fn scenario_mode(mode: StudyMode) -> Option<crate::scenario::Mode> {
-    match mode {
-        StudyMode::Static => None,
-        StudyMode::Transport => Some(crate::scenario::Mode::Transport),
-        StudyMode::Work => Some(crate::scenario::Mode::Work),
-    }
-}
-
-/// The metric catalogue of a study (see [`known_metric`]), for messages.
-pub fn metric_catalogue(study: &Study) -> Vec<String> {
-    let mut v: Vec<String> = DESIGN_COLUMNS.iter().map(|s| s.to_string()).collect();
-    if study.static_enabled {
-        v.extend(TCM_COLUMNS.iter().map(|s| s.to_string()));
-    }
-    if let Some(m) = scenario_mode(study.mode) {
-        v.extend(crate::outcome::run_summary::metric_catalogue(m));
-    }
-    v.extend(study.tune_columns());
-    v
-}
-
-/// The error for a metric name `name` at `key` that the study's cases do not report: the
-/// mode, a "did you mean" hint when a catalogue name is close, and the catalogue.
-pub fn unknown_metric(name: &str, key: &str, study: &Study, doc: &Document) -> InputError {
-    let catalogue = metric_catalogue(study);
-    if name.is_empty() {
-        return doc.err(
-            key,
-            "is empty: name a metric, or leave the key out for the default",
-        );
-    }
-    doc.err(
-        key,
-        format!(
-            "unknown metric `{name}` for mode \"{}\"{}{}; valid: {}",
-            study.mode,
-            if study.static_enabled {
-                " with [static]"
-            } else {
-                ""
-            },
-            did_you_mean(name, catalogue.iter().map(String::as_str)),
-            catalogue.join(", ")
-        ),
-    )
 }
 
 /// `study.objective`, `study.pareto` and `study.maximise` name metrics the cases report

@@ -7,14 +7,11 @@
 //! and column names are written and read only through the items here.
 
 use std::collections::{HashMap, HashSet};
-use std::path::Path;
 
 use super::error::StudyError;
 use super::schema::Study;
 use crate::evaluate::{CaseResult, Metrics};
-use crate::report::{
-    format_f64, write_csv_streamed, write_parquet, Column, ColumnData, ColumnKind, Table, Value,
-};
+use crate::report::{format_f64, Column, ColumnData, ColumnKind, Table, Value};
 
 pub use crate::evaluate::metrics::{
     DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
@@ -361,33 +358,6 @@ pub fn final_table(raw: Table) -> Result<Table, StudyError> {
     let mut cols: Vec<Column> = head.into_iter().flatten().chain(cols).collect();
     cols.extend(tail.into_iter().flatten());
     Ok(Table::from_columns(cols)?)
-}
-
-/// Write compacted raw rows to the partial file of `out` and the final table to
-/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table (built from `raw`'s columns).
-///
-/// With uncertain worlds (`robust`), the per-world columns move to
-/// [`super::robust::WORLDS_CSV`] and the ranking columns are added
-/// ([`super::robust::add_rank_columns`]).
-pub fn write_tables(
-    raw: Table,
-    out: &Path,
-    robust: Option<&super::robust::RobustInfo>,
-) -> Result<Table, StudyError> {
-    write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
-    let mut table = final_table(raw)?;
-    if let Some(curves) = super::robust::split_tuning(&mut table) {
-        write_csv_streamed(&curves, &out.join(super::robust::TUNING_CSV))?;
-    }
-    if let Some(info) = robust {
-        if let Some(worlds) = super::robust::split_worlds(&mut table, info) {
-            write_csv_streamed(&worlds, &out.join(super::robust::WORLDS_CSV))?;
-            super::robust::add_rank_columns(&mut table, &worlds, info);
-        }
-    }
-    write_csv_streamed(&table, &out.join(CASES_CSV))?;
-    write_parquet(&table, &out.join(CASES_PARQUET))?;
-    Ok(table)
 }
 
 /// Packed scenario metrics (one cell per row) as columns `(name, values)`, in order of first

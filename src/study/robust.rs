@@ -11,11 +11,17 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
-use super::records::{CaseStatus, CASE_ID, STATUS};
+use std::path::Path;
+
+use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use super::error::StudyError;
+use super::records::{
+    final_table, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, STATUS,
+};
 use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
-use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::uncertainty::{Uncertainty, WorldSampling};
+use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
+use crate::report::{write_csv_streamed, write_parquet};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
@@ -124,14 +130,12 @@ pub fn study_ledger(study: &Study) -> Option<serde_json::Value> {
 }
 
 /// A world value as a number: numbers as they are, a choice of text or booleans by index.
-fn numeric(v: &toml::Value, d: &super::uncertainty::WorldDist) -> f64 {
+fn numeric(v: &toml::Value, d: &WorldDist) -> f64 {
     match v {
         toml::Value::Float(x) => *x,
         toml::Value::Integer(i) => *i as f64,
         _ => match d {
-            super::uncertainty::WorldDist::Choice(c) => {
-                c.iter().position(|x| x == v).map_or(f64::NAN, |i| i as f64)
-            }
+            WorldDist::Choice(c) => c.iter().position(|x| x == v).map_or(f64::NAN, |i| i as f64),
             _ => f64::NAN,
         },
     }
@@ -413,4 +417,31 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
         below_requirement,
         ranked: pd.eligible.iter().filter(|e| **e).count(),
     })
+}
+
+/// Write compacted raw rows to the partial file of `out` and the final table to
+/// [`CASES_CSV`] and [`CASES_PARQUET`]; returns the final table (built from `raw`'s columns).
+///
+/// With uncertain worlds (`robust`), the per-world columns move to
+/// [`WORLDS_CSV`] and the ranking columns are added
+/// ([`add_rank_columns`]).
+pub fn write_tables(
+    raw: Table,
+    out: &Path,
+    robust: Option<&RobustInfo>,
+) -> Result<Table, StudyError> {
+    write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
+    let mut table = final_table(raw)?;
+    if let Some(curves) = split_tuning(&mut table) {
+        write_csv_streamed(&curves, &out.join(TUNING_CSV))?;
+    }
+    if let Some(info) = robust {
+        if let Some(worlds) = split_worlds(&mut table, info) {
+            write_csv_streamed(&worlds, &out.join(WORLDS_CSV))?;
+            add_rank_columns(&mut table, &worlds, info);
+        }
+    }
+    write_csv_streamed(&table, &out.join(CASES_CSV))?;
+    write_parquet(&table, &out.join(CASES_PARQUET))?;
+    Ok(table)
 }

@@ -8,7 +8,9 @@ use std::str::FromStr;
 use super::runner::{StudyMode, SCENARIO_TABLES};
 use crate::evaluate::static_table::STATIC_TABLE;
 use crate::input::keypath::KeyPath;
-use crate::sampling::Sampling;
+use crate::sampling::{derive_seed, Sampler, Sampling};
+use crate::stats::normal::inv_cdf;
+use crate::stats::sobol::SaltelliDesign;
 
 /// Largest number of cases of a study.
 pub const MAX_CASES: usize = 10_000_000;
@@ -228,9 +230,9 @@ pub struct Study {
     /// case runs.
     pub tune: Option<toml::Table>,
     /// The `[uncertainty]` section: worlds every case meets (issue 22).
-    pub uncertainty: Option<super::uncertainty::Uncertainty>,
+    pub uncertainty: Option<Uncertainty>,
     /// The `[[validate]]` variants, scored at the tuned values.
-    pub validate: Vec<super::uncertainty::Variant>,
+    pub validate: Vec<Variant>,
     /// `[uncertainty]` and `[[validate]]` as written (part of every case hash: a row
     /// depends on them); empty without them.
     pub robust_table: toml::Table,
@@ -295,4 +297,176 @@ pub const GENERATOR_KEYS: [&str; 13] = [
 /// Whether `key` is a scenario-side top-level table (including `static`).
 pub fn is_scenario_table(key: &str) -> bool {
     key == STATIC_TABLE || SCENARIO_TABLES.contains(&key)
+}
+
+// ---- uncertain worlds (`[uncertainty]`, `[[validate]]`; parsed by `super::uncertainty`) ----
+
+/// Seed stream of the worlds (shared by every case: common random numbers).
+const WORLD_STREAM: u64 = 0x574f_524c_4453; // "WORLDS"
+
+/// Most sampled worlds per case.
+pub const MAX_WORLDS: usize = 100_000;
+
+/// A distribution of an uncertain parameter (`distribution = { kind = … }`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum WorldDist {
+    /// Uniform on `[low, high]`.
+    Uniform(f64, f64),
+    /// Log-uniform on `[low, high]`, 0 < low.
+    LogUniform(f64, f64),
+    /// Normal with mean and standard deviation.
+    Normal(f64, f64),
+    /// Log-normal: `exp(N(mu, sigma))` (`mu`, `sigma` of the logarithm).
+    LogNormal(f64, f64),
+    /// One of the listed values, equally likely.
+    Choice(Vec<toml::Value>),
+}
+
+impl WorldDist {
+    /// The value at probability `u` ∈ (0, 1) (inverse CDF; `Choice` by equal bins).
+    pub fn value(&self, u: f64) -> toml::Value {
+        let u = u.clamp(1e-12, 1.0 - 1e-12);
+        toml::Value::Float(match self {
+            WorldDist::Uniform(lo, hi) => lo + u * (hi - lo),
+            WorldDist::LogUniform(lo, hi) => (lo.ln() + u * (hi.ln() - lo.ln())).exp(),
+            WorldDist::Normal(m, s) => m + s * inv_cdf(u),
+            WorldDist::LogNormal(m, s) => (m + s * inv_cdf(u)).exp(),
+            WorldDist::Choice(v) => {
+                let i = ((u * v.len() as f64) as usize).min(v.len() - 1);
+                return v[i].clone();
+            }
+        })
+    }
+
+    /// The 5 % and 95 % quantiles as text (the range a ledger reports), numbers only.
+    pub fn range_text(&self) -> String {
+        match self {
+            WorldDist::Uniform(lo, hi) | WorldDist::LogUniform(lo, hi) => format!("{lo} … {hi}"),
+            WorldDist::Choice(v) => v
+                .iter()
+                .map(crate::report::fmt_value)
+                .collect::<Vec<_>>()
+                .join(" | "),
+            d => {
+                let q = |u: f64| match d.value(u) {
+                    toml::Value::Float(x) => crate::report::fmt_short(x),
+                    _ => String::new(),
+                };
+                format!("{} … {} (5–95 %)", q(0.05), q(0.95))
+            }
+        }
+    }
+}
+
+/// How the worlds are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorldSampling {
+    /// A sampled design of `worlds` points.
+    Points(Sampling),
+    /// Saltelli's design for Sobol indices: `worlds` base samples, `worlds·(d+2)` worlds.
+    Saltelli,
+}
+
+/// An uncertain parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UncertainParam {
+    /// The key as written (the column name in `worlds.csv`).
+    pub name: String,
+    /// The table it edits.
+    pub target: Target,
+    /// Its distribution.
+    pub dist: WorldDist,
+    /// Whether the key holds an integer (values rounded).
+    pub integer: bool,
+}
+
+/// The validated `[uncertainty]` section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncertainty {
+    /// Sampled worlds per case as written (Saltelli: base samples).
+    pub worlds: usize,
+    /// How they are drawn.
+    pub sampling: WorldSampling,
+    /// The uncertain parameters, in file order.
+    pub params: Vec<UncertainParam>,
+    /// Metrics summarised over the worlds (`m_mean`, … columns; the first is the objective).
+    pub metrics: Vec<String>,
+    /// Least success probability for a case to be ranked (default 0.9).
+    pub min_success_probability: f64,
+    /// Fraction of paired worlds the leader must win against every other case to be named
+    /// the winner (default 0.95).
+    pub confidence: f64,
+    /// Relative margin below which two designs are called tied (default 0.01).
+    pub equivalence: f64,
+}
+
+/// A held-out validation variant (`[[validate]]`): overrides not used in tuning, scored at
+/// the tuned values in the nominal world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variant {
+    /// Name (column part, `validate.<name>.<metric>`).
+    pub name: String,
+    /// The overrides, in file order.
+    pub set: Vec<(String, Target, toml::Value)>,
+}
+
+/// One sampled world: a value per uncertain parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    /// Index (0-based, the `world` column).
+    pub index: usize,
+    /// The values, in parameter order.
+    pub values: Vec<toml::Value>,
+}
+
+impl Uncertainty {
+    /// Number of worlds each case meets (besides the nominal one).
+    pub fn n_worlds(&self) -> usize {
+        match self.sampling {
+            WorldSampling::Points(_) => self.worlds,
+            WorldSampling::Saltelli => self.worlds * (self.params.len() + 2),
+        }
+    }
+
+    /// The objective summarised over worlds (first of [`Uncertainty::metrics`]).
+    pub fn objective(&self) -> &str {
+        &self.metrics[0]
+    }
+
+    /// The worlds of a study with seed `seed`: the same for every case.
+    pub fn sample(&self, seed: u64) -> Vec<World> {
+        let d = self.params.len();
+        let seed = derive_seed(seed, WORLD_STREAM);
+        let units: Vec<Vec<f64>> = match self.sampling {
+            WorldSampling::Saltelli => SaltelliDesign { n: self.worlds, d }.points(seed),
+            WorldSampling::Points(s) => {
+                let Ok(sampler) = Sampler::new(s, self.worlds, d, seed) else {
+                    return Vec::new(); // parse() checked the sizes
+                };
+                (0..self.worlds)
+                    .map(|i| {
+                        let mut u = vec![0.0; d];
+                        sampler.point(i, &mut u);
+                        u
+                    })
+                    .collect()
+            }
+        };
+        units
+            .into_iter()
+            .enumerate()
+            .map(|(index, u)| World {
+                index,
+                values: self
+                    .params
+                    .iter()
+                    .zip(&u)
+                    .map(|(p, &x)| match (p.dist.value(x), p.integer) {
+                        (toml::Value::Float(f), true) => toml::Value::Integer(f.round() as i64),
+                        (v, _) => v,
+                    })
+                    .collect(),
+            })
+            .collect()
+    }
 }

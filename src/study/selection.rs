@@ -8,10 +8,11 @@
 
 use std::collections::HashSet;
 
-use super::manifest::Manifest;
-use super::records::{
-    CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
+pub use super::directions::{
+    larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, WORLD_SUFFIXES,
 };
+use super::manifest::Manifest;
+use super::records::{CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION};
 use crate::report::{fmt_short, pareto_front, ColumnData, ColumnKind, Table};
 
 /// Relative difference below which two values of a metric tie in `Selection::best_row`
@@ -27,47 +28,6 @@ pub(crate) fn thin(rows: &[usize]) -> Vec<usize> {
     let k = rows.len().div_ceil(MAX_PLOT_POINTS).max(1);
     rows.iter().copied().step_by(k).collect()
 }
-
-/// Signed metrics whose best value is the one nearest zero: ranked, and put on a Pareto
-/// front, by |x| (the final cross-track error of transport, positive to the left).
-pub const BY_MAGNITUDE: [&str; 1] = ["final_cross_track"];
-
-/// Default objective of a transport study when present: thruster energy per metre of path
-/// covered, which compares designs of different speeds.
-pub const ENERGY_PER_METRE: &str = "energy_per_metre";
-
-/// The 0/1 success metric of a closed-loop run (1 on every ranked case).
-pub const SUCCESS: &str = "success";
-
-/// Whether larger is better for `metric` by default: conditioning (σ_min) and run outcomes
-/// (completion, success, convergence, progress) and their summaries over worlds
-/// (`…_mean`, `…_p05`, …), `success_probability` and `p_best`. Study files add their own with
-/// `study.maximise`.
-pub fn larger_is_better(metric: &str) -> bool {
-    let m = metric;
-    m.starts_with("tcm_sigma_min")
-        || m.starts_with(TCM_STRAIGHT_SIGMA_MIN)
-        || m.starts_with("sigma_min")
-        || [
-            "completed",
-            SUCCESS,
-            "converged",
-            "segments_reached",
-            "simulated_time",
-            "path_progress",
-        ]
-        .iter()
-        .any(|b| {
-            m == *b
-                || m.strip_prefix(b)
-                    .is_some_and(|r| r != "_std" && WORLD_SUFFIXES.contains(&r))
-        })
-        || m == "success_probability"
-        || m == "p_best"
-}
-
-/// Suffixes of a metric's summary over worlds (`energy_per_metre_mean`, …).
-pub const WORLD_SUFFIXES: [&str; 5] = ["_mean", "_std", "_p05", "_p95", "_worst"];
 
 /// Which metrics the report looks at and in which direction.
 pub struct Selection {

@@ -15,7 +15,8 @@ use super::finish::finish_report;
 use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manifest};
 use super::outdir;
 use super::parse::load_study;
-use super::records::{compact, write_tables, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use super::records::{compact, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use super::robust::write_tables;
 use super::tune::TuningHook;
 use crate::report::{read_csv_typed, Table};
 

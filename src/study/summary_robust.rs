@@ -410,6 +410,47 @@ impl<'a> Robust<'a> {
     }
 
     /// Per tracked metric: the sensitivity rows (name, value, lo, hi) and the method.
+    /// Sobol total indices of `metric` per design from a Saltelli design of worlds (values by
+    /// world index), the median over the designs with the median bootstrap interval.
+    fn sobol_rows(
+        &self,
+        per_case: &BTreeMap<i64, Vec<(usize, f64)>>,
+    ) -> (Vec<TornadoRow>, &'static str) {
+        let d = self.info.params.len();
+        let design = SaltelliDesign {
+            n: self.info.worlds / (d + 2),
+            d,
+        };
+        let mut all: Vec<Vec<crate::stats::sobol::SobolIndex>> = Vec::new();
+        for (id, v) in per_case {
+            let mut ys = vec![f64::NAN; self.info.worlds];
+            for (w, x) in v {
+                if *w < ys.len() {
+                    ys[*w] = *x;
+                }
+            }
+            all.push(sobol_indices(&design, &ys, 200, *id as u64));
+        }
+        let med = |f: &dyn Fn(&crate::stats::sobol::SobolIndex) -> f64, j: usize| {
+            let mut v: Vec<f64> = all
+                .iter()
+                .map(|s| f(&s[j]))
+                .filter(|x| x.is_finite())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            crate::stats::describe::quantile_sorted(&v, 0.5)
+        };
+        let rows = (0..d)
+            .map(|j| TornadoRow {
+                name: self.info.params[j].name.clone(),
+                value: med(&|s| s.total, j),
+                lo: med(&|s| s.total_lo, j),
+                hi: med(&|s| s.total_hi, j),
+            })
+            .collect();
+        (rows, "Sobol total index (median over the designs)")
+    }
+
     fn sensitivity(&self, metric: &str) -> Option<(Vec<TornadoRow>, &'static str)> {
         // Every design that ran in its worlds (ranked or not): how the world moves a metric
         // is a question about the model, not about the winners.
@@ -432,38 +473,7 @@ impl<'a> Robust<'a> {
             }
         }
         if self.info.sampling == "saltelli" {
-            let design = SaltelliDesign {
-                n: self.info.worlds / (d + 2),
-                d,
-            };
-            let mut all: Vec<Vec<crate::stats::sobol::SobolIndex>> = Vec::new();
-            for (id, v) in &per_case {
-                let mut ys = vec![f64::NAN; self.info.worlds];
-                for (w, x) in v {
-                    if *w < ys.len() {
-                        ys[*w] = *x;
-                    }
-                }
-                all.push(sobol_indices(&design, &ys, 200, *id as u64));
-            }
-            let med = |f: &dyn Fn(&crate::stats::sobol::SobolIndex) -> f64, j: usize| {
-                let mut v: Vec<f64> = all
-                    .iter()
-                    .map(|s| f(&s[j]))
-                    .filter(|x| x.is_finite())
-                    .collect();
-                v.sort_by(f64::total_cmp);
-                crate::stats::describe::quantile_sorted(&v, 0.5)
-            };
-            let rows = (0..d)
-                .map(|j| TornadoRow {
-                    name: self.info.params[j].name.clone(),
-                    value: med(&|s| s.total, j),
-                    lo: med(&|s| s.total_lo, j),
-                    hi: med(&|s| s.total_hi, j),
-                })
-                .collect();
-            return Some((rows, "Sobol total index (median over the designs)"));
+            return Some(self.sobol_rows(&per_case));
         }
         // Each design's values relative to its own mean, grouped by world (the bootstrap
         // resamples worlds, the unit the parameters vary over).

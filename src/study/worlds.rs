@@ -10,14 +10,16 @@
 //! - per variant `v`: `validate.<v>.<objective>`, `validate.<v>.success` and
 //!   `validate.<v>.gap` (relative change of the objective from the nominal run).
 
+use super::cases::apply_overrides as apply;
 use super::cases::Resolved;
+use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::records::{missed_criterion, CaseStatus};
 use super::schema::Study;
-use super::selection::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::uncertainty::{apply, World};
+use super::schema::World;
 use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
 use crate::scenario::success::Criterion;
 use crate::stats::describe::describe;
+use rayon::prelude::*;
 
 /// Prefix of the per-world columns of a row (`world.<k>.<metric>`).
 pub const WORLD_PREFIX: &str = "world.";
@@ -70,6 +72,14 @@ fn worst(metric: &str, xs: &[f64]) -> f64 {
     }
 }
 
+/// One case's run in one world.
+struct WorldRun {
+    ok: bool,
+    metrics: Metrics,
+    missed: f64,
+    timeout: bool,
+}
+
 /// Why scoring a case in its worlds stopped: its wall-clock budget ran out.
 #[derive(Debug, thiserror::Error)]
 #[error("{TIMEOUT} in world {world} (the case's wall-clock budget)")]
@@ -91,37 +101,57 @@ pub fn score_worlds(
     metrics: &mut Metrics,
 ) -> Result<(), WorldTimeout> {
     if let Some(u) = &study.uncertainty {
+        // The worlds of one case are independent runs: run them side by side (a sweep with
+        // fewer cases than threads keeps every thread busy), each with its own evaluator,
+        // collected in world order so the row does not depend on the thread count.
+        let runs: Vec<WorldRun> = worlds
+            .par_iter()
+            .map(|w| {
+                let overrides = u
+                    .params
+                    .iter()
+                    .zip(&w.values)
+                    .map(|(p, v)| (p.name.as_str(), &p.target, v));
+                match apply(r, overrides) {
+                    Ok(rw) => {
+                        let res = run(&mut Evaluator::new(), &rw, id, deadline);
+                        let timeout =
+                            res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT);
+                        let missed = missed_criterion(res.status, &res.reason)
+                            .and_then(Criterion::parse)
+                            .map_or(f64::NAN, criterion_index);
+                        WorldRun {
+                            ok: res.status == CaseStatus::Ok,
+                            metrics: res.metrics,
+                            missed,
+                            timeout,
+                        }
+                    }
+                    Err(_) => WorldRun {
+                        ok: false,
+                        metrics: Metrics::new(),
+                        missed: criterion_index(Criterion::NoFailure),
+                        timeout: false,
+                    },
+                }
+            })
+            .collect();
         let mut values: Vec<Vec<f64>> = vec![Vec::with_capacity(worlds.len()); u.metrics.len()];
         let mut successes = 0usize;
-        for w in worlds {
-            let overrides = u
-                .params
-                .iter()
-                .zip(&w.values)
-                .map(|(p, v)| (p.name.as_str(), &p.target, v));
-            let (ok, m, missed) = match apply(r, overrides) {
-                Ok(rw) => {
-                    let res = run(evaluator, &rw, id, deadline);
-                    if res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT) {
-                        return Err(WorldTimeout { world: w.index });
-                    }
-                    let missed = missed_criterion(res.status, &res.reason)
-                        .and_then(Criterion::parse)
-                        .map_or(f64::NAN, criterion_index);
-                    (res.status == CaseStatus::Ok, res.metrics, missed)
-                }
-                Err(_) => (false, Metrics::new(), criterion_index(Criterion::NoFailure)),
-            };
-            metrics.push(format!("{WORLD_PREFIX}{}.{MISSED}", w.index), missed);
-            successes += usize::from(ok);
+        for (w, wr) in worlds.iter().zip(&runs) {
+            if wr.timeout {
+                return Err(WorldTimeout { world: w.index });
+            }
+            metrics.push(format!("{WORLD_PREFIX}{}.{MISSED}", w.index), wr.missed);
+            successes += usize::from(wr.ok);
             for (name, col) in u.metrics.iter().zip(values.iter_mut()) {
-                let x = m.value(name);
+                let x = wr.metrics.value(name);
                 col.push(x);
                 metrics.push(format!("{WORLD_PREFIX}{}.{name}", w.index), x);
             }
             metrics.push(
                 format!("{WORLD_PREFIX}{}.{SUCCESS}", w.index),
-                f64::from(u8::from(ok)),
+                f64::from(u8::from(wr.ok)),
             );
         }
         for (name, xs) in u.metrics.iter().zip(&values) {
@@ -159,7 +189,7 @@ fn score_variants(
         .uncertainty
         .as_ref()
         .map(|u| u.objective().to_string())
-        .unwrap_or_else(|| super::selection::ENERGY_PER_METRE.to_string());
+        .unwrap_or_else(|| super::directions::ENERGY_PER_METRE.to_string());
     let nominal = metrics.value(&objective);
     for v in &study.validate {
         let overrides = v.set.iter().map(|(n, t, x)| (n.as_str(), t, x));
