@@ -15,8 +15,8 @@ use super::doe::Case;
 use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
-use super::worlds::score_worlds;
-use crate::evaluate::{CaseInput, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
+use super::worlds::{evaluate_phases, score_worlds};
+use crate::evaluate::{CaseResult, CaseStatus, Deadline, Evaluator, Phases};
 use crate::report::Table;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
@@ -45,17 +45,7 @@ pub fn evaluate_resolved(
     log: bool,
     deadline: Deadline,
 ) -> CaseResult {
-    evaluator.evaluate(&CaseInput {
-        design: &r.design,
-        design_hash: &r.design_hash,
-        scenario: &r.scenario,
-        overrides: &[],
-        seed: r.seed,
-        deadline,
-        phases: study_phases(study),
-        trajectory: log,
-        label: &format!("case {id} design"),
-    })
+    evaluate_phases(evaluator, r, id, study_phases(study), log, deadline)
 }
 
 impl Worker {

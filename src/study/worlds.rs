@@ -40,8 +40,16 @@ fn criterion_index(c: Criterion) -> f64 {
         .map_or(f64::NAN, |i| i as f64)
 }
 
-/// Run `r` (closed loop only) with `evaluator`.
-fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -> CaseResult {
+/// Evaluate resolved case `r` (case `id`) with `evaluator`: the given phases, with the
+/// trajectory when `log`, within `deadline` (the sweep's runs and the worlds' alike).
+pub fn evaluate_phases(
+    evaluator: &mut Evaluator,
+    r: &Resolved,
+    id: usize,
+    phases: Phases,
+    log: bool,
+    deadline: Deadline,
+) -> CaseResult {
     evaluator.evaluate(&CaseInput {
         design: &r.design,
         design_hash: &r.design_hash,
@@ -49,13 +57,19 @@ fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -
         overrides: &[],
         seed: r.seed,
         deadline,
-        phases: Phases {
-            static_analysis: false,
-            closed_loop: true,
-        },
-        trajectory: false,
+        phases,
+        trajectory: log,
         label: &format!("case {id} design"),
     })
+}
+
+/// Run `r` (closed loop only) with `evaluator`.
+fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -> CaseResult {
+    let phases = Phases {
+        static_analysis: false,
+        closed_loop: true,
+    };
+    evaluate_phases(evaluator, r, id, phases, false, deadline)
 }
 
 /// The value of `metric` over worlds that is worst for it.
