@@ -431,6 +431,9 @@ fn history_and_best_do_not_depend_on_the_number_of_threads() {
     assert_ne!(cmaes, SMALL);
     for text in [SMALL, cmaes.as_str()] {
         let p = parse_problem(text, Path::new("small.toml")).unwrap();
+        if p.spec.solver.method == Method::Cmaes {
+            assert_eq!(p.spec.solver.step, 0.3, "CMA-ES's default σ0");
+        }
         let runs: Vec<Outcome> = [1, 2, 3]
             .iter()
             .map(|&j| run(&p, &options(j)).unwrap())

@@ -425,7 +425,10 @@ fn cmaes<E: Evaluator>(
     s: &SolverSettings,
     run: usize,
 ) -> Result<String, Error> {
-    let lambda = default_lambda(u0.len()).saturating_mul(1 << run.min(20));
+    // No larger than the budget could evaluate (the population is allocated up front).
+    let lambda = default_lambda(u0.len())
+        .saturating_mul(1 << run.min(20))
+        .min(s.max_evals.max(2));
     let mut es = Cmaes::new(&u0, s.step, lambda, rng_for(s.seed, run as u64));
     for generation in 0..s.max_iters {
         search.iteration.store(generation + 1, Ordering::Relaxed);

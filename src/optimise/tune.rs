@@ -236,7 +236,7 @@ impl CaseTuner for Tuner {
 fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
     let mut best = curve.last().copied().unwrap_or(f64::NAN);
     for r in records.iter().filter(|r| !r.repeat) {
-        if r.score.feasible && !(r.score.objective >= best) {
+        if r.score.feasible && (best.is_nan() || r.score.objective < best) {
             best = r.score.objective;
         }
         curve.push(best);
