@@ -310,10 +310,20 @@ fn table(o: &Outcome, spec: &Spec) -> usm_study::report::Table {
 #[test]
 fn resume_after_an_interruption_equals_the_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
-    let journal = dir.path().join(JOURNAL_FILE);
+    let mut cm = cmaes_solver(120, 1e-12);
+    cm.restarts = 2;
+    for s in [solver(Method::ParticleSwarm, 50, 120, 1e-12), cm] {
+        let journal = dir.path().join(format!("{:?}-{JOURNAL_FILE}", s.method));
+        resume_case(&journal, s);
+    }
+}
+
+/// Run, cut the journal in the middle of its 52nd line, resume: the same history.
+fn resume_case(journal: &Path, s: SolverSettings) {
+    let journal = journal.to_path_buf();
     let sp = spec(
         vec![param("a.x", -2.0, 2.0, -1.2), param("a.y", -2.0, 2.0, 1.0)],
-        solver(Method::ParticleSwarm, 50, 120, 1e-12),
+        s,
     );
     let full_ev = Analytic::new(rosenbrock);
     let opts = Options {
