@@ -102,6 +102,14 @@ fn solver(method: Method, max_iters: u64, max_evals: usize, tolerance: f64) -> S
     }
 }
 
+/// CMA-ES with σ0 = 0.3 (the problem files' default for it).
+fn cmaes_solver(max_evals: usize, tolerance: f64) -> SolverSettings {
+    SolverSettings {
+        step: 0.3,
+        ..solver(Method::Cmaes, 1000, max_evals, tolerance)
+    }
+}
+
 fn quiet(_: &Record) {}
 
 fn options(jobs: usize) -> Options<'static> {
@@ -132,6 +140,7 @@ fn each_solver_finds_the_rosenbrock_minimum() {
             solver(Method::ParticleSwarm, 400, 20_000, 1e-6),
             5e-2,
         ),
+        (Method::Cmaes, cmaes_solver(3000, 1e-14), 1e-3),
     ];
     for (m, s, tol) in cases {
         let o = solve(rosenbrock, &spec(box2(), s), 2);
@@ -150,8 +159,16 @@ fn each_solver_finds_the_rosenbrock_minimum() {
 #[test]
 fn each_solver_finds_the_bounded_quadratic_minimum_on_the_bound() {
     let box2 = || vec![param("a.x", 0.0, 1.0, 0.8), param("a.y", 0.0, 1.0, 0.2)];
-    for m in [Method::NelderMead, Method::Lbfgs, Method::ParticleSwarm] {
-        let s = solver(m, 300, 3000, 1e-12);
+    for m in [
+        Method::NelderMead,
+        Method::Lbfgs,
+        Method::ParticleSwarm,
+        Method::Cmaes,
+    ] {
+        let s = SolverSettings {
+            step: if m == Method::Cmaes { 0.3 } else { 0.1 },
+            ..solver(m, 300, 3000, 1e-12)
+        };
         let o = solve(bounded_quadratic, &spec(box2(), s), 1);
         let b = &o.best().x;
         assert!(
@@ -169,23 +186,92 @@ fn each_solver_finds_the_bounded_quadratic_minimum_on_the_bound() {
 
 #[test]
 fn the_evaluation_budget_is_exact() {
-    let s = solver(Method::ParticleSwarm, 1000, 37, 1e-12);
-    let o = solve(
-        rosenbrock,
-        &spec(
-            vec![param("a.x", -2.0, 2.0, 0.0), param("a.y", -2.0, 2.0, 0.0)],
-            s,
-        ),
-        2,
-    );
-    // Every recorded point counts, repeats (served from memory, not simulated) included.
-    assert_eq!(o.records.len(), 37);
-    assert!(o.fresh_evaluations() <= 37);
-    assert!(
-        o.stops.iter().any(|s| s.contains("budget")),
-        "{:?}",
-        o.stops
-    );
+    // 37 is no multiple of the swarm (24) nor of CMA-ES's generation (λ = 6 for n = 2), and
+    // CMA-ES's restarts (IPOP, λ 12, 24, …) cannot run past it either.
+    let mut cm = cmaes_solver(37, 1e-12);
+    cm.restarts = 5;
+    for s in [solver(Method::ParticleSwarm, 1000, 37, 1e-12), cm] {
+        let o = solve(
+            rosenbrock,
+            &spec(
+                vec![param("a.x", -2.0, 2.0, 0.0), param("a.y", -2.0, 2.0, 0.0)],
+                s.clone(),
+            ),
+            2,
+        );
+        // Every recorded point counts, repeats (served from memory, not simulated) included.
+        assert_eq!(o.records.len(), 37, "{:?}", s.method);
+        assert!(o.fresh_evaluations() <= 37);
+        assert!(
+            o.stops.iter().any(|s| s.contains("budget")),
+            "{:?}",
+            o.stops
+        );
+    }
+}
+
+/// An evaluator that records every point it is asked to evaluate.
+struct Recording {
+    inner: Analytic,
+    seen: std::sync::Mutex<Vec<Vec<f64>>>,
+}
+
+impl Evaluator for Recording {
+    fn metrics(&self) -> &[String] {
+        self.inner.metrics()
+    }
+    fn evaluate(&self, x: &[f64]) -> Evaluation {
+        self.seen.lock().unwrap().push(x.to_vec());
+        self.inner.evaluate(x)
+    }
+}
+
+/// Pulls every coordinate towards (−1, 5, 5), far outside the box's lower x and upper y, z.
+fn outward(x: &[f64]) -> f64 {
+    (x[0] + 1.0).powi(2) + (x[1] - 5.0).powi(2) + (x[2] - 5.0).powi(2) + 1.0
+}
+
+#[test]
+fn no_solver_evaluates_outside_the_bounds() {
+    // Optimum far outside a narrow box: every solver's proposals leave it; the evaluator sees
+    // only projected points, and the best is the corner (0, 1, 1) of the box.
+    let box3 = || {
+        vec![
+            param("a.x", 0.0, 0.2, 0.1),
+            param("a.y", 0.0, 1.0, 0.5),
+            param("a.z", 0.5, 1.0, 0.9),
+        ]
+    };
+    for (m, step) in [
+        (Method::NelderMead, 0.1),
+        (Method::Lbfgs, 0.1),
+        (Method::ParticleSwarm, 0.1),
+        (Method::Cmaes, 0.5),
+    ] {
+        let mut s = SolverSettings {
+            step,
+            ..solver(m, 200, 400, 1e-9)
+        };
+        s.restarts = 2;
+        let ev = Recording {
+            inner: Analytic::new(outward),
+            seen: Default::default(),
+        };
+        let p = spec(box3(), s);
+        let o = minimise(&p, &ev, "analytic", &options(2)).unwrap();
+        let seen = ev.seen.into_inner().unwrap();
+        assert!(seen.len() > 10, "{m:?}: {} points", seen.len());
+        for x in &seen {
+            for (v, q) in x.iter().zip(&p.space.params) {
+                assert!((q.lower..=q.upper).contains(v), "{m:?}: {x:?} outside");
+            }
+        }
+        let b = &o.best().x;
+        assert!(
+            b[0] < 1e-3 && b[1] > 1.0 - 1e-3 && b[2] > 1.0 - 1e-3,
+            "{m:?}: best {b:?}"
+        );
+    }
 }
 
 #[test]
@@ -224,10 +310,20 @@ fn table(o: &Outcome, spec: &Spec) -> usm_study::report::Table {
 #[test]
 fn resume_after_an_interruption_equals_the_uninterrupted_run() {
     let dir = tempfile::tempdir().unwrap();
-    let journal = dir.path().join(JOURNAL_FILE);
+    let mut cm = cmaes_solver(120, 1e-12);
+    cm.restarts = 2;
+    for s in [solver(Method::ParticleSwarm, 50, 120, 1e-12), cm] {
+        let journal = dir.path().join(format!("{:?}-{JOURNAL_FILE}", s.method));
+        resume_case(&journal, s);
+    }
+}
+
+/// Run, cut the journal in the middle of its 52nd line, resume: the same history.
+fn resume_case(journal: &Path, s: SolverSettings) {
+    let journal = journal.to_path_buf();
     let sp = spec(
         vec![param("a.x", -2.0, 2.0, -1.2), param("a.y", -2.0, 2.0, 1.0)],
-        solver(Method::ParticleSwarm, 50, 120, 1e-12),
+        s,
     );
     let full_ev = Analytic::new(rosenbrock);
     let opts = Options {
@@ -338,19 +434,34 @@ seed = 9
 
 #[test]
 fn history_and_best_do_not_depend_on_the_number_of_threads() {
-    let p = parse_problem(SMALL, Path::new("small.toml")).unwrap();
-    let runs: Vec<Outcome> = [1, 2, 3]
-        .iter()
-        .map(|&j| run(&p, &options(j)).unwrap())
-        .collect();
-    let params: Vec<String> = p.spec.space.params.iter().map(|q| q.name.clone()).collect();
-    let names = ["calm".to_string(), "current".to_string()];
-    let t0 = history_table(&runs[0].records, &params, &runs[0].metrics, &names).unwrap();
-    assert_eq!(runs[0].fresh_evaluations(), 16);
-    for o in &runs[1..] {
-        let t = history_table(&o.records, &params, &o.metrics, &names).unwrap();
-        assert!(t0.bit_eq(&t));
-        assert_eq!(o.best, runs[0].best);
+    let cmaes = SMALL.replace(
+        "method = \"particle-swarm\"\nparticles = 5",
+        "method = \"cmaes\"\nrestarts = 1",
+    );
+    assert_ne!(cmaes, SMALL);
+    for text in [SMALL, cmaes.as_str()] {
+        let p = parse_problem(text, Path::new("small.toml")).unwrap();
+        if p.spec.solver.method == Method::Cmaes {
+            assert_eq!(p.spec.solver.step, 0.3, "CMA-ES's default σ0");
+        }
+        let runs: Vec<Outcome> = [1, 2, 3]
+            .iter()
+            .map(|&j| run(&p, &options(j)).unwrap())
+            .collect();
+        let params: Vec<String> = p.spec.space.params.iter().map(|q| q.name.clone()).collect();
+        let names = ["calm".to_string(), "current".to_string()];
+        let t0 = history_table(&runs[0].records, &params, &runs[0].metrics, &names).unwrap();
+        assert_eq!(
+            runs[0].fresh_evaluations(),
+            16,
+            "{:?}",
+            p.spec.solver.method
+        );
+        for o in &runs[1..] {
+            let t = history_table(&o.records, &params, &o.metrics, &names).unwrap();
+            assert!(t0.bit_eq(&t));
+            assert_eq!(o.best, runs[0].best);
+        }
     }
 }
 

@@ -11,7 +11,8 @@
 //! - [`score`]: objective normalisation, combination over scenarios, constraint violation and
 //!   the feasibility-first ranking.
 //! - [`history`]: evaluation records, the history table and the resume journal.
-//! - [`search`]: the argmin cost function, gradient, observer and the three solvers.
+//! - [`cmaes`]: CMA-ES as an ask/tell state machine (pycma's defaults), driven by `search`.
+//! - [`search`]: the argmin cost function, gradient, observer and the four solvers.
 //! - [`evaluate`]: a problem's point → its metrics (through the one case evaluator,
 //!   [`crate::evaluate`]).
 //! - [`engine`]: [`run`] and [`minimise`]: start point, solver runs, outcome.
@@ -21,6 +22,7 @@
 //! The library API a caller (the `optimise` verb, a sweep tuning each case) uses is
 //! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
 
+pub mod cmaes;
 pub mod engine;
 pub mod evaluate;
 pub mod history;

@@ -32,11 +32,12 @@ use argmin::solver::quasinewton::LBFGS;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
+use super::cmaes::{default_lambda, Cmaes};
 use super::history::{Evaluation, Journal, JournalError, Record};
 use super::problem::{Method, SolverSettings};
 use super::score::{Score, Scorer};
 use super::space::Space;
-use crate::sampling::derive_seed;
+use crate::sampling::{derive_seed, rng_for};
 
 /// Weight of the squared distance outside the unit box added to the cost.
 pub const PENALTY: f64 = 1.0;
@@ -332,6 +333,7 @@ pub fn run_solver<E: Evaluator>(search: &Search<'_, E>, s: &SolverSettings) -> V
             Method::NelderMead => nelder_mead(search, u0, s),
             Method::ParticleSwarm => particle_swarm(search, s, run as u64),
             Method::Lbfgs => lbfgs(search, u0, s),
+            Method::Cmaes => cmaes(search, u0, s, run),
         };
         match result {
             Ok(r) => reasons.push(format!("run {}: {r}", run + 1)),
@@ -411,4 +413,31 @@ fn lbfgs<E: Evaluator>(
         .add_observer(observer(search), ObserverMode::Always)
         .run()?;
     Ok(res.state().get_termination_status().to_string())
+}
+
+/// CMA-ES from `u0` with σ0 = `step`, seeded by `(seed, run)`; run `r` (0-based) has the
+/// population `λ = (4 + ⌊3 ln n⌋)·2^r` (IPOP). Each generation is one batch (evaluated on
+/// `--jobs` threads, recorded in order) and one iteration of the history; the run ends after
+/// `max_iters` generations, on [`Cmaes::stop`] with `tolerance`, or at the budget.
+fn cmaes<E: Evaluator>(
+    search: &Search<'_, E>,
+    u0: Vec<f64>,
+    s: &SolverSettings,
+    run: usize,
+) -> Result<String, Error> {
+    // No larger than the budget could evaluate (the population is allocated up front).
+    let lambda = default_lambda(u0.len())
+        .saturating_mul(1 << run.min(20))
+        .min(s.max_evals.max(2));
+    let mut es = Cmaes::new(&u0, s.step, lambda, rng_for(s.seed, run as u64));
+    for generation in 0..s.max_iters {
+        search.iteration.store(generation + 1, Ordering::Relaxed);
+        let population = es.ask();
+        let costs = search.batch(&population)?;
+        es.tell(&costs);
+        if let Some(why) = es.stop(s.tolerance) {
+            return Ok(format!("{why} after {} generations", generation + 1));
+        }
+    }
+    Ok(format!("{} generations (max_iters)", s.max_iters))
 }

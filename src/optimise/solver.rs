@@ -20,14 +20,19 @@ pub enum Method {
     /// search), for smooth static objectives.
     #[serde(rename = "lbfgs")]
     Lbfgs,
+    /// CMA-ES within the bounds (global-local, seeded; IPOP restarts double the population;
+    /// [`super::cmaes`]).
+    #[serde(rename = "cmaes")]
+    Cmaes,
 }
 
 impl Method {
     /// Every method, as written in problem files.
-    pub const ALL: [(&'static str, Method); 3] = [
+    pub const ALL: [(&'static str, Method); 4] = [
         ("nelder-mead", Method::NelderMead),
         ("particle-swarm", Method::ParticleSwarm),
         ("lbfgs", Method::Lbfgs),
+        ("cmaes", Method::Cmaes),
     ];
 
     /// The name as written.
@@ -50,17 +55,18 @@ pub struct SolverSettings {
     /// repeated points are served from memory but counted.
     pub max_evals: usize,
     /// Nelder–Mead: standard deviation of the simplex's costs; L-BFGS: gradient norm and
-    /// cost change (default 1e-6).
+    /// cost change; CMA-ES: step size and flat best cost (default 1e-6).
     pub tolerance: f64,
     /// Further runs after the first (Nelder–Mead and L-BFGS from the best point so far,
-    /// particle swarm with a new seed; default 0).
+    /// particle swarm with a new seed, CMA-ES from the best point so far with a new seed and
+    /// twice the population (IPOP); default 0).
     pub restarts: usize,
-    /// Seed of the particle swarm (default: `study.seed`).
+    /// Seed of the particle swarm and of CMA-ES (default: `study.seed`).
     pub seed: u64,
     /// Particles of the swarm (default 12, at most [`MAX_PARTICLES`] and `max_evals`).
     pub particles: usize,
-    /// Nelder–Mead initial simplex edge and finite-difference step, in the unit box of the
-    /// normalised parameters (default 0.1 and 1e-4·… see `docs/optimise.md`).
+    /// Nelder–Mead initial simplex edge, CMA-ES initial step size σ0, in the unit box of the
+    /// normalised parameters (default 0.1; 0.3 for CMA-ES).
     pub step: f64,
 }
 
@@ -99,7 +105,7 @@ pub(super) fn parse_solver(
             doc.err(
                 &k("method"),
                 format!(
-                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs",
+                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs, cmaes",
                     s.method
                 ),
             )
@@ -112,7 +118,9 @@ pub(super) fn parse_solver(
         restarts: s.restarts.unwrap_or(0),
         seed: s.seed.unwrap_or(seed),
         particles: s.particles.unwrap_or(12),
-        step: s.step.unwrap_or(0.1),
+        step: s
+            .step
+            .unwrap_or(if method == Method::Cmaes { 0.3 } else { 0.1 }),
     };
     if out.max_iters == 0 {
         return Err(doc.err(&k("max_iters"), "must be >= 1"));

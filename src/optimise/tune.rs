@@ -122,8 +122,9 @@ impl Tuner {
     }
 
     /// The problem tuning one case: the study with the case's resolved tables as its base
-    /// and no axes; each parameter without `start` starts from the case's value.
-    fn case_problem(&self, study: &Study, r: &Resolved) -> Problem {
+    /// and no axes; each parameter without `start` starts from the case's value. Public for
+    /// the solver benchmark (`examples/solver_efficiency.rs`).
+    pub fn case_problem(&self, study: &Study, r: &Resolved) -> Problem {
         let mut cs = study.clone();
         cs.design = r.design.clone();
         cs.scenario_full = r.scenario.clone();

@@ -1,0 +1,213 @@
+//! Sample efficiency of the optimiser's solvers on the main study's per-design tuning problem
+//! (issue 23 item 2): `studies/thrusters.toml`'s `[tune]` (k_ψ, Δ, k_6p, k_6d; energy per
+//! metre subject to success and the cross-track bounds) for 9 designs — rules paper /
+//! distributed / ends × links 3 / 5 / 7, offset 0.10 m.
+//!
+//! Per design: each solver from the case's own start with `BUDGET` evaluations (Nelder–Mead
+//! once, the seeded solvers with three seeds), then a reference optimum: the best feasible
+//! objective of every run, a 300-evaluation particle swarm and a 120-evaluation Nelder–Mead
+//! polish from the best point found (≥ 420 evaluations besides the solver runs). Reported:
+//! the evaluations (simulated runs, the start included) each run needs to come within 1 % of
+//! the reference with a feasible point, and its gap to the reference after 30 evaluations
+//! (the study's per-case budget). One thread, deterministic.
+//!
+//! ```sh
+//! cargo run --release --example solver_efficiency [OUT.csv]   # default benches/solver_efficiency.csv
+//! ```
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use usm_study::evaluate::Deadline;
+use usm_study::optimise::evaluate::CaseEvaluator;
+use usm_study::optimise::history::Record;
+use usm_study::optimise::problem::{Method, SolverSettings};
+use usm_study::optimise::tune::Tuner;
+use usm_study::optimise::{minimise, Options, Spec};
+use usm_study::study::cases::resolve_case;
+use usm_study::study::doe::expand;
+use usm_study::study::parse::load_study;
+
+/// Evaluations per solver run.
+const BUDGET: usize = 120;
+
+/// Best feasible objective after each fresh evaluation (NaN before the first feasible one).
+fn curve(records: &[Record]) -> Vec<f64> {
+    let mut best = f64::NAN;
+    let mut out = Vec::new();
+    for r in records.iter().filter(|r| !r.repeat) {
+        if r.score.feasible && (best.is_nan() || r.score.objective < best) {
+            best = r.score.objective;
+        }
+        out.push(best);
+    }
+    out
+}
+
+fn settings(
+    method: Method,
+    max_evals: usize,
+    restarts: usize,
+    step: f64,
+    seed: u64,
+) -> SolverSettings {
+    SolverSettings {
+        method,
+        max_iters: 1000,
+        max_evals,
+        tolerance: 1e-6,
+        restarts,
+        seed,
+        particles: 12,
+        step,
+    }
+}
+
+/// The `q`-quantile by nearest rank of `xs` (None: not reached, ranked last).
+fn quantile(xs: &[Option<usize>], q: f64) -> Option<usize> {
+    let mut v: Vec<usize> = xs.iter().map(|x| x.unwrap_or(usize::MAX)).collect();
+    v.sort_unstable();
+    let k = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    Some(v[k - 1]).filter(|x| *x != usize::MAX)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "benches/solver_efficiency.csv".into());
+    let study = load_study(Path::new("studies/thrusters.toml"))?;
+    let tuner = Tuner::new(&study)?.ok_or("no [tune] in studies/thrusters.toml")?;
+    let cases = expand(&study, None)?;
+    let quiet = |_: &Record| {};
+    let opts = Options {
+        jobs: 1,
+        journal: None,
+        resume: false,
+        on_record: &quiet,
+    };
+    let seed = study.seed;
+    // (label, settings, seeds): Nelder–Mead is deterministic, the others get three seeds.
+    let solvers: Vec<(&str, SolverSettings, u64)> = vec![
+        (
+            "nelder-mead",
+            settings(Method::NelderMead, BUDGET, 4, 0.2, seed),
+            1,
+        ),
+        (
+            "particle-swarm",
+            settings(Method::ParticleSwarm, BUDGET, 0, 0.1, seed),
+            3,
+        ),
+        ("cmaes", settings(Method::Cmaes, BUDGET, 3, 0.3, seed), 3),
+        (
+            "cmaes-0.2",
+            settings(Method::Cmaes, BUDGET, 3, 0.2, seed),
+            3,
+        ),
+    ];
+    let mut csv =
+        String::from("design,solver,seed,evaluations,best,best_at_30,reference,evals_to_1pct\n");
+    let mut hits: Vec<(String, Option<usize>, f64)> = Vec::new();
+    let t0 = Instant::now();
+    for case in &cases {
+        let (rule, links, offset) = (
+            case.values[0].as_str().unwrap_or_default().to_string(),
+            case.values[1]
+                .as_integer()
+                .or(case.values[1].as_float().map(|v| v as i64))
+                .unwrap_or_default(),
+            case.values[2].as_float().unwrap_or_default(),
+        );
+        if ![3, 5, 7].contains(&links) || (offset - 0.10).abs() > 1e-9 {
+            continue;
+        }
+        let design = format!("{rule}-{links}");
+        let r = resolve_case(&study, case)?;
+        let problem = tuner.case_problem(&study, &r);
+        let ev = CaseEvaluator::new(&problem).for_case(case.id, Deadline::NONE);
+        let run = |s: SolverSettings, start: Option<&[f64]>| {
+            let mut spec: Spec = problem.spec.clone();
+            spec.solver = s;
+            if let Some(x) = start {
+                for (p, v) in spec.space.params.iter_mut().zip(x) {
+                    p.start = *v;
+                }
+            }
+            minimise(&spec, &ev, &study.hash, &opts)
+        };
+        let mut reference = f64::INFINITY;
+        let mut runs = Vec::new();
+        for (name, s, seeds) in &solvers {
+            for k in 0..*seeds {
+                let o = run(
+                    SolverSettings {
+                        seed: s.seed + k,
+                        ..s.clone()
+                    },
+                    None,
+                )?;
+                runs.push((*name, k, curve(&o.records), o.best().x.clone()));
+            }
+        }
+        // The reference: the best of every run above, a 300-evaluation swarm, and a
+        // Nelder–Mead polish (120 evaluations, restarts) from the best point found.
+        let swarm = run(
+            settings(Method::ParticleSwarm, 300, 0, 0.1, seed ^ 0xA5),
+            None,
+        )?;
+        let mut best_x = swarm.best().x.clone();
+        if swarm.best().score.feasible {
+            reference = swarm.best().score.objective;
+        }
+        for (_, _, c, x) in &runs {
+            if let Some(b) = c.last().filter(|b| b.is_finite() && **b < reference) {
+                reference = *b;
+                best_x = x.clone();
+            }
+        }
+        let polish = run(
+            settings(Method::NelderMead, 120, 4, 0.05, seed),
+            Some(&best_x),
+        )?;
+        if polish.best().score.feasible {
+            reference = reference.min(polish.best().score.objective);
+        }
+        for (name, k, c, _) in &runs {
+            let hit = c.iter().position(|b| *b <= reference * 1.01).map(|i| i + 1);
+            let best = c.last().copied().unwrap_or(f64::NAN);
+            let at30 = c.get(29).or(c.last()).copied().unwrap_or(f64::NAN);
+            writeln!(
+                csv,
+                "{design},{name},{k},{},{best},{at30},{reference},{}",
+                c.len(),
+                hit.map_or("".into(), |h| h.to_string())
+            )?;
+            eprintln!(
+                "{design:16} {name:15} {k} best {best:.5} @30 {at30:.5} ref {reference:.5} hit {hit:?}"
+            );
+            hits.push((name.to_string(), hit, at30 / reference - 1.0));
+        }
+        eprintln!("  ({:.0} s so far)", t0.elapsed().as_secs_f64());
+    }
+    std::fs::write(&out, csv)?;
+    eprintln!("wrote {out} in {:.0} s", t0.elapsed().as_secs_f64());
+    println!("| solver | runs | reached 1 % within {BUDGET} | median | 90th percentile | median gap at 30 |");
+    println!("|---|---|---|---|---|---|");
+    let show = |x: Option<usize>| x.map_or(format!("> {BUDGET}"), |v| v.to_string());
+    for (name, _, _) in &solvers {
+        let h: Vec<Option<usize>> = hits.iter().filter(|x| x.0 == *name).map(|x| x.1).collect();
+        let mut gaps: Vec<f64> = hits.iter().filter(|x| x.0 == *name).map(|x| x.2).collect();
+        gaps.sort_by(|a, b| a.total_cmp(b));
+        let gap = gaps.get(gaps.len() / 2).copied().unwrap_or(f64::NAN);
+        println!(
+            "| {name} | {} | {} | {} | {} | {:.1} % |",
+            h.len(),
+            h.iter().filter(|x| x.is_some()).count(),
+            show(quantile(&h, 0.5)),
+            show(quantile(&h, 0.9)),
+            100.0 * gap
+        );
+    }
+    Ok(())
+}
