@@ -111,6 +111,29 @@ fn referenced_cases(md: &str) -> Vec<i64> {
     out
 }
 
+/// Removes the temporaries `.report.html.tmp-PID-…` a killed writer of this page left
+/// (the page is written after the sweep's lock is released, so no lock takeover cleans them):
+/// only those whose process is gone (Linux `/proc`; elsewhere nothing is removed).
+fn remove_dead_temporaries(dir: &Path) {
+    let prefix = format!(".{REPORT_HTML}.tmp-");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(token) = name.strip_prefix(&prefix) else {
+            continue;
+        };
+        let pid = token.split('-').next().and_then(|p| p.parse::<u32>().ok());
+        let alive = pid.is_none_or(|p| {
+            !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{p}")).exists()
+        });
+        if !alive && e.file_type().is_ok_and(|t| t.is_file()) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 /// The verdict line of a summary: the first paragraph after its title when it opens with
 /// `**Winner:`, `**Statistically tied:` or `**No winner`.
 fn verdict_line(md: &str) -> Option<&str> {
@@ -276,6 +299,7 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
     let html = page.render(&figures, &mut warnings);
     let path = dir.join(REPORT_HTML);
     atomic_write(&path, html.as_bytes())?;
+    remove_dead_temporaries(dir);
     Ok(ReviewOutcome {
         path,
         drawings: drawn.len(),
@@ -604,6 +628,22 @@ mod tests {
     use super::*;
     use crate::report::ColumnData;
     use crate::study::records::STATUS;
+
+    #[test]
+    fn only_a_dead_writers_page_temporaries_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = dir.path().join(".report.html.tmp-4194399-ab");
+        let live = dir
+            .path()
+            .join(format!(".report.html.tmp-{}-cd", std::process::id()));
+        let other = dir.path().join(".cases.csv.tmp-4194399-ab");
+        for p in [&dead, &live, &other] {
+            std::fs::write(p, "x").unwrap();
+        }
+        remove_dead_temporaries(dir.path());
+        assert!(!dead.exists() || !Path::new("/proc/self").exists());
+        assert!(live.exists() && other.exists());
+    }
 
     #[test]
     fn outcomes_read_status_and_an_optional_success_column() {
