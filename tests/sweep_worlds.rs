@@ -237,3 +237,20 @@ fn bad_uncertainty_sections_exit_2_naming_the_key() {
         assert!(e.contains("bad.toml:") && e.contains(key), "{edit:?}: {e}");
     }
 }
+
+#[test]
+fn a_saltelli_design_of_worlds_gives_sobol_indices_in_the_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("{BASE}\n[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.6]\n")
+        .replace("sampling = \"sobol\"", "sampling = \"saltelli\"")
+        .replace("worlds = 4", "worlds = 3");
+    let s = write(dir.path(), "saltelli.toml", &text);
+    let out = dir.path().join("saltelli");
+    ok(&sweep(&s, &out, &["--jobs", "2"]));
+    // 3 base samples × (2 parameters + 2) = 12 worlds per case.
+    let w = std::fs::read_to_string(out.join("worlds.csv")).unwrap();
+    assert_eq!(w.lines().count(), 1 + 12 * 2);
+    let md = summary(&out);
+    assert!(md.contains("## Ranking over 12 uncertain worlds"), "{md}");
+    assert!(md.contains("Sobol total index"), "{md}");
+}
