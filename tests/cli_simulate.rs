@@ -222,3 +222,72 @@ fn bad_overrides_and_scenarios_are_clear_errors() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("transport-method2"));
 }
+
+/// A scenario file with `[uncertainty]` (issue 22 item 1): the nominal run's outputs, then the
+/// scenario in every world as a one-case study would run it: `worlds.csv` and
+/// `uncertainty.json`; a key no study may vary exits 2 naming it.
+#[test]
+fn a_scenario_file_with_uncertainty_runs_its_worlds() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"[scenario]
+name = "t1_worlds"
+mode = "transport"
+design = "usm-paper"
+duration = 30.0
+
+[path]
+segments = [ { from = [0.0, 0.0], to = [200.0, 0.0] } ]
+
+[success]
+cross_track_bound = 5.0
+convergence_window = 30.0
+
+[uncertainty]
+worlds = 4
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.0, high = 2.0 }
+"#;
+    let p = dir.path().join("s.toml");
+    std::fs::write(&p, text).unwrap();
+    let out = dir.path().join("out");
+    let o = common::run(&[
+        "simulate",
+        p.to_str().unwrap(),
+        "--no-plots",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    assert!(out.join("summary.json").is_file());
+    let u: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("uncertainty.json")).unwrap())
+            .unwrap();
+    assert_eq!(u["worlds"], 4);
+    let m = &u["metrics"];
+    let (lo, mean, hi) = (
+        m["energy_per_metre_p05"].as_f64().unwrap(),
+        m["energy_per_metre_mean"].as_f64().unwrap(),
+        m["energy_per_metre_p95"].as_f64().unwrap(),
+    );
+    assert!(lo < mean && mean < hi, "{m}");
+    assert!(m["success_probability"].as_f64().is_some());
+    let w = std::fs::read_to_string(out.join("worlds.csv")).unwrap();
+    assert_eq!(w.lines().count(), 5, "{w}");
+
+    let bad = text.replace("hydro.linear_damping_scale", "hydro.linear_damping");
+    std::fs::write(&p, bad).unwrap();
+    let o = common::run(&[
+        "simulate",
+        p.to_str().unwrap(),
+        "--no-plots",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
+    let e = common::stderr(&o);
+    assert!(
+        e.contains("uncertainty.param[0].name") && e.contains("s.toml"),
+        "{e}"
+    );
+}

@@ -12,6 +12,7 @@ mod optimise;
 mod paper;
 mod progress;
 mod simulate;
+mod simulate_worlds;
 mod sweep;
 mod tcm;
 

@@ -47,8 +47,23 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         let (path, value) = parse_override(s)?;
         set(&mut table, &path.0, value, s).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
     }
+    // `[uncertainty]` is the study layer's: the nominal run below, then the worlds.
+    let uncertainty = match table.remove("uncertainty") {
+        Some(toml::Value::Table(t)) => Some(t),
+        Some(_) => anyhow::bail!("{}: uncertainty: must be a table", src.origin),
+        None => None,
+    };
     let file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
+    let worlds = match uncertainty {
+        Some(u) => Some(super::simulate_worlds::prepare(
+            &table,
+            u,
+            &src,
+            &file.scenario.name,
+        )?),
+        None => None,
+    };
     let out = a.out.clone().unwrap_or_else(|| {
         PathBuf::from("out").join(usm_study::report::file_stem_safe(&file.scenario.name))
     });
@@ -69,6 +84,9 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     };
     write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);
+    if let Some(w) = &worlds {
+        super::simulate_worlds::run_worlds(w, &out)?;
+    }
     eprintln!("[simulate] wrote {}", out.display());
     match &r.failure {
         Some((t, cause)) => {
