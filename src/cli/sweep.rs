@@ -271,6 +271,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         },
         outcome.out.display()
     );
+    print_verdict(&outcome.out);
     Ok(if outcome.failed > 0 {
         ExitCode::from(1)
     } else {
@@ -337,6 +338,29 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
 pub struct ReportArgs {
     /// A sweep (or other study) output directory.
     pub dir: PathBuf,
+}
+
+/// The verdict `summary.md` opens with (a study with uncertain worlds), as plain text, and
+/// where the review page is.
+fn print_verdict(dir: &Path) {
+    let Ok(md) = std::fs::read_to_string(dir.join("summary.md")) else {
+        return;
+    };
+    let first = md
+        .lines()
+        .skip(1)
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or_default();
+    if ["**Winner:", "**Statistically tied:", "**No winner"]
+        .iter()
+        .any(|p| first.starts_with(p))
+    {
+        eprintln!("[sweep] {}", first.replace("**", "").replace('`', ""));
+    }
+    eprintln!(
+        "[sweep] review: {}",
+        dir.join(usm_study::pipeline::review::REPORT_HTML).display()
+    );
 }
 
 /// Hands the heap memory freed by the phases before (the case table, its polars frame, the
