@@ -22,6 +22,7 @@
 //!   worlds, success probability, the paired per-world values).
 //! - [`robust`]: the study-level view of the worlds: `worlds.csv`, ranking columns, the
 //!   paired verdict.
+//! - [`dictionary`]: every output column's unit, type and meaning (`docs/columns.md`).
 //! - [`manifest`]: the `manifest.json` of an output directory.
 //! - [`lock`]: the output directory's lock (heartbeat, takeover on `--resume`, signals).
 //! - [`outdir`]: the output directory resolved once, kept free of links out, owned by one
@@ -36,6 +37,7 @@
 pub mod axes;
 pub mod cases;
 pub mod catalogue;
+pub mod dictionary;
 pub mod directions;
 pub mod doe;
 pub mod engine;

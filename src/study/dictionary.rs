@@ -1,0 +1,279 @@
+//! The data dictionary of a study's output tables (issue 25 item 5, first part): every column
+//! `cases.csv` / `cases.parquet`, `worlds.csv` and `tuning.csv` can carry, with its unit, type
+//! and meaning. `docs/columns.md` is [`columns_markdown`] (tests/columns.rs keeps them equal
+//! and checks that every name of the metric catalogue — design, static `T(q)`, run metrics of
+//! both modes, tuning, worlds — is described here).
+
+/// One column (or family of columns: `seg{k}_…`, `tuned.<param>`, `<m>_mean`, …).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColumnDoc {
+    /// The name, or its pattern.
+    pub name: &'static str,
+    /// The unit (`–` for dimensionless, `0/1` for a flag).
+    pub unit: &'static str,
+    /// The type as stored: `f64`, `i64` or `str`.
+    pub kind: &'static str,
+    /// What it means.
+    pub meaning: &'static str,
+}
+
+const fn c(
+    name: &'static str,
+    unit: &'static str,
+    kind: &'static str,
+    meaning: &'static str,
+) -> ColumnDoc {
+    ColumnDoc {
+        name,
+        unit,
+        kind,
+        meaning,
+    }
+}
+
+/// The tables and their columns, in the order they appear.
+pub const DICTIONARY: &[(&str, &[ColumnDoc])] = &[
+    ("cases.csv: identity and status", IDENTITY),
+    ("cases.csv: the design", DESIGN),
+    ("cases.csv: the static T(q) analysis (`[static]`)", STATIC),
+    ("cases.csv: per-case tuning (`[tune]`)", TUNING),
+    ("cases.csv: the closed-loop run, both modes", RUN_COMMON),
+    ("cases.csv: transport runs", RUN_TRANSPORT),
+    ("cases.csv: work runs", RUN_WORK),
+    (
+        "cases.csv: uncertain worlds and ranking (`[uncertainty]`, `[[validate]]`)",
+        WORLDS,
+    ),
+    ("worlds.csv (one row per case and world)", WORLDS_CSV),
+    ("tuning.csv (one row per case and tuning run)", TUNING_CSV),
+];
+
+const IDENTITY: &[ColumnDoc] = &[
+    c("case_id", "–", "i64", "case number, dense from 0 in the order of the design of experiments"),
+    c("hash", "–", "str", "hash of the case's resolved tables, seed and tuning: identifies a row across runs, resumes and merges"),
+    c("<axis name>", "as the key", "f64 or str", "the case's value of each `[[axis]]` (e.g. `design.links`), named as written"),
+    c("status", "–", "str", "`ok` (ran and met every `[success]` criterion), `unsuccessful`, `failed` or `skipped`"),
+    c("reason", "–", "str", "why the case is not `ok`: the first criterion missed and by how much, or the error"),
+];
+
+const DESIGN: &[ColumnDoc] = &[
+    c(
+        "design_bodies",
+        "–",
+        "f64",
+        "number of rigid bodies of the built design",
+    ),
+    c("design_joints", "–", "f64", "number of revolute joints"),
+    c("design_thrusters", "–", "f64", "number of thrusters"),
+    c(
+        "design_length_m",
+        "m",
+        "f64",
+        "length of the straight chain, tail face to head face",
+    ),
+    c("design_mass_kg", "kg", "f64", "total mass of the bodies"),
+];
+
+const STATIC: &[ColumnDoc] = &[
+    c("tcm_singular_fraction", "–", "f64", "fraction of sampled joint configurations whose scaled σ_min of T(q) (all six rows) is below the threshold: how often T(q) is singular"),
+    c("tcm_rank_deficient_fraction", "–", "f64", "fraction of configurations where T(q) loses rank numerically"),
+    c("tcm_sigma_min_min", "–", "f64", "smallest scaled σ_min over the samples (all six rows)"),
+    c("tcm_sigma_min_p05", "–", "f64", "5 % quantile of the scaled σ_min"),
+    c("tcm_sigma_min_p50", "–", "f64", "median scaled σ_min"),
+    c("tcm_sigma_min_mean", "–", "f64", "mean scaled σ_min"),
+    c("tcm_kappa_p50", "–", "f64", "median condition number κ of the scaled T(q)"),
+    c("tcm_kappa_p95", "–", "f64", "95 % quantile of κ"),
+    c("tcm_straight_sigma_min", "–", "f64", "scaled σ_min of the straight configuration q = 0"),
+    c("tcm_lost_surge … tcm_lost_yaw", "–", "f64", "fraction of configurations in which each base axis (surge, sway, heave, roll, pitch, yaw) is the lost direction"),
+    c("tcm_singular_fraction_commanded", "–", "f64", "as tcm_singular_fraction, for the rows the mode's controller commands"),
+    c("tcm_sigma_min_commanded_min", "–", "f64", "smallest scaled σ_min of the commanded rows"),
+    c("tcm_sigma_min_commanded_p05", "–", "f64", "5 % quantile of the commanded rows' σ_min"),
+    c("tcm_sigma_min_commanded_p50", "–", "f64", "median of the commanded rows' σ_min"),
+    c("tcm_kappa_commanded_p50", "–", "f64", "median κ of the commanded rows"),
+    c("tcm_straight_sigma_min_commanded", "–", "f64", "σ_min of the commanded rows at q = 0"),
+];
+
+const TUNING: &[ColumnDoc] = &[
+    c("tuned.<param>", "as the key", "f64", "the tuned value of each `[[tune.param]]` (e.g. `tuned.control.k_psi`), at which the case is scored"),
+    c("tune_evaluations", "–", "f64", "fresh closed-loop runs the tuning used"),
+    c("tune_feasible", "0/1", "f64", "1 when the tuned point met every `[[tune.constraint]]`"),
+    c("tune_noise", "–", "f64", "relative spread (max − min)/min of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start"),
+    c("tune_bound_hits", "–", "f64", "tuned parameters within 0.1 % of a bound of their box"),
+];
+
+const RUN_COMMON: &[ColumnDoc] = &[
+    c("completed", "0/1", "f64", "the run reached its duration without a numerical failure"),
+    c("simulated_time", "s", "f64", "simulated time reached"),
+    c("thruster_energy", "J", "f64", "thruster shaft energy by actuator-disk momentum theory with each thruster's axial inflow"),
+    c("thruster_energy_static", "J", "f64", "the same thrusts at zero inflow"),
+    c("effort_sq", "N²·s", "f64", "∫‖u‖² dt of the thrust held over each control interval"),
+    c("effort_abs", "N·s", "f64", "∫Σ|u_j| dt"),
+    c("joint_energy", "J", "f64", "∫Σ|τ_q,i q̇_i| dt of the joint motors"),
+    c("joint_torque_peak", "N·m", "f64", "largest joint motor torque"),
+    c("peak_thrust", "N", "f64", "largest thrust of any thruster at a control tick"),
+    c("saturation_fraction", "–", "f64", "fraction of control intervals with a thruster at a limit"),
+    c("singularity_exposure", "–", "f64", "fraction of time σ_min of the commanded rows of T(q) is below `[metrics] threshold`"),
+    c("singularity_exposure_full", "–", "f64", "the same for all six rows"),
+    c("sigma_min_min", "–", "f64", "smallest scaled σ_min of T(q) (all rows) over the run"),
+    c("sigma_min_mean", "–", "f64", "mean scaled σ_min over the run"),
+    c("sigma_min_commanded_min", "–", "f64", "smallest σ_min of the commanded rows over the run"),
+    c("sigma_min_commanded_mean", "–", "f64", "mean σ_min of the commanded rows"),
+    c("slack_fraction", "–", "f64", "fraction of allocations whose slack was active"),
+    c("allocation_failures", "–", "f64", "allocations that failed"),
+    c("allocation_residual_fraction", "–", "f64", "fraction of control steps leaving the commanded wrench undelivered beyond `[metrics] residual_tolerance`"),
+    c("success", "0/1", "f64", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
+];
+
+const RUN_TRANSPORT: &[ColumnDoc] = &[
+    c("seg{k}_convergence_time", "s", "f64", "time after segment k became active until |e_y| entered `metrics.band` and stayed (NaN: not within the run)"),
+    c("seg{k}_overshoot", "m", "f64", "largest cross-track excursion past the path on segment k after the first crossing"),
+    c("seg{k}_cross_track_rms", "m", "f64", "RMS cross-track error on segment k after convergence"),
+    c("segments_reached", "–", "f64", "segments that became active"),
+    c("converged", "0/1", "f64", "every reached segment converged"),
+    c("convergence_time", "s", "f64", "convergence time of segment 0"),
+    c("overshoot", "m", "f64", "largest overshoot over the segments"),
+    c("cross_track_rms", "m", "f64", "RMS cross-track error of the head after convergence"),
+    c("base_cross_track_rms", "m", "f64", "the same for the base (tail)"),
+    c("final_cross_track", "m", "f64", "signed cross-track error at the end (positive to the left); ranked by magnitude"),
+    c("path_progress", "m", "f64", "distance the end effector covered along the path"),
+    c("energy_per_metre", "J/m", "f64", "thruster_energy / path_progress: the cruise cost that compares designs of different speeds"),
+];
+
+const RUN_WORK: &[ColumnDoc] = &[
+    c(
+        "final_position_error",
+        "m",
+        "f64",
+        "end-effector position error at the end",
+    ),
+    c(
+        "final_orientation_error_deg",
+        "deg",
+        "f64",
+        "end-effector pointing error at the end, roll excluded",
+    ),
+    c(
+        "settling_time_position",
+        "s",
+        "f64",
+        "time until the position error stays within `metrics.position_tolerance`",
+    ),
+    c(
+        "settling_time_orientation",
+        "s",
+        "f64",
+        "time until the pointing error stays within `metrics.orientation_tolerance_deg`",
+    ),
+    c("base_drift", "m", "f64", "base displacement over the run"),
+    c(
+        "ee_damped_fraction",
+        "–",
+        "f64",
+        "fraction of the logged samples in which the singularity-robust damping λ of the end-effector task was active (λ > 0)",
+    ),
+    c(
+        "ee_damping_max",
+        "–",
+        "f64",
+        "largest damping λ of the end-effector task",
+    ),
+    c("ee_roll_max_deg", "deg", "f64", "largest |deviation| of the end-effector roll from its setpoint over the run (roll is not controlled in work mode)"),
+    c(
+        "ee_roll_max_settled_deg",
+        "deg",
+        "f64",
+        "the same after the pose has settled (NaN when it never settles)",
+    ),
+    c(
+        "ee_roll_std_deg",
+        "deg",
+        "f64",
+        "standard deviation of the roll deviation after settling",
+    ),
+];
+
+const WORLDS: &[ColumnDoc] = &[
+    c("<m>_mean, <m>_std, <m>_p05, <m>_p95", "as <m>", "f64", "mean, sample standard deviation and 5 %/95 % quantiles of tracked metric <m> over the sampled worlds (the plain <m> is the nominal world)"),
+    c("<m>_worst", "as <m>", "f64", "the worst value of <m> over the worlds, by its direction (largest for costs, smallest for σ_min and outcomes, largest |x| for signed metrics)"),
+    c("success_probability", "–", "f64", "fraction of the worlds in which the run met every `[success]` criterion"),
+    c("p_best", "–", "f64", "fraction of the paired worlds in which the case is best on the objective among the ranked cases (ties share); NaN when not ranked"),
+    c("rank_p05, rank_p50, rank_p95", "–", "f64", "5 %, 50 % and 95 % quantiles of the case's rank (1 = best) over the worlds among the ranked cases"),
+    c("validate.<v>.<objective>", "as the objective", "f64", "the objective in held-out variant <v> at the tuned values"),
+    c("validate.<v>.success", "0/1", "f64", "the run in variant <v> met every `[success]` criterion"),
+    c("validate.<v>.gap", "–", "f64", "relative change of the objective from the nominal run in variant <v>: the generalisation gap"),
+];
+
+const WORLDS_CSV: &[ColumnDoc] = &[
+    c(
+        "world",
+        "–",
+        "i64",
+        "world index, the same worlds for every case (common random numbers)",
+    ),
+    c("case_id", "–", "i64", "the case"),
+    c(
+        "<param>",
+        "as the key",
+        "f64",
+        "each `[[uncertainty.param]]`'s value in the world (a choice of text by its index)",
+    ),
+    c("<m>", "as <m>", "f64", "each tracked metric in the world"),
+    c(
+        "success",
+        "0/1",
+        "f64",
+        "the run in the world met every `[success]` criterion",
+    ),
+    c(
+        "missed",
+        "–",
+        "str",
+        "the first `[success]` criterion it missed (empty when none)",
+    ),
+];
+
+const TUNING_CSV: &[ColumnDoc] = &[
+    c("case_id", "–", "i64", "the case"),
+    c("evaluation", "–", "i64", "fresh tuning run, from 1, across the starts"),
+    c("best", "–", "f64", "best feasible tuning objective so far, relative to the start point's scale (NaN before the first feasible point)"),
+];
+
+/// Whether `name` (a concrete column name) is described by the dictionary.
+pub fn is_described(name: &str) -> bool {
+    let seg = |n: &str| {
+        n.strip_prefix("seg")
+            .and_then(|r| r.split_once('_'))
+            .is_some_and(|(k, rest)| k.parse::<usize>().is_ok() && !rest.is_empty())
+            .then(|| format!("seg{{k}}_{}", n.split_once('_').map_or("", |x| x.1)))
+    };
+    let lost = name.starts_with("tcm_lost_");
+    let summary = ["_mean", "_std", "_p05", "_p95", "_worst"]
+        .iter()
+        .any(|s| name.strip_suffix(s).is_some_and(is_described));
+    let pattern = name.starts_with("tuned.")
+        || name.starts_with("validate.")
+        || matches!(name, "rank_p05" | "rank_p50" | "rank_p95");
+    let exact = DICTIONARY
+        .iter()
+        .flat_map(|(_, cols)| cols.iter())
+        .any(|c| c.name == name || seg(name).is_some_and(|p| c.name == p));
+    exact || lost || summary || pattern
+}
+
+/// `docs/columns.md`'s tables.
+pub fn columns_markdown() -> String {
+    let mut out = String::new();
+    for (title, cols) in DICTIONARY {
+        out.push_str(&format!(
+            "### {title}\n\n| column | unit | type | meaning |\n|---|---|---|---|\n"
+        ));
+        for c in *cols {
+            out.push_str(&format!(
+                "| `{}` | {} | {} | {} |\n",
+                c.name, c.unit, c.kind, c.meaning
+            ));
+        }
+        out.push('\n');
+    }
+    out
+}
