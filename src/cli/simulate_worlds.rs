@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use anyhow::Context;
-use usm_study::report::{write_csv, ColumnData, Table};
+use usm_study::report::{file_stem_safe, write_csv, ColumnData, Table};
 use usm_study::scenario::Source;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
@@ -38,17 +38,7 @@ pub fn prepare(
 ) -> anyhow::Result<Worlds> {
     let mut study = toml::Table::new();
     let mut meta = toml::Table::new();
-    let safe: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    meta.insert("name".into(), toml::Value::String(safe));
+    meta.insert("name".into(), toml::Value::String(file_stem_safe(name)));
     study.insert("study".into(), toml::Value::Table(meta));
     let mut scenario_side = table.clone();
     let design = match scenario_side.remove("design") {

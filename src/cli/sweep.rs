@@ -346,16 +346,8 @@ fn print_verdict(dir: &Path) {
     let Ok(md) = std::fs::read_to_string(dir.join("summary.md")) else {
         return;
     };
-    let first = md
-        .lines()
-        .skip(1)
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or_default();
-    if ["**Winner:", "**Statistically tied:", "**No winner"]
-        .iter()
-        .any(|p| first.starts_with(p))
-    {
-        eprintln!("[sweep] {}", first.replace("**", "").replace('`', ""));
+    if let Some(v) = usm_study::study::summary_robust::summary_verdict(&md) {
+        eprintln!("[sweep] {}", v.replace("**", "").replace('`', ""));
     }
     eprintln!(
         "[sweep] review: {}",

@@ -27,6 +27,7 @@ use crate::study::doe::expand;
 use crate::study::parse::load_study;
 use crate::study::plots::{case_name, unsuccessful_rows};
 use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
+use crate::study::summary_robust::summary_verdict;
 
 /// The file name of the page.
 pub const REPORT_HTML: &str = "report.html";
@@ -132,16 +133,6 @@ fn remove_dead_temporaries(dir: &Path) {
             let _ = std::fs::remove_file(e.path());
         }
     }
-}
-
-/// The verdict line of a summary: the first paragraph after its title when it opens with
-/// `**Winner:`, `**Statistically tied:` or `**No winner`.
-fn verdict_line(md: &str) -> Option<&str> {
-    let first = md.lines().skip(1).find(|l| !l.trim().is_empty())?;
-    ["**Winner:", "**Statistically tied:", "**No winner"]
-        .iter()
-        .any(|p| first.starts_with(p))
-        .then_some(first)
 }
 
 /// One drawn design: the cases that share it and its SVG.
@@ -383,7 +374,7 @@ impl Page<'_> {
     /// The answer first: the verdict line `summary.md` opens with over uncertain worlds
     /// ("Winner: …" or "Statistically tied: …"), when it has one.
     fn verdict_section(&self, h: &mut String) {
-        let Some(line) = self.summary.and_then(verdict_line) else {
+        let Some(line) = self.summary.and_then(summary_verdict) else {
             return;
         };
         let _ = writeln!(

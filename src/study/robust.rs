@@ -141,24 +141,33 @@ fn numeric(v: &toml::Value, d: &WorldDist) -> f64 {
     }
 }
 
-/// Move the per-world columns (`world.<k>.<metric>`) out of `table` into a long table
-/// `world`, `case_id`, the parameter values, then each metric; `None` when there are none.
-pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
-    let mut per: BTreeMap<(usize, String), Vec<f64>> = BTreeMap::new();
+/// Moves the `f64` columns whose name `key` maps to a key out of `table`, by key (the journal's
+/// per-world and per-tuning-run columns, which become long tables of their own).
+fn take_columns<K: Ord>(
+    table: &mut Table,
+    key: impl Fn(&str) -> Option<K>,
+) -> BTreeMap<K, Vec<f64>> {
+    let mut taken = BTreeMap::new();
     let mut kept = Vec::with_capacity(table.columns.len());
     for c in std::mem::take(&mut table.columns) {
-        let parsed = c.name.strip_prefix(WORLD_PREFIX).and_then(|rest| {
-            let (k, m) = rest.split_once('.')?;
-            Some((k.parse::<usize>().ok()?, m.to_string()))
-        });
-        match (parsed, &c.data) {
-            (Some(key), ColumnData::F64(v)) => {
-                per.insert(key, v.clone());
+        match (key(&c.name), c.data) {
+            (Some(k), ColumnData::F64(v)) => {
+                taken.insert(k, v);
             }
-            _ => kept.push(c),
+            (_, data) => kept.push(Column { name: c.name, data }),
         }
     }
     table.columns = kept;
+    taken
+}
+
+/// Move the per-world columns (`world.<k>.<metric>`) out of `table` into a long table
+/// `world`, `case_id`, the parameter values, then each metric; `None` when there are none.
+pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
+    let per = take_columns(table, |name| {
+        let (k, m) = name.strip_prefix(WORLD_PREFIX)?.split_once('.')?;
+        Some((k.parse::<usize>().ok()?, m.to_string()))
+    });
     if per.is_empty() {
         return None;
     }
@@ -231,21 +240,9 @@ pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
 /// `case_id`, `evaluation`, `best` (rows past a case's last evaluation left out); `None`
 /// when there are none.
 pub fn split_tuning(table: &mut Table) -> Option<Table> {
-    let mut curves: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
-    let mut kept = Vec::with_capacity(table.columns.len());
-    for c in std::mem::take(&mut table.columns) {
-        let k = c
-            .name
-            .strip_prefix(TUNE_CURVE_PREFIX)
-            .and_then(|k| k.parse::<usize>().ok());
-        match (k, &c.data) {
-            (Some(k), ColumnData::F64(v)) => {
-                curves.insert(k, v.clone());
-            }
-            _ => kept.push(c),
-        }
-    }
-    table.columns = kept;
+    let curves = take_columns(table, |name| {
+        name.strip_prefix(TUNE_CURVE_PREFIX)?.parse::<usize>().ok()
+    });
     if curves.is_empty() {
         return None;
     }
@@ -275,7 +272,9 @@ pub struct Paired {
     pub obj: Vec<Vec<f64>>,
     /// `ok[c][w]`.
     pub ok: Vec<Vec<bool>>,
-    /// Whether case `c` is ranked.
+    /// Whether case `c` ran (`ok` or `unsuccessful`): it met its worlds.
+    pub ran: Vec<bool>,
+    /// Whether case `c` is ranked: it ran and reaches the success requirement.
     pub eligible: Vec<bool>,
 }
 
@@ -310,15 +309,24 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
         obj[r][wc[i] as usize] = sign * x;
         ok[r][wc[i] as usize] = ws[i] == 1.0;
     }
-    let eligible = (0..ids.len())
-        .map(|r| {
+    let ran: Vec<bool> = status
+        .iter()
+        .map(|s| {
             matches!(
-                CaseStatus::parse(&status[r]),
+                CaseStatus::parse(s),
                 Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
-            ) && p[r] >= info.min_success_probability
+            )
         })
         .collect();
-    Some(Paired { obj, ok, eligible })
+    let eligible = (0..ids.len())
+        .map(|r| ran[r] && p[r] >= info.min_success_probability)
+        .collect();
+    Some(Paired {
+        obj,
+        ok,
+        ran,
+        eligible,
+    })
 }
 
 /// Add `p_best` and the rank quantiles (NaN for unranked cases) before `status`.
@@ -400,15 +408,8 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
         equivalence: info.equivalence,
         noise,
     };
-    let status = table.str(STATUS).ok()?;
     let below_requirement = (0..pd.eligible.len())
-        .filter(|&r| {
-            !pd.eligible[r]
-                && matches!(
-                    CaseStatus::parse(&status[r]),
-                    Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
-                )
-        })
+        .filter(|&r| pd.ran[r] && !pd.eligible[r])
         .count();
     Some(StudyVerdict {
         verdict: verdict(&pd.obj, &pd.ok, &pd.eligible, &settings),

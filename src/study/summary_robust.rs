@@ -23,6 +23,19 @@ use crate::stats::ranking::Verdict;
 use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
 
+/// How the verdict line [`Robust::verdict_line`] writes opens.
+pub const VERDICT_OPENINGS: [&str; 3] = ["**Winner:", "**Statistically tied:", "**No winner"];
+
+/// The verdict line of a `summary.md` text: its first paragraph after the title when it is one
+/// ([`VERDICT_OPENINGS`]); `None` for a study without uncertain worlds.
+pub fn summary_verdict(md: &str) -> Option<&str> {
+    let first = md.lines().skip(1).find(|l| !l.trim().is_empty())?;
+    VERDICT_OPENINGS
+        .iter()
+        .any(|p| first.starts_with(p))
+        .then_some(first)
+}
+
 /// Most designs listed in the ranking table and drawn in the rank-interval plot.
 const TOP: usize = 12;
 
@@ -59,6 +72,14 @@ impl<'a> Robust<'a> {
             .map(|a| cell_text(self.table, a, r))
             .collect();
         format!("#{} ({})", self.ids[r], axes.join(", "))
+    }
+
+    /// The leader of the verdict (winner or first of the tie), if any design is ranked.
+    fn leader(&self) -> Option<usize> {
+        match &self.verdict.verdict {
+            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
+            Verdict::NoneEligible => None,
+        }
     }
 
     fn pct(x: f64) -> String {
@@ -292,10 +313,7 @@ impl<'a> Robust<'a> {
             self.col(RANK_COLUMNS[1]),
             self.col(RANK_COLUMNS[2]),
         );
-        let leader = match &self.verdict.verdict {
-            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
-            Verdict::NoneEligible => None,
-        };
+        let leader = self.leader();
         let rank_rows: Vec<RankRow> = rows
             .iter()
             .take(TOP)
@@ -617,10 +635,7 @@ impl<'a> Robust<'a> {
              leader's own in the last column).\n",
             self.scope_text()
         );
-        let leader = match &self.verdict.verdict {
-            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
-            Verdict::NoneEligible => None,
-        };
+        let leader = self.leader();
         let scope = self.scope();
         let mut t = MarkdownTable::new(["variant", "median gap", "successful", "leader's gap"]);
         for v in &self.info.validate {

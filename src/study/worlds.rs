@@ -72,6 +72,11 @@ fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -
     evaluate_phases(evaluator, r, id, phases, false, deadline)
 }
 
+/// Whether a run stopped at the case's wall-clock budget.
+fn timed_out(res: &CaseResult) -> bool {
+    res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT)
+}
+
 /// The value of `metric` over worlds that is worst for it.
 fn worst(metric: &str, xs: &[f64]) -> f64 {
     let finite = xs.iter().copied().filter(|x| x.is_finite());
@@ -116,11 +121,12 @@ pub fn score_worlds(
 ) -> Result<(), WorldTimeout> {
     if let Some(u) = &study.uncertainty {
         // The worlds of one case are independent runs: run them side by side (a sweep with
-        // fewer cases than threads keeps every thread busy), each with its own evaluator,
-        // collected in world order so the row does not depend on the thread count.
+        // fewer cases than threads keeps every thread busy), one evaluator per rayon work
+        // split (its vehicle cache serves every world of an unchanged design), collected in world order
+        // so the row does not depend on the thread count.
         let runs: Vec<WorldRun> = worlds
             .par_iter()
-            .map(|w| {
+            .map_init(Evaluator::new, |evaluator, w| {
                 let overrides = u
                     .params
                     .iter()
@@ -128,9 +134,8 @@ pub fn score_worlds(
                     .map(|(p, v)| (p.name.as_str(), &p.target, v));
                 match apply(r, overrides) {
                     Ok(rw) => {
-                        let res = run(&mut Evaluator::new(), &rw, id, deadline);
-                        let timeout =
-                            res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT);
+                        let res = run(evaluator, &rw, id, deadline);
+                        let timeout = timed_out(&res);
                         let missed = missed_criterion(res.status, &res.reason)
                             .and_then(Criterion::parse)
                             .map_or(f64::NAN, criterion_index);
@@ -210,7 +215,7 @@ fn score_variants(
         let (ok, x) = match apply(r, overrides) {
             Ok(rv) => {
                 let res = run(evaluator, &rv, id, deadline);
-                if res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT) {
+                if timed_out(&res) {
                     return Err(WorldTimeout { world: usize::MAX });
                 }
                 (res.status == CaseStatus::Ok, res.metrics.value(&objective))
