@@ -195,6 +195,15 @@ pub fn inertial_body_poses(base: &BasePose, ws: &KinWorkspace, out: &mut [Se3]) 
     }
 }
 
+/// Reach [m]: `|p_be|`, the distance from the base frame's origin to the end-effector frame's
+/// origin at the straight configuration `q = 0` (docs/model.md §6 "Missions"; for a chain whose
+/// links are collinear at `q = 0`, the largest over joint space).
+pub fn straight_reach(v: &Vehicle) -> f64 {
+    let mut ws = KinWorkspace::new(v);
+    forward_kinematics(v, &vec![0.0; v.n_joints()], &mut ws);
+    ws.g_be.p.norm()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

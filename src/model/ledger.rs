@@ -182,6 +182,14 @@ pub const LEDGER: &[Assumption] = &[
         note: "overall motor-and-propeller efficiency of small ROV thrusters: ±0.1",
     },
     Assumption {
+        key: "metrics.joint_efficiency",
+        name: "joint drive efficiency η_j (electrical energy = joint work / η_j)",
+        value: "0.7",
+        source: Source::Inferred("the paper gives no joint-drive data"),
+        range: Some((0.5, 0.9)),
+        note: "brushless motor with a harmonic or planetary gear; enters `total_energy` only",
+    },
+    Assumption {
         key: "metrics.propeller_diameter",
         name: "propeller diameter",
         value: "0.07 m",

@@ -6,6 +6,7 @@
 //! The nominal scales ([`ModelScales::default`]) change nothing, bit for bit.
 
 use super::{Hydro, ModelError, Vehicle};
+use crate::spatial::{Mat3, Vec3};
 
 /// Scale factors applied to every body and thruster of a design (dimensionless).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,6 +159,51 @@ impl Vehicle {
     }
 }
 
+impl Vehicle {
+    /// Carry a point-mass payload of `mass` [kg] displacing `volume` [m³] at the origin of the
+    /// end-effector frame `F_e` (a mission's payload, docs/model.md §6 "Missions"). The last
+    /// body's mass, centre of gravity (mass-weighted), rotational inertia about the new centre
+    /// of gravity (parallel-axis theorem; the point mass has none about itself), displaced
+    /// volume and centre of buoyancy (volume-weighted) change; its added mass and drag do not.
+    /// `mass = volume = 0` changes nothing, bit for bit.
+    pub fn add_payload(&mut self, mass: f64, volume: f64) -> Result<(), ModelError> {
+        for (k, v) in [
+            ("mission.payload_mass", mass),
+            ("mission.payload_volume", volume),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(ModelError::new(
+                    k,
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
+        }
+        if mass == 0.0 && volume == 0.0 {
+            return Ok(());
+        }
+        let at = self.end_effector.p;
+        let Some(body) = self.bodies.last_mut() else {
+            return Err(ModelError::new(
+                "design",
+                "a payload needs at least one body",
+            ));
+        };
+        let m = body.mass + mass;
+        let cg = (body.cg * body.mass + at * mass) / m;
+        let shift =
+            |mass: f64, d: Vec3| (Mat3::identity() * d.norm_squared() - d * d.transpose()) * mass;
+        body.inertia += shift(body.mass, body.cg - cg) + shift(mass, at - cg);
+        if volume > 0.0 {
+            let v = body.volume + volume;
+            body.cb = (body.cb * body.volume + at * volume) / v;
+            body.volume = v;
+        }
+        body.mass = m;
+        body.cg = cg;
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -237,5 +283,34 @@ mod tests {
             ..ModelScales::default()
         };
         assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "drag");
+    }
+    #[test]
+    fn a_payload_adds_its_mass_moment_and_volume_at_the_end_effector() {
+        let v0 = presets::usm_paper();
+        let mut v = v0.clone();
+        v.add_payload(0.0, 0.0).unwrap();
+        assert_eq!(v, v0);
+        let (m, vol) = (2.0, 0.001);
+        v.add_payload(m, vol).unwrap();
+        let (b, b0) = (v.bodies.last().unwrap(), v0.bodies.last().unwrap());
+        let at = v.end_effector.p;
+        assert_eq!(b.mass, b0.mass + m);
+        // First moment about the body origin: old + m·p_e.
+        assert!((b.cg * b.mass - (b0.cg * b0.mass + at * m)).norm() < 1e-12);
+        // Second moment about the body origin: old + point mass at p_e.
+        let about_origin = |i: &Mat3, mass: f64, c: &Vec3| {
+            i + (Mat3::identity() * c.norm_squared() - c * c.transpose()) * mass
+        };
+        let point = (Mat3::identity() * at.norm_squared() - at * at.transpose()) * m;
+        let lhs = about_origin(&b.inertia, b.mass, &b.cg);
+        let rhs = about_origin(&b0.inertia, b0.mass, &b0.cg) + point;
+        assert!((lhs - rhs).abs().max() < 1e-12 * rhs.abs().max());
+        assert!((b.volume - (b0.volume + vol)).abs() < 1e-15);
+        assert!((b.cb * b.volume - (b0.cb * b0.volume + at * vol)).norm() < 1e-12);
+        assert!(v.validate().is_ok());
+        assert_eq!(
+            v.add_payload(-1.0, 0.0).unwrap_err().key,
+            "mission.payload_mass"
+        );
     }
 }

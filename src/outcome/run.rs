@@ -2,7 +2,8 @@
 //! run's summary metrics ([`super::run_summary`]) and its `[success]` judgement
 //! ([`super::success`]).
 
-use super::run_summary::{add_success, run_summary};
+use super::run_summary::{add_success, run_summary, RunFacts};
+use crate::kinematics::straight_reach;
 use crate::model::Vehicle;
 use crate::scenario::channels::Trajectory;
 use crate::scenario::config::{Mode, ScenarioFile};
@@ -60,11 +61,14 @@ pub fn run_scenario_until(
     stop: Stop,
 ) -> Result<RunResult, ScenarioError> {
     let run = run_loop(v, file, stop)?;
-    let failed = run.failure.is_some();
+    let facts = RunFacts {
+        failed: run.failure.is_some(),
+        reach: straight_reach(v),
+    };
     let mut metrics = run_summary(
         file,
+        facts,
         &run.trajectory,
-        failed,
         &run.allocation_counts,
         &run.energy,
     );

@@ -21,7 +21,7 @@ type Metrics = Vec<(String, f64)>;
 /// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
 /// that computes them adds values in this order, and [`metric_catalogue`] lists them so that
 /// callers (the optimiser) can check names before anything runs.
-pub const COMMON_METRICS: [&str; 19] = [
+pub const COMMON_METRICS: [&str; 21] = [
     "completed",
     "simulated_time",
     "thruster_energy",
@@ -41,13 +41,15 @@ pub const COMMON_METRICS: [&str; 19] = [
     "slack_fraction",
     "allocation_failures",
     "allocation_residual_fraction",
+    "total_energy",
+    "reach",
 ];
 
 /// Per-segment transport metrics, each named `seg{k}_{name}` for segment `k` (0-based).
 pub const SEGMENT_METRICS: [&str; 3] = ["convergence_time", "overshoot", "cross_track_rms"];
 
 /// Transport metrics over the whole run (after the per-segment ones).
-pub const TRANSPORT_METRICS: [&str; 9] = [
+pub const TRANSPORT_METRICS: [&str; 11] = [
     "segments_reached",
     "converged",
     "convergence_time",
@@ -57,6 +59,8 @@ pub const TRANSPORT_METRICS: [&str; 9] = [
     "final_cross_track",
     "path_progress",
     "energy_per_metre",
+    "total_energy_per_metre",
+    "cross_track_iae",
 ];
 
 /// Work-mode regulation metrics (then [`ROLL_METRICS`]).
@@ -135,19 +139,28 @@ fn channel(traj: &Trajectory, c: Channel) -> &[f64] {
     traj.get(c).unwrap_or(&[])
 }
 
+/// What a run's summary needs besides its trajectory and integrals.
+#[derive(Clone, Copy, Debug)]
+pub struct RunFacts {
+    /// Whether the run stopped early.
+    pub failed: bool,
+    /// The design's reach [m] (`kinematics::straight_reach`, metric `reach`).
+    pub reach: f64,
+}
+
 /// The metrics of a run of `file` from its trajectory: the common ones, then the
-/// mode's. `failed` says whether the run stopped early; `counts` are its allocation outcomes;
+/// mode's. `run` says whether the run stopped early and gives the design's reach; `counts` are its allocation outcomes;
 /// `energy` its effort and energy integrals, accumulated at every control step (not from
 /// the log).
 pub fn run_summary(
     file: &ScenarioFile,
+    run: RunFacts,
     traj: &Trajectory,
-    failed: bool,
     counts: &AllocationCounts,
     energy: &EnergyMetrics,
 ) -> Vec<(String, f64)> {
     let mut out = Metrics::new();
-    common_metrics(&mut out, file, traj, failed, counts, energy);
+    common_metrics(&mut out, file, run, traj, counts, energy);
     match file.scenario.mode {
         Mode::Transport => transport_metrics(&mut out, &file.metrics, traj, energy),
         Mode::Work => work_metrics(&mut out, &file.metrics, traj),
@@ -159,7 +172,7 @@ pub fn run_summary(
 /// ([`super::success::judge`]) and append `success` (1 = every criterion met,
 /// 0 = not); returns the first criterion missed.
 pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
-    let missed = judge(&file.success, file.scenario.mode, metrics);
+    let missed = judge(&file.success, &file.mission, file.scenario.mode, metrics);
     let met = if missed.is_none() { 1.0 } else { 0.0 };
     metrics.push((SUCCESS_METRIC.to_string(), met));
     missed
@@ -183,12 +196,16 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 ///   `sigma_min_min`/`_mean` (all rows) and `sigma_min_commanded_min`/`_mean` over the log;
 /// - `slack_fraction` of allocations whose slack was active, `allocation_failures`, and
 ///   `allocation_residual_fraction`, the fraction of control steps whose allocation left the
-///   commanded wrench undelivered beyond `[metrics] residual_tolerance`.
+///   commanded wrench undelivered beyond `[metrics] residual_tolerance`;
+/// - `total_energy` [J]: `thruster_energy + joint_energy / η_j`, the thruster shaft energy plus
+///   the joint drives' electrical energy (`[metrics] joint_efficiency` η_j);
+/// - `reach` [m]: the design's distance from the base frame's origin to the end effector at
+///   `q = 0` (a `[mission] reach` requirement is judged on it).
 fn common_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,
+    run: RunFacts,
     traj: &Trajectory,
-    failed: bool,
     counts: &AllocationCounts,
     e: &EnergyMetrics,
 ) {
@@ -206,7 +223,7 @@ fn common_metrics(
     };
     let steps = counts.steps.max(1) as f64;
     let values = [
-        if failed { 0.0 } else { 1.0 },
+        if run.failed { 0.0 } else { 1.0 },
         t.last().copied().unwrap_or(0.0),
         e.thruster_energy,
         e.thruster_energy_static,
@@ -225,8 +242,32 @@ fn common_metrics(
         counts.slack_active as f64 / steps,
         counts.solver_failures as f64,
         counts.residual as f64 / steps,
+        total_energy(e, &file.metrics),
+        run.reach,
     ];
     add_all(out, &COMMON_METRICS, values);
+}
+
+/// `thruster_energy + joint_energy / η_j` [J] (docs/model.md §6 "Missions").
+fn total_energy(e: &EnergyMetrics, spec: &MetricsSpec) -> f64 {
+    e.thruster_energy + e.joint_energy / spec.joint_efficiency
+}
+
+/// `energy / progress`, NaN without progress (as `EnergyMetrics::energy_per_metre`).
+fn per_metre(energy: f64, progress: f64) -> f64 {
+    if progress > 0.0 {
+        energy / progress
+    } else {
+        f64::NAN
+    }
+}
+
+/// `∫|e_y| dt` [m·s] over the logged run (trapezoid rule): the tracking term of a transport
+/// mission, so that arriving late on the path is not free.
+fn integral_abs(t: &[f64], y: &[f64]) -> f64 {
+    (1..t.len().min(y.len()))
+        .map(|i| 0.5 * (t[i] - t[i - 1]) * (y[i].abs() + y[i - 1].abs()))
+        .sum()
 }
 
 /// Index ranges `[a, b)` of the contiguous runs of equal values in `seg` (the samples during
@@ -246,7 +287,9 @@ fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
 /// Transport: convergence, overshoot and cross-track RMS per segment (after convergence)
 /// and over the run, the base's cross-track RMS, the final cross-track error; the distance
 /// the end-effector covered along the path (`path_progress` [m], at the control rate) and
-/// the thruster shaft energy per metre of it (`energy_per_metre` [J/m]).
+/// the thruster shaft energy per metre of it (`energy_per_metre` [J/m]); `total_energy` per
+/// metre (`total_energy_per_metre` [J/m], thrusters and joint drives) and the integrated
+/// absolute cross-track error `cross_track_iae` [m·s] over the whole run.
 fn transport_metrics(
     out: &mut Metrics,
     spec: &MetricsSpec,
@@ -310,6 +353,8 @@ fn transport_metrics(
         ey.last().copied().unwrap_or(f64::NAN),
         energy.path_progress,
         energy.energy_per_metre(),
+        per_metre(total_energy(energy, spec), energy.path_progress),
+        integral_abs(t, ey),
     ];
     add_all(out, &TRANSPORT_METRICS, values);
 }

@@ -1,20 +1,36 @@
 //! The verdict on a closed-loop run (docs/model.md §6 "Success"): its summary metrics judged against
 //! the scenario's `[success]` criteria ([`SuccessSpec`]), in the order of [`Criterion::ALL`].
 
-use crate::scenario::config::Mode;
+use crate::scenario::config::{MissionSpec, Mode};
 use crate::scenario::success::{Criterion, Missed, SuccessSpec};
 
 /// Judge a run of `mode` by its summary `metrics` (see [`super::run_summary`]) against
-/// `spec`: `None` when it met every criterion, else the first one missed. `metrics` must
+/// `spec` and the `mission`'s requirements: `None` when it met every criterion, else the
+/// first one missed (the mission's reach first, its deadline after the transport criteria). `metrics` must
 /// hold `completed`, `peak_thrust`, `saturation_fraction` and the mode's metrics; a
 /// missing or NaN value misses its criterion.
-pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Option<Missed> {
+pub fn judge(
+    spec: &SuccessSpec,
+    mission: &MissionSpec,
+    mode: Mode,
+    metrics: &[(String, f64)],
+) -> Option<Missed> {
     let get = |k: &str| {
         metrics
             .iter()
             .find(|(n, _)| n == k)
             .map_or(f64::NAN, |x| x.1)
     };
+    let reach = get("reach");
+    if mission.reach > 0.0 && !(reach >= mission.reach) {
+        return Some(Missed {
+            criterion: Criterion::MissionReach,
+            detail: format!(
+                "reach = {reach:.3} m < the mission's {} m (the end effector cannot get there)",
+                mission.reach
+            ),
+        });
+    }
     if get("completed") != 1.0 {
         return Some(Missed {
             criterion: Criterion::NoFailure,
@@ -45,7 +61,9 @@ pub fn judge(spec: &SuccessSpec, mode: Mode, metrics: &[(String, f64)]) -> Optio
         return m;
     }
     match mode {
-        Mode::Transport => judge_transport(spec, &get),
+        Mode::Transport => {
+            judge_transport(spec, &get).or_else(|| judge_deadline(mission.deadline, &get))
+        }
         Mode::Work => {
             let (p, a) = (spec.position_tolerance, spec.orientation_tolerance_deg);
             check(
@@ -114,10 +132,31 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
     None
 }
 
+/// The mission's deadline: every reached segment converged within `deadline` [s] of becoming
+/// active (0 = none; a segment that never converged already missed `convergence_window`).
+fn judge_deadline(deadline: f64, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
+    if deadline <= 0.0 {
+        return None;
+    }
+    let reached = get("segments_reached");
+    let n = if reached.is_finite() && reached > 0.0 {
+        reached as usize
+    } else {
+        0
+    };
+    (0..n).find_map(|k| {
+        let c = get(&format!("seg{k}_convergence_time"));
+        (c.is_nan() || c > deadline).then(|| Missed {
+            criterion: Criterion::MissionDeadline,
+            detail: format!("segment {k} converged after {c:.1} s > the mission's {deadline} s"),
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use crate::outcome::success::judge;
-    use crate::scenario::config::Mode;
+    use crate::scenario::config::{MissionSpec, Mode};
     use crate::scenario::success::{Criterion, SuccessSpec};
 
     fn metrics(kv: &[(&str, f64)]) -> Vec<(String, f64)> {
@@ -147,7 +186,9 @@ mod tests {
     #[test]
     fn transport_criteria_in_order() {
         let s = SuccessSpec::default();
-        let id = |m: &[(String, f64)]| judge(&s, Mode::Transport, m).map(|x| x.criterion);
+        let id = |m: &[(String, f64)]| {
+            judge(&s, &MissionSpec::default(), Mode::Transport, m).map(|x| x.criterion)
+        };
         assert_eq!(id(&transport(-0.05, &[30.0, 44.0])), None);
         // Signed cross-track: judged by magnitude.
         assert_eq!(
@@ -158,7 +199,13 @@ mod tests {
             id(&transport(0.05, &[71.5, 40.0])),
             Some(Criterion::ConvergenceWindow)
         );
-        let m = judge(&s, Mode::Transport, &transport(0.05, &[30.0, f64::NAN])).unwrap();
+        let m = judge(
+            &s,
+            &MissionSpec::default(),
+            Mode::Transport,
+            &transport(0.05, &[30.0, f64::NAN]),
+        )
+        .unwrap();
         assert!(m.detail.starts_with("segment 1 never"), "{}", m.detail);
         assert!(m.to_string().starts_with("convergence_window: segment 1"));
         // Earlier criteria come first: a run that stopped early misses `no_failure` only.
@@ -173,7 +220,12 @@ mod tests {
             max_peak_thrust: 30.0,
             ..SuccessSpec::default()
         };
-        let m = judge(&tight, Mode::Transport, &transport(0.0, &[1.0]));
+        let m = judge(
+            &tight,
+            &MissionSpec::default(),
+            Mode::Transport,
+            &transport(0.0, &[1.0]),
+        );
         assert_eq!(m.map(|x| x.criterion), Some(Criterion::MaxPeakThrust));
     }
 
@@ -185,18 +237,50 @@ mod tests {
             ("final_position_error", 0.01),
             ("final_orientation_error_deg", 0.1),
         ]));
-        assert_eq!(judge(&s, Mode::Work, &m), None);
+        assert_eq!(judge(&s, &MissionSpec::default(), Mode::Work, &m), None);
         m[3].1 = 0.5;
-        let x = judge(&s, Mode::Work, &m).unwrap();
+        let x = judge(&s, &MissionSpec::default(), Mode::Work, &m).unwrap();
         assert_eq!(x.criterion, Criterion::PositionTolerance);
         m[3].1 = 0.01;
         m[4].1 = f64::NAN;
-        let x = judge(&s, Mode::Work, &m).unwrap();
+        let x = judge(&s, &MissionSpec::default(), Mode::Work, &m).unwrap();
         assert_eq!(x.criterion, Criterion::OrientationTolerance);
         // A missing metric misses its criterion.
         assert_eq!(
-            judge(&s, Mode::Work, &metrics(&COMMON)).map(|x| x.criterion),
+            judge(&s, &MissionSpec::default(), Mode::Work, &metrics(&COMMON)).map(|x| x.criterion),
             Some(Criterion::PositionTolerance)
+        );
+    }
+
+    #[test]
+    fn mission_reach_comes_first_and_the_deadline_after_the_windows() {
+        let s = SuccessSpec::default();
+        let mission = MissionSpec {
+            reach: 2.5,
+            deadline: 35.0,
+            ..MissionSpec::default()
+        };
+        let id = |m: &[(String, f64)]| judge(&s, &mission, Mode::Transport, m).map(|x| x.criterion);
+        let mut m = transport(0.05, &[30.0, 34.0]);
+        m.push(("reach".into(), 2.6));
+        assert_eq!(id(&m), None);
+        m.last_mut().unwrap().1 = 2.4;
+        // Even a run that stopped early names the reach first: the design cannot do it.
+        m[0].1 = 0.0;
+        assert_eq!(id(&m), Some(Criterion::MissionReach));
+        let mut m = transport(0.05, &[30.0, 40.0]);
+        m.push(("reach".into(), 2.6));
+        let x = judge(&s, &mission, Mode::Transport, &m).unwrap();
+        assert_eq!(x.criterion, Criterion::MissionDeadline);
+        assert!(
+            x.detail.starts_with("segment 1 converged after 40.0 s"),
+            "{}",
+            x.detail
+        );
+        // Without a mission the same run succeeds.
+        assert_eq!(
+            judge(&s, &MissionSpec::default(), Mode::Transport, &m),
+            None
         );
     }
 }

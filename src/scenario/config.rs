@@ -32,11 +32,14 @@
 //! [physics]                   # which effects, current, integrator (rk4 | dopri5), rtol, atol
 //! [metrics]                   # thresholds, power model
 //! [success]                   # what counts as a successful run (scenario::success)
+//! [mission]                   # payload, reach, convergence deadline (config::MissionSpec)
 //! ```
 //!
 //! A `[design]` table (the design-file schema) may replace `scenario.design`; the sweep engine
 //! uses it to pass a modified design.
 
+mod metrics;
+mod mission;
 mod physics;
 
 use super::success::SuccessSpec;
@@ -51,9 +54,11 @@ use crate::control::ControlError;
 use crate::dynamics::{DynOptions, Integrator, ServoModel, SimConfig, ThrusterModel};
 use crate::input::document::deserialize_table;
 use crate::input::located::{fmt_exact, KeyError};
-use crate::metrics::singularity::{CommandedDofs, RESIDUAL_TOLERANCE, SINGULARITY_THRESHOLD};
+use crate::metrics::singularity::CommandedDofs;
 use crate::metrics::trajectory::PowerModel;
 use crate::model::Vehicle;
+pub use metrics::MetricsSpec;
+pub use mission::MissionSpec;
 pub use physics::{HydroScaleSpec, PhysicsSpec, ServoSpec, ThrusterSpec, SCALE_KEYS};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -253,57 +258,6 @@ impl AllocationSpec {
     }
 }
 
-/// `[metrics]`: thresholds and the power model (docs/model.md §6).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MetricsSpec {
-    /// σ_min threshold of the scaled T(q) (N per N) below which a configuration counts as
-    /// singular, for both `singularity_exposure` (the commanded rows) and
-    /// `singularity_exposure_full` (all six). Default
-    /// [`SINGULARITY_THRESHOLD`], the one the static analysis uses too.
-    pub threshold: f64,
-    /// Relative tolerance of `allocation_residual_fraction`: a control step counts when the
-    /// commanded slack exceeds this fraction of the commanded wrench
-    /// ([`crate::metrics::singularity::residual_exceeds`]). Default [`RESIDUAL_TOLERANCE`].
-    pub residual_tolerance: f64,
-    /// Characteristic length for scaling moments [m]; 0 = half the vehicle length.
-    pub char_length: f64,
-    /// Cross-track band for convergence [m] (transport).
-    pub band: f64,
-    /// Position tolerance for settling [m] (work).
-    pub position_tolerance: f64,
-    /// Orientation tolerance for settling (roll excluded) [deg] (work).
-    pub orientation_tolerance_deg: f64,
-    /// Propeller diameter D [m] of the actuator-disk power model (docs/model.md §6). Default 0.07 m
-    /// (inferred: the paper gives no propeller data).
-    pub propeller_diameter: f64,
-    /// Overall efficiency η of the power model, shaft power = ideal power / η. Default 0.5
-    /// (inferred).
-    pub efficiency: f64,
-    /// A thruster counts as saturated within this distance of a limit [N].
-    pub saturation_tolerance: f64,
-    /// Position magnitude [m] beyond which a run counts as diverged.
-    pub divergence_distance: f64,
-}
-
-impl Default for MetricsSpec {
-    fn default() -> Self {
-        let p = PowerModel::default();
-        Self {
-            threshold: SINGULARITY_THRESHOLD,
-            residual_tolerance: RESIDUAL_TOLERANCE,
-            char_length: 0.0,
-            band: 0.1,
-            position_tolerance: 0.02,
-            orientation_tolerance_deg: 2.0,
-            propeller_diameter: p.propeller_diameter,
-            efficiency: p.efficiency,
-            saturation_tolerance: 1e-3,
-            divergence_distance: 1e4,
-        }
-    }
-}
-
 /// A parsed scenario file. `control` stays a table until the mode decides its schema.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -356,6 +310,9 @@ pub struct ScenarioFile {
     /// Success criteria (docs/model.md §6).
     #[serde(default)]
     pub success: SuccessSpec,
+    /// Mission requirements: payload, reach, deadline (docs/model.md §6 "Missions").
+    #[serde(default)]
+    pub mission: MissionSpec,
 }
 
 /// Mode-specific gains, parsed from `[control]`.
@@ -541,6 +498,7 @@ impl ScenarioFile {
         }
         self.validate_metrics()?;
         self.success.validate()?;
+        self.mission.validate()?;
         self.mode_gains()?;
         self.base_gains().validate().map_err(file_key_error)?;
         self.secondary.validate().map_err(file_key_error)?;
@@ -631,6 +589,7 @@ impl ScenarioFile {
             ),
             ("metrics.propeller_diameter", m.propeller_diameter),
             ("metrics.efficiency", m.efficiency),
+            ("metrics.joint_efficiency", m.joint_efficiency),
             ("metrics.divergence_distance", m.divergence_distance),
         ] {
             positive(k, v)?;

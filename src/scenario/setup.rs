@@ -99,6 +99,13 @@ impl<'f> ClosedLoop<'f> {
         vehicle
             .apply_scales(&file.hydro.scales(file.thrusters.limit_scale), &SCALE_KEYS)
             .map_err(|e| ScenarioError::Key(KeyError::new(e.key, e.message)))?;
+        let mission = &file.mission;
+        let payload_volume = mission
+            .payload_volume
+            .unwrap_or(mission.payload_mass / vehicle.fluid.rho);
+        vehicle
+            .add_payload(mission.payload_mass, payload_volume)
+            .map_err(|e| ScenarioError::Key(KeyError::new(e.key, e.message)))?;
         let v = &vehicle;
         let n_thrusters = v.n_thrusters();
         if n_thrusters == 0 {

@@ -101,7 +101,8 @@ impl SuccessSpec {
     }
 }
 
-/// One success criterion; its id ([`Criterion::as_str`]) is the `[success]` key bounding it.
+/// One success criterion; its id ([`Criterion::as_str`]) is the `[success]` key bounding it
+/// (`mission.<key>` for a `[mission]` requirement).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Criterion {
     /// The run completed (did not diverge or fail numerically).
@@ -118,11 +119,18 @@ pub enum Criterion {
     PositionTolerance,
     /// [`SuccessSpec::orientation_tolerance_deg`] (work).
     OrientationTolerance,
+    /// `[mission] reach` (`super::config::MissionSpec::reach`): the design's reach.
+    MissionReach,
+    /// `[mission] deadline` (transport): every reached segment converged this soon.
+    MissionDeadline,
 }
 
 impl Criterion {
-    /// Every criterion, in the order a run is judged.
-    pub const ALL: [Criterion; 7] = [
+    /// Every criterion. A run is judged in this order, except that the mission's design
+    /// requirement [`Criterion::MissionReach`] comes first (a design that cannot reach fails
+    /// the mission whatever its run did); new criteria are appended, so an index into this
+    /// list stays valid across versions.
+    pub const ALL: [Criterion; 9] = [
         Criterion::NoFailure,
         Criterion::MaxPeakThrust,
         Criterion::MaxSaturationFraction,
@@ -130,6 +138,8 @@ impl Criterion {
         Criterion::ConvergenceWindow,
         Criterion::PositionTolerance,
         Criterion::OrientationTolerance,
+        Criterion::MissionReach,
+        Criterion::MissionDeadline,
     ];
 
     /// The machine-readable id.
@@ -142,6 +152,8 @@ impl Criterion {
             Criterion::ConvergenceWindow => "convergence_window",
             Criterion::PositionTolerance => "position_tolerance",
             Criterion::OrientationTolerance => "orientation_tolerance_deg",
+            Criterion::MissionReach => "mission.reach",
+            Criterion::MissionDeadline => "mission.deadline",
         }
     }
 

@@ -121,6 +121,8 @@ const RUN_COMMON: &[ColumnDoc] = &[
     c("slack_fraction", "–", "f64", "fraction of allocations whose slack was active"),
     c("allocation_failures", "–", "f64", "allocations that failed"),
     c("allocation_residual_fraction", "–", "f64", "fraction of control steps leaving the commanded wrench undelivered beyond `[metrics] residual_tolerance`"),
+    c("total_energy", "J", "f64", "thruster_energy + joint_energy / η_j: thruster shaft energy plus the joint drives' electrical energy (`[metrics] joint_efficiency` η_j, default 0.7)"),
+    c("reach", "m", "f64", "distance from the base frame's origin to the end effector at q = 0 (a `[mission] reach` requirement is judged on it)"),
     c("success", "0/1", "f64", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
 ];
 
@@ -137,6 +139,8 @@ const RUN_TRANSPORT: &[ColumnDoc] = &[
     c("final_cross_track", "m", "f64", "signed cross-track error at the end (positive to the left); ranked by magnitude"),
     c("path_progress", "m", "f64", "distance the end effector covered along the path"),
     c("energy_per_metre", "J/m", "f64", "thruster_energy / path_progress: the cruise cost that compares designs of different speeds"),
+    c("total_energy_per_metre", "J/m", "f64", "total_energy / path_progress: thrusters and joint drives per metre of path"),
+    c("cross_track_iae", "m·s", "f64", "∫|cross-track error| dt over the whole run: the tracking term of a transport mission (arriving late on the path is not free)"),
 ];
 
 const RUN_WORK: &[ColumnDoc] = &[

@@ -47,6 +47,7 @@ struct StudyFile {
     doe: Option<DoeFile>,
     tune: Option<toml::Table>,
     hydro: Option<toml::Table>,
+    mission: Option<toml::Table>,
     uncertainty: Option<toml::Table>,
     validate: Option<Vec<toml::Table>>,
 }
@@ -373,6 +374,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("thrusters", &file.thrusters),
         ("hydro", &file.hydro),
         ("success", &file.success),
+        ("mission", &file.mission),
     ] {
         if let Some(t) = t {
             own.insert(k.into(), toml::Value::Table(t.clone()));

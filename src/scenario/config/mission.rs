@@ -1,0 +1,86 @@
+//! `[mission]`: what a design must do beyond following the path or holding the setpoint —
+//! carry a payload at the end effector, reach a distance, converge by a deadline (docs/model.md
+//! §6 "Missions"). A design that cannot meet a requirement is unsuccessful with the
+//! requirement named (`mission.reach`, `mission.deadline`; `outcome::success::judge`).
+//!
+//! ```toml
+//! [mission]
+//! payload_mass = 2.0     # kg, a point mass at the end-effector frame (0 = none)
+//! payload_volume = 0.002 # m³ displaced by the payload; omitted = neutrally buoyant (m/ρ)
+//! reach = 2.6            # m, |base origin → end effector| at the straight configuration (0 = none)
+//! deadline = 30.0        # s, transport: every reached segment converges this soon (0 = none)
+//! ```
+//!
+//! Every default leaves a run bit for bit as it was without the table.
+
+use crate::input::located::{fmt_exact, KeyError};
+use serde::{Deserialize, Serialize};
+
+/// `[mission]`: payload, reach and deadline requirements. Defaults: none of them.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MissionSpec {
+    /// Payload mass [kg] carried as a point mass at the origin of the end-effector frame
+    /// `F_e` (`model::Vehicle::add_payload`); 0 = no payload.
+    pub payload_mass: f64,
+    /// Volume [m³] the payload displaces (its buoyancy acts at `F_e`); `None` = neutrally
+    /// buoyant, `payload_mass / ρ` (transport has no depth hold, so a heavy payload sinks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payload_volume: Option<f64>,
+    /// Required reach [m]: the distance from the base frame's origin to the end effector at
+    /// the straight configuration `q = 0` (metric `reach`) must be at least this; 0 = none.
+    pub reach: f64,
+    /// Transport: every segment the run reaches must converge (metric
+    /// `seg<k>_convergence_time`) within this many seconds of becoming active; 0 = none.
+    /// Stricter than `success.convergence_window` when smaller.
+    pub deadline: f64,
+}
+
+impl MissionSpec {
+    /// Check the values; errors name `mission.<key>`.
+    pub fn validate(&self) -> Result<(), KeyError> {
+        for (k, v) in [
+            ("payload_mass", self.payload_mass),
+            ("reach", self.reach),
+            ("deadline", self.deadline),
+            ("payload_volume", self.payload_volume.unwrap_or(0.0)),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(KeyError::new(
+                    format!("mission.{k}"),
+                    format!("must be a finite number >= 0, got {}", fmt_exact(v)),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the table asks for anything (a default table changes nothing).
+    pub fn is_active(&self) -> bool {
+        self.payload_mass > 0.0
+            || self.payload_volume.is_some_and(|v| v > 0.0)
+            || self.reach > 0.0
+            || self.deadline > 0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MissionSpec;
+
+    #[test]
+    fn validation_names_the_key_and_defaults_ask_nothing() {
+        assert!(!MissionSpec::default().is_active());
+        assert!(MissionSpec::default().validate().is_ok());
+        let bad = MissionSpec {
+            reach: -1.0,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().key, "mission.reach");
+        let bad = MissionSpec {
+            payload_volume: Some(f64::NAN),
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().key, "mission.payload_volume");
+    }
+}
