@@ -222,6 +222,10 @@ pub struct EnergyMetrics {
     /// control ticks of the along-track advance of the guided point while its segment stays
     /// active (a segment switch starts counting afresh on the new segment).
     pub path_progress: f64,
+    /// Largest `|τ_c,k|` of the commanded base wrench at a control tick, per base axis
+    /// (surge, sway, heave [N]; roll, pitch, yaw [N·m]; base frame, USM-33): the wrench the
+    /// run asked the thrusters for, against which `authority_margin` measures the design.
+    pub wrench_peak: [f64; 6],
 }
 
 impl EnergyMetrics {
@@ -270,6 +274,14 @@ impl EnergyIntegrator {
     pub fn set_joints(&mut self, joint_energy: f64, joint_torque_peak: f64) {
         self.sums.joint_energy = joint_energy;
         self.sums.joint_torque_peak = joint_torque_peak;
+    }
+
+    /// Track the commanded base wrench `tau_c` [N, N·m] (base frame) of a control tick:
+    /// [`EnergyMetrics::wrench_peak`].
+    pub fn track_wrench(&mut self, tau_c: &[f64; 6]) {
+        for (p, t) in self.sums.wrench_peak.iter_mut().zip(tau_c) {
+            *p = p.max(t.abs());
+        }
     }
 
     /// Track the guided point at a control tick: `segment` is the active segment's index,

@@ -21,7 +21,7 @@ type Metrics = Vec<(String, f64)>;
 /// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
 /// that computes them adds values in this order, and [`metric_catalogue`] lists them so that
 /// callers (the optimiser) can check names before anything runs.
-pub const COMMON_METRICS: [&str; 21] = [
+pub const COMMON_METRICS: [&str; 27] = [
     "completed",
     "simulated_time",
     "thruster_energy",
@@ -43,6 +43,12 @@ pub const COMMON_METRICS: [&str; 21] = [
     "allocation_residual_fraction",
     "total_energy",
     "reach",
+    "wrench_peak_surge",
+    "wrench_peak_sway",
+    "wrench_peak_heave",
+    "wrench_peak_roll",
+    "wrench_peak_pitch",
+    "wrench_peak_yaw",
 ];
 
 /// Per-segment transport metrics, each named `seg{k}_{name}` for segment `k` (0-based).
@@ -200,7 +206,10 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 /// - `total_energy` [J]: `thruster_energy + joint_energy / η_j`, the thruster shaft energy plus
 ///   the joint drives' electrical energy (`[metrics] joint_efficiency` η_j);
 /// - `reach` [m]: the design's distance from the base frame's origin to the end effector at
-///   `q = 0` (a `[mission] reach` requirement is judged on it).
+///   `q = 0` (a `[mission] reach` requirement is judged on it);
+/// - `wrench_peak_<axis>` [N or N·m]: the largest `|τ_c|` the base controller commanded
+///   along each base axis at a control tick (base frame, USM-33): the required wrench of
+///   `authority_margin`.
 fn common_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,
@@ -244,6 +253,12 @@ fn common_metrics(
         counts.residual as f64 / steps,
         total_energy(e, &file.metrics),
         run.reach,
+        e.wrench_peak[0],
+        e.wrench_peak[1],
+        e.wrench_peak[2],
+        e.wrench_peak[3],
+        e.wrench_peak[4],
+        e.wrench_peak[5],
     ];
     add_all(out, &COMMON_METRICS, values);
 }

@@ -311,6 +311,7 @@ impl Recorder {
         if let ModeController::Transport { signals: s, .. } = &lp.mode {
             self.energy.track_path(s.segment, s.along_track);
         }
+        self.energy.track_wrench(&lp.cmd.tau_c.into());
         let thrusters = ThrusterSample {
             thrust: &self.thrust,
             inflow: &self.inflow,

@@ -122,6 +122,7 @@ const RUN_COMMON: &[ColumnDoc] = &[
     c("allocation_failures", "–", "f64", "allocations that failed"),
     c("allocation_residual_fraction", "–", "f64", "fraction of control steps leaving the commanded wrench undelivered beyond `[metrics] residual_tolerance`"),
     c("total_energy", "J", "f64", "thruster_energy + joint_energy / η_j: thruster shaft energy plus the joint drives' electrical energy (`[metrics] joint_efficiency` η_j, default 0.7)"),
+    c("wrench_peak_<axis>", "N or N·m", "f64", "largest |τ_c| the base controller commanded along surge, sway, heave (N), roll, pitch, yaw (N·m) at a control tick, base frame: the required wrench of `authority_margin`"),
     c("reach", "m", "f64", "distance from the base frame's origin to the end effector at q = 0 (a `[mission] reach` requirement is judged on it)"),
     c("success", "0/1", "f64", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
 ];
@@ -244,6 +245,7 @@ const TUNING_CSV: &[ColumnDoc] = &[
 
 /// Whether `name` (a concrete column name) is described by the dictionary.
 pub fn is_described(name: &str) -> bool {
+    const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
     let seg = |n: &str| {
         n.strip_prefix("seg")
             .and_then(|r| r.split_once('_'))
@@ -257,10 +259,25 @@ pub fn is_described(name: &str) -> bool {
     let pattern = name.starts_with("tuned.")
         || name.starts_with("validate.")
         || matches!(name, "rank_p05" | "rank_p50" | "rank_p95");
+    // A base axis in the name stands for the `<axis>` family (`wrench_peak_yaw`).
+    let axis = |n: &str| {
+        AXES.iter()
+            .find(|a| n.split('_').any(|w| w == **a))
+            .map(|a| {
+                n.split('_')
+                    .map(|w| if w == *a { "<axis>" } else { w })
+                    .collect::<Vec<_>>()
+                    .join("_")
+            })
+    };
     let exact = DICTIONARY
         .iter()
         .flat_map(|(_, cols)| cols.iter())
-        .any(|c| c.name == name || seg(name).is_some_and(|p| c.name == p));
+        .any(|c| {
+            c.name == name
+                || seg(name).is_some_and(|p| c.name == p)
+                || axis(name).is_some_and(|p| c.name == p)
+        });
     exact || lost || summary || pattern
 }
 
