@@ -101,8 +101,13 @@ pub struct GeneratorSpec {
     pub joint_limit: f64,
     /// Thruster placement rule.
     pub thruster_rule: ThrusterRule,
-    /// Symmetric thrust limit [N].
+    /// Symmetric thrust limit [N] of every thruster (the `fixed` propulsion rule).
     pub thrust_limit: f64,
+    /// Propulsion sizing rule: when > 0, every thruster's symmetric limit is this many
+    /// newtons per kilogram of the design's dry mass (links and joint modules), replacing
+    /// `thrust_limit`, so that designs of different length keep one thrust-to-mass ratio
+    /// [N/kg]. 0 (the default) = the fixed `thrust_limit`.
+    pub thrust_per_kg: f64,
     /// Lateral offset of the longitudinal thruster pair from the body axis [m].
     pub longitudinal_offset: f64,
     /// Axial drag coefficient of the tail and head links.
@@ -125,6 +130,7 @@ impl Default for GeneratorSpec {
             joint_limit: PI / 2.0,
             thruster_rule: ThrusterRule::Paper,
             thrust_limit: 40.0,
+            thrust_per_kg: 0.0,
             longitudinal_offset: 0.10,
             cd_axial_ends: 0.8,
             cd_axial: 0.1,
@@ -176,11 +182,16 @@ impl GeneratorSpec {
                 ));
             }
         }
-        if !self.thrust_limit.is_finite() || self.thrust_limit < 0.0 {
-            return Err(ModelError::new(
-                "generator.thrust_limit",
-                format!("must be finite and >= 0, got {}", self.thrust_limit),
-            ));
+        for (key, v) in [
+            ("thrust_limit", self.thrust_limit),
+            ("thrust_per_kg", self.thrust_per_kg),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(ModelError::new(
+                    format!("generator.{key}"),
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
         }
         let masses = if self.link_mass.is_empty() {
             lengths.iter().map(|l| rho * PI * r * r * l).collect()
@@ -227,7 +238,13 @@ impl GeneratorSpec {
                 self.joint_limit,
             ));
         }
-        let thrusters = self.rule_thrusters(&lengths);
+        let dry_mass: f64 = bodies.iter().map(|b| b.mass).sum();
+        let limit = if self.thrust_per_kg > 0.0 {
+            self.thrust_per_kg * dry_mass
+        } else {
+            self.thrust_limit
+        };
+        let thrusters = self.rule_thrusters(&lengths, limit);
         let last = lengths[n - 1];
         let v = Vehicle {
             name: name.to_string(),
@@ -242,9 +259,8 @@ impl GeneratorSpec {
         Ok(v)
     }
 
-    fn rule_thrusters(&self, lengths: &[f64]) -> Vec<Thruster> {
+    fn rule_thrusters(&self, lengths: &[f64], lim: f64) -> Vec<Thruster> {
         let n = lengths.len();
-        let lim = self.thrust_limit;
         let (ex, ey, ez) = (Vec3::x(), Vec3::y(), Vec3::z());
         let mid = n / 2;
         let inner_first = 1.min(n - 1);
@@ -354,5 +370,28 @@ mod tests {
         };
         assert_eq!(spec.build("g").unwrap_err().key, "generator.links");
         assert!("diagonal".parse::<ThrusterRule>().is_err());
+    }
+
+    #[test]
+    fn per_mass_propulsion_sizes_every_thruster_by_the_dry_mass() {
+        for links in [3, 9] {
+            let spec = GeneratorSpec {
+                links,
+                thrust_per_kg: 0.5,
+                ..Default::default()
+            };
+            let v = spec.build("g").unwrap();
+            let lim = 0.5 * v.total_mass();
+            for t in &v.thrusters {
+                assert_eq!((t.u_min, t.u_max), (-lim, lim));
+            }
+        }
+        let fixed = GeneratorSpec::default().build("g").unwrap();
+        assert!(fixed.thrusters.iter().all(|t| t.u_max == 40.0));
+        let bad = GeneratorSpec {
+            thrust_per_kg: -1.0,
+            ..Default::default()
+        };
+        assert_eq!(bad.build("g").unwrap_err().key, "generator.thrust_per_kg");
     }
 }

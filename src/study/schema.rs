@@ -278,7 +278,7 @@ impl Study {
 
 /// Keys of the design generator table (design-file schema); `design.<key>` is an alias of
 /// `design.generator.<key>` when the base design uses the generator.
-pub const GENERATOR_KEYS: [&str; 13] = [
+pub const GENERATOR_KEYS: [&str; 14] = [
     "links",
     "link_length",
     "link_mass",
@@ -288,6 +288,7 @@ pub const GENERATOR_KEYS: [&str; 13] = [
     "joint_limit_deg",
     "thruster_rule",
     "thrust_limit",
+    "thrust_per_kg",
     "longitudinal_offset",
     "cd_axial_ends",
     "cd_axial",

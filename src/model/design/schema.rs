@@ -102,6 +102,7 @@ pub(super) struct GeneratorFile {
     pub(super) joint_limit_deg: Option<f64>,
     pub(super) thruster_rule: Option<String>,
     pub(super) thrust_limit: Option<f64>,
+    pub(super) thrust_per_kg: Option<f64>,
     pub(super) longitudinal_offset: Option<f64>,
     pub(super) cd_axial_ends: Option<f64>,
     pub(super) cd_axial: Option<f64>,

@@ -34,6 +34,7 @@ fn arb_spec() -> impl Strategy<Value = GeneratorSpec> {
                 joint_limit: jl,
                 thruster_rule: ThrusterRule::ALL[rule],
                 thrust_limit: tl,
+                thrust_per_kg: 0.0,
                 longitudinal_offset: off,
                 cd_axial_ends: ce,
                 cd_axial: ca,
