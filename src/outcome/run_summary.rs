@@ -55,7 +55,7 @@ pub const COMMON_METRICS: [&str; 27] = [
 pub const SEGMENT_METRICS: [&str; 3] = ["convergence_time", "overshoot", "cross_track_rms"];
 
 /// Transport metrics over the whole run (after the per-segment ones).
-pub const TRANSPORT_METRICS: [&str; 11] = [
+pub const TRANSPORT_METRICS: [&str; 12] = [
     "segments_reached",
     "converged",
     "convergence_time",
@@ -67,6 +67,7 @@ pub const TRANSPORT_METRICS: [&str; 11] = [
     "energy_per_metre",
     "total_energy_per_metre",
     "cross_track_iae",
+    "mission_cost",
 ];
 
 /// Work-mode regulation metrics (then [`ROLL_METRICS`]).
@@ -168,7 +169,7 @@ pub fn run_summary(
     let mut out = Metrics::new();
     common_metrics(&mut out, file, run, traj, counts, energy);
     match file.scenario.mode {
-        Mode::Transport => transport_metrics(&mut out, &file.metrics, traj, energy),
+        Mode::Transport => transport_metrics(&mut out, file, traj, energy),
         Mode::Work => work_metrics(&mut out, &file.metrics, traj),
     }
     out
@@ -304,13 +305,16 @@ fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
 /// the end-effector covered along the path (`path_progress` [m], at the control rate) and
 /// the thruster shaft energy per metre of it (`energy_per_metre` [J/m]); `total_energy` per
 /// metre (`total_energy_per_metre` [J/m], thrusters and joint drives) and the integrated
-/// absolute cross-track error `cross_track_iae` [m·s] over the whole run.
+/// absolute cross-track error `cross_track_iae` [m·s] over the whole run; the mission's
+/// score `mission_cost = total_energy_per_metre + w · cross_track_iae` [J/m] (`w` =
+/// `[mission] tracking_weight`, J/m per m·s).
 fn transport_metrics(
     out: &mut Metrics,
-    spec: &MetricsSpec,
+    file: &ScenarioFile,
     traj: &Trajectory,
     energy: &EnergyMetrics,
 ) {
+    let spec = &file.metrics;
     let t = channel(traj, Channel::T);
     let ey = channel(traj, Channel::CrossTrack);
     let base_ct = channel(traj, Channel::BaseCrossTrack);
@@ -358,6 +362,8 @@ fn transport_metrics(
             f64::NAN
         }
     };
+    let total_per_metre = per_metre(total_energy(energy, spec), energy.path_progress);
+    let iae = integral_abs(t, ey);
     let values = [
         runs.len() as f64,
         if all_converged { 1.0 } else { 0.0 },
@@ -368,8 +374,9 @@ fn transport_metrics(
         ey.last().copied().unwrap_or(f64::NAN),
         energy.path_progress,
         energy.energy_per_metre(),
-        per_metre(total_energy(energy, spec), energy.path_progress),
-        integral_abs(t, ey),
+        total_per_metre,
+        iae,
+        total_per_metre + file.mission.tracking_weight * iae,
     ];
     add_all(out, &TRANSPORT_METRICS, values);
 }

@@ -141,6 +141,7 @@ const RUN_TRANSPORT: &[ColumnDoc] = &[
     c("path_progress", "m", "f64", "distance the end effector covered along the path"),
     c("energy_per_metre", "J/m", "f64", "thruster_energy / path_progress: the cruise cost that compares designs of different speeds"),
     c("total_energy_per_metre", "J/m", "f64", "total_energy / path_progress: thrusters and joint drives per metre of path"),
+    c("mission_cost", "J/m", "f64", "total_energy_per_metre + `[mission] tracking_weight` × cross_track_iae: the default objective of transport studies"),
     c("cross_track_iae", "m·s", "f64", "∫|cross-track error| dt over the whole run: the tracking term of a transport mission (arriving late on the path is not free)"),
 ];
 

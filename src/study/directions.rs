@@ -12,6 +12,10 @@ pub const BY_MAGNITUDE: [&str; 1] = ["final_cross_track"];
 /// covered, which compares designs of different speeds.
 pub const ENERGY_PER_METRE: &str = "energy_per_metre";
 
+/// Default objective of a transport study: the mission's score, thruster and joint energy per
+/// metre plus the price of being off the path (`mission_cost`, docs/model.md §6 "Missions").
+pub const TRANSPORT_OBJECTIVE: &str = "mission_cost";
+
 /// The 0/1 success metric of a closed-loop run (1 on every ranked case).
 pub const SUCCESS: &str = "success";
 
@@ -31,6 +35,7 @@ pub fn larger_is_better(metric: &str) -> bool {
             "segments_reached",
             "simulated_time",
             "path_progress",
+            "reach",
         ]
         .iter()
         .any(|b| {

@@ -9,7 +9,7 @@
 use std::collections::HashSet;
 
 pub use super::directions::{
-    larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, WORLD_SUFFIXES,
+    larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, TRANSPORT_OBJECTIVE, WORLD_SUFFIXES,
 };
 use super::manifest::Manifest;
 use super::records::{CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION};
@@ -63,7 +63,8 @@ impl Selection {
         }
         let energy = metrics
             .iter()
-            .find(|m| *m == ENERGY_PER_METRE)
+            .find(|m| *m == TRANSPORT_OBJECTIVE)
+            .or_else(|| metrics.iter().find(|m| *m == ENERGY_PER_METRE))
             .or_else(|| metrics.iter().find(|m| m.contains("energy")))
             .cloned();
         let magnitude: HashSet<String> = metrics
@@ -181,8 +182,10 @@ impl Selection {
             push(x);
             push(y);
         }
-        if let Some(m) = self.metrics.iter().find(|x| *x == ENERGY_PER_METRE) {
-            push(m);
+        for e in [TRANSPORT_OBJECTIVE, ENERGY_PER_METRE] {
+            if let Some(m) = self.metrics.iter().find(|x| *x == e) {
+                push(m);
+            }
         }
         for m in &self.metrics {
             if !m.starts_with("design_") && !m.starts_with("tcm_lost_") && m != SUCCESS {

@@ -69,7 +69,7 @@ fn default_metrics(study: &Study) -> Vec<String> {
     let mut v: Vec<String> = Vec::new();
     let energy = match study.mode {
         super::runner::StudyMode::Work => "thruster_energy",
-        _ => super::directions::ENERGY_PER_METRE,
+        _ => super::directions::TRANSPORT_OBJECTIVE,
     };
     v.push(
         study

@@ -208,7 +208,7 @@ fn score_variants(
         .uncertainty
         .as_ref()
         .map(|u| u.objective().to_string())
-        .unwrap_or_else(|| super::directions::ENERGY_PER_METRE.to_string());
+        .unwrap_or_else(|| super::directions::TRANSPORT_OBJECTIVE.to_string());
     let nominal = metrics.value(&objective);
     for v in &study.validate {
         let overrides = v.set.iter().map(|(n, t, x)| (n.as_str(), t, x));

@@ -9,6 +9,7 @@
 //! payload_volume = 0.002 # m³ displaced by the payload; omitted = neutrally buoyant (m/ρ)
 //! reach = 2.6            # m, |base origin → end effector| at the straight configuration (0 = none)
 //! deadline = 30.0        # s, transport: every reached segment converges this soon (0 = none)
+//! tracking_weight = 0.1  # J/m per m·s: mission_cost = total_energy_per_metre + w·cross_track_iae
 //! ```
 //!
 //! Every default leaves a run bit for bit as it was without the table.
@@ -34,6 +35,10 @@ pub struct MissionSpec {
     /// `seg<k>_convergence_time`) within this many seconds of becoming active; 0 = none.
     /// Stricter than `success.convergence_window` when smaller.
     pub deadline: f64,
+    /// Transport: the price of being off the path, in J/m per m·s of `cross_track_iae`: the
+    /// metric `mission_cost = total_energy_per_metre + tracking_weight · cross_track_iae`
+    /// [J/m], the default objective of transport studies. 0 (the default) = energy alone.
+    pub tracking_weight: f64,
 }
 
 impl MissionSpec {
@@ -43,6 +48,7 @@ impl MissionSpec {
             ("payload_mass", self.payload_mass),
             ("reach", self.reach),
             ("deadline", self.deadline),
+            ("tracking_weight", self.tracking_weight),
             ("payload_volume", self.payload_volume.unwrap_or(0.0)),
         ] {
             if !v.is_finite() || v < 0.0 {
@@ -61,6 +67,7 @@ impl MissionSpec {
             || self.payload_volume.is_some_and(|v| v > 0.0)
             || self.reach > 0.0
             || self.deadline > 0.0
+            || self.tracking_weight > 0.0
     }
 }
 
