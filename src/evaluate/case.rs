@@ -209,6 +209,21 @@ impl Evaluator {
     }
 }
 
+/// Whether the design of `design` cannot meet the `[mission] reach` of the scenario-side table
+/// `scenario` whatever its gains (docs/model.md §6 "Missions"): its straight reach is shorter.
+/// `false` when there is no such requirement or the design does not build (the evaluation
+/// reports that). A tuner skips such a case: tuning cannot change a design's reach.
+pub fn out_of_reach(design: &toml::Table, scenario: &toml::Table, label: &str) -> bool {
+    let required = scenario
+        .get("mission")
+        .and_then(|m| m.get("reach"))
+        .and_then(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+        .unwrap_or(0.0);
+    required > 0.0
+        && parse_design_table(design, label)
+            .is_ok_and(|v| crate::kinematics::straight_reach(&v) < required)
+}
+
 /// The cache key: the design hash, and the design overrides when there are any.
 fn cache_key(input: &CaseInput<'_>) -> String {
     let mut key = input.design_hash.to_string();

@@ -20,7 +20,8 @@ pub mod static_table;
 pub mod status;
 
 pub use case::{
-    CaseInput, CaseResult, Evaluator, Override, OverrideError, Overrides, Phases, Side,
+    out_of_reach, CaseInput, CaseResult, Evaluator, Override, OverrideError, Overrides, Phases,
+    Side,
 };
 pub use deadline::{Deadline, Phase, TimedOut, TIMEOUT};
 pub use metrics::{Metrics, DESIGN_COLUMNS, TCM_COLUMNS};

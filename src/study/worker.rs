@@ -16,7 +16,7 @@ use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
-use crate::evaluate::{CaseResult, CaseStatus, Deadline, Evaluator, Phases};
+use crate::evaluate::{out_of_reach, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
 use crate::report::Table;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
@@ -110,8 +110,15 @@ impl Worker {
         let deadline = Deadline::after(self.budget);
         let row =
             |res: CaseResult| Row::from_result(case.id, r.hash.clone(), case.values.clone(), res);
-        let Some(t) = tuner else {
+        // A design that cannot reach the mission is not tuned nor put in worlds: no gain
+        // changes its reach; one untuned evaluation records its static columns and the miss.
+        let unreachable = out_of_reach(&r.design, &r.scenario, &study.name);
+        let Some(t) = tuner.filter(|_| !unreachable) else {
             let mut res = evaluate_resolved(&mut self.evaluator, study, case.id, r, log, deadline);
+            if unreachable {
+                let traj = res.trajectory.take();
+                return (row(res), traj);
+            }
             self.robust(study, case.id, r, deadline, &mut res);
             let traj = res.trajectory.take();
             return (row(res), traj);
