@@ -202,6 +202,15 @@ fn simulate_draws_the_body_along_the_run_deterministically() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!out("c").join("shapes.svg").exists());
+    // `report` reviews studies: on a single run's folder it says so and exits 2.
+    let o = run(&["report", arg(&out("c"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("is not a study output"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out("c").join("report.html").exists());
 }
 
 /// The width, height and RGBA pixels of an 8-bit RGB or RGBA, non-interlaced PNG (what

@@ -77,3 +77,37 @@ fn every_catalogued_metric_and_every_written_column_is_described() {
         }
     }
 }
+
+/// Every Markdown table of the committed summaries has as many cells in each row as in its
+/// header: a `|` inside a cell (a goal written `min |x|`, a reason) would split it.
+#[test]
+fn committed_summary_tables_are_well_formed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    let mut checked = 0;
+    for dir in std::fs::read_dir(&root).unwrap() {
+        let path = dir.unwrap().path().join("summary.md");
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let cells = |l: &str| l.replace("\\|", "").matches('|').count();
+        let mut header: Option<usize> = None;
+        for (i, line) in text.lines().enumerate() {
+            if !line.starts_with('|') {
+                header = None;
+                continue;
+            }
+            match header {
+                None => header = Some(cells(line)),
+                Some(n) => assert_eq!(
+                    cells(line),
+                    n,
+                    "{}:{}: a row with another cell count than its header: {line}",
+                    path.display(),
+                    i + 1
+                ),
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 20, "no tables found under results/");
+}

@@ -402,13 +402,20 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
     )
     .map_err(study_err)?;
     outdir::check_contained(dir).map_err(study_err)?;
-    if !dir.join("manifest.json").is_file() && !dir.join("summary.json").is_file() {
-        bail!(
-            "{} is not a finished usm-study output (no manifest.json or summary.json); an \
-             interrupted sweep is finished with `sweep STUDY --out {} --resume`",
-            a.dir.display(),
-            a.dir.display()
-        );
+    if !dir.join("manifest.json").is_file() {
+        let hint = if dir.join("summary.json").is_file() {
+            "it holds a single run's summary.json (a `simulate`, `tcm` or `paper` folder: its \
+             figures are already written there); `report` reviews the output of `sweep` or \
+             `optimise`"
+                .to_string()
+        } else {
+            format!(
+                "no manifest.json; an interrupted sweep is finished with `sweep STUDY --out {} \
+                 --resume`",
+                a.dir.display()
+            )
+        };
+        bail!("{} is not a study output: {hint}", a.dir.display());
     }
     if dir.join(CASES_PARQUET).is_file() || dir.join(PARTIAL_FILE).is_file() {
         let warnings = report(dir).map_err(study_err)?;

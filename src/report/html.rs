@@ -40,6 +40,16 @@ fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String
                 continue;
             }
         }
+        if let Some((label, url, len)) = md_link(rest) {
+            let _ = write!(
+                out,
+                "<a href=\"{}\">{}</a>",
+                escape(url),
+                inline(label, None).0
+            );
+            rest = &rest[len..];
+            continue;
+        }
         if rest.starts_with("**") {
             out.push_str(if bold { "</strong>" } else { "<strong>" });
             bold = !bold;
@@ -71,6 +81,38 @@ fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String
         out.push_str("</strong>");
     }
     (out, bad)
+}
+
+/// A Markdown link `[label](url)` at the start of `text`: (label, url, its length in bytes).
+fn md_link(text: &str) -> Option<(&str, &str, usize)> {
+    let rest = text.strip_prefix('[')?;
+    let close = rest.find("](")?;
+    let label = &rest[..close];
+    if label.contains('[') || label.contains('\n') {
+        return None;
+    }
+    let after = &rest[close + 2..];
+    let end = after.find(')')?;
+    let url = &after[..end];
+    (!url.is_empty() && !url.contains(char::is_whitespace)).then_some((
+        label,
+        url,
+        1 + close + 2 + end + 1,
+    ))
+}
+
+/// The anchor a heading gets (GitHub's rule, as Markdown viewers link `#…` to it): lower
+/// case, spaces as `-`, only letters, digits, `-` and `_` kept.
+pub fn heading_anchor(text: &str) -> String {
+    text.trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
 }
 
 /// The cells of a Markdown table row `| a | b |` (escaped pipes `\|` kept inside cells).
@@ -127,8 +169,10 @@ pub fn markdown_to_html(md: &str, shift: usize, link: &dyn Fn(i64) -> Option<Cas
         } else if l.starts_with('#') {
             let level = l.chars().take_while(|c| *c == '#').count();
             let h = (level + shift).min(6);
-            let text = inline(l[level..].trim(), None).0;
-            let _ = writeln!(out, "<h{h}>{text}</h{h}>");
+            let raw = l[level..].trim();
+            let text = inline(raw, None).0;
+            let id = heading_anchor(&raw.replace('`', ""));
+            let _ = writeln!(out, "<h{h} id=\"{}\">{text}</h{h}>", escape(&id));
             i += 1;
         } else if l.trim_start().starts_with('|') {
             let start = i;
@@ -219,6 +263,23 @@ pub fn inline_svg(svg: &str, prefix: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn links_become_anchors_and_headings_get_their_ids() {
+        let h = super::markdown_to_html(
+            "## Cases left out\n\nsee [the cases left out](#cases-left-out), `a|b`.\n",
+            0,
+            &|_| None,
+        );
+        assert!(h.contains("<h2 id=\"cases-left-out\">"), "{h}");
+        assert!(
+            h.contains("<a href=\"#cases-left-out\">the cases left out</a>"),
+            "{h}"
+        );
+        // Not a link: brackets without a target stay text.
+        let h = super::markdown_to_html("a [b] (c)\n", 0, &|_| None);
+        assert!(h.contains("a [b] (c)"), "{h}");
+    }
+
     use super::*;
 
     fn link(id: i64) -> Option<CaseLink> {
@@ -234,12 +295,15 @@ mod tests {
         let md = "# Sweep `t`\n\nMode **ok**, a < b.\n\n## Best\n\n| metric | case |\n|---|---|\n\
                   | `e` | #2 |\n| `f` | #3 |\n| `g` | #42 |\n\n- one\n- two\n";
         let h = markdown_to_html(md, 1, &link);
-        assert!(h.contains("<h2>Sweep <code>t</code></h2>"), "{h}");
+        assert!(
+            h.contains("<h2 id=\"sweep-t\">Sweep <code>t</code></h2>"),
+            "{h}"
+        );
         assert!(
             h.contains("<p>Mode <strong>ok</strong>, a &lt; b.</p>"),
             "{h}"
         );
-        assert!(h.contains("<h3>Best</h3>"));
+        assert!(h.contains("<h3 id=\"best\">Best</h3>"));
         assert!(h.contains(
             "<tr><td><code>e</code></td><td><a href=\"#case-2\">#2 <span class=\"r-name\">paper / 5</span></a></td></tr>"
         ), "{h}");

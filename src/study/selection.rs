@@ -110,12 +110,13 @@ impl Selection {
         }
     }
 
-    /// The goal of `metric` as written in the report: `max`, `min` or `min |x|`.
+    /// The goal of `metric` as written in the report: `max`, `min` or `min abs` (no `|`: the
+    /// goal sits in Markdown table cells).
     pub(crate) fn goal(&self, metric: &str) -> &'static str {
         if self.maximise.contains(metric) {
             "max"
         } else if self.magnitude.contains(metric) {
-            "min |x|"
+            "min abs"
         } else {
             "min"
         }

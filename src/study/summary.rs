@@ -195,7 +195,7 @@ fn header_section(c: &Ctx, m: &Manifest, verdict: Option<String>) -> String {
             "Objective (best/worst case): `{o}` ({}).\n",
             match c.sel.goal(o) {
                 "max" => "larger is better",
-                "min |x|" => "smaller magnitude is better",
+                "min abs" => "smaller magnitude is better",
                 _ => "smaller is better",
             }
         );
@@ -275,7 +275,7 @@ fn best_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "## Best case by each metric\n");
     let _ = writeln!(
         md,
-        "Among the {} successful cases ({}); signed metrics by magnitude (`min |x|`).\n",
+        "Among the {} successful cases ({}); signed metrics by magnitude (`min abs`).\n",
         c.ok_rows.len(),
         left_out_text(c)
     );
