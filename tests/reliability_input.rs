@@ -507,3 +507,34 @@ fn a_valid_study_still_runs() {
     let o = sweep(&p, &d.path().join("o"), &["--jobs", "2"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+/// A misspelt axis name or scenario key gets the closest valid name, not the whole catalogue.
+#[test]
+fn misspelt_axis_names_and_keys_get_a_did_you_mean() {
+    let d = tempfile::tempdir().unwrap();
+    let t = QUICK.replace("name = \"design.links\"", "name = \"design.linsk\"");
+    sweep_refuses(
+        d.path(),
+        "axis.toml",
+        &t,
+        11,
+        &["axis[0].name: unknown parameter `design.linsk`; did you mean `design.links`?"],
+    );
+    let o = run(&["sweep", arg(&write(d.path(), "a2.toml", &t)), "--dry-run"]);
+    assert!(stderr(&o).len() < 300, "no catalogue dump: {}", stderr(&o));
+    let o = run(&[
+        "simulate",
+        "transport-method1",
+        "--set",
+        "control.k_pis=0.3",
+        "--out",
+        arg(&d.path().join("s")),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("control.k_pis: unknown field `k_pis`")
+            && stderr(&o).contains("did you mean `k_psi`?"),
+        "{}",
+        stderr(&o)
+    );
+}

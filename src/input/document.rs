@@ -5,7 +5,7 @@
 //! path of a later semantic check back to its line, so design, scenario and study files
 //! report errors the same way.
 
-use super::keypath::{join_key, parent_path};
+use super::keypath::{did_you_mean, join_key, parent_path};
 use super::located::{line_col, one_line, InputError, KeyError, Located, Location};
 use serde::de::DeserializeOwned;
 use std::ops::Range;
@@ -238,7 +238,7 @@ impl Document {
             .and_then(|o| self.path_at(o))
             .unwrap_or_default()
             .to_string();
-        self.at_offset(offset, key, one_line(e.message()))
+        self.at_offset(offset, key, suggest(one_line(e.message())))
     }
 
     /// Deserialise the document's text into `T`; an error names its key path (and line).
@@ -282,6 +282,26 @@ pub fn read_text(path: &std::path::Path) -> Result<String, std::io::Error> {
 
 /// Deserialise an in-memory table into `T`. On failure the table is printed and parsed
 /// again so that the error names its key path (keys under `prefix`, e.g. `control`);
+/// A serde message naming an unknown field or variant among the expected ones
+/// (`` unknown field `k_pis`, expected one of `method`, `k_psi`, … ``) with a "did you mean"
+/// for the closest expected name appended; any other message unchanged.
+pub fn suggest(message: String) -> String {
+    let unknown = ["unknown field `", "unknown variant `"]
+        .iter()
+        .find_map(|p| message.split_once(p).map(|x| x.1));
+    let Some(rest) = unknown else {
+        return message;
+    };
+    let Some((name, expected)) = rest.split_once('`') else {
+        return message;
+    };
+    let candidates: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    let hint = did_you_mean(name, candidates);
+    if hint.is_empty() {
+        return message;
+    }
+    format!("{message}{hint}")
+}
 /// the success path is a plain `T::deserialize` of the table.
 pub fn deserialize_table<T: DeserializeOwned>(
     table: &toml::Table,
@@ -291,7 +311,7 @@ pub fn deserialize_table<T: DeserializeOwned>(
         Ok(t) => return Ok(t),
         Err(e) => e,
     };
-    let fallback = || KeyError::new(prefix, one_line(err.message()));
+    let fallback = || KeyError::new(prefix, suggest(one_line(err.message())));
     let Ok(text) = toml::to_string(table) else {
         return Err(fallback());
     };
@@ -306,6 +326,21 @@ pub fn deserialize_table<T: DeserializeOwned>(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn an_unknown_field_gets_the_closest_expected_name() {
+        let m = "unknown field `k_pis`, expected one of `method`, `u0`, `k_psi`, `k_6p`";
+        assert_eq!(
+            suggest(m.to_string()),
+            format!("{m}; did you mean `k_psi`?")
+        );
+        let m = "unknown variant `qpp`, expected one of `pinv`, `qp`, `minimax`";
+        assert!(suggest(m.to_string()).ends_with("did you mean `qp`?"));
+        // Nothing close, or another message: unchanged.
+        let m = "unknown field `zzzzzz`, expected `a` or `b`";
+        assert_eq!(suggest(m.to_string()), m);
+        assert_eq!(suggest("invalid type".into()), "invalid type");
+    }
+
     use super::*;
 
     const TEXT: &str = "a = 1\n[b]\nc = [1.0, 2.0]\n\n[[d]]\ne = \"x\"\n[[d]]\ne = nan\n";

@@ -12,7 +12,7 @@ use super::schema::{
 };
 use crate::input::document::Document;
 use crate::input::keypath::{
-    display_pattern, flatten, pattern_allowed, KeyPath, KeyPathError, Seg,
+    did_you_mean, display_pattern, flatten, pattern_allowed, KeyPath, KeyPathError, Seg,
 };
 use crate::sampling::{Sampling, MAX_SOBOL_DIMS};
 
@@ -69,7 +69,8 @@ pub(crate) struct Names {
 }
 
 impl Names {
-    fn list(&self) -> String {
+    /// Every name an axis may take (generator aliases marked `(alias)`).
+    fn all(&self) -> Vec<String> {
         let mut v: Vec<String> = self
             .design
             .iter()
@@ -79,7 +80,37 @@ impl Names {
             v.extend(GENERATOR_KEYS.iter().map(|k| format!("design.{k} (alias)")));
         }
         v.extend(self.scenario.iter().map(|p| display_pattern(p)));
-        v.join(", ")
+        v
+    }
+
+    /// What to tell a user who wrote the unknown axis `name`: the closest valid name when one
+    /// is close; else the valid names of its table (`design.…`, `control.…`), or the tables.
+    fn hint(&self, name: &str) -> String {
+        let all = self.all();
+        let bare: Vec<&str> = all.iter().map(|n| n.trim_end_matches(" (alias)")).collect();
+        let close = did_you_mean(name, bare.iter().copied());
+        if !close.is_empty() {
+            return close;
+        }
+        let table = name.split(['.', '[']).next().unwrap_or("");
+        let same: Vec<&str> = bare
+            .iter()
+            .copied()
+            .filter(|n| n.split(['.', '[']).next() == Some(table))
+            .collect();
+        if same.is_empty() {
+            let mut tables: Vec<&str> = bare
+                .iter()
+                .filter_map(|n| n.split(['.', '[']).next())
+                .collect();
+            tables.dedup();
+            format!(
+                "; no table `{table}`: axes name keys of {}",
+                tables.join(", ")
+            )
+        } else {
+            format!("; valid names under `{table}`: {}", same.join(", "))
+        }
     }
 }
 
@@ -237,11 +268,7 @@ fn validate_axis(
     let unknown = || {
         doc.err(
             &format!("axis[{i}].name"),
-            format!(
-                "unknown parameter `{}`; valid names: {}",
-                a.name,
-                names.list()
-            ),
+            format!("unknown parameter `{}`{}", a.name, names.hint(&a.name)),
         )
     };
     let (target, reference) = axis_target(a, i, names, design, doc)?.ok_or_else(unknown)?;
