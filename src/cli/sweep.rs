@@ -346,8 +346,14 @@ fn print_verdict(dir: &Path) {
     let Ok(md) = std::fs::read_to_string(dir.join("summary.md")) else {
         return;
     };
+    let plain = |s: &str| s.replace("**", "").replace('`', "");
     if let Some(v) = usm_study::study::summary_robust::summary_verdict(&md) {
-        eprintln!("[sweep] {}", v.replace("**", "").replace('`', ""));
+        eprintln!("[sweep] {}", plain(v));
+    }
+    // The leader's caveats, as the box lists them.
+    let opening = usm_study::study::summary_robust::summary_opening(&md).unwrap_or("");
+    for c in opening.lines().filter(|l| l.starts_with("- ")) {
+        eprintln!("[sweep]   caveat: {}", plain(&c[2..]));
     }
     eprintln!(
         "[sweep] review: {}",

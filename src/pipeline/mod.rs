@@ -21,6 +21,7 @@ pub mod error;
 pub mod inspect;
 pub mod optimise;
 pub mod review;
+mod review_top;
 pub mod shapes;
 pub mod simulate;
 pub mod tcm;

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 use super::draw::draw_design;
 use super::error::PipelineError;
+use super::review_top::{pareto_html, verdict_html, Drawing, TOP_STYLE};
 use crate::model::design::parse_design_table;
 use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
 use crate::report::{atomic_write, read_csv, read_parquet, Table};
@@ -27,7 +28,7 @@ use crate::study::doe::expand;
 use crate::study::parse::load_study;
 use crate::study::plots::{case_name, unsuccessful_rows};
 use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
-use crate::study::summary_robust::summary_verdict;
+use crate::study::summary_robust::summary_opening;
 
 /// The file name of the page.
 pub const REPORT_HTML: &str = "report.html";
@@ -133,12 +134,6 @@ fn remove_dead_temporaries(dir: &Path) {
             let _ = std::fs::remove_file(e.path());
         }
     }
-}
-
-/// One drawn design: the cases that share it and its SVG.
-struct Drawing {
-    cases: Vec<i64>,
-    svg: String,
 }
 
 /// Rebuilds and draws the designs of `ids` (cases sharing a design drawn once), from the
@@ -355,33 +350,31 @@ impl Page<'_> {
             h,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
              <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-             <title>Design review: {t}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n\
+             <title>Design review: {t}</title>\n<style>{STYLE}{TOP_STYLE}</style>\n</head>\n<body>\n\
              <h1>Design review: <code>{t}</code></h1>",
             t = escape(&title)
         );
         self.verdict_section(&mut h);
+        if let Some(p) = pareto_html(figures) {
+            h.push_str(&p);
+        }
+        self.success_section(&mut h);
+        self.tables_section(&mut h);
+        self.designs_section(&mut h);
+        plots_section(&mut h, figures, warnings);
         self.study_section(&mut h);
         self.ledger_section(&mut h);
-        self.success_section(&mut h);
-        self.designs_section(&mut h);
-        self.tables_section(&mut h);
-        plots_section(&mut h, figures, warnings);
         self.manifest_section(&mut h);
         h.push_str("</body>\n</html>\n");
         h
     }
 
-    /// The answer first: the verdict line `summary.md` opens with over uncertain worlds
-    /// ("Winner: …" or "Statistically tied: …"), when it has one.
+    /// The answer first: the verdict box of `summary.md` (verdict line, caveats, top three
+    /// side by side with their drawings), when the study has one.
     fn verdict_section(&self, h: &mut String) {
-        let Some(line) = self.summary.and_then(summary_verdict) else {
-            return;
-        };
-        let _ = writeln!(
-            h,
-            "<section id=\"verdict\">\n<h2>Verdict</h2>\n{}</section>",
-            markdown_to_html(line, 0, &|id| self.link(id))
-        );
+        if let Some(block) = self.summary.and_then(summary_opening) {
+            h.push_str(&verdict_html(block, self.drawings, &|id| self.link(id)));
+        }
     }
 
     /// The assumption ledger of the manifest (studies with uncertain worlds): every
@@ -566,7 +559,14 @@ impl Page<'_> {
     fn tables_section(&self, h: &mut String) {
         h.push_str("<section id=\"tables\">\n");
         match self.summary {
-            Some(md) => h.push_str(&markdown_to_html(md, 1, &|id| self.link(id))),
+            Some(md) => {
+                // The verdict box is at the top of the page already.
+                let rest = match summary_opening(md) {
+                    Some(block) => md.replacen(block, "", 1),
+                    None => md.to_string(),
+                };
+                h.push_str(&markdown_to_html(&rest, 1, &|id| self.link(id)));
+            }
             None => h.push_str(
                 "<h2>Tables</h2>\n<p class=\"r-note\">No summary.md in this directory.</p>\n",
             ),

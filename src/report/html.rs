@@ -164,7 +164,7 @@ pub fn markdown_to_html(md: &str, shift: usize, link: &dyn Fn(i64) -> Option<Cas
     let mut i = 0;
     while i < lines.len() {
         let l = lines[i].trim_end();
-        if l.trim().is_empty() {
+        if l.trim().is_empty() || l.starts_with("<!--") {
             i += 1;
         } else if l.starts_with('#') {
             let level = l.chars().take_while(|c| *c == '#').count();

@@ -60,6 +60,7 @@ pub mod summary;
 pub mod summary_robust;
 pub mod tune;
 pub mod uncertainty;
+pub mod verdict_box;
 pub mod worker;
 pub mod worlds;
 

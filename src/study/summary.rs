@@ -72,7 +72,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         key,
     };
     let robust = Robust::load(dir, table, m);
-    let mut md = header_section(&c, m, robust.as_ref().map(Robust::verdict_line));
+    let mut md = header_section(&c, m, robust.as_ref().map(Robust::opening));
     if let Some(r) = &robust {
         md.push_str(&r.sections(dir, &plots, &mut warnings));
     }

@@ -15,6 +15,7 @@ use super::records::CASE_ID;
 use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
 use super::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
 use super::selection::cell_text;
+use super::verdict_box::{verdict_box, BoxInput};
 use super::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
 use crate::report::plot::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
 use crate::report::{fmt_short, read_csv, MarkdownTable, Table};
@@ -34,6 +35,21 @@ pub fn summary_verdict(md: &str) -> Option<&str> {
         .iter()
         .any(|p| first.starts_with(p))
         .then_some(first)
+}
+
+/// The line that ends the verdict and its box in `summary.md` (an HTML comment: Markdown
+/// viewers hide it; the review page takes the block above it as its verdict box).
+pub const VERDICT_END: &str = "<!-- end of the verdict -->";
+
+/// The verdict line and its box ([`Robust::opening`]) of a `summary.md` text, without the
+/// end marker; `None` for a study without uncertain worlds.
+pub fn summary_opening(md: &str) -> Option<&str> {
+    let first = summary_verdict(md)?;
+    let start = md.find(first)?;
+    let end = md[start..]
+        .find(VERDICT_END)
+        .map_or(start + first.len(), |e| start + e);
+    Some(md[start..end].trim_end())
 }
 
 /// Most designs listed in the ranking table and drawn in the rank-interval plot.
@@ -171,6 +187,21 @@ impl<'a> Robust<'a> {
                 self.info.min_success_probability
             ),
         }
+    }
+
+    /// The verdict line and the box under it ([`super::verdict_box`]): the leader's caveats
+    /// and the top designs side by side.
+    pub fn opening(&self) -> String {
+        let ranked = self.ranked_rows();
+        let label = |r: usize| self.label(r);
+        let inp = BoxInput {
+            table: self.table,
+            ranked: &ranked,
+            objective: self.info.objective(),
+            label: &label,
+        };
+        let (line, boxed) = (self.verdict_line(), verdict_box(&inp));
+        format!("{line}\n\n{boxed}{VERDICT_END}")
     }
 
     /// The ranking, tuning-adequacy, sensitivity and validation sections; plots into
