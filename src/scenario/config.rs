@@ -32,10 +32,10 @@
 //! [physics]                   # which effects, current, integrator (rk4 | dopri5), rtol, atol
 //! [metrics]                   # thresholds, power model
 //! [success]                   # what counts as a successful run (scenario::success)
+//! [fault]                     # optional: one thruster fault (scenario::fault)
 //! ```
 //!
-//! A `[design]` table (the design-file schema) may replace `scenario.design`; the sweep engine
-//! uses it to pass a modified design.
+//! A `[design]` table (design-file schema) may replace `scenario.design` (the sweep's route).
 
 mod physics;
 
@@ -356,6 +356,9 @@ pub struct ScenarioFile {
     /// Success criteria (docs/model.md §6).
     #[serde(default)]
     pub success: SuccessSpec,
+    /// One thruster fault during the run (`scenario::fault`); none by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault: Option<super::fault::FaultSpec>,
 }
 
 /// Mode-specific gains, parsed from `[control]`.
@@ -648,7 +651,6 @@ impl ScenarioFile {
 /// Most physics steps of `scenario.dt` in one control period.
 pub const MAX_SUBSTEPS: f64 = 1.0e5;
 
-/// `key` must be a finite number > 0.
 /// Longest scenario name (it names `out/<name>` and appears in file names).
 const MAX_NAME_CHARS: usize = 100;
 
