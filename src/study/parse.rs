@@ -13,6 +13,7 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 pub use super::catalogue::{known_metric, metric_catalogue, unknown_metric};
 use super::error::InputError;
+use super::fault_spec::parse_faults;
 use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
@@ -49,6 +50,7 @@ struct StudyFile {
     hydro: Option<toml::Table>,
     uncertainty: Option<toml::Table>,
     validate: Option<Vec<toml::Table>>,
+    faults: Option<toml::Table>,
 }
 
 #[derive(Deserialize)]
@@ -210,12 +212,17 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         tune: file.tune.clone(),
         uncertainty: None,
         validate: Vec::new(),
+        faults: None,
         robust_table: toml::Table::new(),
     };
     check_report(&study, doc)?;
     let mut study = study;
     study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
     study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
+    study.faults = parse_faults(file.faults.as_ref(), study.mode.is_dynamic(), doc)?;
+    if let Some(f) = &file.faults {
+        (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
+    }
     if let Some(u) = &file.uncertainty {
         study
             .robust_table
