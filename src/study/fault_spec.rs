@@ -29,6 +29,9 @@ pub struct FaultStudy {
     pub informed: bool,
 }
 
+/// The keys of a scenario `[fault]` table, which studies may set (`fault.<key>`).
+pub const FAULT_KEYS: [&str; 5] = ["thruster", "at", "kind", "value", "informed"];
+
 fn yes() -> bool {
     true
 }

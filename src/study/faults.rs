@@ -227,3 +227,42 @@ pub fn fault_table(
         t.finish()
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(ok: bool, objective: f64) -> FaultRun {
+        FaultRun {
+            ok,
+            objective,
+            missed: f64::NAN,
+            timeout: false,
+        }
+    }
+
+    #[test]
+    fn the_worst_fault_is_a_failure_first_then_the_largest_worsening() {
+        let e = "energy_per_metre";
+        let runs = [run(true, 12.0), run(false, 10.5), run(true, 15.0)];
+        assert_eq!(worst_fault(e, 10.0, &runs), 1.0);
+        let runs = [run(true, 12.0), run(true, 15.0), run(true, 15.0)];
+        assert_eq!(worst_fault(e, 10.0, &runs), 1.0, "ties: the lowest index");
+        let runs = [run(true, 12.0), run(true, f64::NAN)];
+        assert_eq!(
+            worst_fault(e, 10.0, &runs),
+            1.0,
+            "a NaN objective is the worst"
+        );
+        let runs = [run(false, 20.0), run(false, 30.0)];
+        assert_eq!(
+            worst_fault(e, 10.0, &runs),
+            1.0,
+            "among failures, the worsening"
+        );
+        // A metric where larger is better: the largest drop.
+        let runs = [run(true, 0.9), run(true, 0.5)];
+        assert_eq!(worst_fault(SUCCESS, 1.0, &runs), 1.0);
+        assert!(worst_fault(e, 10.0, &[]).is_nan());
+    }
+}

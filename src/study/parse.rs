@@ -13,7 +13,7 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 pub use super::catalogue::{known_metric, metric_catalogue, unknown_metric};
 use super::error::InputError;
-use super::fault_spec::parse_faults;
+use super::fault_spec::{parse_faults, FAULT_KEYS};
 use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
@@ -51,6 +51,7 @@ struct StudyFile {
     uncertainty: Option<toml::Table>,
     validate: Option<Vec<toml::Table>>,
     faults: Option<toml::Table>,
+    fault: Option<toml::Table>,
 }
 
 #[derive(Deserialize)]
@@ -380,6 +381,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("thrusters", &file.thrusters),
         ("hydro", &file.hydro),
         ("success", &file.success),
+        ("fault", &file.fault),
     ] {
         if let Some(t) = t {
             own.insert(k.into(), toml::Value::Table(t.clone()));
@@ -400,6 +402,12 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     if mode == StudyMode::Work {
         sc_names.insert("reference".into());
         sc_arrays.insert("reference".into());
+    }
+    // `[fault]` (one thruster fault, `crate::scenario::fault`) has no default either; its keys
+    // may be set by the study, its axes and variants (checked when a case's tables are).
+    if mode.is_dynamic() {
+        sc_names.insert("fault".into());
+        sc_names.extend(FAULT_KEYS.iter().map(|k| format!("fault.{k}")));
     }
     // Reject unknown keys of the study's own scenario-side tables.
     let (mut own_names, mut own_arrays) = (BTreeSet::new(), BTreeSet::new());

@@ -53,7 +53,7 @@ impl From<SettingsError> for String {
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
 /// `[static]`); must cover the top-level keys of [`default_table`].
-pub const SCENARIO_TABLES: [&str; 14] = [
+pub const SCENARIO_TABLES: [&str; 15] = [
     "scenario",
     "hydro",
     "control",
@@ -68,6 +68,7 @@ pub const SCENARIO_TABLES: [&str; 14] = [
     "servo",
     "thrusters",
     "success",
+    "fault",
 ];
 
 /// The mode of a study (`scenario.mode`; written as lower-case text in study files and
