@@ -198,8 +198,10 @@ pub fn fault_table(
             let ok = col(j, SUCCESS).map_or(f64::NAN, |c| c[r]);
             let change = col(j, "change").map_or(f64::NAN, |c| c[r]);
             let missed = col(j, "missed").map_or(f64::NAN, |c| c[r]);
+            // Changes that round to zero print as +0.0 % (not −0.0 %).
+            let p = 100.0 * change;
             let pct = if change.is_finite() {
-                format!(" {:+.1} %", 100.0 * change)
+                format!(" {:+.1} %", if p.abs() < 0.05 { 0.0 } else { p })
             } else {
                 String::new()
             };
