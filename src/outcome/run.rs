@@ -12,6 +12,10 @@ use crate::scenario::{
     parse_table, run_loop, AllocationCounts, ScenarioError, Source, Stop, Timing, TIMEOUT,
 };
 
+/// The metric a run with a `[fault]` adds before `success`: the simulation time the fault
+/// struck [s] (NaN when the run ended before `fault.at`).
+pub const FAULT_TIME_METRIC: &str = "fault_time";
+
 /// The outcome of one run: the trajectory up to the end (or the failure), the metrics, and
 /// the failure if the run stopped early.
 #[derive(Clone, Debug)]
@@ -72,6 +76,9 @@ pub fn run_scenario_until(
         &run.allocation_counts,
         &run.energy,
     );
+    if let Some(t) = run.fault_time {
+        metrics.push((FAULT_TIME_METRIC.to_string(), t));
+    }
     let missed = add_success(&mut metrics, file);
     Ok(RunResult {
         name: file.scenario.name.clone(),

@@ -139,7 +139,8 @@ pub enum Channel {
     /// Joint work `∫ Σ_k |τ_k q̇_k| dt` since t = 0 [J], integrated by the simulator with the
     /// motion (the joint-energy metric, docs/model.md §6).
     JointWork,
-    /// Commanded (allocated) thrust of thruster j [N].
+    /// Commanded (allocated) thrust of thruster j [N]; after a `[fault]` struck, the faulted
+    /// thruster's command (`scenario::fault`).
     UCmd(usize),
     /// Actual thrust of thruster j, clamped to its limits [N].
     U(usize),

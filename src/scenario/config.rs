@@ -33,10 +33,10 @@
 //! [metrics]                   # thresholds, power model
 //! [success]                   # what counts as a successful run (scenario::success)
 //! [mission]                   # payload, reach, convergence deadline (config::MissionSpec)
+//! [fault]                     # optional: one thruster fault (scenario::fault)
 //! ```
 //!
-//! A `[design]` table (the design-file schema) may replace `scenario.design`; the sweep engine
-//! uses it to pass a modified design.
+//! A `[design]` table (design-file schema) may replace `scenario.design` (the sweep's route).
 
 mod metrics;
 mod mission;
@@ -313,6 +313,9 @@ pub struct ScenarioFile {
     /// Mission requirements: payload, reach, deadline (docs/model.md §6 "Missions").
     #[serde(default)]
     pub mission: MissionSpec,
+    /// One thruster fault during the run (`scenario::fault`); none by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault: Option<super::fault::FaultSpec>,
 }
 
 /// Mode-specific gains, parsed from `[control]`.
@@ -607,7 +610,6 @@ impl ScenarioFile {
 /// Most physics steps of `scenario.dt` in one control period.
 pub const MAX_SUBSTEPS: f64 = 1.0e5;
 
-/// `key` must be a finite number > 0.
 /// Longest scenario name (it names `out/<name>` and appears in file names).
 const MAX_NAME_CHARS: usize = 100;
 

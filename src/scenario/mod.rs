@@ -32,6 +32,7 @@ pub mod channels;
 pub mod config;
 mod controller;
 mod error;
+pub mod fault;
 pub(crate) mod recorder;
 pub mod run;
 mod setup;
@@ -292,6 +293,9 @@ fn parse_source(
 pub fn parse_table(table: &toml::Table, src: &Source) -> Result<ScenarioFile, ScenarioError> {
     let f: ScenarioFile = deserialize_table(table, "").map_err(|e| src.invalid(e))?;
     f.validate().map_err(|e| src.invalid(e))?;
+    if let Some(fault) = &f.fault {
+        fault.validate().map_err(|e| src.invalid(e))?;
+    }
     Ok(f)
 }
 
@@ -311,6 +315,9 @@ pub fn resolve_design(file: &ScenarioFile, src: &Source) -> Result<Vehicle, Scen
         load_design(&arg).map_err(ScenarioError::Design)?
     };
     file.check_design(&v).map_err(|e| src.invalid(e))?;
+    if let Some(fault) = &file.fault {
+        fault.thruster_index(&v).map_err(|e| src.invalid(e))?;
+    }
     check_log_size(file, &v).map_err(|e| src.invalid(e))?;
     Ok(v)
 }
@@ -347,6 +354,10 @@ pub fn check_table(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), KeyE
     let f: ScenarioFile = deserialize_table(scenario, "")?;
     f.validate()?;
     f.check_design(vehicle)?;
+    if let Some(fault) = &f.fault {
+        fault.validate()?;
+        fault.thruster_index(vehicle)?;
+    }
     check_log_size(&f, vehicle)
 }
 

@@ -38,6 +38,9 @@ pub struct LoopRun {
     pub energy: EnergyMetrics,
     /// Wall-clock breakdown.
     pub timing: Timing,
+    /// With a `[fault]`: the simulation time it struck [s] (NaN if the run ended before);
+    /// `None` without one.
+    pub fault_time: Option<f64>,
 }
 
 /// Why a control period ended the run: (simulation time [s], cause).
@@ -88,11 +91,30 @@ impl ClosedLoop<'_> {
         thruster_matrix(&self.vehicle, &self.ws, &mut self.t_mat);
     }
 
-    /// Allocate: thrusts for τ_c (USM-36/37).
+    /// Allocate: thrusts for τ_c (USM-36/37). With a `[fault]` that has struck, the informed
+    /// allocator sees the reconfigured T(q) and τ, and the thrusts become the ones the
+    /// thrusters produce, with the slack `s = T u − τ_c` of those (`scenario::fault`).
     fn allocate(&mut self, t: f64) -> Result<(), Failure> {
-        self.allocator
-            .allocate_into(&self.t_mat, &self.cmd.tau_c, &mut self.alloc)
-            .map_err(|e| (t, format!("allocation: {e}")))
+        let tau_c = self.cmd.tau_c;
+        if let Some(f) = self.fault.as_mut() {
+            f.update(t, self.alloc.u[f.thruster()]);
+        }
+        let result = match self.fault.as_mut() {
+            Some(f) if f.reconfigures() => {
+                let (t_alloc, tau) = f.reconfigured(&self.t_mat, &tau_c);
+                self.allocator.allocate_into(t_alloc, &tau, &mut self.alloc)
+            }
+            _ => (self.allocator).allocate_into(&self.t_mat, &tau_c, &mut self.alloc),
+        };
+        result.map_err(|e| (t, format!("allocation: {e}")))?;
+        if let Some(f) = self.fault.as_ref().filter(|f| f.struck_at.is_some()) {
+            f.produce(&mut self.alloc.u);
+            self.alloc.s = -tau_c;
+            for (col, u) in self.t_mat.column_iter().zip(&self.alloc.u) {
+                self.alloc.s += col * *u;
+            }
+        }
+        Ok(())
     }
 
     /// Advance the physics over one control period with the commands held; the recorder sees
@@ -194,6 +216,7 @@ pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun,
     rec.timing.physics_evaluations = stats.evaluations;
     rec.energy
         .set_joints(lp.sim.joint_work(), lp.sim.joint_torque_peak());
+    let fault_time = (lp.fault.as_ref()).map(|f| f.struck_at.unwrap_or(f64::NAN));
     let (trajectory, allocation_counts, energy, timing) = rec.finish(started);
     Ok(LoopRun {
         trajectory,
@@ -201,5 +224,6 @@ pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun,
         allocation_counts,
         energy,
         timing,
+        fault_time,
     })
 }

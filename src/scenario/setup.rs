@@ -6,6 +6,7 @@ use super::channels::check_log_size;
 use super::config::{ScenarioFile, SCALE_KEYS};
 use super::controller::{Command, ModeController};
 use super::error::ScenarioError;
+use super::fault::Fault;
 use crate::allocation::{Allocation, Allocator};
 use crate::control::dynamic::DynamicController;
 use crate::dynamics::{SimState, Simulator};
@@ -42,6 +43,8 @@ pub(crate) struct ClosedLoop<'f> {
     pub qd_meas: Vec<f64>,
     /// Control periods in the run (the loop visits 0..=n_control).
     pub n_control: usize,
+    /// The file's thruster fault, if any (`scenario::fault`).
+    pub fault: Option<Fault>,
 }
 
 /// The initial state of the file on `v`: position, yaw and (optionally) joint angles.
@@ -122,6 +125,10 @@ impl<'f> ClosedLoop<'f> {
         let q0 = sim.state().joint_angles.clone();
         let mode = ModeController::new(v, file, gains, &q0, &sim.state().pose)?;
         let allocator = allocator(v, file)?;
+        let fault = (file.fault.as_ref())
+            .map(|f| Fault::new(f, v))
+            .transpose()
+            .map_err(ScenarioError::Key)?;
         let cmd = Command {
             qd_ref: vec![0.0; q0.len()],
             q_ref: q0,
@@ -139,6 +146,7 @@ impl<'f> ClosedLoop<'f> {
             mode,
             allocator,
             cmd,
+            fault,
             vehicle,
         })
     }

@@ -44,6 +44,7 @@ pub const DICTIONARY: &[(&str, &[ColumnDoc])] = &[
         "cases.csv: uncertain worlds and ranking (`[uncertainty]`, `[[validate]]`)",
         WORLDS,
     ),
+    ("cases.csv: single thruster faults (`[faults]`)", FAULTS),
     ("worlds.csv (one row per case and world)", WORLDS_CSV),
     ("tuning.csv (one row per case and tuning run)", TUNING_CSV),
 ];
@@ -209,6 +210,16 @@ const WORLDS: &[ColumnDoc] = &[
     c("validate.<v>.gap", "–", "f64", "relative change of the objective from the nominal run in variant <v>: the generalisation gap"),
 ];
 
+const FAULTS: &[ColumnDoc] = &[
+    c("fault_time", "s", "f64", "a run with a scenario `[fault]`: the simulation time the fault struck (NaN if the run ended before `fault.at`)"),
+    c("fault_tolerance", "–", "f64", "fraction of the design's thrusters whose single fault (`[faults]`, re-run at the case's values in the nominal world) still leaves the run successful"),
+    c("worst_fault", "–", "f64", "0-based index of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest index"),
+    c("fault.t<j>.success", "0/1", "f64", "the run with thruster <j> failed met every `[success]` criterion (NaN: the design has no thruster <j>)"),
+    c("fault.t<j>.objective", "as the objective", "f64", "the study's objective (`study.objective`, else the worlds' objective, else `energy_per_metre`) with thruster <j> failed"),
+    c("fault.t<j>.change", "–", "f64", "relative change of the objective from the nominal run with thruster <j> failed, `(x − x₀)/|x₀|`"),
+    c("fault.t<j>.missed", "–", "f64", "the first `[success]` criterion the run with thruster <j> failed missed, as its index in the criterion list (`no_failure` for a failed run; NaN when it met all)"),
+];
+
 const WORLDS_CSV: &[ColumnDoc] = &[
     c(
         "world",
@@ -259,6 +270,7 @@ pub fn is_described(name: &str) -> bool {
         .any(|s| name.strip_suffix(s).is_some_and(is_described));
     let pattern = name.starts_with("tuned.")
         || name.starts_with("validate.")
+        || name.starts_with("fault.t")
         || matches!(name, "rank_p05" | "rank_p50" | "rank_p95");
     // A base axis in the name stands for the `<axis>` family (`wrench_peak_yaw`).
     let axis = |n: &str| {

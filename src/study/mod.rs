@@ -42,6 +42,8 @@ pub mod directions;
 pub mod doe;
 pub mod engine;
 pub mod error;
+pub mod fault_spec;
+pub mod faults;
 pub mod finish;
 pub mod hash;
 pub mod journal;

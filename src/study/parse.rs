@@ -13,6 +13,7 @@ use serde::Deserialize;
 use super::axes::{parse_axes, valid_names, AxisFile};
 pub use super::catalogue::{known_metric, metric_catalogue, unknown_metric};
 use super::error::InputError;
+use super::fault_spec::{parse_faults, FAULT_KEYS};
 use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
@@ -50,6 +51,8 @@ struct StudyFile {
     mission: Option<toml::Table>,
     uncertainty: Option<toml::Table>,
     validate: Option<Vec<toml::Table>>,
+    faults: Option<toml::Table>,
+    fault: Option<toml::Table>,
 }
 
 #[derive(Deserialize)]
@@ -211,12 +214,17 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         tune: file.tune.clone(),
         uncertainty: None,
         validate: Vec::new(),
+        faults: None,
         robust_table: toml::Table::new(),
     };
     check_report(&study, doc)?;
     let mut study = study;
     study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
     study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
+    study.faults = parse_faults(file.faults.as_ref(), study.mode.is_dynamic(), doc)?;
+    if let Some(f) = &file.faults {
+        (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
+    }
     if let Some(u) = &file.uncertainty {
         study
             .robust_table
@@ -375,6 +383,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("hydro", &file.hydro),
         ("success", &file.success),
         ("mission", &file.mission),
+        ("fault", &file.fault),
     ] {
         if let Some(t) = t {
             own.insert(k.into(), toml::Value::Table(t.clone()));
@@ -395,6 +404,12 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     if mode == StudyMode::Work {
         sc_names.insert("reference".into());
         sc_arrays.insert("reference".into());
+    }
+    // `[fault]` (one thruster fault, `crate::scenario::fault`) has no default either; its keys
+    // may be set by the study, its axes and variants (checked when a case's tables are).
+    if mode.is_dynamic() {
+        sc_names.insert("fault".into());
+        sc_names.extend(FAULT_KEYS.iter().map(|k| format!("fault.{k}")));
     }
     // Reject unknown keys of the study's own scenario-side tables.
     let (mut own_names, mut own_arrays) = (BTreeSet::new(), BTreeSet::new());

@@ -233,6 +233,8 @@ pub struct Study {
     pub uncertainty: Option<Uncertainty>,
     /// The `[[validate]]` variants, scored at the tuned values.
     pub validate: Vec<Variant>,
+    /// `[faults]`: the single thruster fault every case is re-run with, per thruster.
+    pub faults: Option<super::fault_spec::FaultStudy>,
     /// `[uncertainty]` and `[[validate]]` as written (part of every case hash: a row
     /// depends on them); empty without them.
     pub robust_table: toml::Table,

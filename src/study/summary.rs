@@ -14,6 +14,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::faults::{fault_table, FAULT_PREFIX};
 use super::manifest::Manifest;
 use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
@@ -84,6 +85,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         pareto_plot(table, &c.axes, &f, &plots, &mut warnings);
         let _ = writeln!(md);
     }
+    fault_section(&c, &mut md);
     left_out_section(&c, &mut md);
     if let Err(e) = crate::report::atomic_write(&dir.join("summary.md"), md.as_bytes()) {
         warnings.push(e.to_string());
@@ -270,6 +272,21 @@ fn tune_section(c: &Ctx, md: &mut String, robust: bool) {
     );
 }
 
+/// The layouts × single faults table ([`fault_table`]) of the successful cases, best objective
+/// first (at most 40 rows).
+fn fault_section(c: &Ctx, md: &mut String) {
+    let Some(o) = &c.sel.objective else { return };
+    let Ok(v) = c.table.f64(o) else { return };
+    let sign = if c.sel.goal(o) == "max" { -1.0 } else { 1.0 };
+    let key = |r: usize| sign * c.sel.ranked(o, v[r]);
+    let mut ranked = c.ok_rows.clone();
+    ranked.sort_by(|&a, &b| key(a).total_cmp(&key(b)).then(a.cmp(&b)));
+    ranked.truncate(40);
+    if let Some(t) = fault_table(c.table, &ranked, &c.ids, o) {
+        md.push_str(&t);
+    }
+}
+
 /// The best case by each metric (design columns aside).
 fn best_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(md, "## Best case by each metric\n");
@@ -286,6 +303,7 @@ fn best_section(c: &Ctx, md: &mut String) {
             && !m.starts_with(TUNED_PREFIX)
             && *m != TUNE_EVALUATIONS
             && *m != TUNE_FEASIBLE
+            && !m.starts_with(FAULT_PREFIX)
     });
     for metric in shown {
         let goal = c.sel.goal(metric);

@@ -12,6 +12,7 @@ use std::time::Duration;
 
 use super::cases::Resolved;
 use super::doe::Case;
+use super::faults::score_faults;
 use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
@@ -73,7 +74,8 @@ impl Worker {
         deadline: Deadline,
         res: &mut CaseResult,
     ) {
-        let robust = study.uncertainty.is_some() || !study.validate.is_empty();
+        let robust =
+            study.uncertainty.is_some() || !study.validate.is_empty() || study.faults.is_some();
         if !robust || matches!(res.status, CaseStatus::Failed | CaseStatus::Skipped) {
             return;
         }
@@ -90,7 +92,9 @@ impl Worker {
             r,
             deadline,
             &mut res.metrics,
-        ) {
+        )
+        .and_then(|()| score_faults(study, id, r, deadline, &mut res.metrics))
+        {
             res.status = CaseStatus::Failed;
             res.reason = e.to_string();
         }

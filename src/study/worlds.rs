@@ -33,7 +33,7 @@ pub const VALIDATE_PREFIX: &str = "validate.";
 pub const MISSED: &str = "missed";
 
 /// The index of `c` in [`Criterion::ALL`].
-fn criterion_index(c: Criterion) -> f64 {
+pub(super) fn criterion_index(c: Criterion) -> f64 {
     Criterion::ALL
         .iter()
         .position(|x| *x == c)
