@@ -92,9 +92,9 @@ fn transport_equals_thrusters_placed_about_the_reference() {
     let hi = [30.0; 7];
     let about_r = attainable_authority(&t, &lo, &hi, dofs, &r).unwrap();
     let moved = attainable_authority(&tr, &lo, &hi, dofs, &Vector3::zeros()).unwrap();
-    for k in 0..6 {
-        assert_eq!(about_r.positive[k].is_nan(), !dofs[k]);
-        if dofs[k] {
+    for (k, &on) in dofs.iter().enumerate() {
+        assert_eq!(about_r.positive[k].is_nan(), !on);
+        if on {
             assert!(close(about_r.positive[k], moved.positive[k]));
             assert!(close(about_r.negative[k], moved.negative[k]));
         }

@@ -91,7 +91,7 @@ impl JointRanges {
         let mut out = Vec::with_capacity(raw.len());
         for (k, ([lo, hi], j)) in raw.iter().zip(&v.joints).enumerate() {
             let (a, b) = (lo.max(j.min), hi.min(j.max));
-            if !(a <= b) {
+            if a > b || a.is_nan() || b.is_nan() {
                 return bad(
                     "joint_ranges",
                     format!(
