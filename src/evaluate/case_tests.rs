@@ -55,7 +55,9 @@ fn a_static_case_has_its_design_and_tcm_metrics_by_name() {
     // Bit for bit (the uncommanded roll authority is NaN, which `==` would not equal).
     let again = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
     let bits = |m: &Metrics| -> Vec<(String, u64)> {
-        m.iter().map(|(n, x)| (n.to_string(), x.to_bits())).collect()
+        m.iter()
+            .map(|(n, x)| (n.to_string(), x.to_bits()))
+            .collect()
     };
     assert_eq!(bits(&again.metrics), bits(&r.metrics));
 }
