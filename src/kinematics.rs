@@ -187,6 +187,23 @@ pub fn generalized_thrust_map(v: &Vehicle, ws: &KinWorkspace, out: &mut Mat<f64>
     }
 }
 
+/// The vehicle's centre of mass in the base frame `F_b` [m] at the configuration of `ws`
+/// (after [`forward_kinematics`]): `Σ m_i g_bi(c_i) / Σ m_i`, `c_i` body `i`'s centre of gravity
+/// ([`crate::model::Body::cg`]). The base origin when the total mass is not positive.
+pub fn centre_of_mass(v: &Vehicle, ws: &KinWorkspace) -> Vec3 {
+    let mut sum = Vec3::zeros();
+    let mut mass = 0.0;
+    for (b, g) in v.bodies.iter().zip(&ws.g_b) {
+        sum += g.act_point(&b.cg) * b.mass;
+        mass += b.mass;
+    }
+    if mass > 0.0 {
+        sum / mass
+    } else {
+        Vec3::zeros()
+    }
+}
+
 /// Pose of every body in the inertial frame, `g_Ii = g_Ib g_bi`.
 pub fn inertial_body_poses(base: &BasePose, ws: &KinWorkspace, out: &mut [Se3]) {
     let g_ib = base.to_se3();
@@ -377,6 +394,26 @@ mod tests {
                 assert!((map[(c, j)] - expect).abs() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn centre_of_mass_of_the_straight_and_folded_usm() {
+        // Straight: every body's CG on the x axis at its middle, so the CoM is Σ m_i x_i / Σ m_i
+        // of the body centres; rotating a joint moves only the bodies after it.
+        let v = usm_paper();
+        let mut ws = KinWorkspace::new(&v);
+        let (mut x, mut m) = (0.0, 0.0);
+        for (i, b) in v.bodies.iter().enumerate() {
+            x += b.mass * ws.g_b[i].act_point(&b.cg).x;
+            m += b.mass;
+        }
+        let c = centre_of_mass(&v, &ws);
+        assert!((c - Vec3::new(x / m, 0.0, 0.0)).norm() < 1e-12, "{c:?}");
+        let mut q = vec![0.0; v.n_joints()];
+        q[2] = 0.5;
+        forward_kinematics(&v, &q, &mut ws);
+        let bent = centre_of_mass(&v, &ws);
+        assert!((bent - c).norm() > 1e-3 && bent.x < c.x, "{bent:?}");
     }
 
     #[test]

@@ -42,6 +42,49 @@ fn usm_paper_straight_reference_values() {
 }
 
 #[test]
+fn usm_paper_straight_authority_in_newtons_about_the_centre_of_mass() {
+    // Issue 24 "Must show": the attainable force along each commanded axis of transport, in N
+    // about the centre of mass, and the N−1 worst case.
+    let d = json(&["inspect", "usm-paper", "--format", "json"]);
+    let a = &d["authority"];
+    assert_eq!(a["reference"], "com");
+    assert_eq!(a["commanded_axes"], "surge+sway+heave+pitch+yaw");
+    // Straight, the CoM lies on the body axis, inside the 3.3 m body.
+    let r = f(&a["reference_point"][0]);
+    assert!(
+        r > 0.5 && r < 2.8 && f(&a["reference_point"][1]).abs() < 1e-12,
+        "{r}"
+    );
+    // Surge: only the longitudinal pair (2 × 40 N) pushes along x and its moments cancel.
+    for sign in ["positive", "negative"] {
+        assert!((f(&a["attainable"][sign][0]) - 80.0).abs() < 1e-6, "{a}");
+        assert!(a["attainable"][sign][3].is_null(), "roll is not commanded");
+        for k in [1, 2, 4, 5] {
+            assert!(f(&a["attainable"][sign][k]) > 1.0, "{k}: {a}");
+        }
+    }
+    // N−1: removing either longitudinal thruster (T3, T4: mirrored) halves surge.
+    let t = &a["n1"]["thrusters"];
+    for i in [2, 3] {
+        assert!((f(&t[i]["loss"]) - 0.5).abs() < 1e-6, "{}", t[i]);
+        assert_eq!(t[i]["loss_axis"], "surge");
+        assert!((f(&t[i]["straight"]["positive"][0]) - 40.0).abs() < 1e-6);
+    }
+    let worst = a["n1"]["worst_thruster"].as_u64().unwrap() as usize;
+    let loss = f(&t[worst]["loss"]);
+    assert!(t.as_array().unwrap().iter().all(|x| f(&x["loss"]) <= loss));
+    assert!(loss > 0.5 && loss <= 1.0);
+    assert!(f(&a["n1"]["worst_force"]) < f(&a["min_force"]));
+    // The text report says the same.
+    let out = run(&["inspect", "usm-paper"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("about the centre of mass") && text.contains("N−1"),
+        "{text}"
+    );
+}
+
+#[test]
 fn bent_usm_paper_has_full_rank_and_state_is_used() {
     let dir = tempfile::tempdir().unwrap();
     let state = write(

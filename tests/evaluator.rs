@@ -8,7 +8,9 @@ use usm_study::evaluate::{CaseStatus, Deadline, Evaluator};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::parse_study;
-use usm_study::study::records::{metric_columns, Row, DESIGN_COLUMNS, TCM_COLUMNS};
+use usm_study::study::records::{
+    metric_columns, Row, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS,
+};
 use usm_study::study::worker::evaluate_resolved;
 use usm_study::study::{run_sweep, SweepOptions};
 
@@ -40,7 +42,7 @@ fn a_row_writes_the_evaluators_metrics_by_name_in_schema_order() {
     let packed = row.packed(&study);
     assert!(packed.is_empty(), "static studies pack nothing: {packed}");
     let cells = row.values(&study, &texts, &packed);
-    let n = DESIGN_COLUMNS.len() + TCM_COLUMNS.len();
+    let n = DESIGN_COLUMNS.len() + TCM_COLUMNS.len() + AUTHORITY_COLUMNS.len();
     assert_eq!(cells.len(), 4 + 1 + n);
     for (k, x) in expected.iter().enumerate() {
         match cells[5 + k] {

@@ -499,6 +499,30 @@ fn design_show_points_at_real_commands() {
     assert!(text.contains("usm-study inspect my_design.toml"), "{text}");
 }
 
+#[test]
+fn authority_keys_of_static_are_accepted_and_bad_ones_refused_at_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    let with = |line: &str| QUICK.replace("samples = 16", &format!("samples = 16\n{line}"));
+    let t = with("authority_reference = \"tail\"");
+    sweep_refuses(
+        d.path(),
+        "ref.toml",
+        &t,
+        9,
+        &["static.authority_reference", "tail"],
+    );
+    let t = with("joint_range = -0.5");
+    sweep_refuses(d.path(), "range.toml", &t, 9, &["joint_range", ">= 0"]);
+    let t = with("authority_reference = [0.1, 0.0, 0.0]\njoint_range = 0.3\nn1_samples = 4")
+        .replace(
+            "name = \"quick\"",
+            "name = \"quick\"\nobjective = \"authority_min_force\"",
+        );
+    let p = write(d.path(), "good.toml", &t);
+    let o = run(&["sweep", arg(&p), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
 /// A quick static sweep still runs (the new checks refuse nothing valid).
 #[test]
 fn a_valid_study_still_runs() {

@@ -31,11 +31,13 @@
 //! Files: `settings` (method, formulation, [`AllocSettings`] with defaults and `validate()`),
 //! `error` ([`AllocError`] and the input checks), `allocator` ([`Allocator`], [`Allocation`],
 //! [`AllocStatus`], [`AllocPath`]), `interior` (the certified interior shortcut of `qp`),
-//! `conic` (the Clarabel formulations), `attainable` (attainable wrench);
+//! `conic` (the Clarabel formulations), `attainable` (attainable wrench), `authority` (attainable
+//! authority along the commanded axes about a reference point, and N−1);
 //! `pinv` (the damped pseudoinverse kernel and `T u`); here: the one-shot conveniences.
 
 mod allocator;
 mod attainable;
+mod authority;
 mod conic;
 mod error;
 mod interior;
@@ -48,6 +50,10 @@ use nalgebra::{Matrix6xX, Vector6};
 
 pub use allocator::{AllocPath, AllocStatus, Allocation, Allocator};
 pub use attainable::{attainable_wrench, AttainableWrench};
+pub use authority::{
+    attainable_authority, attainable_authority_n1, transport_moments, AttainableAuthority,
+    AuthoritySolver,
+};
 pub(crate) use error::check_t;
 use error::{check_lambda, check_tau, check_vec};
 pub use error::{AllocError, MAX_LAMBDA, MAX_T_ENTRY};

@@ -57,6 +57,7 @@ pub fn run(a: &InspectArgs) -> anyhow::Result<ExitCode> {
             let mut o = String::new();
             write_design(&mut o, &v, &report.kinematics);
             write_kinematics(&mut o, &report.kinematics);
+            write_authority(&mut o, &report.kinematics);
             write_dynamics(&mut o, &report);
             print!("{o}");
         }
@@ -196,6 +197,56 @@ fn write_kinematics(o: &mut String, k: &KinematicsReport) {
                 fmt_num(att.negative[i])
             );
         }
+    }
+}
+
+/// Attainable authority about the centre of mass along transport's commanded axes, and N−1.
+fn write_authority(o: &mut String, k: &KinematicsReport) {
+    let a = &k.authority;
+    let r = a.reference_point;
+    let _ = writeln!(
+        o,
+        "\nattainable authority within the thrust limits, {} axes ({}), other commanded axes \
+         at zero, about the centre of mass [{} {} {}] m (base frame) [N, N·m]:",
+        a.mode,
+        a.commanded_axes,
+        fmt_num(r[0]),
+        fmt_num(r[1]),
+        fmt_num(r[2])
+    );
+    for (i, axis) in ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !a.attainable.positive[*i].is_nan() || !a.attainable.negative[*i].is_nan())
+    {
+        let _ = writeln!(
+            o,
+            "  {axis:<6} +{} / -{}",
+            fmt_num(a.attainable.positive[i]),
+            fmt_num(a.attainable.negative[i])
+        );
+    }
+    let _ = writeln!(
+        o,
+        "  weakest: force {} N, moment {} N·m",
+        fmt_num(a.min_force),
+        fmt_num(a.min_moment)
+    );
+    let n1 = &a.n1;
+    if let Some(w) = n1.thrusters.get(n1.worst_thruster) {
+        let _ = writeln!(
+            o,
+            "N−1 (one thruster at zero thrust): worst thruster {} ({}) loses {} % of its {} \
+             authority; weakest force {} N, moment {} N·m over all removals (mean {} N, {} N·m)",
+            w.index,
+            w.name,
+            fmt_num(100.0 * w.loss),
+            w.loss_axis,
+            fmt_num(n1.worst_force),
+            fmt_num(n1.worst_moment),
+            fmt_num(n1.mean_force),
+            fmt_num(n1.mean_moment)
+        );
     }
 }
 

@@ -8,15 +8,18 @@
 //! are kept); it never reaches the caller.
 
 use super::deadline::{Deadline, Phase};
-use super::metrics::{design_metrics, tcm_metrics, Metrics, DESIGN_COLUMNS, TCM_COLUMNS};
-use super::static_table::{static_spec, STATIC_TABLE};
+use super::metrics::{
+    authority_metrics, design_metrics, tcm_metrics, Metrics, AUTHORITY_COLUMNS, DESIGN_COLUMNS,
+    TCM_COLUMNS,
+};
+use super::static_table::{authority_spec, static_spec, STATIC_TABLE};
 use super::status::{missed_criterion, CaseStatus};
 use crate::input::keypath::{set, Seg, SetError};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::report::Table;
 use crate::sampling::derive_seed;
-use crate::statics::{analyse, SinkError, StaticError};
+use crate::statics::{analyse, authority_analysis, SinkError, StaticError};
 
 /// Which phases a case runs besides building its design.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -249,8 +252,10 @@ fn apply(input: &CaseInput<'_>) -> Result<(toml::Table, toml::Table), OverrideEr
     Ok((design, scenario))
 }
 
-/// The static analysis into the [`TCM_COLUMNS`]; `false` when the case ended (a `timeout`
-/// once the deadline passed: it is checked for every sample handed over, so after each chunk).
+/// The static analysis into the [`TCM_COLUMNS`], then the authority analysis into the
+/// [`AUTHORITY_COLUMNS`]; `false` when the case ended (a `timeout` once the deadline passed: it
+/// is checked for every sample handed over, so after each chunk, and for every authority
+/// configuration).
 fn static_phase(
     v: &Vehicle,
     scenario: &toml::Table,
@@ -264,22 +269,38 @@ fn static_phase(
             return false;
         }
     };
+    let auth = match authority_spec(scenario) {
+        Ok(s) => s,
+        Err(m) => {
+            out.end(CaseStatus::Skipped, m.to_string());
+            return false;
+        }
+    };
     let deadline = input.deadline;
     let mut on_time =
         |_: usize, _: &[f64], _: &_| deadline.check(Phase::Static).map_err(SinkError::from);
-    match analyse(v, &spec, 1, &mut on_time, &|_| {}) {
-        Ok(s) => {
+    let mut check = || deadline.check(Phase::Static).map_err(SinkError::from);
+    let both = analyse(v, &spec, 1, &mut on_time, &|_| {})
+        .and_then(|s| Ok((s, authority_analysis(v, &spec, &auth, &mut check)?)));
+    match both {
+        Ok((s, a)) => {
             out.metrics.push_all(&TCM_COLUMNS, &tcm_metrics(&s));
+            out.metrics
+                .push_all(&AUTHORITY_COLUMNS, &authority_metrics(&a));
             true
         }
-        Err(StaticError::Sink(m)) => {
-            out.end(CaseStatus::Failed, m.to_string());
-            false
-        }
         Err(e) => {
-            out.end(CaseStatus::Failed, e.to_string());
+            out.end(CaseStatus::Failed, static_failure(e));
             false
         }
+    }
+}
+
+/// The reason of a failed static phase: a sink's own message (the deadline), else the error.
+fn static_failure(e: StaticError) -> String {
+    match e {
+        StaticError::Sink(m) => m.to_string(),
+        e => e.to_string(),
     }
 }
 

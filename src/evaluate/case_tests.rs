@@ -3,7 +3,7 @@
 use std::time::{Duration, Instant};
 
 use super::*;
-use crate::evaluate::{Deadline, DESIGN_COLUMNS, TCM_COLUMNS};
+use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use crate::input::keypath::Seg;
 
 fn design() -> toml::Table {
@@ -45,12 +45,61 @@ fn a_static_case_has_its_design_and_tcm_metrics_by_name() {
     let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
     assert_eq!(r.status, CaseStatus::Ok, "{}", r.reason);
     assert!(r.success() && r.criterion().is_none() && r.failure().is_none());
-    assert_eq!(r.metrics.len(), DESIGN_COLUMNS.len() + TCM_COLUMNS.len());
+    assert_eq!(
+        r.metrics.len(),
+        DESIGN_COLUMNS.len() + TCM_COLUMNS.len() + AUTHORITY_COLUMNS.len()
+    );
     assert_eq!(r.metrics.get("design_thrusters"), Some(7.0));
     assert!(r.metrics.value("tcm_singular_fraction").is_finite());
     // Same seed, same numbers (a second evaluator: no cache involved).
+    // Bit for bit (the uncommanded roll authority is NaN, which `==` would not equal).
     let again = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
-    assert_eq!(again.metrics, r.metrics);
+    let bits = |m: &Metrics| -> Vec<(String, u64)> {
+        m.iter()
+            .map(|(n, x)| (n.to_string(), x.to_bits()))
+            .collect()
+    };
+    assert_eq!(bits(&again.metrics), bits(&r.metrics));
+}
+
+#[test]
+fn a_static_case_has_its_authority_columns_and_bad_authority_keys_skip_it() {
+    // usm-paper in transport (the default static mode): roll uncommanded, 7 thrusters.
+    let d = design();
+    let s: toml::Table = toml::from_str(
+        "[scenario]\nmode = \"static\"\n[static]\nsamples = 8\njoint_range = 0.0\nn1_samples = 2\n",
+    )
+    .unwrap();
+    let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
+    assert_eq!(r.status, CaseStatus::Ok, "{}", r.reason);
+    let m = |n: &str| r.metrics.value(n);
+    assert!(m("authority_roll_pos").is_nan() && m("authority_surge_pos") > 0.0);
+    assert_eq!(m("under_actuated"), 0.0);
+    assert_eq!(m("under_actuated_axes"), 0.0);
+    // The mission range ±0 is the straight configuration.
+    assert_eq!(
+        m("authority_mission_min_force"),
+        m("authority_straight_min_force")
+    );
+    assert!(m("n1_loss_t6").is_finite() && m("n1_loss_t7").is_nan());
+    assert_eq!(
+        m("n1_worst_loss"),
+        m(&format!("n1_loss_t{}", m("n1_worst_thruster")))
+    );
+    for bad in [
+        "authority_reference = \"tail\"",
+        "joint_range = -1.0",
+        "joint_ranges = [[1.0, 0.0]]",
+    ] {
+        let s: toml::Table = toml::from_str(&format!(
+            "[scenario]\nmode = \"static\"\n[static]\nsamples = 8\n{bad}\n"
+        ))
+        .unwrap();
+        let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
+        assert_eq!(r.status, CaseStatus::Skipped, "{bad}");
+        let key = bad.split(' ').next().unwrap();
+        assert!(r.reason.contains(key), "{bad}: {}", r.reason);
+    }
 }
 
 #[test]

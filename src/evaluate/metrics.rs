@@ -3,7 +3,7 @@
 //! by name; a metric a case did not compute reads as NaN.
 
 use crate::model::Vehicle;
-use crate::statics::{Distribution, StaticSummary};
+use crate::statics::{AuthoritySummary, Distribution, StaticSummary};
 
 /// Number of thrusters of the built design.
 pub const DESIGN_THRUSTERS: &str = "design_thrusters";
@@ -46,6 +46,60 @@ pub const TCM_COLUMNS: [&str; 21] = [
     "tcm_sigma_min_commanded_p50",
     "tcm_kappa_commanded_p50",
     "tcm_straight_sigma_min_commanded",
+];
+
+/// How many thrusters get an `n1_loss_t{i}` column (the main study's designs have at most 16;
+/// the N−1 figures of the others are in `summary.json` / `inspect`).
+pub const N1_LOSS_COLUMNS: usize = 16;
+
+/// Attainable-authority columns (present when the static analysis runs, docs/model.md §6):
+/// per axis and sign the smallest authority over the sampled configurations (N, N·m; NaN when
+/// uncommanded), the smallest force and moment (all samples, the straight configuration, the
+/// mission range), the under-actuation flag and axes bitmask, N−1 figures and the per-thruster
+/// N−1 loss (`n1_loss_t0` … `n1_loss_t15`).
+pub const AUTHORITY_COLUMNS: [&str; 42] = [
+    "authority_surge_pos",
+    "authority_surge_neg",
+    "authority_sway_pos",
+    "authority_sway_neg",
+    "authority_heave_pos",
+    "authority_heave_neg",
+    "authority_roll_pos",
+    "authority_roll_neg",
+    "authority_pitch_pos",
+    "authority_pitch_neg",
+    "authority_yaw_pos",
+    "authority_yaw_neg",
+    "authority_min_force",
+    "authority_min_moment",
+    "authority_straight_min_force",
+    "authority_straight_min_moment",
+    "authority_mission_min_force",
+    "authority_mission_min_moment",
+    "under_actuated",
+    "under_actuated_axes",
+    "n1_worst_force",
+    "n1_worst_moment",
+    "n1_mean_force",
+    "n1_mean_moment",
+    "n1_worst_thruster",
+    "n1_worst_loss",
+    "n1_loss_t0",
+    "n1_loss_t1",
+    "n1_loss_t2",
+    "n1_loss_t3",
+    "n1_loss_t4",
+    "n1_loss_t5",
+    "n1_loss_t6",
+    "n1_loss_t7",
+    "n1_loss_t8",
+    "n1_loss_t9",
+    "n1_loss_t10",
+    "n1_loss_t11",
+    "n1_loss_t12",
+    "n1_loss_t13",
+    "n1_loss_t14",
+    "n1_loss_t15",
 ];
 
 /// Named metrics in the order they were computed. A name is expected once; [`Metrics::set`]
@@ -164,6 +218,42 @@ pub fn tcm_metrics(s: &StaticSummary) -> [f64; TCM_COLUMNS.len()] {
         q(&s.kappa_commanded, 0.5),
         s.straight.metrics.sigma_min_commanded,
     ]
+}
+
+/// The [`AUTHORITY_COLUMNS`] of an authority summary.
+pub fn authority_metrics(s: &AuthoritySummary) -> [f64; AUTHORITY_COLUMNS.len()] {
+    let mut out = [f64::NAN; AUTHORITY_COLUMNS.len()];
+    for k in 0..6 {
+        out[2 * k] = s.full.min.positive[k];
+        out[2 * k + 1] = s.full.min.negative[k];
+    }
+    let mission =
+        |f: fn(&crate::statics::AuthorityStats) -> f64| s.mission.as_ref().map_or(f64::NAN, f);
+    let worst_loss =
+        s.n1.thrusters
+            .get(s.n1.worst_thruster)
+            .map_or(f64::NAN, |t| t.loss);
+    let rest = [
+        s.full.min_force,
+        s.full.min_moment,
+        s.straight_min_force,
+        s.straight_min_moment,
+        mission(|m| m.min_force),
+        mission(|m| m.min_moment),
+        f64::from(u8::from(s.under_actuated)),
+        f64::from(s.under_actuated_mask),
+        s.n1.worst_force,
+        s.n1.worst_moment,
+        s.n1.mean_force,
+        s.n1.mean_moment,
+        s.n1.worst_thruster as f64,
+        worst_loss,
+    ];
+    out[12..12 + rest.len()].copy_from_slice(&rest);
+    for (o, t) in out[12 + rest.len()..].iter_mut().zip(&s.n1.thrusters) {
+        *o = t.loss;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -24,5 +24,5 @@ pub use case::{
     Side,
 };
 pub use deadline::{Deadline, Phase, TimedOut, TIMEOUT};
-pub use metrics::{Metrics, DESIGN_COLUMNS, TCM_COLUMNS};
+pub use metrics::{Metrics, AUTHORITY_COLUMNS, DESIGN_COLUMNS, N1_LOSS_COLUMNS, TCM_COLUMNS};
 pub use status::{missed_criterion, CaseStatus, UnknownStatus};

@@ -6,7 +6,7 @@ use serde::Deserialize;
 
 use crate::sampling::Sampling;
 use crate::scenario::config::{Mode, ScenarioFile};
-use crate::statics::StaticSpec;
+use crate::statics::{AuthorityReference, AuthoritySpec, JointRanges, StaticSpec};
 
 /// The key of the `[static]` table in study files and resolved scenario-side tables.
 pub const STATIC_TABLE: &str = "static";
@@ -21,7 +21,29 @@ struct StaticFile {
     char_length: Option<f64>,
     rank_rel_tol: Option<f64>,
     mode: Option<Mode>,
+    authority_reference: Option<ReferenceFile>,
+    joint_range: Option<f64>,
+    joint_ranges: Option<Vec<[f64; 2]>>,
+    n1_samples: Option<usize>,
 }
+
+/// `static.authority_reference`: a name or a point.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ReferenceFile {
+    Name(String),
+    Point([f64; 3]),
+}
+
+/// The keys of `[static]` that have no entry in [`static_default_table`] (so that the case
+/// hashes of studies without them stay as they were), with whether each may be an array: the
+/// study parser accepts them beside the defaults.
+pub const STATIC_OPTIONAL_KEYS: [(&str, bool); 4] = [
+    ("authority_reference", true),
+    ("joint_range", false),
+    ("joint_ranges", true),
+    ("n1_samples", false),
+];
 
 /// Defaults of the `[static]` table, from [`StaticSpec::default`] (`char_length = 0`: half
 /// the vehicle length, or `metrics.char_length` when that is > 0).
@@ -114,6 +136,58 @@ pub fn static_spec(scenario: &toml::Table, seed: u64) -> Result<StaticSpec, Stat
     Ok(spec)
 }
 
+/// The authority settings of a resolved scenario-side table (`[static]` keys
+/// `authority_reference` = `"com"` | `"base"` | `[x, y, z]` (m, base frame), `joint_range` (rad,
+/// `±r` on every joint) or `joint_ranges` (`[[lo, hi], …]` rad, one per joint), `n1_samples`),
+/// defaults from [`AuthoritySpec::default`].
+pub fn authority_spec(scenario: &toml::Table) -> Result<AuthoritySpec, StaticTableError> {
+    let t = scenario
+        .get(STATIC_TABLE)
+        .cloned()
+        .unwrap_or(toml::Value::Table(toml::Table::new()));
+    let f = StaticFile::deserialize(t).map_err(StaticTableError::Table)?;
+    let d = AuthoritySpec::default();
+    let reference = match f.authority_reference {
+        None => d.reference,
+        Some(ReferenceFile::Name(n)) if n == "com" => AuthorityReference::Com,
+        Some(ReferenceFile::Name(n)) if n == "base" => AuthorityReference::Base,
+        Some(ReferenceFile::Name(n)) => {
+            return Err(StaticTableError::Authority {
+                key: "authority_reference",
+                message: format!("`{n}` is none of \"com\", \"base\" or [x, y, z] (m)"),
+            })
+        }
+        Some(ReferenceFile::Point(p)) if p.iter().all(|x| x.is_finite()) => {
+            AuthorityReference::Point(p)
+        }
+        Some(ReferenceFile::Point(p)) => {
+            return Err(StaticTableError::Authority {
+                key: "authority_reference",
+                message: format!("{p:?} is not a finite point"),
+            })
+        }
+    };
+    let mission = match (f.joint_range, f.joint_ranges) {
+        (Some(_), Some(_)) => {
+            return Err(StaticTableError::Authority {
+                key: "joint_ranges",
+                message: "give `joint_range` or `joint_ranges`, not both".into(),
+            })
+        }
+        (Some(r), None) => Some(JointRanges::Symmetric(r)),
+        (None, Some(r)) => Some(JointRanges::PerJoint(r)),
+        (None, None) => None,
+    };
+    if let Some(m) = &mission {
+        m.validate().map_err(StaticTableError::Setting)?;
+    }
+    Ok(AuthoritySpec {
+        reference,
+        mission,
+        n1_samples: f.n1_samples.unwrap_or(d.n1_samples),
+    })
+}
+
 /// Why a `[static]` table does not give static-analysis settings (the study parser places it
 /// at the table's line; a sweep case whose overrides break it is skipped with this reason).
 #[derive(Debug, thiserror::Error)]
@@ -127,6 +201,14 @@ pub enum StaticTableError {
     /// A setting is out of range.
     #[error("{0}")]
     Setting(#[source] crate::statics::StaticError),
+    /// An authority setting is not usable.
+    #[error("static.{key}: {message}")]
+    Authority {
+        /// The key in `[static]`.
+        key: &'static str,
+        /// What is wrong.
+        message: String,
+    },
     /// More samples per case than a worker may keep.
     #[error(
         "static.samples: {samples} samples per case would keep {:.1} GB of per-sample values \
@@ -137,6 +219,17 @@ pub enum StaticTableError {
         /// The samples asked for.
         samples: usize,
     },
+}
+
+impl StaticTableError {
+    /// The `[static]` key the error is about, when it is one key.
+    pub fn key(&self) -> Option<&'static str> {
+        match self {
+            Self::Authority { key, .. } => Some(key),
+            Self::Setting(crate::statics::StaticError::Setting { key, .. }) => Some(key),
+            _ => None,
+        }
+    }
 }
 
 /// Most static samples of one sweep case: 16 bytes each are kept (σ_min and κ), 160 MB at the

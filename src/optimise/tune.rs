@@ -19,7 +19,7 @@ use super::evaluate::CaseEvaluator;
 use super::history::Record;
 use super::problem::parse_spec;
 use super::{minimise, Options, Problem, Spec};
-use crate::evaluate::{Deadline, TCM_COLUMNS};
+use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
 use crate::input::document::Document;
 use crate::input::keypath::get;
 use crate::sampling::{derive_seed, Sampler, Sampling};
@@ -109,10 +109,9 @@ impl Tuner {
             .map(|ps| ps.iter().map(|p| p.get("start").is_some()).collect())
             .unwrap_or_default();
         let static_needed = study.static_enabled
-            && spec
-                .metrics()
-                .iter()
-                .any(|m| TCM_COLUMNS.contains(&m.as_str()));
+            && spec.metrics().iter().any(|m| {
+                TCM_COLUMNS.contains(&m.as_str()) || AUTHORITY_COLUMNS.contains(&m.as_str())
+            });
         Ok(Some(Tuner {
             spec,
             explicit_start,

@@ -5,11 +5,14 @@ use faer::Mat;
 use serde::Serialize;
 
 use super::error::PipelineError;
+use crate::allocation::AttainableAuthority;
 use crate::dynamics::{inspect_dynamics, DynOptions, DynamicsReport, SimState};
 use crate::kinematics::{ee_jacobian, forward_kinematics, thruster_matrix_owned, KinWorkspace};
 use crate::metrics::singularity::{tcm_metrics, tcm_svd_metrics, LostDirection, TcmMetrics};
 use crate::model::Vehicle;
+use crate::scenario::Mode;
 use crate::state::VehicleState;
+use crate::statics::{authority_at, AuthorityReference, N1Summary};
 
 /// The kinematic part of the inspect report (stable JSON keys, SI units).
 #[derive(Debug, Serialize)]
@@ -36,6 +39,48 @@ pub struct KinematicsReport {
     pub tcm_lost_directions: Vec<LostDirection>,
     /// Metrics of the moment-scaled T(q) (docs/model.md §6): σ_min, κ, rank, attainable wrench.
     pub tcm_scaled: TcmMetrics,
+    /// Attainable authority along transport's commanded axes in N and N·m about the centre of
+    /// mass, and N−1, at this configuration (docs/model.md §6).
+    pub authority: AuthorityReport,
+}
+
+/// Attainable authority at the report's configuration (docs/model.md §6).
+#[derive(Debug, Serialize)]
+pub struct AuthorityReport {
+    /// The mode whose default controller's commanded axes are scored (`transport`).
+    pub mode: String,
+    /// Those axes (`surge+sway+heave+pitch+yaw`).
+    pub commanded_axes: String,
+    /// The reference point (`com`).
+    pub reference: String,
+    /// The centre of mass in the base frame [m].
+    pub reference_point: [f64; 3],
+    /// Per axis and sign: the largest force [N] / moment [N·m] along it within the thrust
+    /// limits, the other commanded axes at zero (`null` when uncommanded).
+    pub attainable: AttainableAuthority,
+    /// The smallest commanded force [N].
+    pub min_force: f64,
+    /// The smallest commanded moment [N·m].
+    pub min_moment: f64,
+    /// One thruster removed: per thruster and the worst case.
+    pub n1: N1Summary,
+}
+
+/// The [`AuthorityReport`] of `v` at `q` [rad].
+fn authority_report(v: &Vehicle, q: &[f64]) -> Result<AuthorityReport, PipelineError> {
+    let mode = Mode::Transport;
+    let dofs = mode.default_commanded_dofs();
+    let (a, r, n1) = authority_at(v, dofs, &AuthorityReference::Com, q)?;
+    Ok(AuthorityReport {
+        mode: mode.to_string(),
+        commanded_axes: dofs.label(),
+        reference: AuthorityReference::Com.to_string(),
+        reference_point: r,
+        attainable: a,
+        min_force: a.min_force(dofs.mask()),
+        min_moment: a.min_moment(dofs.mask()),
+        n1,
+    })
 }
 
 /// The whole inspect report: kinematics and dynamics at one state.
@@ -103,6 +148,7 @@ pub fn kinematics_report(
         tcm_rank: raw.rank,
         tcm_lost_directions: raw.lost_directions,
         tcm_scaled: scaled,
+        authority: authority_report(v, &s.q)?,
     })
 }
 

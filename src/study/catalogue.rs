@@ -1,7 +1,7 @@
 //! The metric catalogue of a study: which metric names its cases report (design, static
 //! `T(q)`, run and tuning columns), and the located error for a name that is none of them.
 
-use super::records::{DESIGN_COLUMNS, TCM_COLUMNS};
+use super::records::{AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::StudyMode;
 use super::schema::Study;
 use crate::input::document::Document;
@@ -13,7 +13,8 @@ use crate::input::located::InputError;
 /// per-case tuning column.
 pub fn known_metric(name: &str, study: &Study) -> bool {
     DESIGN_COLUMNS.contains(&name)
-        || (study.static_enabled && TCM_COLUMNS.contains(&name))
+        || (study.static_enabled
+            && (TCM_COLUMNS.contains(&name) || AUTHORITY_COLUMNS.contains(&name)))
         || scenario_mode(study.mode)
             .is_some_and(|m| crate::outcome::run_summary::is_run_metric(m, name))
         || study.tune_columns().iter().any(|c| c == name)
@@ -32,7 +33,12 @@ fn scenario_mode(mode: StudyMode) -> Option<crate::scenario::Mode> {
 pub fn metric_catalogue(study: &Study) -> Vec<String> {
     let mut v: Vec<String> = DESIGN_COLUMNS.iter().map(|s| s.to_string()).collect();
     if study.static_enabled {
-        v.extend(TCM_COLUMNS.iter().map(|s| s.to_string()));
+        v.extend(
+            TCM_COLUMNS
+                .iter()
+                .chain(&AUTHORITY_COLUMNS)
+                .map(|s| s.to_string()),
+        );
     }
     if let Some(m) = scenario_mode(study.mode) {
         v.extend(crate::outcome::run_summary::metric_catalogue(m));

@@ -36,6 +36,10 @@ pub const DICTIONARY: &[(&str, &[ColumnDoc])] = &[
     ("cases.csv: identity and status", IDENTITY),
     ("cases.csv: the design", DESIGN),
     ("cases.csv: the static T(q) analysis (`[static]`)", STATIC),
+    (
+        "cases.csv: attainable authority and N−1 (`[static]`, docs/model.md §6)",
+        AUTHORITY,
+    ),
     ("cases.csv: per-case tuning (`[tune]`)", TUNING),
     ("cases.csv: the closed-loop run, both modes", RUN_COMMON),
     ("cases.csv: transport runs", RUN_TRANSPORT),
@@ -92,6 +96,25 @@ const STATIC: &[ColumnDoc] = &[
     c("tcm_sigma_min_commanded_p50", "–", "f64", "median of the commanded rows' σ_min"),
     c("tcm_kappa_commanded_p50", "–", "f64", "median κ of the commanded rows"),
     c("tcm_straight_sigma_min_commanded", "–", "f64", "σ_min of the commanded rows at q = 0"),
+];
+
+const AUTHORITY: &[ColumnDoc] = &[
+    c("authority_surge_pos, authority_surge_neg … authority_yaw_pos, authority_yaw_neg", "N (surge, sway, heave), N·m (roll, pitch, yaw)", "f64", "per base axis and sign, the smallest over the sampled configurations (full joint limits) of the largest force or moment the thrusters deliver along that axis within their limits, the other commanded axes held at zero and the uncommanded ones free, moments about `static.authority_reference` (default the centre of mass); NaN for an uncommanded axis"),
+    c("authority_min_force", "N", "f64", "smallest of the commanded force columns above (the weakest commanded force anywhere in the joint limits)"),
+    c("authority_min_moment", "N·m", "f64", "smallest of the commanded moment columns above"),
+    c("authority_straight_min_force", "N", "f64", "smallest commanded force (axes and signs) at the straight configuration q = 0"),
+    c("authority_straight_min_moment", "N·m", "f64", "smallest commanded moment at q = 0"),
+    c("authority_mission_min_force", "N", "f64", "as authority_min_force over the declared mission range (`static.joint_range` / `joint_ranges`); NaN without one"),
+    c("authority_mission_min_moment", "N·m", "f64", "as authority_min_moment over the declared mission range; NaN without one"),
+    c("under_actuated", "0/1", "f64", "1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
+    c("under_actuated_axes", "–", "f64", "bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
+    c("n1_worst_force", "N", "f64", "N−1: smallest commanded force with one thruster removed (held at zero thrust), over thrusters and the N−1 configurations (q = 0 and the first `static.n1_samples` samples)"),
+    c("n1_worst_moment", "N·m", "f64", "N−1: smallest commanded moment with one thruster removed"),
+    c("n1_mean_force", "N", "f64", "N−1: mean over the removed thruster of its smallest commanded force"),
+    c("n1_mean_moment", "N·m", "f64", "N−1: mean over the removed thruster of its smallest commanded moment"),
+    c("n1_worst_thruster", "–", "f64", "index (0-based) of the thruster whose removal loses the largest fraction of authority"),
+    c("n1_worst_loss", "–", "f64", "that fraction: the largest n1_loss_t{i}"),
+    c("n1_loss_t{i}", "–", "f64", "fraction of authority lost when thruster i (0 … 15) is removed, worst commanded axis, sign and N−1 configuration: 1 − (authority without it)/(authority with it), over the axes and signs it had authority on (0: nothing lost, 1: an axis lost entirely); NaN beyond the design's thrusters"),
 ];
 
 const TUNING: &[ColumnDoc] = &[
@@ -264,7 +287,15 @@ pub fn is_described(name: &str) -> bool {
             .is_some_and(|(k, rest)| k.parse::<usize>().is_ok() && !rest.is_empty())
             .then(|| format!("seg{{k}}_{}", n.split_once('_').map_or("", |x| x.1)))
     };
-    let lost = name.starts_with("tcm_lost_");
+    let lost = name.starts_with("tcm_lost_")
+        || name
+            .strip_prefix("n1_loss_t")
+            .is_some_and(|i| i.parse::<usize>().is_ok())
+        || name.strip_prefix("authority_").is_some_and(|r| {
+            ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+                .iter()
+                .any(|a| r == format!("{a}_pos") || r == format!("{a}_neg"))
+        });
     let summary = ["_mean", "_std", "_p05", "_p95", "_worst"]
         .iter()
         .any(|s| name.strip_suffix(s).is_some_and(is_described));

@@ -19,7 +19,8 @@ pub const TRANSPORT_OBJECTIVE: &str = "mission_cost";
 /// The 0/1 success metric of a closed-loop run (1 on every ranked case).
 pub const SUCCESS: &str = "success";
 
-/// Whether larger is better for `metric` by default: conditioning (σ_min) and run outcomes
+/// Whether larger is better for `metric` by default: conditioning (σ_min), attainable authority
+/// (`authority_…`, the N−1 forces and moments) and run outcomes
 /// (completion, success, convergence, progress) and their summaries over worlds
 /// (`…_mean`, `…_p05`, …), `success_probability` and `p_best`. Study files add their own with
 /// `study.maximise`.
@@ -27,6 +28,14 @@ pub fn larger_is_better(metric: &str) -> bool {
     let m = metric;
     m.starts_with("tcm_sigma_min")
         || m.starts_with(TCM_STRAIGHT_SIGMA_MIN)
+        || m.starts_with("authority_")
+        || [
+            "n1_worst_force",
+            "n1_worst_moment",
+            "n1_mean_force",
+            "n1_mean_moment",
+        ]
+        .contains(&m)
         || m.starts_with("sigma_min")
         || [
             "completed",

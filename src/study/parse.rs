@@ -18,7 +18,9 @@ use super::hash::study_hash;
 use super::runner::{self, StudyMode};
 use super::schema::{Axis, Doe, DoeKind, ReportSettings, Study, Target, MAX_CASES};
 use super::uncertainty::{parse_uncertainty, parse_variants};
-use crate::evaluate::static_table::{static_default_table, static_spec, STATIC_TABLE};
+use crate::evaluate::static_table::{
+    authority_spec, static_default_table, static_spec, STATIC_OPTIONAL_KEYS, STATIC_TABLE,
+};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::{flatten, pattern_allowed};
 use crate::input::located::{KeyError, Location};
@@ -400,6 +402,15 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     }
     let (mut sc_names, mut sc_arrays) = (BTreeSet::new(), BTreeSet::new());
     flatten(&defaults, "", &mut sc_names, &mut sc_arrays);
+    if static_enabled {
+        for (k, array) in STATIC_OPTIONAL_KEYS {
+            let p = format!("{STATIC_TABLE}.{k}");
+            if array {
+                sc_arrays.insert(p.clone());
+            }
+            sc_names.insert(p);
+        }
+    }
     // `[reference]` (work mode) has no default; its keys are checked by parsing it below.
     if mode == StudyMode::Work {
         sc_names.insert("reference".into());
@@ -436,6 +447,12 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     if static_enabled {
         if let Err(m) = static_spec(&reference, 0) {
             return Err(doc.err(STATIC_TABLE, m.to_string()));
+        }
+        if let Err(m) = authority_spec(&reference) {
+            let key = m
+                .key()
+                .map_or(STATIC_TABLE.to_string(), |k| format!("{STATIC_TABLE}.{k}"));
+            return Err(doc.err(&key, m.to_string()));
         }
     }
     Ok(ScenarioSide {

@@ -14,7 +14,8 @@ use crate::evaluate::{CaseResult, Metrics};
 use crate::report::{format_f64, Column, ColumnData, ColumnKind, Table, Value};
 
 pub use crate::evaluate::metrics::{
-    DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION, TCM_STRAIGHT_SIGMA_MIN,
+    AUTHORITY_COLUMNS, DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION,
+    TCM_STRAIGHT_SIGMA_MIN,
 };
 pub use crate::evaluate::{missed_criterion, CaseStatus};
 
@@ -130,7 +131,12 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
             .map(|c| (c.to_string(), ColumnKind::F64)),
     );
     if study.static_enabled {
-        s.extend(TCM_COLUMNS.iter().map(|c| (c.to_string(), ColumnKind::F64)));
+        s.extend(
+            TCM_COLUMNS
+                .iter()
+                .chain(&AUTHORITY_COLUMNS)
+                .map(|c| (c.to_string(), ColumnKind::F64)),
+        );
     }
     s.extend(
         study
@@ -150,7 +156,12 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
 pub fn metric_columns(study: &Study) -> Vec<String> {
     let mut c: Vec<String> = DESIGN_COLUMNS.iter().map(|n| n.to_string()).collect();
     if study.static_enabled {
-        c.extend(TCM_COLUMNS.iter().map(|n| n.to_string()));
+        c.extend(
+            TCM_COLUMNS
+                .iter()
+                .chain(&AUTHORITY_COLUMNS)
+                .map(|n| n.to_string()),
+        );
     }
     c.extend(study.tune_columns());
     c

@@ -65,6 +65,7 @@ fn default_metrics(study: &Study) -> Vec<String> {
             && !study.tune_columns().iter().any(|c| c == m)
             && !super::records::DESIGN_COLUMNS.contains(&m)
             && !super::records::TCM_COLUMNS.contains(&m)
+            && !crate::evaluate::AUTHORITY_COLUMNS.contains(&m)
     };
     let mut v: Vec<String> = Vec::new();
     let energy = match study.mode {
