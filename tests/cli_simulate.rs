@@ -266,9 +266,9 @@ distribution = { kind = "uniform", low = 0.0, high = 2.0 }
     assert_eq!(u["worlds"], 4);
     let m = &u["metrics"];
     let (lo, mean, hi) = (
-        m["energy_per_metre_p05"].as_f64().unwrap(),
-        m["energy_per_metre_mean"].as_f64().unwrap(),
-        m["energy_per_metre_p95"].as_f64().unwrap(),
+        m["mission_cost_p05"].as_f64().unwrap(),
+        m["mission_cost_mean"].as_f64().unwrap(),
+        m["mission_cost_p95"].as_f64().unwrap(),
     );
     assert!(lo < mean && mean < hi, "{m}");
     assert!(m["success_probability"].as_f64().is_some());

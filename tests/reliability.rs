@@ -645,7 +645,7 @@ fn report_refuses_a_folder_that_is_not_a_finished_output_or_is_locked() {
     let o = run(&["report", empty.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("is not a finished usm-study output"),
+        stderr(&o).contains("is not a study output"),
         "{}",
         stderr(&o)
     );

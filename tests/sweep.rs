@@ -501,7 +501,7 @@ fn unsuccessful_cases_are_left_out_of_the_ranking() {
         .lines()
         .find(|l| l.starts_with("| `final_cross_track` |"))
         .unwrap();
-    assert!(line.contains(&format!("| min |x| | #{by_abs} |")), "{line}");
+    assert!(line.contains(&format!("| min abs | #{by_abs} |")), "{line}");
     // On the front too: |x| makes the case nearest the path dominate the most negative one.
     assert!(
         !front.contains(&by_value) || by_value == by_abs,

@@ -310,10 +310,21 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     let mut sc = scenario.clone();
     sc.remove(STATIC_TABLE);
     let stop = input.deadline.stop();
-    let run = match crate::outcome::run_case(v, &sc, input.seed, input.trajectory, stop) {
+    // The scored evaluation (with the static phase) also measures the run's authority margin,
+    // from its logged joint angles; tuning and world runs do not.
+    let margin = input.phases.static_analysis;
+    let log = input.trajectory || margin;
+    let mut run = match crate::outcome::run_case(v, &sc, input.seed, log, stop) {
         Ok(r) => r,
         Err(e) => return out.end(CaseStatus::Failed, e.to_string()),
     };
+    if margin {
+        let m = run_authority_margin(v, &sc, &run);
+        out.metrics.push(AUTHORITY_MARGIN, m);
+    }
+    if !input.trajectory {
+        run.trajectory = None;
+    }
     let trajectory = match run
         .trajectory
         .map(|t| crate::report::figures::trajectory_table(&t))
@@ -323,11 +334,85 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     };
     if let Some(f) = run.failure {
         out.end(CaseStatus::Failed, f);
+    } else if let Some(axes) = under_actuated(out) {
+        out.end(
+            CaseStatus::Unsuccessful,
+            format!(
+                "under_actuated: no authority over the commanded {axes} anywhere in the sampled \
+                 joint space (static analysis); not ranked whatever its run did"
+            ),
+        );
     } else if let Some(m) = run.missed {
         out.end(CaseStatus::Unsuccessful, m);
     }
     out.metrics.extend(run.metrics);
     out.trajectory = trajectory;
+}
+
+/// The metric of [`run_authority_margin`].
+pub const AUTHORITY_MARGIN: &str = "authority_margin";
+
+/// Configurations of a run's log at which its authority margin is measured (evenly spaced).
+const MARGIN_CONFIGS: usize = 15;
+
+/// The commanded axes a static analysis found unattainable everywhere (its
+/// `under_actuated_axes` bit mask, surge = 1 … yaw = 32), as words; `None` when it found
+/// none or did not run.
+fn under_actuated(out: &CaseResult) -> Option<String> {
+    if out.metrics.get("under_actuated") != Some(1.0) {
+        return None;
+    }
+    let mask = out.metrics.get("under_actuated_axes").unwrap_or(0.0) as u32;
+    let names = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+    let axes: Vec<&str> = (0..6)
+        .filter(|k| mask & (1 << k) != 0)
+        .map(|k| names[k])
+        .collect();
+    Some(if axes.is_empty() {
+        "axes".into()
+    } else {
+        axes.join(", ")
+    })
+}
+
+/// `authority_margin` of a run (docs/model.md §6): the smallest ratio, over the commanded axes
+/// the run asked something of, of the wrench the thrusters can deliver about the base frame's
+/// origin (the frame of τ_c) within their limits — the least over [`MARGIN_CONFIGS`] joint
+/// configurations of its log — to the largest wrench the base controller commanded
+/// (`wrench_peak_<axis>`). ≥ 1: the layout could have delivered every peak demand; NaN
+/// when nothing was logged or asked.
+fn run_authority_margin(v: &Vehicle, scenario: &toml::Table, run: &crate::outcome::CaseRun) -> f64 {
+    use crate::scenario::channels::Channel;
+    use crate::statics::authority::{authority_over, weakest_ratio, AuthorityReference};
+    let (Some(traj), Ok(file)) = (
+        run.trajectory.as_ref(),
+        crate::scenario::parse_table(scenario, &crate::scenario::Source::unplaced("scenario")),
+    ) else {
+        return f64::NAN;
+    };
+    let commanded = file.commanded();
+    let names = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+    let metric = |n: &str| run.metrics.iter().find(|m| m.0 == n).map_or(0.0, |m| m.1);
+    let required: [f64; 6] = std::array::from_fn(|k| metric(&format!("wrench_peak_{}", names[k])));
+    let qs: Vec<&[f64]> = (0..v.n_joints())
+        .map(|j| traj.get(Channel::Q(j)).unwrap_or(&[]))
+        .collect();
+    let n = qs.first().map_or(0, |q| q.len());
+    if n == 0 {
+        return f64::NAN;
+    }
+    let picks = (0..MARGIN_CONFIGS.min(n)).map(|i| i * (n - 1) / (MARGIN_CONFIGS - 1).max(1));
+    let configs: Vec<Vec<f64>> = picks
+        .map(|i| {
+            qs.iter()
+                .map(|q| q.get(i).copied().unwrap_or(0.0))
+                .collect()
+        })
+        .collect();
+    match authority_over(v, commanded, &AuthorityReference::Base, configs) {
+        Ok(stats) => weakest_ratio(&stats.min, commanded, &required),
+        Err(_) => f64::NAN,
+    }
 }
 
 #[cfg(test)]

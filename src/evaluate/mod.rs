@@ -21,8 +21,8 @@ pub mod status;
 
 pub use case::{
     out_of_reach, CaseInput, CaseResult, Evaluator, Override, OverrideError, Overrides, Phases,
-    Side,
+    Side, AUTHORITY_MARGIN,
 };
 pub use deadline::{Deadline, Phase, TimedOut, TIMEOUT};
 pub use metrics::{Metrics, AUTHORITY_COLUMNS, DESIGN_COLUMNS, N1_LOSS_COLUMNS, TCM_COLUMNS};
-pub use status::{missed_criterion, CaseStatus, UnknownStatus};
+pub use status::{disqualified, missed_criterion, CaseStatus, UnknownStatus, DISQUALIFYING};

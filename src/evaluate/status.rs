@@ -54,6 +54,16 @@ pub fn missed_criterion(status: CaseStatus, reason: &str) -> Option<&str> {
     }
 }
 
+/// Reasons that disqualify a design whatever the world, gains or fault: it cannot reach the
+/// mission (`mission.reach`), or cannot command an axis anywhere in joint space
+/// (`under_actuated`). Such a case is neither tuned further, put in worlds nor ranked.
+pub const DISQUALIFYING: [&str; 2] = ["mission.reach:", "under_actuated:"];
+
+/// Whether an unsuccessful case's `reason` is one of [`DISQUALIFYING`].
+pub fn disqualified(reason: &str) -> bool {
+    DISQUALIFYING.iter().any(|p| reason.starts_with(p))
+}
+
 impl fmt::Display for CaseStatus {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.as_str())

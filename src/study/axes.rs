@@ -84,7 +84,7 @@ impl Names {
     }
 
     /// What to tell a user who wrote the unknown axis `name`: the closest valid name when one
-    /// is close; else the valid names of its table (`design.…`, `control.…`), or the tables.
+    /// is close; else the valid names of its table (`design.…`, `control.…`), or all of them.
     fn hint(&self, name: &str) -> String {
         let all = self.all();
         let bare: Vec<&str> = all.iter().map(|n| n.trim_end_matches(" (alias)")).collect();
@@ -99,15 +99,7 @@ impl Names {
             .filter(|n| n.split(['.', '[']).next() == Some(table))
             .collect();
         if same.is_empty() {
-            let mut tables: Vec<&str> = bare
-                .iter()
-                .filter_map(|n| n.split(['.', '[']).next())
-                .collect();
-            tables.dedup();
-            format!(
-                "; no table `{table}`: axes name keys of {}",
-                tables.join(", ")
-            )
+            format!("; valid names: {}", all.join(", "))
         } else {
             format!("; valid names under `{table}`: {}", same.join(", "))
         }

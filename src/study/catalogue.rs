@@ -4,6 +4,7 @@
 use super::records::{AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::StudyMode;
 use super::schema::Study;
+use crate::evaluate::AUTHORITY_MARGIN;
 use crate::input::document::Document;
 use crate::input::keypath::did_you_mean;
 use crate::input::located::InputError;
@@ -15,6 +16,7 @@ pub fn known_metric(name: &str, study: &Study) -> bool {
     DESIGN_COLUMNS.contains(&name)
         || (study.static_enabled
             && (TCM_COLUMNS.contains(&name) || AUTHORITY_COLUMNS.contains(&name)))
+        || (study.static_enabled && study.mode.is_dynamic() && name == AUTHORITY_MARGIN)
         || scenario_mode(study.mode)
             .is_some_and(|m| crate::outcome::run_summary::is_run_metric(m, name))
         || study.tune_columns().iter().any(|c| c == name)
@@ -42,6 +44,9 @@ pub fn metric_catalogue(study: &Study) -> Vec<String> {
     }
     if let Some(m) = scenario_mode(study.mode) {
         v.extend(crate::outcome::run_summary::metric_catalogue(m));
+    }
+    if study.static_enabled && study.mode.is_dynamic() {
+        v.push(AUTHORITY_MARGIN.to_string());
     }
     v.extend(study.tune_columns());
     v

@@ -147,6 +147,7 @@ const RUN_COMMON: &[ColumnDoc] = &[
     c("allocation_residual_fraction", "–", "f64", "fraction of control steps leaving the commanded wrench undelivered beyond `[metrics] residual_tolerance`"),
     c("total_energy", "J", "f64", "thruster_energy + joint_energy / η_j: thruster shaft energy plus the joint drives' electrical energy (`[metrics] joint_efficiency` η_j, default 0.7)"),
     c("wrench_peak_<axis>", "N or N·m", "f64", "largest |τ_c| the base controller commanded along surge, sway, heave (N), roll, pitch, yaw (N·m) at a control tick, base frame: the required wrench of `authority_margin`"),
+    c("authority_margin", "–", "f64", "smallest ratio, over the commanded axes the run asked something of, of the wrench the thrusters can deliver within their limits about the base origin (least over 15 configurations of the nominal run's log) to the peak commanded wrench `wrench_peak_<axis>`; ≥ 1: every peak demand was deliverable (static analysis and a closed loop)"),
     c("reach", "m", "f64", "distance from the base frame's origin to the end effector at q = 0 (a `[mission] reach` requirement is judged on it)"),
     c("success", "0/1", "f64", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
 ];

@@ -16,11 +16,12 @@ use std::path::Path;
 use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::error::StudyError;
 use super::records::{
-    final_table, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, STATUS,
+    final_table, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, REASON, STATUS,
 };
 use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
 use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
+use crate::evaluate::disqualified;
 use crate::report::{write_csv_streamed, write_parquet};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
@@ -309,13 +310,16 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
         obj[r][wc[i] as usize] = sign * x;
         ok[r][wc[i] as usize] = ws[i] == 1.0;
     }
+    // A disqualified design (out of reach, under-actuated) never ran in worlds.
+    let reason = table.str(REASON).ok();
     let ran: Vec<bool> = status
         .iter()
-        .map(|s| {
+        .enumerate()
+        .map(|(r, s)| {
             matches!(
                 CaseStatus::parse(s),
                 Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
-            )
+            ) && !reason.is_some_and(|x| disqualified(&x[r]))
         })
         .collect();
     let eligible = (0..ids.len())

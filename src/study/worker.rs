@@ -17,7 +17,9 @@ use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
-use crate::evaluate::{out_of_reach, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
+use crate::evaluate::{
+    disqualified, out_of_reach, CaseResult, CaseStatus, Deadline, Evaluator, Phases,
+};
 use crate::report::Table;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
@@ -76,7 +78,10 @@ impl Worker {
     ) {
         let robust =
             study.uncertainty.is_some() || !study.validate.is_empty() || study.faults.is_some();
-        if !robust || matches!(res.status, CaseStatus::Failed | CaseStatus::Skipped) {
+        if !robust
+            || matches!(res.status, CaseStatus::Failed | CaseStatus::Skipped)
+            || disqualified(&res.reason)
+        {
             return;
         }
         let worlds = study
