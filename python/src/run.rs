@@ -172,6 +172,16 @@ pub fn simulate(
     Ok(run)
 }
 
+/// Threads per core `jobs` may ask for, as on the command line: more only adds thread
+/// start-up and memory (the rows do not depend on the thread count).
+const JOBS_PER_CORE: usize = 4;
+
+/// `jobs` capped at [`JOBS_PER_CORE`] × the cores (at least 8); 0 (all cores) is kept.
+fn capped(jobs: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    jobs.min((JOBS_PER_CORE * cores).max(8))
+}
+
 /// One row of `simulate_many`: named metrics, whether it met `[success]`, why it failed.
 type Row = (Vec<(String, f64)>, bool, Option<String>);
 
@@ -208,7 +218,7 @@ pub fn simulate_many<'py>(
     let rows: Vec<Row> = py.detach(move || -> Result<Vec<Row>, Failure> {
         let (table, src) = base_table(&scenario, design.as_deref())?;
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs)
+            .num_threads(capped(jobs))
             .build()
             .map_err(|e| err(&e))?;
         let results: Vec<Result<Row, Failure>> = pool.install(|| {
@@ -217,7 +227,9 @@ pub fn simulate_many<'py>(
                 .map(|sets| {
                     let (file, vehicle) = prepare(&table, &src, sets)?;
                     let r = run_scenario(&vehicle, &file).map_err(|e| err(&e))?;
-                    let failure = r.failure.map(|(t, c)| format!("t = {t} s: {c}"));
+                    let failure = r
+                        .failure
+                        .map(|(t, c)| format!("run stopped at t = {t:.3} s: {c}"));
                     Ok((r.metrics, r.missed.is_none(), failure))
                 })
                 .collect()

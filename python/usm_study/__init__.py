@@ -241,7 +241,7 @@ def simulate_many(
 
     params: a list of ``{key: value}`` override dicts (``--set`` keys, SI units), or a polars
     DataFrame whose column names are the keys (one run per row). jobs: threads (0: all
-    cores); the rows are the same, bit for bit, for any ``jobs`` and equal those of
+    cores; capped at 4 per core, as on the command line); the rows are the same, bit for bit, for any ``jobs`` and equal those of
     ``simulate`` with the same overrides. The GIL is released during the batch.
 
     Returns a DataFrame: the parameter columns, then every summary metric (SI units), then
