@@ -173,3 +173,16 @@ def test_tcm_equals_the_cli(tmp_path):
     for k in ("singular_fraction", "sigma_min", "kappa", "worst", "samples", "seed"):
         assert r.summary[k] == cli_summary[k], k
     assert r.samples.height == 256
+
+
+def test_sweep_writes_the_cli_outputs(tmp_path):
+    study = DATA / "sweep_small.toml"
+    r = usm_study.sweep(study, out=tmp_path / "py", jobs=2)
+    assert r.counts["cases"] == 4 and r.counts["ok"] + r.counts["unsuccessful"] == 4
+    p = cli("sweep", str(study), "--out", str(tmp_path / "cli"), "--jobs", "1")
+    assert p.returncode in (0, 1), p.stderr
+    cli_cases = pl.read_parquet(tmp_path / "cli" / "cases.parquet")
+    # The case table holds no wall times: the same rows, bit for bit (NaN equal to NaN).
+    assert r.cases.height == 4 and r.cases.equals(cli_cases)
+    for f in ("cases.csv", "summary.md", "manifest.json", "report.html"):
+        assert (tmp_path / "py" / f).is_file(), f
