@@ -8,7 +8,8 @@ use crate::UsmStudyError;
 
 /// An error met without the GIL (inside a run or a batch): its message, raised as a
 /// [`UsmStudyError`] once the GIL is held again.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, thiserror::Error)]
+#[error("{0}")]
 pub struct Failure(pub String);
 
 impl From<Failure> for PyErr {

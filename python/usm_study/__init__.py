@@ -60,7 +60,7 @@ class Design:
     """A vehicle design: a preset (``usm-paper``, ``uvms-planar``) or a design file.
 
     ``toml`` is the design in explicit form (every body, joint and thruster written out,
-    SI units), as ``usm-study design export`` writes it.
+    SI units), as ``usm-study design show`` prints it.
     """
 
     source: str
