@@ -182,20 +182,20 @@ impl CaseTuner for Tuner {
             let out = minimise(&spec, &ev, &study.hash, &opts).map_err(TuneError::from_error)?;
             evaluations += out.fresh_evaluations();
             best_so_far(&out.records, &mut curve);
+            // Each start normalises its objective by its own start point: compare starts by
+            // the unnormalised objective, not by their scores.
             let b = out.best().clone();
-            bests.push(if b.score.feasible {
-                b.score.objective
-            } else {
-                f64::NAN
-            });
-            if best
-                .as_ref()
-                .is_none_or(|x: &Record| b.score.better_than(&x.score))
-            {
-                best = Some(b);
+            let raw = raw_objective(&out.scorer, &b);
+            bests.push(if b.score.feasible { raw } else { f64::NAN });
+            let better = |x: &(Record, f64)| match (b.score.feasible, x.0.score.feasible) {
+                (true, true) => raw < x.1,
+                _ => b.score.better_than(&x.0.score),
+            };
+            if best.as_ref().is_none_or(better) {
+                best = Some((b, raw));
             }
         }
-        let best = best.ok_or_else(|| TuneError::msg("no tuning start ran"))?;
+        let (best, _) = best.ok_or_else(|| TuneError::msg("no tuning start ran"))?;
         let mut resolved = ev.resolve(&best.x, 0).map_err(TuneError::from_error)?;
         resolved.hash = r.hash.clone();
         Ok(Tuned {
@@ -243,6 +243,19 @@ fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
 }
 
 /// Relative spread `(max − min) / |min|` of the finite values (NaN with fewer than two).
+/// The unnormalised objective of `r`: `Σ w_i · m_i` with each term's metric averaged over the
+/// scenarios. The starts of a tuning normalise by their own start points, so their scores are
+/// not comparable; this is.
+fn raw_objective(scorer: &super::score::Scorer, r: &Record) -> f64 {
+    scorer
+        .objective
+        .terms
+        .iter()
+        .zip(&scorer.term_columns)
+        .map(|(t, &c)| t.weight * super::score::mean_of(&r.metrics, c))
+        .sum()
+}
+
 fn relative_spread(xs: &[f64]) -> f64 {
     let f: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
     if f.len() < 2 {
@@ -266,5 +279,48 @@ fn case_value(target: &Target, r: &Resolved) -> Option<f64> {
         toml::Value::Float(x) => Some(*x),
         toml::Value::Integer(n) => Some(*n as f64),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::problem::{Combine, Objective, Term};
+    use super::super::score::{Score, Scorer};
+    use super::{raw_objective, Record};
+
+    #[test]
+    fn starts_normalised_at_different_points_compare_by_their_raw_objective() {
+        let objective = Objective {
+            terms: vec![Term {
+                metric: "e".into(),
+                weight: 2.0,
+            }],
+            combine: Combine::Mean,
+            normalise: true,
+        };
+        let names = vec!["e".to_string()];
+        // Two starts normalised by start points 10 and 100: scores 0.5 and 0.1 hide that the
+        // first found 5 and the second 10.
+        let a = Scorer::new(&objective, &[], &names, &[vec![10.0]]);
+        let b = Scorer::new(&objective, &[], &names, &[vec![100.0]]);
+        let rec = |m: f64| Record {
+            index: 1,
+            run: 1,
+            iteration: 0,
+            u: vec![],
+            x: vec![],
+            metrics: vec![vec![m]],
+            failure: None,
+            repeat: false,
+            score: Score {
+                objective: 0.0,
+                violation: 0.0,
+                feasible: true,
+            },
+        };
+        assert_eq!(a.scenario_objective(&[5.0]), 1.0);
+        assert_eq!(b.scenario_objective(&[10.0]), 0.2);
+        assert_eq!(raw_objective(&a, &rec(5.0)), 10.0);
+        assert_eq!(raw_objective(&b, &rec(10.0)), 20.0);
     }
 }

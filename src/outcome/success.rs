@@ -22,7 +22,7 @@ pub fn judge(
             .map_or(f64::NAN, |x| x.1)
     };
     let reach = get("reach");
-    if mission.reach > 0.0 && !(reach >= mission.reach) {
+    if mission.reach > 0.0 && (reach.is_nan() || reach < mission.reach) {
         return Some(Missed {
             criterion: Criterion::MissionReach,
             detail: format!(

@@ -181,6 +181,18 @@ fn change(a: f64, b: f64) -> String {
     }
 }
 
+/// A warning when the best came in the last 10 % of the `n` evaluations (`best` its index,
+/// 0-based): the budget, not convergence, may have ended the search.
+fn late_best_warning(best: usize, n: usize) -> Option<String> {
+    (n >= 10 && best * 10 >= n * 9).then(|| {
+        format!(
+            "**Warning: the best point came at evaluation {best} of {n}, in the last 10 % of the \
+             budget** — the search was still improving when it stopped; a larger \
+             `solver.max_evals` (or `--resume` with one) may find better.\n\n"
+        )
+    })
+}
+
 /// `summary.md`: the outcome, then start vs best for parameters, objective terms and
 /// constraints.
 pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
@@ -207,6 +219,9 @@ pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
             "INFEASIBLE"
         },
     );
+    if let Some(w) = late_best_warning(b.index, o.records.len()) {
+        md.push_str(&w);
+    }
     md.push_str(&format!(
         "Objective {} → {} ({}); start {}, best {}.\n\nStops: {}.\n\n## Parameters\n\n",
         fmt_num(s.score.objective),
@@ -408,4 +423,14 @@ fn y_extent(p: &Panel) -> Option<(f64, f64)> {
         None => Some((y, y)),
         Some((lo, hi)) => Some((lo.min(y), hi.max(y))),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_best_in_the_last_tenth_of_the_budget_is_warned_about() {
+        assert!(super::late_best_warning(175, 180).is_some());
+        assert!(super::late_best_warning(100, 180).is_none());
+        assert!(super::late_best_warning(4, 5).is_none());
+    }
 }

@@ -594,7 +594,7 @@ fn plots_section(h: &mut String, figures: &[PathBuf], warnings: &mut Vec<String>
     // The Pareto plot is at the top of the page already.
     let figures: Vec<&PathBuf> = figures
         .iter()
-        .filter(|p| !p.file_name().is_some_and(|n| n == "pareto.svg"))
+        .filter(|p| p.file_name().is_none_or(|n| n != "pareto.svg"))
         .collect();
     h.push_str("<section id=\"plots\">\n<h2>Plots</h2>\n");
     if figures.is_empty() {
