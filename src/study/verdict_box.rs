@@ -27,6 +27,10 @@ pub const REVIEW_METRICS: [&str; 12] = [
     "tune_noise",
 ];
 
+/// A leader's tuning noise above this (relative spread of its independent tuning starts) is a
+/// caveat of its own.
+pub const NOISY_TUNING: f64 = 0.1;
+
 /// How many designs the box sets side by side.
 pub const TOP_N: usize = 3;
 
@@ -139,7 +143,23 @@ pub fn verdict_box(inp: &BoxInput) -> String {
     let mut md = String::new();
     let cav = caveats(inp);
     if let Some(&leader) = inp.ranked.first() {
-        if cav.is_empty() {
+        let noise = column(inp.table, "tune_noise").map_or(f64::NAN, |c| c[leader]);
+        if noise > NOISY_TUNING {
+            let _ = writeln!(
+                md,
+                "Caveat: the tuning of {} did not settle — its independent starts ended {:.0} % \
+                 apart (`tune_noise`); its cost is what this budget found, not the design's best.\n",
+                (inp.label)(leader),
+                100.0 * noise
+            );
+        }
+        if inp.ranked.len() < 4 {
+            let _ = writeln!(
+                md,
+                "Caveats by quartile: not judged — {} ranked design(s) are too few for quartiles.\n",
+                inp.ranked.len()
+            );
+        } else if cav.is_empty() {
             let _ = writeln!(
                 md,
                 "Caveats: none — {} is outside the worst quartile of the ranked designs on \
