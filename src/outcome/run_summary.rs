@@ -4,7 +4,7 @@
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
-use super::success::judge;
+use super::success::{judge, success_margin};
 use crate::metrics::trajectory::{
     segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
 };
@@ -110,6 +110,7 @@ pub fn metric_catalogue(mode: Mode) -> Vec<String> {
             );
         }
     }
+    names.push(SUCCESS_MARGIN.to_string());
     names.push(SUCCESS_METRIC.to_string());
     names
 }
@@ -117,7 +118,7 @@ pub fn metric_catalogue(mode: Mode) -> Vec<String> {
 /// Whether `name` is a metric a run of `mode` reports: a catalogue name, or for transport
 /// `seg{k}_{name}` with `k` a segment index.
 pub fn is_run_metric(mode: Mode, name: &str) -> bool {
-    if COMMON_METRICS.contains(&name) || name == SUCCESS_METRIC {
+    if COMMON_METRICS.contains(&name) || name == SUCCESS_METRIC || name == SUCCESS_MARGIN {
         return true;
     }
     match mode {
@@ -175,10 +176,15 @@ pub fn run_summary(
     out
 }
 
+/// The run's signed, normalised distance to its success bounds ([`success_margin`]).
+pub const SUCCESS_MARGIN: &str = "success_margin";
+
 /// Judge the run by its `metrics` against `file`'s `[success]` criteria
-/// ([`super::success::judge`]) and append `success` (1 = every criterion met,
-/// 0 = not); returns the first criterion missed.
+/// ([`super::success::judge`]) and append `success_margin` and `success` (1 = every criterion
+/// met, 0 = not); returns the first criterion missed.
 pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
+    let margin = success_margin(&file.success, &file.mission, file.scenario.mode, metrics);
+    metrics.push((SUCCESS_MARGIN.to_string(), margin));
     let missed = judge(&file.success, &file.mission, file.scenario.mode, metrics);
     let met = if missed.is_none() { 1.0 } else { 0.0 };
     metrics.push((SUCCESS_METRIC.to_string(), met));

@@ -132,6 +132,81 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
     None
 }
 
+/// The run's signed, normalised distance to its `[success]` and `[mission]` bounds (metric
+/// `success_margin`): the smallest over the criteria that apply of `(bound − value) / bound`
+/// (`|final_cross_track|`, each reached segment's convergence time, the saturation fraction,
+/// the peak thrust when bounded, the work pose errors, the reach requirement as
+/// `(reach − required) / required`). Positive: every bound met with at least that relative room;
+/// negative: the worst miss relative to its bound ("missed by 1 cm of 0.1 m" is −0.1); −1 for a
+/// run that stopped early or a segment that never converged.
+pub fn success_margin(
+    spec: &SuccessSpec,
+    mission: &MissionSpec,
+    mode: Mode,
+    metrics: &[(String, f64)],
+) -> f64 {
+    let get = |k: &str| {
+        metrics
+            .iter()
+            .find(|(n, _)| n == k)
+            .map_or(f64::NAN, |x| x.1)
+    };
+    if get("completed") != 1.0 {
+        return -1.0;
+    }
+    // Room below an upper bound, relative to it; a NaN value is a full miss.
+    let room = |x: f64, bound: f64| {
+        if x.is_nan() {
+            -1.0
+        } else if bound > 0.0 {
+            (bound - x) / bound
+        } else if x <= 0.0 {
+            0.0
+        } else {
+            -1.0
+        }
+    };
+    let mut m = room(get("saturation_fraction"), spec.max_saturation_fraction);
+    if spec.max_peak_thrust > 0.0 {
+        m = m.min(room(get("peak_thrust"), spec.max_peak_thrust));
+    }
+    if mission.reach > 0.0 {
+        let r = get("reach");
+        m = m.min(if r.is_nan() {
+            -1.0
+        } else {
+            (r - mission.reach) / mission.reach
+        });
+    }
+    match mode {
+        Mode::Transport => {
+            m = m.min(room(get("final_cross_track").abs(), spec.cross_track_bound));
+            let reached = get("segments_reached");
+            let n = if reached.is_finite() && reached > 0.0 {
+                reached as usize
+            } else {
+                0
+            };
+            let window = if mission.deadline > 0.0 {
+                spec.convergence_window.min(mission.deadline)
+            } else {
+                spec.convergence_window
+            };
+            for k in 0..n {
+                m = m.min(room(get(&format!("seg{k}_convergence_time")), window));
+            }
+        }
+        Mode::Work => {
+            m = m.min(room(get("final_position_error"), spec.position_tolerance));
+            m = m.min(room(
+                get("final_orientation_error_deg"),
+                spec.orientation_tolerance_deg,
+            ));
+        }
+    }
+    m
+}
+
 /// The mission's deadline: every reached segment converged within `deadline` [s] of becoming
 /// active (0 = none; a segment that never converged already missed `convergence_window`).
 fn judge_deadline(deadline: f64, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
@@ -282,5 +357,22 @@ mod tests {
             judge(&s, &MissionSpec::default(), Mode::Transport, &m),
             None
         );
+    }
+
+    #[test]
+    fn the_success_margin_says_by_how_much_a_bound_was_met_or_missed() {
+        use crate::outcome::success::success_margin;
+        let s = SuccessSpec::default();
+        let none = MissionSpec::default();
+        let margin = |m: &[(String, f64)]| success_margin(&s, &none, Mode::Transport, m);
+        // 0.05 m of 0.1 m: half the room left; convergence 30 of 60 s, saturation 0.01 of 0.05.
+        assert!((margin(&transport(0.05, &[30.0])) - 0.5).abs() < 1e-12);
+        // Missed by 1 cm: −0.1.
+        assert!((margin(&transport(-0.11, &[30.0])) + 0.1).abs() < 1e-12);
+        // A segment that never converged, or a run that stopped: −1.
+        assert_eq!(margin(&transport(0.0, &[f64::NAN])), -1.0);
+        let mut stopped = transport(0.0, &[1.0]);
+        stopped[0].1 = 0.0;
+        assert_eq!(margin(&stopped), -1.0);
     }
 }

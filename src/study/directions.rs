@@ -45,6 +45,7 @@ pub fn larger_is_better(metric: &str) -> bool {
             "simulated_time",
             "path_progress",
             "reach",
+            "success_margin",
         ]
         .iter()
         .any(|b| {

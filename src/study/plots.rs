@@ -247,12 +247,14 @@ pub(crate) fn axis_plots(
 }
 
 /// `heatmap_<a>__<b>.svg` for every pair of axes with at least two levels each: the mean of
-/// `objective` per cell over the `ok` rows.
+/// `objective` per cell over the `ok` rows (`rows.0`), or, when those do not fill two levels of
+/// both axes, over every case that ran (`rows.1`, `ok` and unsuccessful; the title says so).
+/// A pair that cannot be drawn either way is named in `warnings`.
 pub(crate) fn heatmaps(
     table: &Table,
     axes: &[&str],
     objective: &str,
-    ok_rows: &[usize],
+    rows: (&[usize], &[usize]),
     plots: &Path,
     warnings: &mut Vec<String>,
 ) {
@@ -261,11 +263,25 @@ pub(crate) fn heatmaps(
     };
     for i in 0..axes.len() {
         for j in i + 1..axes.len() {
-            let (la, lb) = (
-                levels(table, axes[i], ok_rows),
-                levels(table, axes[j], ok_rows),
-            );
+            let grid = |r: &[usize]| (levels(table, axes[i], r), levels(table, axes[j], r));
+            let (ok_a, ok_b) = grid(rows.0);
+            let (la, lb, over) = if ok_a.len() >= 2 && ok_b.len() >= 2 {
+                (ok_a, ok_b, "the successful cases".to_string())
+            } else {
+                let (a, b) = grid(rows.1);
+                let n = rows.0.len();
+                (
+                    a,
+                    b,
+                    format!("all {} cases that ran ({n} successful)", rows.1.len()),
+                )
+            };
             if la.len() < 2 || lb.len() < 2 {
+                warnings.push(format!(
+                    "heatmap of {} × {} not drawn: fewer than two values of each among the \
+                     cases that ran",
+                    axes[i], axes[j]
+                ));
                 continue;
             }
             let mut zz = Vec::with_capacity(la.len() * lb.len());
@@ -280,7 +296,7 @@ pub(crate) fn heatmaps(
                 la.iter().map(|l| l.1).collect(),
                 lb.iter().map(|l| l.1).collect(),
                 zz,
-                &format!("mean {} over the successful cases", metric_title(objective)),
+                &format!("mean {} over {over}", metric_title(objective)),
                 &axis_label(table, axes[i], &la),
                 &axis_label(table, axes[j], &lb),
                 &metric_title(objective),

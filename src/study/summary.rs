@@ -21,6 +21,7 @@ use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
 use super::summary_robust::Robust;
+use crate::outcome::run_summary::SUCCESS_MARGIN;
 use crate::report::{fmt_short, MarkdownTable, Table};
 
 /// What every section of the summary reads.
@@ -93,7 +94,17 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     axis_plots(table, &c.axes, &c.key, &c.ok_rows, &plots, &mut warnings);
     if m.doe == DoeKind::Grid {
         if let Some(o) = &c.sel.objective {
-            heatmaps(table, &c.axes, o, &c.ok_rows, &plots, &mut warnings);
+            // Too few successful cases to fill a grid: every case that ran, said so in the
+            // title (a sensitivity study's unsuccessful cases are information).
+            let mut ran: Vec<usize> = c.ok_rows.clone();
+            ran.extend(
+                c.left_out
+                    .iter()
+                    .filter(|x| x.1 == CaseStatus::Unsuccessful)
+                    .map(|x| x.0),
+            );
+            ran.sort_unstable();
+            heatmaps(table, &c.axes, o, (&c.ok_rows, &ran), &plots, &mut warnings);
         }
     }
     timeseries_plot(dir, &plots, &mut warnings);
@@ -330,8 +341,11 @@ fn effects_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(
         md,
         "\n## Effect of each axis\n\nPer axis value: the cases that ran (`ok` or \
-         `unsuccessful`), how many of them succeeded, and the mean of each key metric over the \
-         successful ones.\n"
+         `unsuccessful`), how many of them succeeded and their success rate, the mean \
+         `success_margin` of all that ran (signed distance to the success bounds: < 0 missed, \
+         by that fraction of the bound), and the mean of each key metric over the successful \
+         ones (`ok`) beside its mean over all that ran (`all`): unsuccessful cases are \
+         information in a sensitivity study.\n"
     );
     let mut ran: Vec<usize> = c.ok_rows.clone();
     ran.extend(
@@ -341,11 +355,41 @@ fn effects_section(c: &Ctx, md: &mut String) {
             .map(|x| x.0),
     );
     ran.sort_unstable();
+    let margin = c.table.f64(SUCCESS_MARGIN).ok();
+    // Metrics constant over the cases that ran say nothing per axis value: left out (named).
+    let varies = |k: &str| {
+        c.table.f64(k).is_ok_and(|v| {
+            let xs: Vec<f64> = ran
+                .iter()
+                .map(|&r| v[r])
+                .filter(|x| x.is_finite())
+                .collect();
+            xs.iter().any(|x| *x != xs[0])
+        })
+    };
+    let (keys, constant): (Vec<&String>, Vec<&String>) = c.key.iter().partition(|k| varies(k));
+    let keys: Vec<&String> = keys.into_iter().take(6).collect();
+    if !constant.is_empty() {
+        let names: Vec<String> = constant.iter().map(|k| format!("`{k}`")).collect();
+        let _ = writeln!(
+            md,
+            "Left out as constant over the cases that ran: {}.\n",
+            names.join(", ")
+        );
+    }
     for a in &c.axes {
         let _ = writeln!(md, "### `{a}`\n");
-        let header = ["value", "cases", "successful"]
+        let mut header: Vec<String> = ["value", "cases", "successful", "success rate"]
             .into_iter()
-            .chain(c.key.iter().map(String::as_str));
+            .map(String::from)
+            .collect();
+        if margin.is_some() {
+            header.push(format!("`{SUCCESS_MARGIN}` (all)"));
+        }
+        for k in &keys {
+            header.push(format!("`{k}` (ok)"));
+            header.push(format!("`{k}` (all)"));
+        }
         let mut t = MarkdownTable::new(header);
         for (label, _, rows) in levels(c.table, a, &ran) {
             let ok: Vec<usize> = rows
@@ -353,19 +397,24 @@ fn effects_section(c: &Ctx, md: &mut String) {
                 .copied()
                 .filter(|r| c.ok_rows.binary_search(r).is_ok())
                 .collect();
-            let means = c
-                .key
-                .iter()
-                .map(|k| fmt_short(c.table.f64(k).map(|v| mean(v, &ok)).unwrap_or(f64::NAN)));
-            t.row(
-                [
-                    label.replace('|', "\\|"),
-                    rows.len().to_string(),
-                    ok.len().to_string(),
-                ]
-                .into_iter()
-                .chain(means),
-            );
+            let mut row = vec![
+                label.replace('|', "\\|"),
+                rows.len().to_string(),
+                ok.len().to_string(),
+                format!(
+                    "{:.0} %",
+                    100.0 * ok.len() as f64 / rows.len().max(1) as f64
+                ),
+            ];
+            if let Some(m) = margin {
+                row.push(fmt_short(mean(m, &rows)));
+            }
+            for k in &keys {
+                let col = c.table.f64(k).ok();
+                row.push(fmt_short(col.map_or(f64::NAN, |v| mean(v, &ok))));
+                row.push(fmt_short(col.map_or(f64::NAN, |v| mean(v, &rows))));
+            }
+            t.row(row);
         }
         let _ = writeln!(md, "{}", t.finish());
     }
