@@ -363,7 +363,7 @@ fn under_actuated(out: &CaseResult) -> Option<String> {
         return None;
     }
     let mask = out.metrics.get("under_actuated_axes").unwrap_or(0.0) as u32;
-    let names = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+    let names = crate::metrics::singularity::AXIS_NAMES;
     let axes: Vec<&str> = (0..6)
         .filter(|k| mask & (1 << k) != 0)
         .map(|k| names[k])
@@ -391,7 +391,7 @@ fn run_authority_margin(v: &Vehicle, scenario: &toml::Table, run: &crate::outcom
         return f64::NAN;
     };
     let commanded = file.commanded();
-    let names = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+    let names = crate::metrics::singularity::AXIS_NAMES;
     let metric = |n: &str| run.metrics.iter().find(|m| m.0 == n).map_or(0.0, |m| m.1);
     let required: [f64; 6] = std::array::from_fn(|k| metric(&format!("wrench_peak_{}", names[k])));
     let qs: Vec<&[f64]> = (0..v.n_joints())

@@ -6,7 +6,7 @@
 
 use super::success::{judge, success_margin};
 use crate::metrics::trajectory::{
-    segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
+    integrate, segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
 };
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
@@ -287,9 +287,8 @@ fn per_metre(energy: f64, progress: f64) -> f64 {
 /// `∫|e_y| dt` [m·s] over the logged run (trapezoid rule): the tracking term of a transport
 /// mission, so that arriving late on the path is not free.
 fn integral_abs(t: &[f64], y: &[f64]) -> f64 {
-    (1..t.len().min(y.len()))
-        .map(|i| 0.5 * (t[i] - t[i - 1]) * (y[i].abs() + y[i - 1].abs()))
-        .sum()
+    let abs: Vec<f64> = y.iter().map(|x| x.abs()).collect();
+    integrate(t, &abs)
 }
 
 /// Index ranges `[a, b)` of the contiguous runs of equal values in `seg` (the samples during

@@ -508,7 +508,7 @@ fn channel_family(name: &str) -> Option<String> {
 
 /// Whether `name` (a concrete column name) is described by the dictionary.
 pub fn is_described(name: &str) -> bool {
-    const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+    const AXES: [&str; 6] = crate::metrics::singularity::AXIS_NAMES;
     let seg = |n: &str| {
         n.strip_prefix("seg")
             .and_then(|r| r.split_once('_'))
@@ -520,8 +520,7 @@ pub fn is_described(name: &str) -> bool {
             .strip_prefix("n1_loss_t")
             .is_some_and(|i| i.parse::<usize>().is_ok())
         || name.strip_prefix("authority_").is_some_and(|r| {
-            ["surge", "sway", "heave", "roll", "pitch", "yaw"]
-                .iter()
+            AXES.iter()
                 .any(|a| r == format!("{a}_pos") || r == format!("{a}_neg"))
         });
     let summary = ["_mean", "_std", "_p05", "_p95", "_worst"]

@@ -39,6 +39,19 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
+    /// The rows that ran (`ok` or unsuccessful), ascending.
+    fn ran_rows(&self) -> Vec<usize> {
+        let mut ran: Vec<usize> = self.ok_rows.clone();
+        ran.extend(
+            self.left_out
+                .iter()
+                .filter(|x| x.1 == CaseStatus::Unsuccessful)
+                .map(|x| x.0),
+        );
+        ran.sort_unstable();
+        ran
+    }
+
     /// A table with the columns `first…` followed by one column per axis.
     fn table(&self, first: &[&str]) -> MarkdownTable {
         MarkdownTable::new(first.iter().copied().chain(self.axes.iter().copied()))
@@ -96,15 +109,14 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
         if let Some(o) = &c.sel.objective {
             // Too few successful cases to fill a grid: every case that ran, said so in the
             // title (a sensitivity study's unsuccessful cases are information).
-            let mut ran: Vec<usize> = c.ok_rows.clone();
-            ran.extend(
-                c.left_out
-                    .iter()
-                    .filter(|x| x.1 == CaseStatus::Unsuccessful)
-                    .map(|x| x.0),
+            heatmaps(
+                table,
+                &c.axes,
+                o,
+                (&c.ok_rows, &c.ran_rows()),
+                &plots,
+                &mut warnings,
             );
-            ran.sort_unstable();
-            heatmaps(table, &c.axes, o, (&c.ok_rows, &ran), &plots, &mut warnings);
         }
     }
     timeseries_plot(dir, &plots, &mut warnings);
@@ -347,14 +359,7 @@ fn effects_section(c: &Ctx, md: &mut String) {
          ones (`ok`) beside its mean over all that ran (`all`): unsuccessful cases are \
          information in a sensitivity study.\n"
     );
-    let mut ran: Vec<usize> = c.ok_rows.clone();
-    ran.extend(
-        c.left_out
-            .iter()
-            .filter(|x| x.1 == CaseStatus::Unsuccessful)
-            .map(|x| x.0),
-    );
-    ran.sort_unstable();
+    let ran = c.ran_rows();
     let margin = c.table.f64(SUCCESS_MARGIN).ok();
     // Metrics constant over the cases that ran say nothing per axis value: left out (named).
     let varies = |k: &str| {
