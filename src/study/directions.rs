@@ -21,7 +21,8 @@ pub const SUCCESS: &str = "success";
 
 /// Whether larger is better for `metric` by default: conditioning (σ_min), attainable authority
 /// (`authority_…`, the N−1 forces and moments) and run outcomes
-/// (completion, success, convergence, progress) and their summaries over worlds
+/// (completion, success, convergence, progress, reach, success margin, fault tolerance) and
+/// their summaries over worlds
 /// (`…_mean`, `…_p05`, …), `success_probability` and `p_best`. Study files add their own with
 /// `study.maximise`.
 pub fn larger_is_better(metric: &str) -> bool {
@@ -46,6 +47,7 @@ pub fn larger_is_better(metric: &str) -> bool {
             "path_progress",
             "reach",
             "success_margin",
+            "fault_tolerance",
         ]
         .iter()
         .any(|b| {
@@ -59,3 +61,28 @@ pub fn larger_is_better(metric: &str) -> bool {
 
 /// Suffixes of a metric's summary over worlds (`energy_per_metre_mean`, …).
 pub const WORLD_SUFFIXES: [&str; 5] = ["_mean", "_std", "_p05", "_p95", "_worst"];
+
+#[cfg(test)]
+mod tests {
+    use super::larger_is_better;
+
+    #[test]
+    fn outcomes_a_design_review_wants_high_rank_larger_first() {
+        for m in [
+            "fault_tolerance",
+            "reach",
+            "success_margin",
+            "authority_margin",
+            "success_probability",
+        ] {
+            assert!(larger_is_better(m), "{m}");
+        }
+        for m in [
+            "mission_cost",
+            "fault_tolerance_typo",
+            "saturation_fraction",
+        ] {
+            assert!(!larger_is_better(m), "{m}");
+        }
+    }
+}

@@ -92,7 +92,7 @@ pub fn caveats(inp: &BoxInput) -> Vec<String> {
             continue;
         }
         xs.sort_by(f64::total_cmp);
-        let larger = larger_is_better(&m) || m.starts_with("authority") || m == "fault_tolerance";
+        let larger = larger_is_better(&m);
         let (worst_q, bad) = if larger {
             let q = quantile_sorted(&xs, 0.25);
             (q, x < q)
