@@ -18,7 +18,9 @@ use std::str::FromStr;
 pub enum ThrusterRule {
     /// The paper's 7-thruster pattern generalised: vertical + lateral on link 1, a
     /// longitudinal pair and a vertical on the middle link `⌊N/2⌋`, lateral + vertical on
-    /// link `N-2` (for `N = 5` with the paper's lengths this is the docs/model.md §2 layout).
+    /// link `N-2`; at 3 and 4 links the groups that would share the middle link move to the
+    /// end links ([`paper_rule_links`]), so no link carries more than the paper's 3. With
+    /// [`BodyProfile::Paper`] at `N = 5` this is `usm-paper` (USM Table II).
     Paper,
     /// A lateral and a vertical thruster on every inner link, plus the longitudinal pair on
     /// the middle link.
@@ -80,6 +82,67 @@ impl FromStr for ThrusterRule {
     }
 }
 
+/// Where the generator takes link lengths and masses from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum BodyProfile {
+    /// `link_length` and `link_mass` as given (one value or one per link; masses default to
+    /// neutrally buoyant solid cylinders).
+    #[default]
+    Uniform,
+    /// USM Table II (../shared/seeds, docs/model.md §2) generalised to `N` links: the tail link
+    /// 0.62 m / 14.3 kg, the head link 0.37 m / 7.8 kg, the middle link `⌊N/2⌋` (the one
+    /// carrying the longitudinal pair) 0.726 m / 9.8 kg and every other inner link
+    /// 0.584 m / 12.7 kg. At `N = 5` this is Table II exactly (81.3 kg with the four 6 kg
+    /// modules, 3.300 m); `link_length` and `link_mass` are ignored.
+    Paper,
+}
+
+impl BodyProfile {
+    /// All profiles, in the order of their names in error messages.
+    pub const ALL: [BodyProfile; 2] = [BodyProfile::Uniform, BodyProfile::Paper];
+
+    /// The profile's name as written in design and study files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            BodyProfile::Uniform => "uniform",
+            BodyProfile::Paper => "paper",
+        }
+    }
+
+    /// The profile called `s`, if any.
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|p| p.name() == s)
+    }
+}
+
+/// USM Table II's (length [m], mass [kg]) of link `k` of `n` under [`BodyProfile::Paper`].
+fn paper_link(k: usize, n: usize) -> (f64, f64) {
+    if k == 0 {
+        (0.62, 14.3)
+    } else if k == n - 1 {
+        (0.37, 7.8)
+    } else if k == n / 2 {
+        (0.726, 9.8)
+    } else {
+        (0.584, 12.7)
+    }
+}
+
+/// The three links the [`ThrusterRule::Paper`] groups go on, `a < b < c`: group A (vertical +
+/// lateral) on `a`, group B (longitudinal pair + vertical) on `b = ⌊N/2⌋`, group C (lateral +
+/// vertical) on `c`. The paper's links 1 and `N-2` when they differ from `b`, otherwise the tail
+/// link 0 and the head link `N-1`: so no link carries more than the paper's per-link count
+/// (2, 3, 2). `None` below 3 links (7 thrusters do not fit under that cap on 2 links).
+pub fn paper_rule_links(n: usize) -> Option<(usize, usize, usize)> {
+    if n < 3 {
+        return None;
+    }
+    let b = n / 2;
+    let a = if b > 1 { 1 } else { 0 };
+    let c = if n - 2 > b { n - 2 } else { n - 1 };
+    Some((a, b, c))
+}
+
 /// Parameters of the generator. Defaults follow `usm-paper` (radius 0.085 m, 0.104 m / 6 kg
 /// joint modules, ±90° joints, ±40 N thrusters, drag coefficients of USM Table II).
 #[derive(Clone, Debug, PartialEq)]
@@ -91,6 +154,8 @@ pub struct GeneratorSpec {
     /// Link masses [kg]: empty = neutrally buoyant solid cylinders `ρπr²l`; one value for
     /// every link; or exactly `N` values.
     pub link_mass: Vec<f64>,
+    /// Where lengths and masses come from ([`BodyProfile`]); `Paper` overrides the two above.
+    pub body_profile: BodyProfile,
     /// Radius of every body [m].
     pub radius: f64,
     /// Joint module length [m].
@@ -124,6 +189,7 @@ impl Default for GeneratorSpec {
             links: 5,
             link_length: vec![0.6],
             link_mass: Vec::new(),
+            body_profile: BodyProfile::Uniform,
             radius: 0.085,
             module_length: 0.104,
             module_mass: 6.0,
@@ -165,7 +231,28 @@ impl GeneratorSpec {
                 format!("must be between 2 and 20, got {n}"),
             ));
         }
-        let lengths = per_link("link_length", &self.link_length, n)?;
+        if self.thruster_rule == ThrusterRule::Paper && paper_rule_links(n).is_none() {
+            return Err(ModelError::new(
+                "generator.links",
+                format!(
+                    "the paper thruster rule needs at least 3 links (7 thrusters, at most 3 on \
+                     one link), got {n}"
+                ),
+            ));
+        }
+        let (lengths, masses) = match self.body_profile {
+            BodyProfile::Paper => (0..n).map(|k| paper_link(k, n)).unzip(),
+            BodyProfile::Uniform => {
+                let lengths = per_link("link_length", &self.link_length, n)?;
+                let masses = if self.link_mass.is_empty() {
+                    let r = self.radius;
+                    lengths.iter().map(|l| Fluid::default().rho * PI * r * r * l).collect()
+                } else {
+                    per_link("link_mass", &self.link_mass, n)?
+                };
+                (lengths, masses)
+            }
+        };
         let fluid = Fluid::default();
         let rho = fluid.rho;
         let r = self.radius;
@@ -193,11 +280,6 @@ impl GeneratorSpec {
                 ));
             }
         }
-        let masses = if self.link_mass.is_empty() {
-            lengths.iter().map(|l| rho * PI * r * r * l).collect()
-        } else {
-            per_link("link_mass", &self.link_mass, n)?
-        };
         let mut bodies = Vec::with_capacity(2 * n - 1);
         for k in 0..n {
             if k > 0 {
@@ -265,6 +347,8 @@ impl GeneratorSpec {
         let mid = n / 2;
         let inner_first = 1.min(n - 1);
         let inner_last = n.saturating_sub(2).max(inner_first);
+        // Checked in `build`: the paper rule has three distinct links.
+        let (ga, gb, gc) = paper_rule_links(n).unwrap_or((0, mid, n - 1));
         let mut out: Vec<Thruster> = Vec::new();
         let mut add = |link: usize, frac: f64, y: f64, dir: Vec3| {
             let name = format!("T{}", out.len() + 1);
@@ -286,12 +370,12 @@ impl GeneratorSpec {
                 // Fractions of the link length from the docs/model.md §2 layout on usm-paper:
                 // 0.237/0.584, 0.347/0.584, 0.278/0.726, 0.488/0.726.
                 let (f1, f2) = (0.237 / 0.584, 0.347 / 0.584);
-                add(inner_first, f1, 0.0, ez);
-                add(inner_first, f2, 0.0, ey);
-                pair(&mut add, mid, 0.278 / 0.726);
-                add(mid, 0.488 / 0.726, 0.0, ez);
-                add(inner_last, f1, 0.0, ey);
-                add(inner_last, f2, 0.0, ez);
+                add(ga, f1, 0.0, ez);
+                add(ga, f2, 0.0, ey);
+                pair(&mut add, gb, 0.278 / 0.726);
+                add(gb, 0.488 / 0.726, 0.0, ez);
+                add(gc, f1, 0.0, ey);
+                add(gc, f2, 0.0, ez);
             }
             ThrusterRule::Distributed => {
                 for link in inner_first..=inner_last {
@@ -340,20 +424,78 @@ mod tests {
     }
 
     #[test]
-    fn paper_rule_reproduces_paper_layout() {
-        // With the paper's lengths the rule puts thrusters where docs/model.md §2 lists them.
+    fn paper_profile_and_rule_at_five_links_is_usm_paper() {
+        // USM Table II: the generated 5-link paper design has the preset's bodies (masses,
+        // lengths, inertias) and thrusters (bodies, positions, directions, limits).
         let spec = GeneratorSpec {
-            links: 5,
-            link_length: vec![0.62, 0.584, 0.726, 0.584, 0.37],
+            body_profile: BodyProfile::Paper,
             ..Default::default()
         };
         let g = spec.build("g").unwrap();
         let p = super::super::presets::usm_paper();
+        assert_eq!(g.bodies.len(), p.bodies.len());
+        for (a, b) in g.bodies.iter().zip(&p.bodies) {
+            assert_eq!((a.mass, a.length, a.volume), (b.mass, b.length, b.volume));
+            assert_eq!(a.inertia, b.inertia);
+        }
+        assert!((g.total_mass() - 81.3).abs() < 1e-9);
+        assert_eq!(g.thrusters.len(), p.thrusters.len());
         for (a, b) in g.thrusters.iter().zip(&p.thrusters) {
             assert_eq!(a.body, b.body);
-            assert!((a.position - b.position).norm() < 1e-12);
+            assert!((a.position - b.position).norm() < 1e-12, "{}", a.name);
             assert_eq!(a.direction, b.direction);
+            assert_eq!((a.u_min, a.u_max), (b.u_min, b.u_max));
         }
+        assert_eq!(g.joints.len(), p.joints.len());
+    }
+
+    #[test]
+    fn paper_rule_never_stacks_more_than_the_papers_per_link_count() {
+        // The paper carries 2, 3, 2 thrusters on links 1, 2, 3; at 3 and 4 links the groups
+        // that would share the middle link go to the end links instead.
+        for n in 3..=12 {
+            let spec = GeneratorSpec {
+                links: n,
+                ..Default::default()
+            };
+            let v = spec.build("g").unwrap();
+            assert_eq!(v.n_thrusters(), 7);
+            let mut per_body = std::collections::BTreeMap::new();
+            for t in &v.thrusters {
+                *per_body.entry(t.body).or_insert(0) += 1;
+            }
+            assert_eq!(per_body.len(), 3, "n = {n}: {per_body:?}");
+            assert!(per_body.values().all(|&c| c <= 3), "n = {n}: {per_body:?}");
+        }
+        let three = GeneratorSpec {
+            links: 3,
+            ..Default::default()
+        }
+        .build("g")
+        .unwrap();
+        let bodies: Vec<usize> = three.thrusters.iter().map(|t| t.body).collect();
+        assert_eq!(bodies, [0, 0, 2, 2, 2, 4, 4]);
+        let two = GeneratorSpec {
+            links: 2,
+            ..Default::default()
+        };
+        assert!(two.build("g").unwrap_err().to_string().contains("at least 3 links"));
+    }
+
+    #[test]
+    fn paper_profile_at_other_link_counts() {
+        // Tail 0.62, head 0.37, middle 0.726, other inner links 0.584 m.
+        let v = GeneratorSpec {
+            links: 7,
+            body_profile: BodyProfile::Paper,
+            ..Default::default()
+        }
+        .build("g")
+        .unwrap();
+        let lengths: Vec<f64> = (0..7).map(|k| v.bodies[link_body(k)].length).collect();
+        assert_eq!(lengths, [0.62, 0.584, 0.584, 0.726, 0.584, 0.584, 0.37]);
+        let masses: f64 = (0..7).map(|k| v.bodies[link_body(k)].mass).sum();
+        assert!((masses - (14.3 + 7.8 + 9.8 + 4.0 * 12.7)).abs() < 1e-9);
     }
 
     #[test]

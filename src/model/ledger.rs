@@ -337,8 +337,11 @@ pub const LEDGER: &[Assumption] = &[
     Assumption {
         key: "",
         name: "generator: thruster rules",
-        value: "paper (fractions of the usm-paper layout), distributed (0.35/0.65 of each inner link), \
-                ends (0.4/0.6 of the end links), longitudinal pair ±0.10 m on the middle link",
+        value: "paper (fractions of the usm-paper layout on links 1, ⌊N/2⌋, N−2; the end links at 3–4 \
+                links, never more than 3 per link), distributed (0.35/0.65 of each inner link), \
+                ends (0.4/0.6 of the end links), longitudinal pair ±0.10 m on the middle link; \
+                body profile `paper`: Table II's tail/head/middle/inner link lengths and masses \
+                at any N",
         source: Source::Inferred("rules of this workbench, generalising the inferred usm-paper layout"),
         range: None,
         note: "design-side (`generator.thruster_rule`)",

@@ -280,10 +280,11 @@ impl Study {
 
 /// Keys of the design generator table (design-file schema); `design.<key>` is an alias of
 /// `design.generator.<key>` when the base design uses the generator.
-pub const GENERATOR_KEYS: [&str; 14] = [
+pub const GENERATOR_KEYS: [&str; 15] = [
     "links",
     "link_length",
     "link_mass",
+    "body_profile",
     "radius",
     "module_length",
     "module_mass",

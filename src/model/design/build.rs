@@ -5,7 +5,7 @@
 use super::error::{DesignError, DesignErrorKind, DesignFault};
 use super::schema::{BodyRef, BodySpec, DesignFile, FrameSpec, HydroSpec, JointSpec, ThrusterSpec};
 use crate::input::document::Document;
-use crate::model::generator::{GeneratorSpec, ThrusterRule};
+use crate::model::generator::{BodyProfile, GeneratorSpec, ThrusterRule};
 use crate::model::presets;
 use crate::model::{Body, Fluid, Hydro, Joint, ModelError, Thruster, Vehicle};
 use crate::spatial::{rot_axis_angle, Mat3, Mat6, Se3, Vec3};
@@ -211,8 +211,29 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
             .parse::<ThrusterRule>()
             .map_err(|e| ctx.schema("generator.thruster_rule", e.to_string()))?,
     };
+    let body_profile = match &g.body_profile {
+        None => d.body_profile,
+        Some(s) => BodyProfile::parse(s).ok_or_else(|| {
+            ctx.schema(
+                "generator.body_profile",
+                format!("unknown body profile '{s}'; valid: uniform, paper"),
+            )
+        })?,
+    };
+    if body_profile == BodyProfile::Paper {
+        for key in ["link_length", "link_mass"] {
+            if ctx.doc.contains(&format!("generator.{key}")) {
+                return Err(ctx.invalid(
+                    &format!("generator.{key}"),
+                    "cannot be given with body_profile = \"paper\" (USM Table II sets every \
+                     link's length and mass)",
+                ));
+            }
+        }
+    }
     let spec = GeneratorSpec {
         links: g.links.unwrap_or(d.links),
+        body_profile,
         link_length: g
             .link_length
             .as_ref()

@@ -96,6 +96,7 @@ pub(super) struct GeneratorFile {
     pub(super) links: Option<usize>,
     pub(super) link_length: Option<OneOrMany>,
     pub(super) link_mass: Option<OneOrMany>,
+    pub(super) body_profile: Option<String>,
     pub(super) radius: Option<f64>,
     pub(super) module_length: Option<f64>,
     pub(super) module_mass: Option<f64>,

@@ -163,6 +163,20 @@ fn generator_files() {
     };
     assert_eq!(v, spec.build("g4").unwrap());
     assert_eq!((v.bodies.len(), v.n_joints(), v.n_thrusters()), (7, 6, 6));
+    // USM Table II from the generator; lengths cannot be given beside the profile.
+    let v = parse_design("[generator]\nbody_profile = \"paper\"\n", "p.toml").unwrap();
+    assert!((v.total_mass() - 81.3).abs() < 1e-9 && (v.total_length() - 3.3).abs() < 1e-9);
+    let e = parse_design(
+        "[generator]\nbody_profile = \"paper\"\nlink_length = 0.5\n",
+        "p.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("generator.link_length") && e.contains("Table II"), "{e}");
+    let e = parse_design("[generator]\nbody_profile = \"tabel\"\n", "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("uniform, paper"), "{e}");
     // Defaults only; name from the file stem.
     let v = parse_design("[generator]\n", "designs/usm5.toml").unwrap();
     assert_eq!(v, GeneratorSpec::default().build("usm5").unwrap());
