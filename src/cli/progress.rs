@@ -71,8 +71,11 @@ impl Progress {
             "?".into()
         };
         eprintln!(
-            "[{}] {done}/{} {}, {rate:.1} {}/s, ETA {eta}",
-            self.label, self.total, self.unit, self.unit
+            "[{}] {done}/{} {}, {}, ETA {eta}",
+            self.label,
+            self.total,
+            self.unit,
+            rate_text(rate, self.unit)
         );
     }
 
@@ -81,5 +84,27 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
+    }
+}
+
+/// A throughput readable at any speed: `12.3 cases/s`, or `25.4 s per case` below 0.5 per
+/// second (a robust study's cases take tens of seconds; "0.0 cases/s" says nothing).
+/// `unit` is the plural noun; its singular drops a trailing `s`.
+pub fn rate_text(per_second: f64, unit: &str) -> String {
+    if per_second >= 0.5 || per_second <= 0.0 || !per_second.is_finite() {
+        format!("{per_second:.1} {unit}/s")
+    } else {
+        let one = unit.strip_suffix('s').unwrap_or(unit);
+        format!("{:.1} s per {one}", 1.0 / per_second)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn slow_rates_read_as_seconds_per_item() {
+        assert_eq!(super::rate_text(12.34, "cases"), "12.3 cases/s");
+        assert_eq!(super::rate_text(0.04, "cases"), "25.0 s per case");
+        assert_eq!(super::rate_text(0.0, "cases"), "0.0 cases/s");
     }
 }

@@ -257,18 +257,21 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     }
     review("sweep", &outcome.out)?;
     eprintln!(
-        "[sweep] {} cases: {} ok, {} unsuccessful, {} failed, {} skipped; {:.1} s ({:.1} cases/s); wrote {}",
+        "[sweep] {} cases: {} ok, {} unsuccessful, {} failed, {} skipped; {:.1} s ({}); wrote {}",
         outcome.in_shard,
         outcome.ok,
         outcome.unsuccessful,
         outcome.failed,
         outcome.skipped,
         outcome.elapsed_s,
-        if outcome.elapsed_s > 0.0 {
-            outcome.ran as f64 / outcome.elapsed_s
-        } else {
-            0.0
-        },
+        super::progress::rate_text(
+            if outcome.elapsed_s > 0.0 {
+                outcome.ran as f64 / outcome.elapsed_s
+            } else {
+                0.0
+            },
+            "cases"
+        ),
         outcome.out.display()
     );
     print_verdict(&outcome.out);

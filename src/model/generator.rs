@@ -246,7 +246,10 @@ impl GeneratorSpec {
                 let lengths = per_link("link_length", &self.link_length, n)?;
                 let masses = if self.link_mass.is_empty() {
                     let r = self.radius;
-                    lengths.iter().map(|l| Fluid::default().rho * PI * r * r * l).collect()
+                    lengths
+                        .iter()
+                        .map(|l| Fluid::default().rho * PI * r * r * l)
+                        .collect()
                 } else {
                     per_link("link_mass", &self.link_mass, n)?
                 };
@@ -479,7 +482,11 @@ mod tests {
             links: 2,
             ..Default::default()
         };
-        assert!(two.build("g").unwrap_err().to_string().contains("at least 3 links"));
+        assert!(two
+            .build("g")
+            .unwrap_err()
+            .to_string()
+            .contains("at least 3 links"));
     }
 
     #[test]

@@ -172,7 +172,10 @@ fn generator_files() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("generator.link_length") && e.contains("Table II"), "{e}");
+    assert!(
+        e.contains("generator.link_length") && e.contains("Table II"),
+        "{e}"
+    );
     let e = parse_design("[generator]\nbody_profile = \"tabel\"\n", "p.toml")
         .unwrap_err()
         .to_string();
