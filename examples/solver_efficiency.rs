@@ -13,7 +13,11 @@
 //!
 //! ```sh
 //! cargo run --release --example solver_efficiency [OUT.csv]   # default benches/solver_efficiency.csv
+//! SOLVERS=nelder-mead,bayes BUDGET=75 cargo run --release --example solver_efficiency out.csv
 //! ```
+//!
+//! `SOLVERS` (comma-separated labels: nelder-mead, particle-swarm, cmaes, cmaes-0.2, bayes;
+//! default all) and `BUDGET` (evaluations per run, default 120) cut the work.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -29,8 +33,8 @@ use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::load_study;
 
-/// Evaluations per solver run.
-const BUDGET: usize = 120;
+/// Evaluations per solver run unless `BUDGET` says otherwise.
+const DEFAULT_BUDGET: usize = 120;
 
 /// Best feasible objective after each fresh evaluation (NaN before the first feasible one).
 fn curve(records: &[Record]) -> Vec<f64> {
@@ -87,25 +91,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         on_record: &quiet,
     };
     let seed = study.seed;
+    let budget: usize = std::env::var("BUDGET")
+        .ok()
+        .and_then(|b| b.parse().ok())
+        .unwrap_or(DEFAULT_BUDGET);
+    let chosen = std::env::var("SOLVERS").ok();
     // (label, settings, seeds): Nelder–Mead is deterministic, the others get three seeds.
-    let solvers: Vec<(&str, SolverSettings, u64)> = vec![
+    let mut solvers: Vec<(&str, SolverSettings, u64)> = vec![
         (
             "nelder-mead",
-            settings(Method::NelderMead, BUDGET, 4, 0.2, seed),
+            settings(Method::NelderMead, budget, 4, 0.2, seed),
             1,
         ),
         (
             "particle-swarm",
-            settings(Method::ParticleSwarm, BUDGET, 0, 0.1, seed),
+            settings(Method::ParticleSwarm, budget, 0, 0.1, seed),
             3,
         ),
-        ("cmaes", settings(Method::Cmaes, BUDGET, 3, 0.3, seed), 3),
+        ("cmaes", settings(Method::Cmaes, budget, 3, 0.3, seed), 3),
         (
             "cmaes-0.2",
-            settings(Method::Cmaes, BUDGET, 3, 0.2, seed),
+            settings(Method::Cmaes, budget, 3, 0.2, seed),
             3,
         ),
+        ("bayes", settings(Method::Bayes, budget, 0, 0.1, seed), 3),
     ];
+    if let Some(list) = &chosen {
+        solvers.retain(|(name, _, _)| list.split(',').any(|c| c.trim() == *name));
+    }
     let mut csv =
         String::from("design,solver,seed,evaluations,best,best_at_30,reference,evals_to_1pct\n");
     let mut hits: Vec<(String, Option<usize>, f64)> = Vec::new();
@@ -173,6 +186,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if polish.best().score.feasible {
             reference = reference.min(polish.best().score.objective);
         }
+        if !reference.is_finite() {
+            // No feasible point anywhere (e.g. a design the mission's reach rules out):
+            // nothing to come within 1 % of.
+            eprintln!("{design:16} no feasible point in any run: left out");
+            continue;
+        }
         for (name, k, c, _) in &runs {
             let hit = c.iter().position(|b| *b <= reference * 1.01).map(|i| i + 1);
             let best = c.last().copied().unwrap_or(f64::NAN);
@@ -192,9 +211,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     std::fs::write(&out, csv)?;
     eprintln!("wrote {out} in {:.0} s", t0.elapsed().as_secs_f64());
-    println!("| solver | runs | reached 1 % within {BUDGET} | median | 90th percentile | median gap at 30 |");
+    println!("| solver | runs | reached 1 % within {budget} | median | 90th percentile | median gap at 30 |");
     println!("|---|---|---|---|---|---|");
-    let show = |x: Option<usize>| x.map_or(format!("> {BUDGET}"), |v| v.to_string());
+    let show = |x: Option<usize>| x.map_or(format!("> {budget}"), |v| v.to_string());
     for (name, _, _) in &solvers {
         let h: Vec<Option<usize>> = hits.iter().filter(|x| x.0 == *name).map(|x| x.1).collect();
         let mut gaps: Vec<f64> = hits.iter().filter(|x| x.0 == *name).map(|x| x.2).collect();

@@ -141,6 +141,9 @@ fn each_solver_finds_the_rosenbrock_minimum() {
             5e-2,
         ),
         (Method::Cmaes, cmaes_solver(3000, 1e-14), 1e-3),
+        // A surrogate method: a small budget, a looser tolerance (its strength is the first
+        // tens of evaluations, not the last digits).
+        (Method::Bayes, solver(Method::Bayes, 1000, 150, 1e-6), 5e-2),
     ];
     for (m, s, tol) in cases {
         let o = solve(rosenbrock, &spec(box2(), s), 2);
@@ -164,10 +167,11 @@ fn each_solver_finds_the_bounded_quadratic_minimum_on_the_bound() {
         Method::Lbfgs,
         Method::ParticleSwarm,
         Method::Cmaes,
+        Method::Bayes,
     ] {
         let s = SolverSettings {
             step: if m == Method::Cmaes { 0.3 } else { 0.1 },
-            ..solver(m, 300, 3000, 1e-12)
+            ..solver(m, 300, if m == Method::Bayes { 120 } else { 3000 }, 1e-12)
         };
         let o = solve(bounded_quadratic, &spec(box2(), s), 1);
         let b = &o.best().x;
@@ -247,10 +251,11 @@ fn no_solver_evaluates_outside_the_bounds() {
         (Method::Lbfgs, 0.1),
         (Method::ParticleSwarm, 0.1),
         (Method::Cmaes, 0.5),
+        (Method::Bayes, 0.1),
     ] {
         let mut s = SolverSettings {
             step,
-            ..solver(m, 200, 400, 1e-9)
+            ..solver(m, 200, if m == Method::Bayes { 100 } else { 400 }, 1e-9)
         };
         s.restarts = 2;
         let ev = Recording {
@@ -439,7 +444,11 @@ fn history_and_best_do_not_depend_on_the_number_of_threads() {
         "method = \"cmaes\"\nrestarts = 1",
     );
     assert_ne!(cmaes, SMALL);
-    for text in [SMALL, cmaes.as_str()] {
+    let bayes = SMALL.replace(
+        "method = \"particle-swarm\"\nparticles = 5",
+        "method = \"bayes\"",
+    );
+    for text in [SMALL, cmaes.as_str(), bayes.as_str()] {
         let p = parse_problem(text, Path::new("small.toml")).unwrap();
         if p.spec.solver.method == Method::Cmaes {
             assert_eq!(p.spec.solver.step, 0.3, "CMA-ES's default σ0");

@@ -22,6 +22,7 @@
 //! The library API a caller (the `optimise` verb, a sweep tuning each case) uses is
 //! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
 
+pub mod bayes;
 pub mod cmaes;
 pub mod engine;
 pub mod evaluate;

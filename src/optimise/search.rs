@@ -32,6 +32,7 @@ use argmin::solver::quasinewton::LBFGS;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
+use super::bayes::{latin_hypercube, propose, Observation};
 use super::cmaes::{default_lambda, Cmaes};
 use super::history::{Evaluation, Journal, JournalError, Record};
 use super::problem::{Method, SolverSettings};
@@ -267,6 +268,20 @@ impl<'a, E: Evaluator> Search<'a, E> {
     fn exhausted(&self) -> bool {
         self.lock().exhausted
     }
+
+    /// Every recorded point so far as a surrogate's observation (repeats included once).
+    fn observations(&self) -> Vec<Observation> {
+        let st = self.lock();
+        st.records
+            .iter()
+            .filter(|r| !r.repeat)
+            .map(|r| Observation {
+                u: r.u.clone(),
+                objective: r.score.objective,
+                feasible: r.score.feasible,
+            })
+            .collect()
+    }
 }
 
 /// The problem handed to argmin (a reference: the search outlives each run).
@@ -334,6 +349,7 @@ pub fn run_solver<E: Evaluator>(search: &Search<'_, E>, s: &SolverSettings) -> V
             Method::ParticleSwarm => particle_swarm(search, s, run as u64),
             Method::Lbfgs => lbfgs(search, u0, s),
             Method::Cmaes => cmaes(search, u0, s, run),
+            Method::Bayes => bayes(search, s, run),
         };
         match result {
             Ok(r) => reasons.push(format!("run {}: {r}", run + 1)),
@@ -440,4 +456,31 @@ fn cmaes<E: Evaluator>(
         }
     }
     Ok(format!("{} generations (max_iters)", s.max_iters))
+}
+
+/// Bayesian optimisation ([`super::bayes`]), seeded by `(seed, run)`: the first run evaluates
+/// `max(d + 1, 2d)` Latin-hypercube points as one batch, then one proposal per iteration
+/// (each an iteration of the history) until `max_iters`, the budget, or no proposal.
+/// Restarts continue on every observation so far with a new seed.
+fn bayes<E: Evaluator>(
+    search: &Search<'_, E>,
+    s: &SolverSettings,
+    run: usize,
+) -> Result<String, Error> {
+    let d = search.space.dim();
+    let mut rng = rng_for(s.seed, run as u64);
+    if run == 0 {
+        search.iteration.store(1, Ordering::Relaxed);
+        search.batch(&latin_hypercube((d + 1).max(2 * d), d, &mut rng))?;
+    }
+    for it in 0..s.max_iters {
+        search.iteration.store(it + 2, Ordering::Relaxed);
+        let Some(u) = propose(&search.observations(), &mut rng) else {
+            return Ok(format!(
+                "no proposal after {it} iterations (surrogate not fitted)"
+            ));
+        };
+        search.batch(&[u])?;
+    }
+    Ok(format!("{} iterations (max_iters)", s.max_iters))
 }

@@ -24,15 +24,20 @@ pub enum Method {
     /// [`super::cmaes`]).
     #[serde(rename = "cmaes")]
     Cmaes,
+    /// Bayesian optimisation: Gaussian-process surrogates of the objective and of
+    /// feasibility, constrained expected improvement (global, seeded; [`super::bayes`]).
+    #[serde(rename = "bayes")]
+    Bayes,
 }
 
 impl Method {
     /// Every method, as written in problem files.
-    pub const ALL: [(&'static str, Method); 4] = [
+    pub const ALL: [(&'static str, Method); 5] = [
         ("nelder-mead", Method::NelderMead),
         ("particle-swarm", Method::ParticleSwarm),
         ("lbfgs", Method::Lbfgs),
         ("cmaes", Method::Cmaes),
+        ("bayes", Method::Bayes),
     ];
 
     /// The name as written.
@@ -61,7 +66,8 @@ pub struct SolverSettings {
     /// particle swarm with a new seed, CMA-ES from the best point so far with a new seed and
     /// twice the population (IPOP); default 0).
     pub restarts: usize,
-    /// Seed of the particle swarm and of CMA-ES (default: `study.seed`).
+    /// Seed of the particle swarm, of CMA-ES and of Bayesian optimisation (default:
+    /// `study.seed`).
     pub seed: u64,
     /// Particles of the swarm (default 12, at most [`MAX_PARTICLES`] and `max_evals`).
     pub particles: usize,
@@ -105,7 +111,7 @@ pub(super) fn parse_solver(
             doc.err(
                 &k("method"),
                 format!(
-                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs, cmaes",
+                    "unknown method `{}`; valid: nelder-mead, particle-swarm, lbfgs, cmaes, bayes",
                     s.method
                 ),
             )
