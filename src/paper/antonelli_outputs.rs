@@ -15,7 +15,8 @@ use serde::Serialize;
 use crate::dynamics::manoeuvring::ManoeuvringKernel;
 use crate::model::presets::uvms_planar;
 use crate::paper::antonelli::dynamic::{
-    run_dynamic_case, BaseTrajectory, Case3Reading, DynamicCase, DynamicHistory, CASE3_READINGS,
+    run_dynamic_case, run_dynamic_case_on, BaseTrajectory, Case3Reading, DynamicCase,
+    DynamicHistory, CASE3_READINGS,
 };
 use crate::paper::antonelli::{
     antonelli_case, run_kinematic_case, AntonelliCase, KinematicHistory, TaskTrace,
@@ -205,6 +206,8 @@ pub struct DynamicSummary {
     pub max_position_error: f64,
     /// Largest yaw error [rad].
     pub max_yaw_error: f64,
+    /// Largest `|r|` over the logged samples [rad/s].
+    pub max_yaw_rate: f64,
     /// Final pose `(x, y, ψ)` [m, m, rad].
     pub final_pose: [f64; 3],
     /// Final `‖f‖` [N] and `‖m‖` [N·m].
@@ -231,6 +234,7 @@ pub fn summarize_dynamic(h: &DynamicHistory) -> DynamicSummary {
         moment_integral_first_10s: logged_integral(&h.t, &h.moment_norm, 10.0),
         max_position_error: h.max_position_error(),
         max_yaw_error: h.max_yaw_error(),
+        max_yaw_rate: h.twist[5].iter().fold(0.0, |m: f64, r| m.max(r.abs())),
         final_pose: [
             last(&h.position[0]),
             last(&h.position[1]),
@@ -315,6 +319,8 @@ pub struct ReadingTable1 {
     pub reading: Case3Reading,
     /// Its Table I beside the paper's.
     pub table1: Table1,
+    /// The two runs (3a, 3b) in numbers.
+    pub runs: [DynamicSummary; 2],
 }
 
 /// Table I under every reading of [`CASE3_READINGS`], in that order; `case1` is case 1's
@@ -333,6 +339,71 @@ pub fn case3_readings(case1: &BaseTrajectory) -> Result<Vec<ReadingTable1>, Pipe
             Ok(ReadingTable1 {
                 reading: *reading,
                 table1: Table1::new(&a, &b),
+                runs: [summarize_dynamic(&a), summarize_dynamic(&b)],
+            })
+        })
+        .collect()
+}
+
+/// Table I as written with one group of the NPS AUV II's coefficients changed: how much of
+/// each entry that group carries (not a reading of the paper; the diagnosis of FINDINGS.md).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sensitivity {
+    /// Short name.
+    pub name: &'static str,
+    /// What is changed.
+    pub what: &'static str,
+    /// Table I beside the paper's.
+    pub table1: Table1,
+    /// The two runs (3a, 3b) in numbers.
+    pub runs: [DynamicSummary; 2],
+}
+
+type Change = fn(&mut crate::model::manoeuvring::Manoeuvring);
+
+/// The coefficient groups [`case3_sensitivities`] changes.
+const SENSITIVITIES: [(&str, &str, Change); 3] = [
+    (
+        "no_velocity_products",
+        "as written without the velocity-product derivatives (Healey's lift and coupling terms)",
+        |m| m.products.iter_mut().for_each(|p| p.fill(0.0)),
+    ),
+    (
+        "no_crossflow",
+        "as written without the cross-flow drag integrals",
+        |m| m.crossflow.width = 0.0,
+    ),
+    (
+        "crossflow_x1_8",
+        "as written with the cross-flow drag coefficients x1.8",
+        |m| {
+            m.crossflow.k_y *= 1.8;
+            m.crossflow.k_z *= 1.8;
+        },
+    ),
+];
+
+/// Table I as written under each coefficient change of the module's sensitivity list
+/// (velocity products off, cross-flow off, cross-flow ×1.8); `case1` as in
+/// [`case3_readings`].
+pub fn case3_sensitivities(case1: &BaseTrajectory) -> Result<Vec<Sensitivity>, PipelineError> {
+    let hold = BaseTrajectory::hold([0.0; 3]);
+    let reading = Case3Reading::AS_WRITTEN;
+    SENSITIVITIES
+        .iter()
+        .map(|(name, what, change)| {
+            let case = |n: &str| DynamicCase::from_reading(n, &reading);
+            let mut v = case("").vehicle();
+            if let crate::model::Hydro::Manoeuvring(m) = &mut v.bodies[0].hydro {
+                change(m);
+            }
+            let a = run_dynamic_case_on(&v, &case("case3a"), &hold)?;
+            let b = run_dynamic_case_on(&v, &case("case3b"), &reading.reference_b(case1))?;
+            Ok(Sensitivity {
+                name,
+                what,
+                table1: Table1::new(&a, &b),
+                runs: [summarize_dynamic(&a), summarize_dynamic(&b)],
             })
         })
         .collect()
@@ -363,6 +434,7 @@ struct Summary<'a> {
     table1_reading: &'static str,
     table1: &'a Table1,
     table1_readings: ReadingMap<'a>,
+    table1_sensitivity: &'a [Sensitivity],
     steady_current_forces: [SteadyCurrentForces; 2],
 }
 
@@ -414,6 +486,7 @@ pub fn run_antonelli(
         &as_written.reference_b(&case1),
     )?;
     let readings = case3_readings(&case1)?;
+    let sensitivity = case3_sensitivities(&case1)?;
     for h in [&a, &b] {
         write_table(h.columns(), &out.join(format!("{}.csv", h.name)))?;
     }
@@ -437,6 +510,7 @@ pub fn run_antonelli(
         table1_reading: as_written.name,
         table1: &table1,
         table1_readings: ReadingMap(&readings),
+        table1_sensitivity: &sensitivity,
         steady_current_forces: [
             steady_current_forces(&current, 0.0),
             steady_current_forces(&current, 0.78),
