@@ -23,7 +23,7 @@
 //!   ([`DynamicCase::surge_resistance`]);
 //! - the regulation law of the paper's reference [1], without feed-forward
 //!   ([`SlidingLaw::Regulation`]);
-//! - one account of the Munk moment: Healey's measured derivatives alone, without Fossen's
+//! - one account of the Munk moment: Healey's empirical derivatives alone, without Fossen's
 //!   added-mass Coriolis `C_A` on top ([`DynamicCase::added_mass_coriolis`] = false; the
 //!   free-body check of `tests/kirchhoff.rs` shows that a table which carries the Munk moment
 //!   plus `C_A` counts it twice).
@@ -153,9 +153,9 @@ pub struct DynamicCase {
     pub law: SlidingLaw,
     /// Add Fossen's added-mass Coriolis `C_A(ν_r) ν_r` to the derivative table
     /// ([`crate::model::manoeuvring::Manoeuvring::kirchhoff`]). As written: `false` — Healey's
-    /// measured derivatives already hold the Munk moment (their `N_uv`), as in MSS
+    /// empirical derivatives already hold the Munk moment (their `N_uv`), as in MSS
     /// `npsauv.m`; `true` counts it twice (AC-3's `C(q, ζ_r) ζ_r` after Fossen [5] taken
-    /// literally beside the measured table).
+    /// literally beside the empirical table).
     pub added_mass_coriolis: bool,
     /// Keep the surge resistance `Cd0 ½ρL² |u|u`, the only force a current along x̂ produces
     /// in the model. As written: `false` (the paper: "an ocean current parallel to the x̂
