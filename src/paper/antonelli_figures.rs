@@ -162,7 +162,7 @@ pub fn write_figures(
         norm_figure(
             dynamic,
             false,
-            "Case 3: norm of the vehicle forces (Fig. 7)",
+            "Case 3 as written: norm of the vehicle forces (Fig. 7)",
         ),
     ));
     figures.push((
@@ -170,7 +170,7 @@ pub fn write_figures(
         norm_figure(
             dynamic,
             true,
-            "Case 3: norm of the vehicle moments (Fig. 8)",
+            "Case 3 as written: norm of the vehicle moments (Fig. 8)",
         ),
     ));
     for (file, f) in figures {

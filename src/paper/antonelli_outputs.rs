@@ -2,9 +2,11 @@
 //! the kinematic cases 1, 1b and 2 ([`crate::paper::antonelli`]) on `uvms-planar` and the
 //! dynamic case 3 ([`crate::paper::antonelli::dynamic`]: the NPS AUV II under current,
 //! 3a holding its pose, 3b following case 1's re-orientation). Writes one CSV of time
-//! histories per case (`<case>.csv`), the paper-like figures (`fig*.svg`, see
-//! [`super::antonelli_figures`]) and a `summary.json` of what the paper's text claims, with
-//! `table1` beside the paper's Table I and the steady-state breakdown of the current forces.
+//! histories per case (`<case>.csv`; case 3 under the as-written reading), the paper-like
+//! figures (`fig*.svg`, see [`super::antonelli_figures`]) and a `summary.json` of what the
+//! paper's text claims, with `table1` (the as-written reading) and `table1_readings` (every
+//! named reading, [`CASE3_READINGS`]) beside the paper's Table I, and the steady-state
+//! breakdown of the current forces.
 
 use std::path::Path;
 
@@ -13,7 +15,8 @@ use serde::Serialize;
 use crate::dynamics::manoeuvring::ManoeuvringKernel;
 use crate::model::presets::uvms_planar;
 use crate::paper::antonelli::dynamic::{
-    run_dynamic_case, BaseTrajectory, DynamicCase, DynamicHistory,
+    run_dynamic_case, run_dynamic_case_on, BaseTrajectory, Case3Reading, DynamicCase,
+    DynamicHistory, CASE3_READINGS,
 };
 use crate::paper::antonelli::{
     antonelli_case, run_kinematic_case, AntonelliCase, KinematicHistory, TaskTrace,
@@ -132,7 +135,8 @@ impl Table1Values {
 }
 
 /// Table I of ours beside the paper's: the four integrals (`force_integral_a` … flattened into
-/// this object), the paper's values, ours/paper for each, and the a/b ratios.
+/// this object), the paper's values, the relative difference `ours/paper − 1` of each, and
+/// the a/b ratios.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Table1 {
     /// Ours.
@@ -140,8 +144,8 @@ pub struct Table1 {
     pub ours: Table1Values,
     /// The paper's.
     pub paper: Table1Values,
-    /// Ours divided by the paper's, entry by entry.
-    pub ours_over_paper: Table1Values,
+    /// `ours / paper − 1`, entry by entry (0.19: ours 19 % above the paper's).
+    pub relative_difference: Table1Values,
     /// `[force a/b, moment a/b]`, ours.
     pub ratio_a_over_b: [f64; 2],
     /// `[force a/b, moment a/b]`, the paper's (2.875, 1.638).
@@ -162,12 +166,12 @@ impl Table1 {
             .as_array()
             .iter()
             .zip(p.as_array())
-            .map(|(o, p)| o / p)
+            .map(|(o, p)| o / p - 1.0)
             .collect();
         Self {
             ours,
             paper: p,
-            ours_over_paper: Table1Values {
+            relative_difference: Table1Values {
                 force_integral_a: q[0],
                 force_integral_b: q[1],
                 moment_integral_a: q[2],
@@ -202,6 +206,8 @@ pub struct DynamicSummary {
     pub max_position_error: f64,
     /// Largest yaw error [rad].
     pub max_yaw_error: f64,
+    /// Largest `|r|` over the logged samples [rad/s].
+    pub max_yaw_rate: f64,
     /// Final pose `(x, y, ψ)` [m, m, rad].
     pub final_pose: [f64; 3],
     /// Final `‖f‖` [N] and `‖m‖` [N·m].
@@ -228,6 +234,7 @@ pub fn summarize_dynamic(h: &DynamicHistory) -> DynamicSummary {
         moment_integral_first_10s: logged_integral(&h.t, &h.moment_norm, 10.0),
         max_position_error: h.max_position_error(),
         max_yaw_error: h.max_yaw_error(),
+        max_yaw_rate: h.twist[5].iter().fold(0.0, |m: f64, r| m.max(r.abs())),
         final_pose: [
             last(&h.position[0]),
             last(&h.position[1]),
@@ -249,16 +256,23 @@ pub struct SteadyCurrentForces {
     pub resistance: [f64; 6],
     /// Cross-flow drag.
     pub crossflow: [f64; 6],
-    /// Added-mass Coriolis `−C_A(ν_r) ν_r` (the Munk moment `(M_A,22 − M_A,11) u v` on yaw),
-    /// part of the paper's AC-3 set-up ([`DynamicCase::added_mass_coriolis`]).
+    /// Added-mass Coriolis `−C_A(ν_r) ν_r` (the Munk moment `(M_A,11 − M_A,22) u v` on yaw, a
+    /// second time beside Healey's `N_uv`): only in the readings with
+    /// [`DynamicCase::added_mass_coriolis`].
     pub added_mass_coriolis: [f64; 6],
-    /// `‖f‖` and `‖m‖` of the total (all four parts) [N, N·m].
+    /// `‖f‖` and `‖m‖` [N, N·m] as written: products and cross-flow.
     pub norms: [f64; 2],
-    /// `100 s × norms`: what a perfect station keeper spends over the paper's 100 s.
+    /// `‖f‖` and `‖m‖` [N, N·m] of all four parts (the previous reading).
+    pub norms_previous: [f64; 2],
+    /// `100 s × norms`: what a perfect station keeper spends over the paper's 100 s, as
+    /// written.
     pub over_100s: [f64; 2],
+    /// `100 s × norms_previous`.
+    pub over_100s_previous: [f64; 2],
 }
 
-/// The current's force on the still vehicle at heading `psi` (at rest, so `V_r = −R_Ibᵀ ν_c`).
+/// The current's force on the still vehicle at heading `psi` (at rest, so `V_r = −R_Ibᵀ ν_c`),
+/// by part; the norms as written (no surge resistance, no `C_A`) and with every part.
 pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> SteadyCurrentForces {
     let v = nps_auv2();
     let hydro = nps_auv2_hydro(v.fluid.rho);
@@ -280,11 +294,9 @@ pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> Steady
     // Fossen's C_A(ν_r) ν_r at CO (the Kirchhoff term; the water applies its negative).
     let m_a = Se3::new(hydro.axes, Vec3::zeros()).inertia_to_parent(&hydro.added_mass);
     let ca = -cross_force(&rel, &(m_a * rel));
-    let total = pr + re + cf + ca;
-    let norms = [
-        total.fixed_rows::<3>(0).norm(),
-        total.fixed_rows::<3>(3).norm(),
-    ];
+    let norms_of = |w: Vec6| [w.fixed_rows::<3>(0).norm(), w.fixed_rows::<3>(3).norm()];
+    let norms = norms_of(pr + cf);
+    let norms_previous = norms_of(pr + re + cf + ca);
     let arr = |w: Vec6| [w[0], w[1], w[2], w[3], w[4], w[5]];
     SteadyCurrentForces {
         heading: psi,
@@ -293,78 +305,123 @@ pub fn steady_current_forces(current: &crate::spatial::Vec3, psi: f64) -> Steady
         crossflow: arr(cf),
         added_mass_coriolis: arr(ca),
         norms,
+        norms_previous,
         over_100s: norms.map(|n| 100.0 * n),
+        over_100s_previous: norms_previous.map(|n| 100.0 * n),
     }
 }
 
-/// Table I's four integrals under one modelling choice other than the paper's set-up.
+/// Table I under one named reading of case 3 ([`CASE3_READINGS`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Case3Variant {
-    /// Short name.
-    pub name: &'static str,
-    /// What differs from [`DynamicCase::paper`] and case 3b's reference.
-    pub what: &'static str,
-    /// The integrals (a and b).
-    pub values: Table1Values,
+pub struct ReadingTable1 {
+    /// The reading: its name, what it is and its switches.
+    #[serde(flatten)]
+    pub reading: Case3Reading,
+    /// Its Table I beside the paper's.
+    pub table1: Table1,
+    /// The two runs (3a, 3b) in numbers.
+    pub runs: [DynamicSummary; 2],
 }
 
-/// The diagnostic variants of case 3 (`hold`: 3a's reference; `case1`: 3b's): the MSS form
-/// without `C_A`; 3b re-orienting in place (case 1's yaw, position held), with and without
-/// current; sliding-mode gains ×4 (`K_D`, and `Λ` = 1 1/s).
-pub fn case3_variants(
-    hold: &BaseTrajectory,
-    case1: &BaseTrajectory,
-) -> Result<Vec<Case3Variant>, PipelineError> {
-    let mut in_place = case1.clone();
-    for k in 0..2 {
-        in_place.pose[k].iter_mut().for_each(|x| *x = 0.0);
-        in_place.rate[k].iter_mut().for_each(|x| *x = 0.0);
-    }
-    let paper = DynamicCase::paper("variant");
-    let mut mss = paper.clone();
-    mss.added_mass_coriolis = false;
-    let mut still = paper.clone();
-    still.current = crate::spatial::Vec3::zeros();
-    let mut stiff = paper.clone();
-    stiff.gains.k_d.iter_mut().for_each(|k| *k *= 4.0);
-    stiff.gains.lambda = [1.0; 6];
-    let runs: [(&'static str, &'static str, &DynamicCase, &BaseTrajectory); 4] = [
-        (
-            "mss_without_c_a",
-            "no added-mass Coriolis C_A (MSS npsauv.m form)",
-            &mss,
-            case1,
-        ),
-        (
-            "reorientation_in_place",
-            "3b: case 1's yaw, position held at the origin",
-            &paper,
-            &in_place,
-        ),
-        (
-            "reorientation_in_place_still_water",
-            "3b re-orienting in place without current (a: holds still in still water)",
-            &still,
-            &in_place,
-        ),
-        ("gains_x4", "K_D ×4 and Λ = 1 1/s", &stiff, case1),
-    ];
-    runs.into_iter()
-        .map(|(name, what, case, b_ref)| {
-            let a = run_dynamic_case(case, hold)?;
-            let b = run_dynamic_case(case, b_ref)?;
-            Ok(Case3Variant {
-                name,
-                what,
-                values: Table1Values {
-                    force_integral_a: a.force_integral,
-                    force_integral_b: b.force_integral,
-                    moment_integral_a: a.moment_integral,
-                    moment_integral_b: b.moment_integral,
-                },
+/// Table I under every reading of [`CASE3_READINGS`], in that order; `case1` is case 1's
+/// vehicle motion ([`BaseTrajectory::from_kinematic`]), from which each reading takes 3b's
+/// reference ([`Case3Reading::reference_b`]); 3a holds the initial pose.
+pub fn case3_readings(case1: &BaseTrajectory) -> Result<Vec<ReadingTable1>, PipelineError> {
+    let hold = BaseTrajectory::hold([0.0; 3]);
+    CASE3_READINGS
+        .iter()
+        .map(|reading| {
+            let a = run_dynamic_case(&DynamicCase::from_reading("case3a", reading), &hold)?;
+            let b = run_dynamic_case(
+                &DynamicCase::from_reading("case3b", reading),
+                &reading.reference_b(case1),
+            )?;
+            Ok(ReadingTable1 {
+                reading: *reading,
+                table1: Table1::new(&a, &b),
+                runs: [summarize_dynamic(&a), summarize_dynamic(&b)],
             })
         })
         .collect()
+}
+
+/// Table I as written with one group of the NPS AUV II's coefficients changed: how much of
+/// each entry that group carries (not a reading of the paper; the diagnosis of FINDINGS.md).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sensitivity {
+    /// Short name.
+    pub name: &'static str,
+    /// What is changed.
+    pub what: &'static str,
+    /// Table I beside the paper's.
+    pub table1: Table1,
+    /// The two runs (3a, 3b) in numbers.
+    pub runs: [DynamicSummary; 2],
+}
+
+type Change = fn(&mut crate::model::manoeuvring::Manoeuvring);
+
+/// The coefficient groups [`case3_sensitivities`] changes.
+const SENSITIVITIES: [(&str, &str, Change); 3] = [
+    (
+        "no_velocity_products",
+        "as written without the velocity-product derivatives (Healey's lift and coupling terms)",
+        |m| m.products.iter_mut().for_each(|p| p.fill(0.0)),
+    ),
+    (
+        "no_crossflow",
+        "as written without the cross-flow drag integrals",
+        |m| m.crossflow.width = 0.0,
+    ),
+    (
+        "crossflow_x1_8",
+        "as written with the cross-flow drag coefficients x1.8",
+        |m| {
+            m.crossflow.k_y *= 1.8;
+            m.crossflow.k_z *= 1.8;
+        },
+    ),
+];
+
+/// Table I as written under each coefficient change of the module's sensitivity list
+/// (velocity products off, cross-flow off, cross-flow ×1.8); `case1` as in
+/// [`case3_readings`].
+pub fn case3_sensitivities(case1: &BaseTrajectory) -> Result<Vec<Sensitivity>, PipelineError> {
+    let hold = BaseTrajectory::hold([0.0; 3]);
+    let reading = Case3Reading::AS_WRITTEN;
+    SENSITIVITIES
+        .iter()
+        .map(|(name, what, change)| {
+            let case = |n: &str| DynamicCase::from_reading(n, &reading);
+            let mut v = case("").vehicle();
+            if let crate::model::Hydro::Manoeuvring(m) = &mut v.bodies[0].hydro {
+                change(m);
+            }
+            let a = run_dynamic_case_on(&v, &case("case3a"), &hold)?;
+            let b = run_dynamic_case_on(&v, &case("case3b"), &reading.reference_b(case1))?;
+            Ok(Sensitivity {
+                name,
+                what,
+                table1: Table1::new(&a, &b),
+                runs: [summarize_dynamic(&a), summarize_dynamic(&b)],
+            })
+        })
+        .collect()
+}
+
+/// `table1_readings` of `summary.json`: an object keyed by reading name, in
+/// [`CASE3_READINGS`] order.
+struct ReadingMap<'a>(&'a [ReadingTable1]);
+
+impl Serialize for ReadingMap<'_> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(self.0.len()))?;
+        for r in self.0 {
+            m.serialize_entry(r.reading.name, r)?;
+        }
+        m.end()
+    }
 }
 
 /// `summary.json`: the case summaries, Table I and the choices the paper leaves open.
@@ -374,8 +431,10 @@ struct Summary<'a> {
     inferred: &'static str,
     cases: &'a [CaseSummary],
     case3: &'a [DynamicSummary],
+    table1_reading: &'static str,
     table1: &'a Table1,
-    table1_variants: &'a [Case3Variant],
+    table1_readings: ReadingMap<'a>,
+    table1_sensitivity: &'a [Sensitivity],
     steady_current_forces: [SteadyCurrentForces; 2],
 }
 
@@ -384,12 +443,12 @@ struct Summary<'a> {
 pub struct AntonelliOutcome {
     /// Cases 1, 1b, 2.
     pub kinematic: Vec<CaseSummary>,
-    /// Cases 3a, 3b.
+    /// Cases 3a, 3b (as written).
     pub dynamic: Vec<DynamicSummary>,
-    /// Table I, ours beside the paper's.
+    /// Table I as written, ours beside the paper's.
     pub table1: Table1,
-    /// Table I under other modelling choices (the diagnosis of the differences).
-    pub variants: Vec<Case3Variant>,
+    /// Table I under every named reading (the as-written one first).
+    pub readings: Vec<ReadingTable1>,
 }
 
 fn write_table(columns: Vec<(String, &[f64])>, path: &Path) -> Result<(), PipelineError> {
@@ -418,11 +477,16 @@ pub fn run_antonelli(
         summaries.push(s);
         histories.push(h);
     }
-    let reference_b = case3b_reference()?;
+    let case1 = case1_vehicle_motion()?;
+    let as_written = Case3Reading::AS_WRITTEN;
     let hold = BaseTrajectory::hold([0.0; 3]);
     let a = run_dynamic_case(&DynamicCase::paper("case3a"), &hold)?;
-    let b = run_dynamic_case(&DynamicCase::paper("case3b"), &reference_b)?;
-    let variants = case3_variants(&hold, &reference_b)?;
+    let b = run_dynamic_case(
+        &DynamicCase::paper("case3b"),
+        &as_written.reference_b(&case1),
+    )?;
+    let readings = case3_readings(&case1)?;
+    let sensitivity = case3_sensitivities(&case1)?;
     for h in [&a, &b] {
         write_table(h.columns(), &out.join(format!("{}.csv", h.name)))?;
     }
@@ -435,14 +499,18 @@ pub fn run_antonelli(
         inferred: "arm geometry of uvms-planar (SPEC §8); 10 s kinematic runs (the quintic's \
                    duration); RK4 at 1 ms, samples every 50 ms; Moore–Penrose pseudoinverses \
                    of the planar Jacobians (λ = 0). Case 3: the NPS AUV II alone (legacy MSS \
-                   constants ρ = 1000, m = 5454.54), starting at rest; the MSS derivative \
-                   table as damping beside Fossen's added-mass Coriolis C_A (AC-3); \
-                   sliding-mode gains and boundary layer of control::sliding; 100 Hz control, \
-                   RK4 at 10 ms; 3b follows case 1's vehicle motion and then holds it",
+                   constants ρ = 1000, m = 5454.54), starting at rest; sliding-mode gains and \
+                   boundary layer of paper::sliding; 100 Hz control, RK4 at 10 ms. Read from \
+                   the text (table1, reading as_written): 3b follows case 1's heading with \
+                   the position held; no surge resistance (a current along x is not \
+                   modelled); the regulation law of ref. [1] without feed-forward; Healey's \
+                   derivatives alone (no C_A on top). Other readings: table1_readings",
         cases: &summaries,
         case3: &dynamic,
+        table1_reading: as_written.name,
         table1: &table1,
-        table1_variants: &variants,
+        table1_readings: ReadingMap(&readings),
+        table1_sensitivity: &sensitivity,
         steady_current_forces: [
             steady_current_forces(&current, 0.0),
             steady_current_forces(&current, 0.78),
@@ -454,7 +522,7 @@ pub fn run_antonelli(
         kinematic: summaries,
         dynamic,
         table1,
-        variants,
+        readings,
     })
 }
 
@@ -466,9 +534,9 @@ pub fn run_antonelli(
 pub enum AntonelliPreset {
     /// A kinematic case (1, 1b, 2).
     Kinematic(AntonelliCase),
-    /// Case 3a: hold the pose against the current.
+    /// Case 3a: hold the pose against the current (as written).
     Case3a,
-    /// Case 3b: follow case 1's re-orientation.
+    /// Case 3b: follow case 1's re-orientation (as written: heading only, position held).
     Case3b,
 }
 
@@ -495,8 +563,9 @@ impl AntonelliPreset {
     }
 }
 
-/// Case 1's vehicle motion sampled at case 3's control rate (10 ms): the reference of 3b.
-fn case3b_reference() -> Result<BaseTrajectory, PipelineError> {
+/// Case 1's vehicle motion sampled at case 3's control rate (10 ms), from which each reading
+/// takes 3b's reference ([`Case3Reading::reference_b`]).
+pub fn case1_vehicle_motion() -> Result<BaseTrajectory, PipelineError> {
     let mut case1 = antonelli_case(AntonelliCase::Case1);
     case1.record_every = 10;
     Ok(BaseTrajectory::from_kinematic(&run_kinematic_case(
@@ -522,7 +591,10 @@ pub fn run_antonelli_preset(
             let (name, reference) = if preset == AntonelliPreset::Case3a {
                 ("case3a", BaseTrajectory::hold([0.0; 3]))
             } else {
-                ("case3b", case3b_reference()?)
+                (
+                    "case3b",
+                    Case3Reading::AS_WRITTEN.reference_b(&case1_vehicle_motion()?),
+                )
             };
             let h = run_dynamic_case(&DynamicCase::paper(name), &reference)?;
             write_table(h.columns(), &out.join(format!("{name}.csv")))?;

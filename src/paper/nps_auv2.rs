@@ -15,7 +15,8 @@
 //!   propeller-race terms (`Zqn`, `Zwn`, `Kpn`, `Mqn`, `Mwn`) enter with MSS's ε = −1 of a
 //!   stopped propeller;
 //! - surge resistance `−Cd0 ½ρL² |u| u` (MSS writes `u²`, which pushes backwards whatever
-//!   the sign of `u`);
+//!   the sign of `u`); case 3 as written turns it off
+//!   ([`crate::paper::antonelli::dynamic::DynamicCase::surge_resistance`]);
 //! - cross-flow integrand for pitch `(w − x q)` like heave (MSS has `w + x q`, notes §5.3;
 //!   no difference in the planar motions of case 3).
 //!

@@ -1,18 +1,33 @@
-//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (docs/model.md §8), after their
-//! reference [1] (Antonelli & Chiaverini, ACC 1998, "Singularity-free regulation of UVMS"),
-//! whose law is not restated in the seed and whose text we did not have. We use the
-//! quaternion-based sliding-mode law in the form of Antonelli's later book ("Underwater
-//! Robots", after Slotine & Li), from memory of that book — an inference:
+//! Sliding-mode vehicle control for Antonelli & Chiaverini's case 3 (docs/model.md §8).
+//!
+//! What the paper says of it, in full (section 5, third case study): "Two simulations have
+//! been performed considering the full-dimensional dynamic model of the NPS AUV II under a
+//! sliding mode control law [1]", with "[1] G. Antonelli and S. Chiaverini, *Singularity-Free
+//! Regulation of Underwater Vehicle-Manipulator Systems*, Proc. American Control Conference,
+//! Philadelphia, PA, 1998". The law of [1] is a **regulation** law (its title); its text is
+//! not in the seed and we did not have it. We use the quaternion-based sliding-mode law in the
+//! form of Antonelli's later book ("Underwater Robots", after Slotine & Li), from memory of
+//! that book — an inference. Its regulation form ([`SlidingLaw::Regulation`], the paper's
+//! case 3 as written) is
 //!
 //! ```text
-//! s = [R_Ibᵀ ṗ_d − v; R_Ibᵀ ω_d − ω] + Λ [R_Ibᵀ (p_d − p); ε̃],   τ = K_D s + K_S sat(s/φ) + ĝ
+//! s = Λ [R_Ibᵀ (p_d − p); ε̃] − [v; ω],   τ = K_D s + K_S sat(s/φ) + ĝ
 //! ```
 //!
-//! with `V_b = [v; ω]` the base twist in `F_b`, `(p_d, R_d)` the desired base pose in the
-//! inertial frame, `ṗ_d, ω_d` its rates (inertial), `ε̃` the vector part of `R_Ibᵀ R_d` as a
-//! quaternion with non-negative scalar part (the orientation error in `F_b`, ≈ ½θ axis), and
-//! `ĝ = −(restoring wrench)` the compensation of weight and buoyancy. `τ` is the base wrench
-//! `[f; m]` in `F_b` [N, N·m].
+//! with no feed-forward of the reference's velocity or acceleration: a moving set-point
+//! `(p_d(t), R_d(t))` is regulated to as if it were constant at each instant. The tracking form
+//! ([`SlidingLaw::Tracking`], the project's earlier reading) adds the reference's velocity to
+//! the sliding variable:
+//!
+//! ```text
+//! s = [R_Ibᵀ ṗ_d − v; R_Ibᵀ ω_d − ω] + Λ [R_Ibᵀ (p_d − p); ε̃]
+//! ```
+//!
+//! Neither form feeds the reference acceleration forward. `V_b = [v; ω]` is the base twist in
+//! `F_b`, `(p_d, R_d)` the desired base pose in the inertial frame, `ṗ_d, ω_d` its rates
+//! (inertial), `ε̃` the vector part of `R_Ibᵀ R_d` as a quaternion with non-negative scalar
+//! part (the orientation error in `F_b`, ≈ ½θ axis), and `ĝ = −(restoring wrench)` the
+//! compensation of weight and buoyancy. `τ` is the base wrench `[f; m]` in `F_b` [N, N·m].
 //!
 //! Inferred (stated, overridable in [`SlidingModeGains`]): the boundary layer `φ` replacing
 //! `sign(s)` by a saturation (no chattering: a chattering switch term would add its own
@@ -88,9 +103,20 @@ pub struct PoseReference {
     pub angular_velocity: Vec3,
 }
 
-/// The sliding variable `s` (in `F_b`) of the law in the module doc.
+/// Which form of the sliding variable (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlidingLaw {
+    /// `s = Λ ỹ − ν`: the regulation law of the paper's reference [1]; the reference's
+    /// velocity never enters.
+    Regulation,
+    /// `s = ν_d + Λ ỹ − ν`: the reference's velocity fed forward (tracking).
+    Tracking,
+}
+
+/// The sliding variable `s` (in `F_b`) of the law in the module doc, in the form `law`.
 pub fn sliding_variable(
     gains: &SlidingModeGains,
+    law: SlidingLaw,
     pose: &BasePose,
     twist: &Vec6,
     reference: &PoseReference,
@@ -98,10 +124,15 @@ pub fn sliding_variable(
     let rt = pose.orientation.inverse();
     let e_p = rt * (reference.position - pose.position);
     let e_o = quat_error_vec(&reference.orientation, &pose.orientation);
-    let v_d = rt * reference.velocity;
-    let w_d = rt * reference.angular_velocity;
     let err = [e_p.x, e_p.y, e_p.z, e_o.x, e_o.y, e_o.z];
-    let vel = [v_d.x, v_d.y, v_d.z, w_d.x, w_d.y, w_d.z];
+    let vel = match law {
+        SlidingLaw::Regulation => [0.0; 6],
+        SlidingLaw::Tracking => {
+            let v_d = rt * reference.velocity;
+            let w_d = rt * reference.angular_velocity;
+            [v_d.x, v_d.y, v_d.z, w_d.x, w_d.y, w_d.z]
+        }
+    };
     Vec6::from_fn(|i, _| vel[i] - twist[i] + gains.lambda[i] * err[i])
 }
 
@@ -130,7 +161,7 @@ mod tests {
             velocity: Vec3::zeros(),
             angular_velocity: Vec3::zeros(),
         };
-        let s = sliding_variable(&g, &pose, &Vec6::zeros(), &r);
+        let s = sliding_variable(&g, SlidingLaw::Regulation, &pose, &Vec6::zeros(), &r);
         assert_eq!(s, Vec6::zeros());
         let rest = Vec6::new(0.0, 0.0, 3.0, 1.0, 0.0, 0.0);
         assert_eq!(sliding_mode_wrench(&g, &s, &rest), -rest);
@@ -153,12 +184,44 @@ mod tests {
             velocity: Vec3::zeros(),
             angular_velocity: Vec3::zeros(),
         };
-        let s = sliding_variable(&g, &pose, &Vec6::zeros(), &r);
+        let s = sliding_variable(&g, SlidingLaw::Regulation, &pose, &Vec6::zeros(), &r);
         let tau = sliding_mode_wrench(&g, &s, &Vec6::zeros());
         assert!(
             tau[1] < 0.0 && tau[0].abs() < 1e-9 * tau[1].abs(),
             "{tau:?}"
         );
         assert!(tau[5] > 0.0, "{tau:?}");
+    }
+
+    #[test]
+    fn regulation_ignores_the_reference_velocity_and_tracking_feeds_it_forward() {
+        // Regulation (the paper's reference [1]): s = Λ ỹ − ν whatever the reference's rates;
+        // tracking adds R_Ibᵀ ṗ_d and R_Ibᵀ ω_d.
+        let g = SlidingModeGains::default();
+        let pose = BasePose {
+            orientation: UnitQuaternion::from_axis_angle(&Vec3::z_axis(), 0.4),
+            position: Vec3::new(0.1, -0.2, 0.0),
+        };
+        let twist = Vec6::new(0.05, -0.02, 0.0, 0.0, 0.0, 0.03);
+        let still = PoseReference {
+            position: Vec3::new(0.3, 0.1, 0.0),
+            orientation: UnitQuaternion::from_axis_angle(&Vec3::z_axis(), 0.6),
+            velocity: Vec3::zeros(),
+            angular_velocity: Vec3::zeros(),
+        };
+        let moving = PoseReference {
+            velocity: Vec3::new(0.7, -0.4, 0.0),
+            angular_velocity: Vec3::new(0.0, 0.0, 0.25),
+            ..still
+        };
+        let reg =
+            |r: &PoseReference| sliding_variable(&g, SlidingLaw::Regulation, &pose, &twist, r);
+        let trk = |r: &PoseReference| sliding_variable(&g, SlidingLaw::Tracking, &pose, &twist, r);
+        assert_eq!(reg(&still), reg(&moving));
+        assert_eq!(reg(&still), trk(&still));
+        let ff = trk(&moving) - trk(&still);
+        let body_v = pose.orientation.inverse() * moving.velocity;
+        assert!((ff[0] - body_v.x).abs() < 1e-15 && (ff[1] - body_v.y).abs() < 1e-15);
+        assert!((ff[5] - 0.25).abs() < 1e-15, "{ff:?}");
     }
 }

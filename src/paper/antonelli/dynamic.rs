@@ -5,13 +5,32 @@
 //!
 //! - **3a**: the vehicle holds its initial pose (0, 0, ψ = 0): the control forces only
 //!   compensate the current;
-//! - **3b**: the vehicle follows the vehicle motion of case 1 (re-orientation to
-//!   ψ = 0.78 rad into the current within 10 s, position held by the secondary task), then
-//!   holds the final pose.
+//! - **3b**: the vehicle "moves according to the results of the first simulation in the first
+//!   case study" (the paper): it re-orients to ψ = 0.78 rad into the current within 10 s
+//!   along case 1's heading, then holds the final pose.
 //!
 //! The paper's Table I is `∫‖f‖dt` and `∫‖m‖dt` of the generalised control forces `τ_r`
 //! (AC-2) over the run: [`DynamicHistory::force_integral`], [`DynamicHistory::moment_integral`]
 //! (the control wrench is held over each control period, so the sums are exact).
+//!
+//! **Readings.** The text leaves four choices to interpretation; a [`Case3Reading`] fixes them.
+//! The default, [`Case3Reading::AS_WRITTEN`], takes the text literally:
+//! - 3b holds the vehicle's position, as case 1 does ("the end-effector location and vehicle
+//!   position are held while the vehicle body is re-oriented"), and follows case 1's heading
+//!   only;
+//! - a current along x̂ produces no force ("an ocean current parallel to the x̂ axis is not
+//!   even modelled"): the surge resistance `Cd0 ½ρL² |u|u` is off
+//!   ([`DynamicCase::surge_resistance`]);
+//! - the regulation law of the paper's reference [1], without feed-forward
+//!   ([`SlidingLaw::Regulation`]);
+//! - one account of the Munk moment: Healey's empirical derivatives alone, without Fossen's
+//!   added-mass Coriolis `C_A` on top ([`DynamicCase::added_mass_coriolis`] = false; the
+//!   free-body check of `tests/kirchhoff.rs` shows that a table which carries the Munk moment
+//!   plus `C_A` counts it twice).
+//!
+//! [`Case3Reading::PREVIOUS`] is the project's earlier reading (3b follows case 1's vehicle
+//! translation too, surge resistance on, tracking with feed-forward, `C_A` on top);
+//! [`CASE3_READINGS`] lists every named reading that `paper antonelli` reports.
 //!
 //! Inferred (the paper does not say; overridable in [`DynamicCase`]): the vehicle alone (the
 //! arm's parameters are unknown, docs/model.md §8), starting at rest; depth, roll and pitch references
@@ -23,9 +42,10 @@ use crate::dynamics::{
     Simulator,
 };
 use crate::kinematics::BasePose;
+use crate::model::{Hydro, Vehicle};
 use crate::paper::nps_auv2::{actuator_thrusts, nps_auv2};
 use crate::paper::sliding::{
-    sliding_mode_wrench, sliding_variable, PoseReference, SlidingModeGains,
+    sliding_mode_wrench, sliding_variable, PoseReference, SlidingLaw, SlidingModeGains,
 };
 use crate::scenario::ScenarioError;
 use crate::spatial::{euler_zyx, Vec3, Vec6};
@@ -128,26 +148,206 @@ pub struct DynamicCase {
     pub current: Vec3,
     /// Sliding-mode gains.
     pub gains: SlidingModeGains,
+    /// The form of the sliding variable: [`SlidingLaw::Regulation`] (as written: the
+    /// paper's reference [1] is a regulation law) or [`SlidingLaw::Tracking`].
+    pub law: SlidingLaw,
     /// Add Fossen's added-mass Coriolis `C_A(ν_r) ν_r` to the derivative table
-    /// ([`crate::model::manoeuvring::Manoeuvring::kirchhoff`]). The paper's set-up: `true`
-    /// (AC-3 writes `C(q, ζ_r) ζ_r` after Fossen [5], whose `C` holds `C_A`); `false` is
-    /// MSS `npsauv.m`.
+    /// ([`crate::model::manoeuvring::Manoeuvring::kirchhoff`]). As written: `false` — Healey's
+    /// empirical derivatives already hold the Munk moment (their `N_uv`), as in MSS
+    /// `npsauv.m`; `true` counts it twice (AC-3's `C(q, ζ_r) ζ_r` after Fossen [5] taken
+    /// literally beside the empirical table).
     pub added_mass_coriolis: bool,
+    /// Keep the surge resistance `Cd0 ½ρL² |u|u`, the only force a current along x̂ produces
+    /// in the model. As written: `false` (the paper: "an ocean current parallel to the x̂
+    /// axis is not even modelled").
+    pub surge_resistance: bool,
 }
 
+/// One reading of case 3's set-up (module doc): which of the text's open choices a run
+/// makes. Turned into settings by [`DynamicCase::from_reading`] and 3b's reference by
+/// [`Case3Reading::reference_b`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Case3Reading {
+    /// Short name (`as_written`, `previous`, …): the key in `summary.json`.
+    pub name: &'static str,
+    /// What the reading is, in words.
+    pub what: &'static str,
+    /// 3b follows case 1's vehicle translation as well as its heading (`false`: the
+    /// position is held at its start, as case 1's text says it is).
+    pub follow_case1_translation: bool,
+    /// [`DynamicCase::surge_resistance`].
+    pub surge_resistance: bool,
+    /// Feed the reference's velocity forward ([`SlidingLaw::Tracking`]; `false`:
+    /// [`SlidingLaw::Regulation`]).
+    pub feed_forward: bool,
+    /// [`DynamicCase::added_mass_coriolis`].
+    pub added_mass_coriolis: bool,
+    /// The paper's current (`false`: still water).
+    pub current: bool,
+    /// `K_D` ×4 and `Λ` = 1 1/s instead of the default gains.
+    pub stiff_gains: bool,
+}
+
+impl Case3Reading {
+    /// The text taken literally (the default; module doc).
+    pub const AS_WRITTEN: Case3Reading = Case3Reading {
+        name: "as_written",
+        what: "as written: position held in 3b, no force from a current along x, \
+               regulation law (no feed-forward), Healey's derivatives alone (Munk moment once)",
+        follow_case1_translation: false,
+        surge_resistance: false,
+        feed_forward: false,
+        added_mass_coriolis: false,
+        current: true,
+        stiff_gains: false,
+    };
+
+    /// The project's earlier default: 3b follows case 1's translation and heading, surge
+    /// resistance on, tracking with feed-forward, Fossen's `C_A` on top of Healey's table.
+    pub const PREVIOUS: Case3Reading = Case3Reading {
+        name: "previous",
+        what: "earlier default: 3b follows case 1's translation and heading, surge resistance, \
+               tracking with feed-forward, C_A on top of Healey's derivatives",
+        follow_case1_translation: true,
+        surge_resistance: true,
+        feed_forward: true,
+        added_mass_coriolis: true,
+        current: true,
+        stiff_gains: false,
+    };
+
+    /// 3b's reference under this reading, from case 1's vehicle motion `case1`
+    /// ([`BaseTrajectory::from_kinematic`]): as it is, or with the position held at the
+    /// start (`x, y` and their rates from the first sample).
+    pub fn reference_b(&self, case1: &BaseTrajectory) -> BaseTrajectory {
+        let mut r = case1.clone();
+        if !self.follow_case1_translation {
+            for k in 0..2 {
+                let x0 = r.pose[k].first().copied().unwrap_or(0.0);
+                r.pose[k].iter_mut().for_each(|x| *x = x0);
+                r.rate[k].iter_mut().for_each(|x| *x = 0.0);
+            }
+        }
+        r
+    }
+}
+
+/// Every named reading `paper antonelli` reports, the default first: the as-written one, the
+/// earlier default, each of the four choices flipped alone from the as-written one, its gain
+/// and still-water checks, and the earlier diagnostic variants of the previous default.
+pub const CASE3_READINGS: [Case3Reading; 12] = [
+    Case3Reading::AS_WRITTEN,
+    Case3Reading::PREVIOUS,
+    Case3Reading {
+        name: "as_written_with_c_a",
+        what: "as written, plus Fossen's C_A on top of Healey's derivatives (Munk moment twice)",
+        added_mass_coriolis: true,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "as_written_with_surge_resistance",
+        what: "as written, plus the surge resistance Cd0 (a current along x pushes)",
+        surge_resistance: true,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "as_written_with_feed_forward",
+        what: "as written, but tracking: the reference's velocity fed forward",
+        feed_forward: true,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "as_written_with_case1_translation",
+        what: "as written, but 3b follows case 1's vehicle translation as well",
+        follow_case1_translation: true,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "as_written_gains_x4",
+        what: "as written, with K_D x4 and Lambda = 1 1/s",
+        stiff_gains: true,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "as_written_still_water",
+        what: "as written, without current (a: nothing to do; b: the re-orientation alone)",
+        current: false,
+        ..Case3Reading::AS_WRITTEN
+    },
+    Case3Reading {
+        name: "previous_without_c_a",
+        what: "previous, without C_A (the MSS npsauv.m form)",
+        added_mass_coriolis: false,
+        ..Case3Reading::PREVIOUS
+    },
+    Case3Reading {
+        name: "previous_in_place",
+        what: "previous, but 3b holds the position (case 1's heading only)",
+        follow_case1_translation: false,
+        ..Case3Reading::PREVIOUS
+    },
+    Case3Reading {
+        name: "previous_in_place_still_water",
+        what: "previous, 3b holding the position, without current",
+        follow_case1_translation: false,
+        current: false,
+        ..Case3Reading::PREVIOUS
+    },
+    Case3Reading {
+        name: "previous_gains_x4",
+        what: "previous, with K_D x4 and Lambda = 1 1/s",
+        stiff_gains: true,
+        ..Case3Reading::PREVIOUS
+    },
+];
+
 impl DynamicCase {
-    /// The paper's set-up named `name`.
+    /// The paper's set-up named `name`, as written ([`Case3Reading::AS_WRITTEN`]).
     pub fn paper(name: &str) -> Self {
-        let c = 0.1 * std::f64::consts::SQRT_2;
+        Self::from_reading(name, &Case3Reading::AS_WRITTEN)
+    }
+
+    /// The set-up named `name` under `reading`.
+    pub fn from_reading(name: &str, reading: &Case3Reading) -> Self {
+        let c = if reading.current {
+            0.1 * std::f64::consts::SQRT_2
+        } else {
+            0.0
+        };
+        let mut gains = SlidingModeGains::default();
+        if reading.stiff_gains {
+            gains.k_d.iter_mut().for_each(|k| *k *= 4.0);
+            gains.lambda = [1.0; 6];
+        }
         Self {
             name: name.into(),
             duration: 100.0,
             control_dt: 0.01,
             log_every: 20,
             current: Vec3::new(c, c, 0.0),
-            gains: SlidingModeGains::default(),
-            added_mass_coriolis: true,
+            gains,
+            law: if reading.feed_forward {
+                SlidingLaw::Tracking
+            } else {
+                SlidingLaw::Regulation
+            },
+            added_mass_coriolis: reading.added_mass_coriolis,
+            surge_resistance: reading.surge_resistance,
         }
+    }
+
+    /// The vehicle this case simulates: the NPS AUV II ([`nps_auv2`]) in the case's current,
+    /// with `C_A` and the surge resistance as the case says.
+    pub fn vehicle(&self) -> Vehicle {
+        let mut v = nps_auv2();
+        v.fluid.current = self.current;
+        if let Hydro::Manoeuvring(m) = &mut v.bodies[0].hydro {
+            m.kirchhoff = self.added_mass_coriolis;
+            if !self.surge_resistance {
+                m.quadratic[0] = 0.0;
+            }
+        }
+        v
     }
 
     /// Positive finite times, `log_every ≥ 1`, finite current, valid gains.
@@ -259,18 +459,31 @@ impl DynamicHistory {
 }
 
 /// Run case 3 with reference `reference` (3a: [`BaseTrajectory::hold`] of the initial pose;
-/// 3b: [`BaseTrajectory::from_kinematic`] of case 1). The vehicle starts at rest at the
-/// reference's initial pose. Errors on invalid settings; a numerical failure of the
-/// simulation is reported as an error naming the quantity and time.
+/// 3b: [`Case3Reading::reference_b`] of case 1's [`BaseTrajectory::from_kinematic`]) on the
+/// case's vehicle ([`DynamicCase::vehicle`]). The vehicle starts at rest at the reference's
+/// initial pose. Errors on invalid settings; a numerical failure of the simulation is
+/// reported as an error naming the quantity and time.
 pub fn run_dynamic_case(
     case: &DynamicCase,
     reference: &BaseTrajectory,
 ) -> Result<DynamicHistory, ScenarioError> {
+    run_dynamic_case_on(&case.vehicle(), case, reference)
+}
+
+/// [`run_dynamic_case`] on a given vehicle `v` (for sensitivity studies: [`DynamicCase::vehicle`]
+/// with some coefficients changed). `v` must have six base actuators laid out as
+/// [`nps_auv2`]'s ([`actuator_thrusts`]); its `fluid.current` is used as it is.
+pub fn run_dynamic_case_on(
+    v: &Vehicle,
+    case: &DynamicCase,
+    reference: &BaseTrajectory,
+) -> Result<DynamicHistory, ScenarioError> {
     case.validate()?;
-    let mut v = nps_auv2();
-    v.fluid.current = case.current;
-    if let crate::model::Hydro::Manoeuvring(m) = &mut v.bodies[0].hydro {
-        m.kirchhoff = case.added_mass_coriolis;
+    if v.thrusters.len() != 6 || v.n_joints() != 0 {
+        return Err(ScenarioError::Rule(
+            "case 3 needs a jointless vehicle with the six base actuators of nps_auv2",
+        )
+        .in_case(&case.name));
     }
     let cfg = SimConfig {
         integrator: Integrator::Rk4 {
@@ -279,15 +492,15 @@ pub fn run_dynamic_case(
         ..SimConfig::default()
     };
     let sim_err = |e: crate::dynamics::SimError| ScenarioError::Sim(e).in_case(&case.name);
-    let mut sim = Simulator::new(&v, cfg).map_err(sim_err)?;
+    let mut sim = Simulator::new(v, cfg).map_err(sim_err)?;
     let r0 = reference.reference(0.0);
-    let mut state = SimState::rest(&v);
+    let mut state = SimState::rest(v);
     state.pose = BasePose {
         orientation: r0.orientation,
         position: r0.position,
     };
     sim.set_state(state).map_err(sim_err)?;
-    let mut ws = DynWorkspace::new(&v);
+    let mut ws = DynWorkspace::new(v);
     let mut restoring = [0.0; 6];
     let mut h = DynamicHistory {
         name: case.name.clone(),
@@ -298,8 +511,8 @@ pub fn run_dynamic_case(
         let t = step as f64 * case.control_dt;
         let r = reference.reference(t);
         let s = sim.state();
-        restoring_generalized(&v, &mut ws, &s.pose, &[], &mut restoring);
-        let sv = sliding_variable(&case.gains, &s.pose, &s.base_twist, &r);
+        restoring_generalized(v, &mut ws, &s.pose, &[], &mut restoring);
+        let sv = sliding_variable(&case.gains, case.law, &s.pose, &s.base_twist, &r);
         let tau = sliding_mode_wrench(&case.gains, &sv, &Vec6::from_column_slice(&restoring));
         if step % case.log_every == 0 || step == steps {
             h.log(t, s, &r, &tau);
