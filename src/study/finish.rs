@@ -8,6 +8,7 @@ use super::doe::expand;
 use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
 use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use super::rerank::Rerank;
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
@@ -106,16 +107,39 @@ fn rerun_extremes(
 }
 
 /// Regenerate `summary.md` and the plots of an output directory from `cases.parquet` (or
-/// `cases.csv`) and `manifest.json`.
+/// `cases.csv`) and `manifest.json`; returns non-fatal warnings.
 pub fn report(dir: &Path) -> Result<Notes, StudyError> {
-    let m = read_manifest(dir)?;
+    Ok(report_ranked(dir, &Rerank::default())?.warnings)
+}
+
+/// What [`report_ranked`] wrote besides the report.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reported {
+    /// Outputs that could not be written.
+    pub warnings: Notes,
+    /// What the re-ranking changed (see [`super::rerank`]).
+    pub notes: Notes,
+}
+
+/// [`report`] re-ranked by `rerank` (`usm-study report DIR --objective M --pareto A,B`): an
+/// unknown metric is refused (bad input, with the closest name) before anything is written.
+pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError> {
+    let mut m = read_manifest(dir)?;
     let pq = dir.join(CASES_PARQUET);
-    let table = if pq.is_file() {
+    let mut table = if pq.is_file() {
         crate::report::read_parquet(&pq)?
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
         let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
-    Ok(write_report(dir, &table, &m))
+    let notes = if rerank.is_empty() {
+        Notes::new()
+    } else {
+        super::rerank::apply(dir, &mut m, &mut table, rerank)?
+    };
+    Ok(Reported {
+        warnings: write_report(dir, &table, &m),
+        notes,
+    })
 }
