@@ -48,6 +48,16 @@ fn every_thruster_fails_once_and_the_summary_tables_the_outcome() {
     for (out, jobs) in [(&one, "1"), (&two, "2")] {
         let o = sweep(&study, out, &["--jobs", jobs]);
         assert!(o.status.success(), "{}", stderr(&o));
+        // The end of a sweep names its answer and where the review page is.
+        let err = stderr(&o);
+        assert!(
+            err.contains("[sweep] best by `") && err.contains(" at "),
+            "{err}"
+        );
+        assert!(
+            err.contains("[sweep] review: ") && err.contains("report.html"),
+            "{err}"
+        );
     }
     let csv = String::from_utf8(read(&one.join("cases.csv"))).unwrap();
     assert_eq!(read(&one.join("cases.csv")), read(&two.join("cases.csv")));

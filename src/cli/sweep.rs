@@ -360,8 +360,8 @@ fn parse_pareto(s: &str) -> Result<[String; 2], String> {
     }
 }
 
-/// The verdict `summary.md` opens with (a study with uncertain worlds), as plain text, and
-/// where the review page is.
+/// The verdict `summary.md` opens with (a study with uncertain worlds) as plain text, else the
+/// best case by the objective, and where the review page is.
 fn print_verdict(verb: &str, dir: &Path) {
     let Ok(md) = std::fs::read_to_string(dir.join("summary.md")) else {
         return;
@@ -369,6 +369,8 @@ fn print_verdict(verb: &str, dir: &Path) {
     let plain = |s: &str| s.replace("**", "").replace('`', "");
     if let Some(v) = usm_study::study::summary_robust::summary_verdict(&md) {
         eprintln!("[{verb}] {}", plain(v));
+    } else if let Some(best) = usm_study::study::finish::best_case_line(dir) {
+        eprintln!("[{verb}] {best}");
     }
     // The leader's caveats, as the box lists them.
     let opening = usm_study::study::summary_robust::summary_opening(&md).unwrap_or("");

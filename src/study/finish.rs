@@ -143,3 +143,23 @@ pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError
         notes,
     })
 }
+
+/// The terminal's one-line answer of a study output without uncertain worlds (which have a
+/// verdict line instead): the best successful case by the objective, its design and value,
+/// e.g. "best by `mission_cost` (min): #41 (distributed/9/0.14) at 1.2345"; `None` when
+/// no case is ranked or the files cannot be read.
+pub fn best_case_line(dir: &Path) -> Option<String> {
+    let m = read_manifest(dir).ok()?;
+    let table = crate::report::read_parquet(&dir.join(CASES_PARQUET)).ok()?;
+    let sel = Selection::new(&table, &m);
+    let o = sel.objective.as_deref()?;
+    let row = sel.best_row(&table, o, false)?;
+    let id = table.i64(CASE_ID).ok()?.get(row).copied()?;
+    let axes: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    Some(format!(
+        "best by `{o}` ({}): #{id} ({}) at {}",
+        sel.goal(o),
+        super::plots::case_name(&table, &axes, row),
+        super::selection::cell_text(&table, o, row)
+    ))
+}
