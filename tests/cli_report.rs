@@ -443,6 +443,21 @@ fn the_case_table_parquet_carries_units_types_and_meanings() {
     assert_eq!(kind("case_id"), ColumnKind::I64);
     assert_eq!(kind("status"), ColumnKind::Str);
     assert_eq!(kind("peak_thrust"), ColumnKind::F64);
+    // Counts are whole numbers in every case here: stored as integers, "3" in the CSV.
+    assert_eq!(kind("design_thrusters"), ColumnKind::I64);
+    let csv = String::from_utf8(read(&out.join("cases.csv"))).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let k = head.iter().position(|h| *h == "design_joints").unwrap();
+    let joints: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(k).unwrap())
+        .collect();
+    assert_eq!(
+        joints,
+        ["4", "4", "8", "8"],
+        "two joints between neighbouring links"
+    );
     let meta = parquet_metadata(&pq).unwrap();
     let text = &meta
         .iter()
@@ -460,6 +475,7 @@ fn the_case_table_parquet_carries_units_types_and_meanings() {
     assert_eq!(col("peak_thrust")["unit"], "N");
     assert_eq!(col("peak_thrust")["type"], "f64");
     assert_eq!(col("case_id")["type"], "i64");
+    assert_eq!(col("design_thrusters")["type"], "i64");
     assert!(col("design.links")["meaning"]
         .as_str()
         .unwrap()

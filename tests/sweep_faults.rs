@@ -76,7 +76,9 @@ fn every_thruster_fails_once_and_the_summary_tables_the_outcome() {
     for x in column(&csv, "fault_tolerance") {
         assert_eq!(x.parse::<f64>().unwrap(), 6.0 / 7.0);
     }
-    assert_eq!(column(&csv, "worst_fault"), ["2.0", "2.0"]);
+    // A thruster number: written as an integer.
+    assert_eq!(column(&csv, "worst_fault"), ["2", "2"]);
+    assert_eq!(column(&csv, "design_thrusters"), ["7", "7"]);
     // pinv misses cross_track_bound (index 3 in Criterion::ALL), qp max_saturation_fraction (2).
     assert_eq!(column(&csv, "fault.t2.missed"), ["3.0", "2.0"]);
     assert_eq!(column(&csv, "fault.t1.change"), ["0.0", "0.0"]);

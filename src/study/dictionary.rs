@@ -70,11 +70,11 @@ const DESIGN: &[ColumnDoc] = &[
     c(
         "design_bodies",
         "–",
-        "f64",
+        "i64",
         "number of rigid bodies of the built design",
     ),
-    c("design_joints", "–", "f64", "number of revolute joints"),
-    c("design_thrusters", "–", "f64", "number of thrusters"),
+    c("design_joints", "–", "i64", "number of revolute joints"),
+    c("design_thrusters", "–", "i64", "number of thrusters"),
     c(
         "design_length_m",
         "m",
@@ -112,22 +112,22 @@ const AUTHORITY: &[ColumnDoc] = &[
     c("authority_mission_min_force", "N", "f64", "as authority_min_force over the declared mission range (`static.joint_range` / `joint_ranges`); NaN without one"),
     c("authority_mission_min_moment", "N·m", "f64", "as authority_min_moment over the declared mission range; NaN without one"),
     c("under_actuated", "0/1", "f64", "a flag, not ranked: 1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
-    c("under_actuated_axes", "bitmask", "f64", "an identifier, not ranked: bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
+    c("under_actuated_axes", "bitmask", "i64", "an identifier, not ranked: bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
     c("n1_worst_force", "N", "f64", "N−1: smallest commanded force with one thruster removed (held at zero thrust), over thrusters and the N−1 configurations (q = 0 and the first `static.n1_samples` samples)"),
     c("n1_worst_moment", "N·m", "f64", "N−1: smallest commanded moment with one thruster removed"),
     c("n1_mean_force", "N", "f64", "N−1: mean over the removed thruster of its smallest commanded force"),
     c("n1_mean_moment", "N·m", "f64", "N−1: mean over the removed thruster of its smallest commanded moment"),
-    c("n1_worst_thruster", "index", "f64", "number (from 1: thruster `T1` is 1) of the thruster whose removal loses the largest fraction of authority; an identifier, not ranked"),
+    c("n1_worst_thruster", "index", "i64", "number (from 1: thruster `T1` is 1) of the thruster whose removal loses the largest fraction of authority; an identifier, not ranked"),
     c("n1_worst_loss", "–", "f64", "that fraction: the largest n1_loss_t{i}"),
     c("n1_loss_t{i}", "–", "f64", "fraction of authority lost when thruster `T<i>` (i = 1 … 16) is removed, worst commanded axis, sign and N−1 configuration: 1 − (authority without it)/(authority with it), over the axes and signs it had authority on (0: nothing lost, 1: an axis lost entirely); NaN beyond the design's thrusters"),
 ];
 
 const TUNING: &[ColumnDoc] = &[
     c("tuned.<param>", "as the key", "f64", "the tuned value of each `[[tune.param]]` (e.g. `tuned.control.k_psi`), at which the case is scored"),
-    c("tune_evaluations", "–", "f64", "fresh closed-loop runs the tuning used"),
+    c("tune_evaluations", "–", "i64", "fresh closed-loop runs the tuning used"),
     c("tune_feasible", "0/1", "f64", "1 when the tuned point met every `[[tune.constraint]]`"),
     c("tune_noise", "–", "f64", "relative spread (max − min)/min of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start"),
-    c("tune_bound_hits", "–", "f64", "tuned parameters within 0.1 % of a bound of their box"),
+    c("tune_bound_hits", "–", "i64", "tuned parameters within 0.1 % of a bound of their box"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
@@ -243,7 +243,7 @@ const WORLDS: &[ColumnDoc] = &[
 const FAULTS: &[ColumnDoc] = &[
     c("fault_time", "s", "f64", "a run with a scenario `[fault]`: the simulation time the fault struck (NaN if the run ended before `fault.at`)"),
     c("fault_tolerance", "–", "f64", "fraction of the design's thrusters whose single fault (`[faults]`, re-run at the case's values in the nominal world) still leaves the run successful"),
-    c("worst_fault", "index", "f64", "number (from 1: thruster `T1` is 1) of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest number; an identifier, not ranked"),
+    c("worst_fault", "index", "i64", "number (from 1: thruster `T1` is 1) of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest number; an identifier, not ranked"),
     c("fault.t<j>.success", "0/1", "f64", "the run with thruster `T<j>` (j from 1) failed met every `[success]` criterion (NaN: the design has no thruster `T<j>`)"),
     c("fault.t<j>.objective", "as the objective", "f64", "the study's objective (`study.objective`, else the worlds' objective, else `energy_per_metre`) with thruster <j> failed"),
     c("fault.t<j>.change", "–", "f64", "relative change of the objective from the nominal run with thruster <j> failed, `(x − x₀)/|x₀|`"),
@@ -625,6 +625,42 @@ fn named_doc(name: &str) -> Option<&'static ColumnDoc> {
         .iter()
         .flat_map(|(_, cols)| cols.iter())
         .find(|c| c.name == name)
+}
+
+/// Whether `column` holds whole numbers (counts, numbers of things, bitmasks): the dictionary
+/// types it `i64`. The case tables are computed in `f64` (NaN where a case has no value); their
+/// files store such a column as integers when every value is one ([`integers_for_files`]).
+pub fn is_integer_column(column: &str) -> bool {
+    describe(column).is_some_and(|d| d.kind == "i64")
+        && !matches!(
+            column,
+            "case_id" | "world" | "evaluation" | "run" | "iteration"
+        )
+}
+
+/// Store the integer columns of a case table (see [`is_integer_column`]) as `i64` when every
+/// value is a whole number (`to_files`), or back as `f64` after reading a file (`!to_files`),
+/// so that the report computes on `f64` and the files say "3", not "3.0". A column holding a
+/// NaN (a case that did not build or run) stays `f64`. Exact both ways for |x| < 2⁵³.
+pub fn integers_for_files(table: &mut crate::report::Table, to_files: bool) {
+    use crate::report::ColumnData;
+    for c in &mut table.columns {
+        if !is_integer_column(&c.name) {
+            continue;
+        }
+        let data = match &c.data {
+            ColumnData::F64(v)
+                if to_files && v.iter().all(|x| x.fract() == 0.0 && x.abs() < 9.0e15) =>
+            {
+                ColumnData::I64(v.iter().map(|x| *x as i64).collect())
+            }
+            ColumnData::I64(v) if !to_files => {
+                ColumnData::F64(v.iter().map(|x| *x as f64).collect())
+            }
+            _ => continue,
+        };
+        c.data = data;
+    }
 }
 
 /// `docs/columns.md`'s tables.

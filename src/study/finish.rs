@@ -133,6 +133,7 @@ pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError
         let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
+    super::dictionary::integers_for_files(&mut table, false);
     let notes = if rerank.is_empty() {
         Notes::new()
     } else {
@@ -150,7 +151,8 @@ pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError
 /// no case is ranked or the files cannot be read.
 pub fn best_case_line(dir: &Path) -> Option<String> {
     let m = read_manifest(dir).ok()?;
-    let table = crate::report::read_parquet(&dir.join(CASES_PARQUET)).ok()?;
+    let mut table = crate::report::read_parquet(&dir.join(CASES_PARQUET)).ok()?;
+    super::dictionary::integers_for_files(&mut table, false);
     let sel = Selection::new(&table, &m);
     let o = sel.objective.as_deref()?;
     let row = sel.best_row(&table, o, false)?;

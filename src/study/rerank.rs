@@ -14,10 +14,10 @@ use std::path::Path;
 use super::error::{Notes, StudyError};
 use super::manifest::{write_manifest, Manifest};
 use super::records::{Extreme, CASES_CSV, CASES_PARQUET};
-use super::robust::{add_rank_columns, write_cases_parquet, P_BEST, RANK_COLUMNS, WORLDS_CSV};
+use super::robust::{add_rank_columns, write_case_files, P_BEST, RANK_COLUMNS, WORLDS_CSV};
 use super::selection::Selection;
 use crate::input::keypath::did_you_mean;
-use crate::report::{read_csv, write_csv_streamed, Table};
+use crate::report::{read_csv, Table};
 
 /// A re-ranking: the objective and the Pareto pair `[x, y]` to report by (`None`: as the
 /// study set them).
@@ -89,9 +89,8 @@ pub fn apply(
                 .columns
                 .retain(|c| c.name != P_BEST && !RANK_COLUMNS.contains(&c.name.as_str()));
             add_rank_columns(table, &worlds, info);
-            write_csv_streamed(table, &dir.join(CASES_CSV))?;
             let axes: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
-            write_cases_parquet(table, dir, &axes)?;
+            write_case_files(table, dir, &axes)?;
             notes.push(format!(
                 "p_best and the rank quantiles recomputed over the worlds by `{o}`; \
                  {CASES_CSV} and {CASES_PARQUET} rewritten"

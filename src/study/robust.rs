@@ -448,14 +448,18 @@ pub fn write_tables(
             add_rank_columns(&mut table, &worlds, info);
         }
     }
-    write_csv_streamed(&table, &out.join(CASES_CSV))?;
-    write_cases_parquet(&table, out, axes)?;
+    write_case_files(&mut table, out, axes)?;
     Ok(table)
 }
 
-/// Write `table` to [`CASES_PARQUET`] in `out`, with the dictionary of its columns in the
-/// file's metadata.
-pub fn write_cases_parquet(table: &Table, out: &Path, axes: &[&str]) -> Result<(), StudyError> {
+/// Write `table` to [`CASES_CSV`] and [`CASES_PARQUET`] in `out`: whole-number columns as
+/// integers ([`super::dictionary::integers_for_files`]; `table` is left as it was), the
+/// dictionary of the columns in the Parquet file's metadata.
+pub fn write_case_files(table: &mut Table, out: &Path, axes: &[&str]) -> Result<(), StudyError> {
+    super::dictionary::integers_for_files(table, true);
     let meta = super::dictionary::parquet_metadata(table, axes);
-    Ok(write_parquet_with(table, &out.join(CASES_PARQUET), &meta)?)
+    let written = write_csv_streamed(table, &out.join(CASES_CSV))
+        .and_then(|()| write_parquet_with(table, &out.join(CASES_PARQUET), &meta));
+    super::dictionary::integers_for_files(table, false);
+    Ok(written?)
 }
