@@ -359,3 +359,125 @@ fn the_report_renders_in_a_headless_browser() {
         colours.len()
     );
 }
+
+/// `report DIR --objective M --pareto X,Y` re-ranks a finished study without re-running it:
+/// summary.md, the Pareto plot and report.html use the new objective and pair, manifest.json
+/// records them; a misspelt metric is refused (exit 2) with the closest name and leaves the
+/// output as it was.
+#[test]
+fn report_re_ranks_a_finished_study_by_another_objective() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = sweep(dir.path());
+    let md0 = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        md0.contains("Objective (best/worst case): `mission_cost`"),
+        "{md0}"
+    );
+    let o = run(&["report", arg(&out), "--objective", "peak_thrusts"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--objective: unknown metric `peak_thrusts`")
+            && stderr(&o).contains("did you mean `peak_thrust`?"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&["report", arg(&out), "--pareto", "peak_thrust,worst_fault"]);
+    assert_eq!(o.status.code(), Some(2), "an identifier is not a metric");
+    assert_eq!(
+        std::fs::read_to_string(out.join("summary.md")).unwrap(),
+        md0,
+        "a refused re-ranking writes nothing"
+    );
+    let o = run(&[
+        "report",
+        arg(&out),
+        "--objective",
+        "peak_thrust",
+        "--pareto",
+        "peak_thrust,saturation_fraction",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("ranked by `peak_thrust` (min)"),
+        "{}",
+        stderr(&o)
+    );
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        md.contains("Objective (best/worst case): `peak_thrust`"),
+        "{md}"
+    );
+    assert!(
+        md.contains("## Pareto-optimal cases: `peak_thrust` vs `saturation_fraction`"),
+        "{md}"
+    );
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&read(&out.join("manifest.json"))).unwrap();
+    assert_eq!(manifest["report"]["objective"], "peak_thrust");
+    assert_eq!(
+        manifest["report"]["pareto"],
+        serde_json::json!(["peak_thrust", "saturation_fraction"])
+    );
+    let pareto = String::from_utf8(read(&out.join("plots/pareto.svg"))).unwrap();
+    assert!(pareto.contains("Pareto front: peak thrust [N] vs saturation fraction"));
+    let html = String::from_utf8(read(&out.join("report.html"))).unwrap();
+    assert!(html.contains("peak_thrust"));
+    // A later report without options keeps the recorded ranking.
+    let o = run(&["report", arg(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(out.join("summary.md")).unwrap(), md);
+}
+
+/// `cases.parquet` carries the data dictionary in its file metadata: every column with its
+/// unit, type (as stored) and meaning; read back, the types are the table's (ids as integers,
+/// status as text).
+#[test]
+fn the_case_table_parquet_carries_units_types_and_meanings() {
+    use usm_study::report::{parquet_metadata, read_parquet, ColumnKind};
+    use usm_study::study::dictionary::PARQUET_COLUMNS_KEY;
+    let dir = tempfile::tempdir().unwrap();
+    let out = sweep(dir.path());
+    let pq = out.join("cases.parquet");
+    let table = read_parquet(&pq).unwrap();
+    let kind = |n: &str| table.column(n).unwrap().data.kind();
+    assert_eq!(kind("case_id"), ColumnKind::I64);
+    assert_eq!(kind("status"), ColumnKind::Str);
+    assert_eq!(kind("peak_thrust"), ColumnKind::F64);
+    // Counts are whole numbers in every case here: stored as integers, "3" in the CSV.
+    assert_eq!(kind("design_thrusters"), ColumnKind::I64);
+    let csv = String::from_utf8(read(&out.join("cases.csv"))).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let k = head.iter().position(|h| *h == "design_joints").unwrap();
+    let joints: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(k).unwrap())
+        .collect();
+    assert_eq!(
+        joints,
+        ["4", "4", "8", "8"],
+        "two joints between neighbouring links"
+    );
+    let meta = parquet_metadata(&pq).unwrap();
+    let text = &meta
+        .iter()
+        .find(|(k, _)| k == PARQUET_COLUMNS_KEY)
+        .unwrap()
+        .1;
+    let cols: Vec<serde_json::Value> = serde_json::from_str(text).unwrap();
+    let names: Vec<&str> = cols.iter().map(|c| c["name"].as_str().unwrap()).collect();
+    let table_names: Vec<&str> = table.columns.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, table_names, "one entry per column, in order");
+    for c in &cols {
+        assert!(c["unit"].is_string() && c["meaning"].is_string(), "{c}");
+    }
+    let col = |n: &str| cols.iter().find(|c| c["name"] == n).unwrap();
+    assert_eq!(col("peak_thrust")["unit"], "N");
+    assert_eq!(col("peak_thrust")["type"], "f64");
+    assert_eq!(col("case_id")["type"], "i64");
+    assert_eq!(col("design_thrusters")["type"], "i64");
+    assert!(col("design.links")["meaning"]
+        .as_str()
+        .unwrap()
+        .contains("[[axis]]"));
+}

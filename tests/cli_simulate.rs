@@ -291,3 +291,49 @@ distribution = { kind = "uniform", low = 0.0, high = 2.0 }
         "{e}"
     );
 }
+
+/// Ctrl-C (SIGINT) stops a run cleanly at its next control period: the outputs of the run up
+/// to then are written, stderr says when it stopped and what was written, and the exit code
+/// is 130. The run is 10⁴ s long, so it is always still going when the signal comes.
+#[test]
+fn ctrl_c_stops_a_run_and_says_what_was_written() {
+    use std::io::{BufRead, BufReader};
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().display().to_string();
+    let mut child = common::usm_study()
+        .args([
+            "simulate",
+            "transport-method1",
+            "--out",
+            &out,
+            "--no-plots",
+            "--set",
+            "scenario.duration=10000",
+            "--set",
+            "scenario.log_dt=1.0",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    // The first line is printed just before the run starts (and the handler is in place
+    // before its first control period).
+    err.read_line(&mut first).unwrap();
+    assert!(first.starts_with("[simulate]"), "{first}");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    // SAFETY: kill sends a signal to our own child process.
+    let pid = i32::try_from(child.id()).unwrap();
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{rest}");
+    assert!(rest.contains("interrupted at t = "), "{rest}");
+    assert!(rest.contains("wrote the run up to then to"), "{rest}");
+    let s = summary(d.path());
+    assert_eq!(s["failure"]["cause"], "interrupted", "{s}");
+    assert!(s["failure"]["time"].as_f64().unwrap() < 10000.0);
+    assert!(d.path().join("timeseries.csv").is_file());
+}

@@ -149,3 +149,33 @@ fn timeseries_and_history_columns_are_described() {
     // Not vacuous: a channel-like name outside the families is not described.
     assert!(!is_described("base_zz") && !is_described("wobble_3"));
 }
+
+/// Identifier and flag columns (a thruster's number, the under-actuation flag and bitmask, a
+/// criterion's index) are marked so in the dictionary and are exactly the ones the report
+/// does not rank (`directions::is_identifier`): they never appear in the best-by-metric table.
+#[test]
+fn identifier_columns_are_marked_and_not_ranked() {
+    use usm_study::study::dictionary::DICTIONARY;
+    use usm_study::study::directions::is_identifier;
+    let marked: Vec<&str> = DICTIONARY
+        .iter()
+        .flat_map(|(_, cols)| cols.iter())
+        .filter(|c| {
+            c.meaning.contains("identifier, not ranked") || c.meaning.contains("flag, not ranked")
+        })
+        .map(|c| c.name)
+        .collect();
+    assert_eq!(
+        marked,
+        [
+            "under_actuated",
+            "under_actuated_axes",
+            "n1_worst_thruster",
+            "worst_fault",
+            "fault.t<j>.missed"
+        ]
+    );
+    for name in marked {
+        assert!(is_identifier(&name.replace("<j>", "1")), "{name}");
+    }
+}

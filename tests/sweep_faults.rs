@@ -48,34 +48,47 @@ fn every_thruster_fails_once_and_the_summary_tables_the_outcome() {
     for (out, jobs) in [(&one, "1"), (&two, "2")] {
         let o = sweep(&study, out, &["--jobs", jobs]);
         assert!(o.status.success(), "{}", stderr(&o));
+        // The end of a sweep names its answer and where the review page is.
+        let err = stderr(&o);
+        assert!(
+            err.contains("[sweep] best by `") && err.contains(" at "),
+            "{err}"
+        );
+        assert!(
+            err.contains("[sweep] review: ") && err.contains("report.html"),
+            "{err}"
+        );
     }
     let csv = String::from_utf8(read(&one.join("cases.csv"))).unwrap();
     assert_eq!(read(&one.join("cases.csv")), read(&two.join("cases.csv")));
     assert_eq!(column(&csv, "status"), ["ok", "ok"]);
-    // usm-paper has 7 thrusters: each case ran 7 faulted runs. Measured: losing thruster 1
-    // (a main longitudinal thruster) fails the mission with either allocator — pinv misses the
-    // cross-track bound (final cross-track beyond 0.2 m), qp saturates; the other six are
-    // survived (thrusters 0, 4 and 6 are idle on this planar path: objective change 0).
-    for j in 0..7 {
+    // usm-paper has 7 thrusters (T1 … T7, numbered from 1 in the columns too): each case ran
+    // 7 faulted runs. Measured: losing T2 (a main longitudinal thruster) fails the mission
+    // with either allocator — pinv misses the cross-track bound (final cross-track beyond
+    // 0.2 m), qp saturates; the other six are survived (T1, T5 and T7 are idle on this planar
+    // path: objective change 0).
+    for j in 1..=7 {
         let ok = column(&csv, &format!("fault.t{j}.success"));
-        let want = if j == 1 { "0.0" } else { "1.0" };
-        assert_eq!(ok, [want, want], "thruster {j}");
+        let want = if j == 2 { "0.0" } else { "1.0" };
+        assert_eq!(ok, [want, want], "thruster T{j}");
     }
-    assert!(!csv.contains("fault.t7."));
+    assert!(!csv.contains("fault.t0.") && !csv.contains("fault.t8."));
     for x in column(&csv, "fault_tolerance") {
         assert_eq!(x.parse::<f64>().unwrap(), 6.0 / 7.0);
     }
-    assert_eq!(column(&csv, "worst_fault"), ["1.0", "1.0"]);
+    // A thruster number: written as an integer.
+    assert_eq!(column(&csv, "worst_fault"), ["2", "2"]);
+    assert_eq!(column(&csv, "design_thrusters"), ["7", "7"]);
     // pinv misses cross_track_bound (index 3 in Criterion::ALL), qp max_saturation_fraction (2).
-    assert_eq!(column(&csv, "fault.t1.missed"), ["3.0", "2.0"]);
-    assert_eq!(column(&csv, "fault.t0.change"), ["0.0", "0.0"]);
-    assert_eq!(column(&csv, "fault.t3.missed"), ["NaN", "NaN"]);
+    assert_eq!(column(&csv, "fault.t2.missed"), ["3.0", "2.0"]);
+    assert_eq!(column(&csv, "fault.t1.change"), ["0.0", "0.0"]);
+    assert_eq!(column(&csv, "fault.t4.missed"), ["NaN", "NaN"]);
     let md = std::fs::read_to_string(one.join("summary.md")).unwrap();
     assert!(md.contains("## Single thruster faults"), "{md}");
     assert!(
-        md.contains("| case | fault_tolerance | worst_fault | t0 | t1 | t2 | t3 | t4 | t5 | t6 |")
+        md.contains("| case | fault_tolerance | worst_fault | t1 | t2 | t3 | t4 | t5 | t6 | t7 |")
     );
-    assert!(md.contains("| 0.8571 | t1 | ✓ +0.0 % | ✗ "), "{md}");
+    assert!(md.contains("| 0.8571 | t2 | ✓ +0.0 % | ✗ "), "{md}");
     let html = std::fs::read_to_string(one.join("report.html")).unwrap();
     assert!(html.contains("Single thruster faults"));
 }

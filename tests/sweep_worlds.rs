@@ -256,3 +256,42 @@ fn a_saltelli_design_of_worlds_gives_sobol_indices_in_the_summary() {
     assert!(md.contains("## Ranking over 12 uncertain worlds"), "{md}");
     assert!(md.contains("Sobol total index"), "{md}");
 }
+
+/// `report DIR --objective M` re-ranks a study over its worlds without re-running: `p_best`,
+/// the ranks and the verdict follow the new objective (one the worlds recorded), and going
+/// back gives the original ranking; an objective the worlds did not record is refused.
+#[test]
+fn report_re_ranks_over_the_worlds_by_another_recorded_metric() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "{}\n[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.55]\n",
+        BASE.replace(
+            "sampling = \"sobol\"",
+            "sampling = \"sobol\"\nmetrics = [\"energy_per_metre\", \"peak_thrust\"]"
+        )
+    );
+    let path = write(dir.path(), "two.toml", &text);
+    let out = dir.path().join("two");
+    ok(&sweep(&path, &out, &["--jobs", "2"]));
+    assert!(verdict(&out).starts_with("**Winner: #1"));
+    assert_eq!(column(&out, "p_best"), vec![0.0, 1.0]);
+    let report = |objective: &str| run(&["report", arg(&out), "--objective", objective]);
+    // The efficiency changes the energy, not the thrust: by peak thrust the two tie.
+    ok(&report("peak_thrust"));
+    let v = verdict(&out);
+    assert!(
+        v.starts_with("**Statistically tied") && v.contains("peak_thrust"),
+        "{v}"
+    );
+    assert_eq!(column(&out, "p_best"), vec![0.5, 0.5]);
+    let o = report("thruster_energy");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("was not recorded over the uncertain worlds"),
+        "{}",
+        stderr(&o)
+    );
+    ok(&report("energy_per_metre"));
+    assert!(verdict(&out).starts_with("**Winner: #1"));
+    assert_eq!(column(&out, "p_best"), vec![0.0, 1.0]);
+}

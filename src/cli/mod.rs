@@ -48,7 +48,9 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Merge the outputs of sweep shards into one result.
     Merge(sweep::MergeArgs),
-    /// Regenerate summary.md and plots of a sweep output directory.
+    /// Rebuild the review of a finished study (sweep, merge or optimise output): summary.md,
+    /// plots and report.html, from its files alone; `--objective` / `--pareto` re-rank it
+    /// without re-running any case.
     Report(sweep::ReportArgs),
     /// Optimise gains, layouts or references of a problem file with argmin (Nelder–Mead,
     /// particle swarm, L-BFGS), feasibility first.

@@ -1,16 +1,20 @@
 //! `usm-study simulate SCENARIO [--out DIR] [--allocation METHOD] [--set key=value ...]`.
+//!
+//! Ctrl-C (SIGINT) or SIGTERM stops the run at its next control period: the outputs of the
+//! run up to then are written, what was written is printed, and the exit code is 130.
 
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use usm_study::allocation::Method;
 use usm_study::input::keypath::{parse_override, set};
-use usm_study::outcome::{run_scenario, RunResult};
+use usm_study::outcome::{run_scenario_until, RunResult};
 use usm_study::paper::antonelli_outputs::{run_antonelli_preset as run_preset, AntonelliPreset};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use usm_study::report::fmt_num;
-use usm_study::scenario::{load_table, parse_table, resolve_design};
+use usm_study::scenario::{load_table, parse_table, resolve_design, Stop, INTERRUPTED};
 
 /// Arguments of `simulate`.
 #[derive(Debug, Args)]
@@ -76,7 +80,8 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         file.scenario.duration,
         file.allocation.method.name()
     );
-    let r = run_scenario(&vehicle, &file)?;
+    catch_interrupt();
+    let r = run_scenario_until(&vehicle, &file, Stop::NEVER.on_flag(&INTERRUPT))?;
     let files = RunFiles {
         timeseries: true,
         figure: !a.no_plots,
@@ -84,6 +89,25 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     };
     write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);
+    if let Some((t, INTERRUPTED)) = r.failure.as_ref().map(|(t, c)| (t, c.as_str())) {
+        eprintln!(
+            "[simulate] interrupted at t = {t:.3} s of {} s: wrote the run up to then to {} \
+             (timeseries.csv/.parquet, summary.json{}){}",
+            file.scenario.duration,
+            out.display(),
+            if a.no_plots {
+                ""
+            } else {
+                ", figure.svg, shapes.svg, animation.svg"
+            },
+            if worlds.is_some() {
+                "; the [uncertainty] worlds were not run"
+            } else {
+                ""
+            }
+        );
+        return Ok(ExitCode::from(130));
+    }
     if let Some(w) = &worlds {
         super::simulate_worlds::run_worlds(w, &out)?;
     }
@@ -96,6 +120,36 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::from(1))
         }
         None => Ok(ExitCode::SUCCESS),
+    }
+}
+
+/// Set by the first SIGINT/SIGTERM of `simulate`: the run stops at its next control period
+/// and its outputs up to then are written. A second signal exits at once.
+static INTERRUPT: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_interrupt(sig: libc::c_int) {
+    if INTERRUPT.swap(true, Ordering::SeqCst) {
+        const MSG: &[u8] = b"\nusm-study simulate: interrupted again; stopping without writing\n";
+        // SAFETY: write and _exit are async-signal-safe.
+        unsafe {
+            libc::write(2, MSG.as_ptr().cast(), MSG.len());
+            libc::_exit(128 + sig);
+        }
+    }
+}
+
+/// Route SIGINT (Ctrl-C) and SIGTERM to [`INTERRUPT`] (a signal the parent ignores stays
+/// ignored).
+fn catch_interrupt() {
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: `on_interrupt` only performs async-signal-safe operations (an atomic swap,
+        // write, _exit).
+        unsafe {
+            let handler = on_interrupt as extern "C" fn(libc::c_int) as libc::sighandler_t;
+            if libc::signal(sig, handler) == libc::SIG_IGN {
+                libc::signal(sig, libc::SIG_IGN);
+            }
+        }
     }
 }
 

@@ -20,7 +20,9 @@ use usm_study::study::engine::output_dir;
 use usm_study::study::outdir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::study::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
-use usm_study::study::{load_study, merge, report, run_sweep, StudyError, SweepOptions};
+use usm_study::study::{
+    load_study, merge, report_ranked, run_sweep, Reported, Rerank, StudyError, SweepOptions,
+};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -274,7 +276,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         ),
         outcome.out.display()
     );
-    print_verdict(&outcome.out);
+    print_verdict("sweep", &outcome.out);
     Ok(if outcome.failed > 0 {
         ExitCode::from(1)
     } else {
@@ -339,27 +341,47 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
 /// Arguments of `report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
-    /// A sweep (or other study) output directory.
+    /// A study output directory: of `sweep`, `merge` or `optimise` (one with manifest.json).
     pub dir: PathBuf,
+    /// Re-rank by this metric (a column of cases.csv) without re-running: the verdict,
+    /// summary.md, the plots and report.html pick the best case by it; larger or smaller is
+    /// better as for a study's `objective`. With [uncertainty], one of the metrics the worlds
+    /// recorded (p_best and the ranks are recomputed). Recorded in manifest.json.
+    #[arg(long, value_name = "METRIC")]
+    pub objective: Option<String>,
+    /// Plot this trade-off as the Pareto front, `X,Y` (two metric columns), without
+    /// re-running. Recorded in manifest.json.
+    #[arg(long, value_name = "X,Y", value_parser = parse_pareto)]
+    pub pareto: Option<[String; 2]>,
 }
 
-/// The verdict `summary.md` opens with (a study with uncertain worlds), as plain text, and
-/// where the review page is.
-fn print_verdict(dir: &Path) {
+/// A `--pareto X,Y` value.
+fn parse_pareto(s: &str) -> Result<[String; 2], String> {
+    match s.split(',').map(str::trim).collect::<Vec<_>>()[..] {
+        [x, y] if !x.is_empty() && !y.is_empty() => Ok([x.to_string(), y.to_string()]),
+        _ => Err(format!("expected two metric names X,Y, got '{s}'")),
+    }
+}
+
+/// The verdict `summary.md` opens with (a study with uncertain worlds) as plain text, else the
+/// best case by the objective, and where the review page is.
+fn print_verdict(verb: &str, dir: &Path) {
     let Ok(md) = std::fs::read_to_string(dir.join("summary.md")) else {
         return;
     };
     let plain = |s: &str| s.replace("**", "").replace('`', "");
     if let Some(v) = usm_study::study::summary_robust::summary_verdict(&md) {
-        eprintln!("[sweep] {}", plain(v));
+        eprintln!("[{verb}] {}", plain(v));
+    } else if let Some(best) = usm_study::study::finish::best_case_line(dir) {
+        eprintln!("[{verb}] {best}");
     }
     // The leader's caveats, as the box lists them.
     let opening = usm_study::study::summary_robust::summary_opening(&md).unwrap_or("");
     for c in opening.lines().filter(|l| l.starts_with("- ")) {
-        eprintln!("[sweep]   caveat: {}", plain(&c[2..]));
+        eprintln!("[{verb}]   caveat: {}", plain(&c[2..]));
     }
     eprintln!(
-        "[sweep] review: {}",
+        "[{verb}] review: {}",
         dir.join(usm_study::pipeline::review::REPORT_HTML).display()
     );
 }
@@ -426,8 +448,15 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
         };
         bail!("{} is not a study output: {hint}", a.dir.display());
     }
+    let rerank = Rerank {
+        objective: a.objective.clone(),
+        pareto: a.pareto.clone(),
+    };
     if dir.join(CASES_PARQUET).is_file() || dir.join(PARTIAL_FILE).is_file() {
-        let warnings = report(dir).map_err(study_err)?;
+        let Reported { warnings, notes } = report_ranked(dir, &rerank).map_err(study_err)?;
+        for n in &notes {
+            eprintln!("[report] {n}");
+        }
         for w in &warnings {
             eprintln!("[report] warning: {w}");
         }
@@ -440,8 +469,16 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
         }
         outdir::record_owned(dir, lock.created, &outdir::SWEEP_FILES).map_err(study_err)?;
         eprintln!("[report] wrote {}/summary.md and plots/", a.dir.display());
+    } else if !rerank.is_empty() {
+        bail!(
+            "--objective/--pareto: {} has no case table (cases.parquet) to re-rank",
+            a.dir.display()
+        );
     }
     review("report", dir)?;
     drop(lock);
+    if dir.join(CASES_PARQUET).is_file() {
+        print_verdict("report", dir);
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -56,7 +56,7 @@ pub const N1_LOSS_COLUMNS: usize = 16;
 /// per axis and sign the smallest authority over the sampled configurations (N, N·m; NaN when
 /// uncommanded), the smallest force and moment (all samples, the straight configuration, the
 /// mission range), the under-actuation flag and axes bitmask, N−1 figures and the per-thruster
-/// N−1 loss (`n1_loss_t0` … `n1_loss_t15`).
+/// N−1 loss (`n1_loss_t1` … `n1_loss_t16`, numbered like the thrusters `T1` …).
 pub const AUTHORITY_COLUMNS: [&str; 42] = [
     "authority_surge_pos",
     "authority_surge_neg",
@@ -84,7 +84,6 @@ pub const AUTHORITY_COLUMNS: [&str; 42] = [
     "n1_mean_moment",
     "n1_worst_thruster",
     "n1_worst_loss",
-    "n1_loss_t0",
     "n1_loss_t1",
     "n1_loss_t2",
     "n1_loss_t3",
@@ -100,6 +99,7 @@ pub const AUTHORITY_COLUMNS: [&str; 42] = [
     "n1_loss_t13",
     "n1_loss_t14",
     "n1_loss_t15",
+    "n1_loss_t16",
 ];
 
 /// Named metrics in the order they were computed. A name is expected once; [`Metrics::set`]
@@ -246,7 +246,8 @@ pub fn authority_metrics(s: &AuthoritySummary) -> [f64; AUTHORITY_COLUMNS.len()]
         s.n1.worst_moment,
         s.n1.mean_force,
         s.n1.mean_moment,
-        s.n1.worst_thruster as f64,
+        // Numbered from 1, like the thrusters (`T1`) and the `n1_loss_t<i>` columns.
+        (s.n1.worst_thruster + 1) as f64,
         worst_loss,
     ];
     out[12..12 + rest.len()].copy_from_slice(&rest);

@@ -181,13 +181,15 @@ fn drawings(dir: &Path, study_file: Option<&str>, ids: &[i64]) -> Result<Vec<Dra
 fn read_cases(dir: &Path) -> Option<Table> {
     let pq = dir.join(CASES_PARQUET);
     let csv = dir.join(CASES_CSV);
-    if pq.is_file() {
+    let mut t = if pq.is_file() {
         read_parquet(&pq).ok()
     } else if csv.is_file() {
         read_csv(&csv).ok()
     } else {
         None
-    }
+    }?;
+    crate::study::dictionary::integers_for_files(&mut t, false);
+    Some(t)
 }
 
 /// The SVG figures of `dir`: `plots/*.svg` then `*.svg`, each sorted by name.

@@ -12,7 +12,7 @@ use crate::control::transport::yaw_joint_mask;
 use crate::model::Vehicle;
 use crate::outcome::RunResult;
 use crate::report::figures::{run_figure, trajectory_table};
-use crate::report::{atomic_write, write_csv, write_parquet};
+use crate::report::{atomic_write, write_csv, write_parquet_with};
 
 /// Sets `allocation.method` in a scenario table (the `--allocation` override, and the paper's
 /// allocator comparison).
@@ -84,7 +84,9 @@ pub fn write_run_outputs(
     let table = trajectory_table(&r.trajectory)?;
     if files.timeseries {
         write_csv(&table, &out.join("timeseries.csv"))?;
-        write_parquet(&table, &out.join("timeseries.parquet"))?;
+        // The channels' units and meanings travel with the Parquet file.
+        let meta = crate::study::dictionary::parquet_metadata(&table, &[]);
+        write_parquet_with(&table, &out.join("timeseries.parquet"), &meta)?;
     }
     let text = serde_json::to_string_pretty(&summary_json(r, &vehicle.name))?;
     atomic_write(&out.join("summary.json"), text.as_bytes())?;

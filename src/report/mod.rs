@@ -47,4 +47,7 @@ pub use plot::{
     Figure, Heatmap, LabelledPoint, LineStyle, Panel, PanelKind, RankRow, Series, TornadoRow,
 };
 pub use table::{Column, ColumnData, ColumnKind, Table, Value};
-pub use table_io::{read_csv, read_csv_typed, read_parquet, write_csv, write_parquet};
+pub use table_io::{
+    parquet_metadata, read_csv, read_csv_typed, read_parquet, write_csv, write_parquet,
+    write_parquet_with,
+};

@@ -24,15 +24,15 @@
 //! Use [`read_csv_typed`] (explicit schema) or Parquet where that matters.
 //!
 //! Parquet files are written by polars with its default settings (zstd compression); they keep
-//! the exact schema.
+//! the exact schema, and may carry file-level key/value metadata ([`write_parquet_with`]).
 
 use std::fs::File;
 use std::path::Path;
 use std::sync::Arc;
 
 use polars::prelude::{
-    Column as PlColumn, CsvReadOptions, CsvWriter, DataFrame, DataType, Field, ParquetReader,
-    ParquetWriter, PlSmallStr, PolarsError, Schema, SerReader, SerWriter,
+    Column as PlColumn, CsvReadOptions, CsvWriter, DataFrame, DataType, Field, KeyValueMetadata,
+    ParquetReader, ParquetWriter, PlSmallStr, PolarsError, Schema, SerReader, SerWriter,
 };
 
 use super::atomic::atomic_write;
@@ -149,11 +149,40 @@ pub fn write_csv(table: &Table, path: &Path) -> Result<()> {
 
 /// Writes `table` as Parquet to `path` (atomically, polars' default settings).
 pub fn write_parquet(table: &Table, path: &Path) -> Result<()> {
+    write_parquet_with(table, path, &[])
+}
+
+/// [`write_parquet`] with file-level key/value metadata `meta` (e.g. a data dictionary; read
+/// back with [`parquet_metadata`]).
+pub fn write_parquet_with(table: &Table, path: &Path, meta: &[(String, String)]) -> Result<()> {
     let err = polars_err(path, "writing Parquet");
     let mut df = to_dataframe(table).map_err(&err)?;
     let mut buf = Vec::new();
-    ParquetWriter::new(&mut buf).finish(&mut df).map_err(&err)?;
+    let kv = (!meta.is_empty()).then(|| KeyValueMetadata::from_static(meta.to_vec()));
+    ParquetWriter::new(&mut buf)
+        .with_key_value_metadata(kv)
+        .finish(&mut df)
+        .map_err(&err)?;
     atomic_write(path, &buf)
+}
+
+/// The file-level key/value metadata of a Parquet file (keys without a value left out).
+pub fn parquet_metadata(path: &Path) -> Result<Vec<(String, String)>> {
+    let file = File::open(path).map_err(|source| ReportError::Io {
+        path: path.to_path_buf(),
+        action: "opening",
+        source,
+    })?;
+    let mut reader = ParquetReader::new(file);
+    let meta = reader
+        .get_metadata()
+        .map_err(polars_err(path, "reading Parquet"))?;
+    Ok(meta
+        .key_value_metadata()
+        .iter()
+        .flatten()
+        .filter_map(|kv| Some((kv.key.clone(), kv.value.clone()?)))
+        .collect())
 }
 
 fn csv_options() -> CsvReadOptions {

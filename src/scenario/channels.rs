@@ -178,6 +178,8 @@ const TRANSPORT: [Channel; 9] = [
 
 impl Channel {
     /// The column name in trajectory tables (`t`, `base_x`, `ee_u`, `cross_track`, `u_3`, …).
+    /// Indexed families are numbered from 1 like the design's names (joint `q1`, thruster
+    /// `T1`): `Channel::Q(0)` is `q_1`, `Channel::U(2)` is `u_3`.
     pub fn name(self) -> String {
         let fixed = match self {
             Channel::T => "t",
@@ -204,14 +206,14 @@ impl Channel {
             Channel::EeTwist(a) => return format!("ee_{}", a.suffix()),
             Channel::Setpoint(a) => return format!("sp_{}", a.suffix()),
             Channel::TwistRef(a) => return format!("ref_{}", a.suffix()),
-            Channel::Q(k) => return format!("q_{k}"),
-            Channel::QRef(k) => return format!("qref_{k}"),
-            Channel::Qd(k) => return format!("qd_{k}"),
-            Channel::Tau(k) => return format!("tau_{k}"),
-            Channel::UCmd(j) => return format!("ucmd_{j}"),
-            Channel::U(j) => return format!("u_{j}"),
-            Channel::Power(j) => return format!("power_{j}"),
-            Channel::Inflow(j) => return format!("inflow_{j}"),
+            Channel::Q(k) => return format!("q_{}", k + 1),
+            Channel::QRef(k) => return format!("qref_{}", k + 1),
+            Channel::Qd(k) => return format!("qd_{}", k + 1),
+            Channel::Tau(k) => return format!("tau_{}", k + 1),
+            Channel::UCmd(j) => return format!("ucmd_{}", j + 1),
+            Channel::U(j) => return format!("u_{}", j + 1),
+            Channel::Power(j) => return format!("power_{}", j + 1),
+            Channel::Inflow(j) => return format!("inflow_{}", j + 1),
         };
         fixed.to_string()
     }
@@ -306,7 +308,7 @@ impl Trajectory {
     }
 
     /// An indexed family in index order, e.g. `indexed(Channel::U)` for the actual thrusts
-    /// `u_0, u_1, …` (stops at the first index the run did not log).
+    /// `u_1, u_2, …` (stops at the first index the run did not log).
     pub fn indexed(&self, family: fn(usize) -> Channel) -> Vec<&[f64]> {
         (0..).map_while(|k| self.get(family(k))).collect()
     }
@@ -359,16 +361,16 @@ mod tests {
         let expected = "t base_x base_y base_z base_roll base_pitch base_yaw base_u base_v \
             base_w base_p base_q base_r ee_x ee_y ee_z ee_roll ee_pitch ee_yaw ee_u ee_v ee_w \
             ee_p ee_q ee_r psi psi_r cross_track along_track segment heading_error surge_error \
-            base_cross_track path_y q_0 qref_0 qd_0 tau_0 joint_work ucmd_0 ucmd_1 u_0 u_1 power_0 power_1 \
-            inflow_0 inflow_1 sigma_min sigma_min_commanded slack_norm alloc_status";
+            base_cross_track path_y q_1 qref_1 qd_1 tau_1 joint_work ucmd_1 ucmd_2 u_1 u_2 power_1 power_2 \
+            inflow_1 inflow_2 sigma_min sigma_min_commanded slack_norm alloc_status";
         assert_eq!(names.join(" "), expected);
         let work: Vec<String> = channel_layout(Mode::Work, 0, 1)
             .into_iter()
             .map(Channel::name)
             .collect();
         let expected = "sp_x sp_y sp_z sp_roll sp_pitch sp_yaw ee_position_error \
-            ee_orientation_error ee_damping ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_0 \
-            u_0 power_0 inflow_0";
+            ee_orientation_error ee_damping ref_u ref_v ref_w ref_p ref_q ref_r joint_work ucmd_1 \
+            u_1 power_1 inflow_1";
         assert_eq!(work[25..45].join(" "), expected);
     }
 

@@ -43,7 +43,7 @@ pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
-pub use run::{run_loop, LoopRun, Stop, TIMEOUT};
+pub use run::{run_loop, LoopRun, Stop, INTERRUPTED, TIMEOUT};
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::KeyError;

@@ -21,6 +21,7 @@ use crate::metrics::trajectory::EnergyMetrics;
 use crate::model::Vehicle;
 use crate::spatial::Vec6;
 use nalgebra::Matrix6;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// One closed-loop run before its metrics: the trajectory up to the end (or the failure), the
@@ -162,28 +163,73 @@ impl ClosedLoop<'_> {
 /// The failure cause of a run stopped by its wall-clock deadline ([`run_loop`]).
 pub const TIMEOUT: &str = "timeout";
 
-/// When a closed-loop run must stop on the wall clock: at an instant, or never. [`run_loop`]
-/// checks it cooperatively before every control period; a run still going when it is
-/// [`due`](Stop::due) stops there with the failure cause [`TIMEOUT`] and keeps its trajectory
-/// up to then. A case's `crate::evaluate::Deadline` hands one out (`Deadline::stop`), so that
-/// the loop does not depend on the evaluator that budgets it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// The failure cause of a run stopped by its interrupt flag ([`Stop::on_flag`]; `simulate`
+/// on Ctrl-C).
+pub const INTERRUPTED: &str = "interrupted";
+
+/// When a closed-loop run must stop early: at a wall-clock instant, when a flag is raised
+/// (an interrupt), or never. [`run_loop`] checks it cooperatively before every control period;
+/// a run still going when it is [`due`](Stop::due) stops there with the failure cause
+/// [`TIMEOUT`] (or [`INTERRUPTED`]) and keeps its trajectory up to then. A case's
+/// `crate::evaluate::Deadline` hands one out (`Deadline::stop`), so that the loop does not
+/// depend on the evaluator that budgets it.
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Stop {
     at: Option<Instant>,
+    flag: Option<&'static AtomicBool>,
 }
 
+impl PartialEq for Stop {
+    fn eq(&self, other: &Stop) -> bool {
+        self.at == other.at
+            && match (self.flag, other.flag) {
+                (None, None) => true,
+                (Some(a), Some(b)) => std::ptr::eq(a, b),
+                _ => false,
+            }
+    }
+}
+
+impl Eq for Stop {}
+
 impl Stop {
-    /// Never stop on the wall clock: the run goes to the end of the scenario (or its failure).
-    pub const NEVER: Stop = Stop { at: None };
+    /// Never stop early: the run goes to the end of the scenario (or its failure).
+    pub const NEVER: Stop = Stop {
+        at: None,
+        flag: None,
+    };
 
     /// Stop at `instant`.
     pub fn at(instant: Instant) -> Stop {
-        Stop { at: Some(instant) }
+        Stop {
+            at: Some(instant),
+            flag: None,
+        }
     }
 
-    /// Whether the stop time has passed (never for [`Stop::NEVER`]).
+    /// This stop, and also as soon as `flag` is set (e.g. by a SIGINT handler).
+    pub fn on_flag(self, flag: &'static AtomicBool) -> Stop {
+        Stop {
+            flag: Some(flag),
+            ..self
+        }
+    }
+
+    /// Why the run must stop now, if it must: [`INTERRUPTED`] when the flag is set, else
+    /// [`TIMEOUT`] when the stop time has passed.
+    pub fn cause(self) -> Option<&'static str> {
+        if self.flag.is_some_and(|f| f.load(Ordering::Relaxed)) {
+            Some(INTERRUPTED)
+        } else if self.at.is_some_and(|d| Instant::now() >= d) {
+            Some(TIMEOUT)
+        } else {
+            None
+        }
+    }
+
+    /// Whether the run must stop now (never for [`Stop::NEVER`]).
     pub fn due(self) -> bool {
-        self.at.is_some_and(|d| Instant::now() >= d)
+        self.cause().is_some()
     }
 }
 
@@ -191,9 +237,9 @@ impl Stop {
 /// problems return a [`ScenarioError`] before anything runs; a run that fails (diverges,
 /// NaN, singular mass matrix) returns `Ok` with `failure` set and the trajectory up to then.
 ///
-/// The wall-clock [`Stop`] is checked cooperatively before every control period: a run still
-/// going when it is due stops there with the failure cause [`TIMEOUT`] (the trajectory up to
-/// then is kept, as for any failure). A control period is bounded in work: at most
+/// The [`Stop`] is checked cooperatively before every control period: a run still going when
+/// it is due stops there with the failure cause [`TIMEOUT`] or [`INTERRUPTED`] (the trajectory
+/// up to then is kept, as for any failure). A control period is bounded in work: at most
 /// `MAX_SUBSTEPS` (1e5) RK4 steps (`scenario.control_dt / dt`, checked by validation) or
 /// `MAX_STEPS_PER_SPAN` (1e5) Dormand–Prince trials.
 pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun, ScenarioError> {
@@ -201,8 +247,8 @@ pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun,
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
     let failure = (0..=lp.n_control).find_map(|k| {
-        if stop.due() {
-            return Some((k as f64 * file.scenario.control_dt, TIMEOUT.to_string()));
+        if let Some(cause) = stop.cause() {
+            return Some((k as f64 * file.scenario.control_dt, cause.to_string()));
         }
         let period_started = Instant::now();
         let result = lp.period(k, &mut rec);

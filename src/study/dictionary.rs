@@ -70,11 +70,11 @@ const DESIGN: &[ColumnDoc] = &[
     c(
         "design_bodies",
         "–",
-        "f64",
+        "i64",
         "number of rigid bodies of the built design",
     ),
-    c("design_joints", "–", "f64", "number of revolute joints"),
-    c("design_thrusters", "–", "f64", "number of thrusters"),
+    c("design_joints", "–", "i64", "number of revolute joints"),
+    c("design_thrusters", "–", "i64", "number of thrusters"),
     c(
         "design_length_m",
         "m",
@@ -111,23 +111,23 @@ const AUTHORITY: &[ColumnDoc] = &[
     c("authority_straight_min_moment", "N·m", "f64", "smallest commanded moment at q = 0"),
     c("authority_mission_min_force", "N", "f64", "as authority_min_force over the declared mission range (`static.joint_range` / `joint_ranges`); NaN without one"),
     c("authority_mission_min_moment", "N·m", "f64", "as authority_min_moment over the declared mission range; NaN without one"),
-    c("under_actuated", "0/1", "f64", "1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
-    c("under_actuated_axes", "–", "f64", "bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
+    c("under_actuated", "0/1", "f64", "a flag, not ranked: 1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
+    c("under_actuated_axes", "bitmask", "i64", "an identifier, not ranked: bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
     c("n1_worst_force", "N", "f64", "N−1: smallest commanded force with one thruster removed (held at zero thrust), over thrusters and the N−1 configurations (q = 0 and the first `static.n1_samples` samples)"),
     c("n1_worst_moment", "N·m", "f64", "N−1: smallest commanded moment with one thruster removed"),
     c("n1_mean_force", "N", "f64", "N−1: mean over the removed thruster of its smallest commanded force"),
     c("n1_mean_moment", "N·m", "f64", "N−1: mean over the removed thruster of its smallest commanded moment"),
-    c("n1_worst_thruster", "–", "f64", "index (0-based) of the thruster whose removal loses the largest fraction of authority"),
+    c("n1_worst_thruster", "index", "i64", "number (from 1: thruster `T1` is 1) of the thruster whose removal loses the largest fraction of authority; an identifier, not ranked"),
     c("n1_worst_loss", "–", "f64", "that fraction: the largest n1_loss_t{i}"),
-    c("n1_loss_t{i}", "–", "f64", "fraction of authority lost when thruster i (0 … 15) is removed, worst commanded axis, sign and N−1 configuration: 1 − (authority without it)/(authority with it), over the axes and signs it had authority on (0: nothing lost, 1: an axis lost entirely); NaN beyond the design's thrusters"),
+    c("n1_loss_t{i}", "–", "f64", "fraction of authority lost when thruster `T<i>` (i = 1 … 16) is removed, worst commanded axis, sign and N−1 configuration: 1 − (authority without it)/(authority with it), over the axes and signs it had authority on (0: nothing lost, 1: an axis lost entirely); NaN beyond the design's thrusters"),
 ];
 
 const TUNING: &[ColumnDoc] = &[
     c("tuned.<param>", "as the key", "f64", "the tuned value of each `[[tune.param]]` (e.g. `tuned.control.k_psi`), at which the case is scored"),
-    c("tune_evaluations", "–", "f64", "fresh closed-loop runs the tuning used"),
+    c("tune_evaluations", "–", "i64", "fresh closed-loop runs the tuning used"),
     c("tune_feasible", "0/1", "f64", "1 when the tuned point met every `[[tune.constraint]]`"),
     c("tune_noise", "–", "f64", "relative spread (max − min)/min of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start"),
-    c("tune_bound_hits", "–", "f64", "tuned parameters within 0.1 % of a bound of their box"),
+    c("tune_bound_hits", "–", "i64", "tuned parameters within 0.1 % of a bound of their box"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
@@ -243,11 +243,11 @@ const WORLDS: &[ColumnDoc] = &[
 const FAULTS: &[ColumnDoc] = &[
     c("fault_time", "s", "f64", "a run with a scenario `[fault]`: the simulation time the fault struck (NaN if the run ended before `fault.at`)"),
     c("fault_tolerance", "–", "f64", "fraction of the design's thrusters whose single fault (`[faults]`, re-run at the case's values in the nominal world) still leaves the run successful"),
-    c("worst_fault", "–", "f64", "0-based index of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest index"),
-    c("fault.t<j>.success", "0/1", "f64", "the run with thruster <j> failed met every `[success]` criterion (NaN: the design has no thruster <j>)"),
+    c("worst_fault", "index", "i64", "number (from 1: thruster `T1` is 1) of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest number; an identifier, not ranked"),
+    c("fault.t<j>.success", "0/1", "f64", "the run with thruster `T<j>` (j from 1) failed met every `[success]` criterion (NaN: the design has no thruster `T<j>`)"),
     c("fault.t<j>.objective", "as the objective", "f64", "the study's objective (`study.objective`, else the worlds' objective, else `energy_per_metre`) with thruster <j> failed"),
     c("fault.t<j>.change", "–", "f64", "relative change of the objective from the nominal run with thruster <j> failed, `(x − x₀)/|x₀|`"),
-    c("fault.t<j>.missed", "–", "f64", "the first `[success]` criterion the run with thruster <j> failed missed, as its index in the criterion list (`no_failure` for a failed run; NaN when it met all)"),
+    c("fault.t<j>.missed", "–", "f64", "an identifier, not ranked: the first `[success]` criterion the run with thruster <j> failed missed, as its index (from 0) in the criterion list (`no_failure` for a failed run; NaN when it met all)"),
 ];
 
 const WORLDS_CSV: &[ColumnDoc] = &[
@@ -380,7 +380,7 @@ const TIMESERIES_CSV: &[ColumnDoc] = &[
         "f64",
         "work: damping λ of J_e^# (USM-42), 0 outside the singular region",
     ),
-    c("q_<i>", "rad", "f64", "joint i angle"),
+    c("q_<i>", "rad", "f64", "joint i angle (joints and thrusters numbered from 1 like the design's names: `q_1` is joint `q1`, `u_1` thruster `T1`)"),
     c("qref_<i>", "rad", "f64", "joint i angle reference"),
     c("qd_<i>", "rad/s", "f64", "joint i rate"),
     c("tau_<i>", "N·m", "f64", "joint i motor torque"),
@@ -506,51 +506,161 @@ fn channel_family(name: &str) -> Option<String> {
     }
 }
 
+/// `seg3_overshoot` → `seg{k}_overshoot`.
+fn seg_family(n: &str) -> Option<String> {
+    n.strip_prefix("seg")
+        .and_then(|r| r.split_once('_'))
+        .is_some_and(|(k, rest)| k.parse::<usize>().is_ok() && !rest.is_empty())
+        .then(|| format!("seg{{k}}_{}", n.split_once('_').map_or("", |x| x.1)))
+}
+
+/// A base axis in the name stands for the `<axis>` family (`wrench_peak_yaw`).
+fn axis_family(n: &str) -> Option<String> {
+    crate::metrics::singularity::AXIS_NAMES
+        .iter()
+        .find(|a| n.split('_').any(|w| w == **a))
+        .map(|a| {
+            n.split('_')
+                .map(|w| if w == *a { "<axis>" } else { w })
+                .collect::<Vec<_>>()
+                .join("_")
+        })
+}
+
+/// The dictionary entry describing `name` (a concrete column name, not an axis), if any:
+/// its own row, or the row of its family (`seg{k}_…`, `q_<i>`, `fault.t<j>.…`, `<m>_mean`, …).
+pub fn describe(name: &str) -> Option<&'static ColumnDoc> {
+    const AXES: [&str; 6] = crate::metrics::singularity::AXIS_NAMES;
+    let docs = || DICTIONARY.iter().flat_map(|(_, cols)| cols.iter());
+    let named = |n: &str| docs().find(|c| c.name == n || c.name.split(", ").any(|a| a == n));
+    let starting = |p: &str| docs().find(|c| c.name.starts_with(p));
+    if let Some(d) = named(name) {
+        return Some(d);
+    }
+    for family in [seg_family(name), axis_family(name), channel_family(name)]
+        .into_iter()
+        .flatten()
+    {
+        if let Some(d) = named(&family) {
+            return Some(d);
+        }
+    }
+    if name.starts_with("tcm_lost_") {
+        return starting("tcm_lost_");
+    }
+    if name
+        .strip_prefix("n1_loss_t")
+        .is_some_and(|i| i.parse::<usize>().is_ok())
+    {
+        return named("n1_loss_t{i}");
+    }
+    if name.strip_prefix("authority_").is_some_and(|r| {
+        AXES.iter()
+            .any(|a| r == format!("{a}_pos") || r == format!("{a}_neg"))
+    }) {
+        return starting("authority_surge_pos");
+    }
+    if let Some(rest) = name.strip_prefix("fault.t") {
+        let what = rest.split_once('.').map_or("", |x| x.1);
+        return named(&format!("fault.t<j>.{what}")).or_else(|| starting("fault.t<j>"));
+    }
+    if name.starts_with("tuned.") {
+        return named("tuned.<param>");
+    }
+    if let Some(rest) = name.strip_prefix("validate.") {
+        let what = rest.rsplit_once('.').map_or("", |x| x.1);
+        return named(&format!("validate.<v>.{what}"))
+            .or_else(|| named("validate.<v>.<objective>"));
+    }
+    if name.strip_suffix("_worst").is_some_and(is_described) {
+        return named("<m>_worst");
+    }
+    ["_mean", "_std", "_p05", "_p95"]
+        .iter()
+        .any(|s| name.strip_suffix(s).is_some_and(is_described))
+        .then(|| named("<m>_mean"))
+        .flatten()
+}
+
 /// Whether `name` (a concrete column name) is described by the dictionary.
 pub fn is_described(name: &str) -> bool {
-    const AXES: [&str; 6] = crate::metrics::singularity::AXIS_NAMES;
-    let seg = |n: &str| {
-        n.strip_prefix("seg")
-            .and_then(|r| r.split_once('_'))
-            .is_some_and(|(k, rest)| k.parse::<usize>().is_ok() && !rest.is_empty())
-            .then(|| format!("seg{{k}}_{}", n.split_once('_').map_or("", |x| x.1)))
-    };
-    let lost = name.starts_with("tcm_lost_")
-        || name
-            .strip_prefix("n1_loss_t")
-            .is_some_and(|i| i.parse::<usize>().is_ok())
-        || name.strip_prefix("authority_").is_some_and(|r| {
-            AXES.iter()
-                .any(|a| r == format!("{a}_pos") || r == format!("{a}_neg"))
-        });
-    let summary = ["_mean", "_std", "_p05", "_p95", "_worst"]
+    describe(name).is_some()
+}
+
+/// The key of the Parquet file-level metadata holding the data dictionary of a table's
+/// columns ([`parquet_metadata`]).
+pub const PARQUET_COLUMNS_KEY: &str = "usm_study:columns";
+
+/// The Parquet file-level metadata of `table` (a study's case table with the axis columns
+/// `axes`): under [`PARQUET_COLUMNS_KEY`], a JSON array with, for each column in order, its
+/// `name`, `unit`, `type` (as stored) and `meaning` from the dictionary (`null` unit and
+/// meaning for a column it does not describe).
+pub fn parquet_metadata(table: &crate::report::Table, axes: &[&str]) -> Vec<(String, String)> {
+    let cols: Vec<serde_json::Value> = table
+        .columns
         .iter()
-        .any(|s| name.strip_suffix(s).is_some_and(is_described));
-    let pattern = name.starts_with("tuned.")
-        || name.starts_with("validate.")
-        || name.starts_with("fault.t")
-        || matches!(name, "rank_p05" | "rank_p50" | "rank_p95");
-    // A base axis in the name stands for the `<axis>` family (`wrench_peak_yaw`).
-    let axis = |n: &str| {
-        AXES.iter()
-            .find(|a| n.split('_').any(|w| w == **a))
-            .map(|a| {
-                n.split('_')
-                    .map(|w| if w == *a { "<axis>" } else { w })
-                    .collect::<Vec<_>>()
-                    .join("_")
+        .map(|c| {
+            let doc = if axes.contains(&c.name.as_str()) {
+                named_doc("<axis name>")
+            } else {
+                describe(&c.name)
+            };
+            serde_json::json!({
+                "name": c.name,
+                "unit": doc.map(|d| d.unit),
+                "type": c.data.kind().to_string(),
+                "meaning": doc.map(|d| d.meaning),
             })
-    };
-    let exact = DICTIONARY
+        })
+        .collect();
+    vec![(
+        PARQUET_COLUMNS_KEY.to_string(),
+        serde_json::Value::Array(cols).to_string(),
+    )]
+}
+
+/// The entry named exactly `name`.
+fn named_doc(name: &str) -> Option<&'static ColumnDoc> {
+    DICTIONARY
         .iter()
         .flat_map(|(_, cols)| cols.iter())
-        .any(|c| {
-            c.name == name
-                || seg(name).is_some_and(|p| c.name == p)
-                || axis(name).is_some_and(|p| c.name == p)
-                || channel_family(name).is_some_and(|p| c.name == p)
-        });
-    exact || lost || summary || pattern
+        .find(|c| c.name == name)
+}
+
+/// Whether `column` holds whole numbers (counts, numbers of things, bitmasks): the dictionary
+/// types it `i64`. The case tables are computed in `f64` (NaN where a case has no value); their
+/// files store such a column as integers when every value is one ([`integers_for_files`]).
+pub fn is_integer_column(column: &str) -> bool {
+    describe(column).is_some_and(|d| d.kind == "i64")
+        && !matches!(
+            column,
+            "case_id" | "world" | "evaluation" | "run" | "iteration"
+        )
+}
+
+/// Store the integer columns of a case table (see [`is_integer_column`]) as `i64` when every
+/// value is a whole number (`to_files`), or back as `f64` after reading a file (`!to_files`),
+/// so that the report computes on `f64` and the files say "3", not "3.0". A column holding a
+/// NaN (a case that did not build or run) stays `f64`. Exact both ways for |x| < 2⁵³.
+pub fn integers_for_files(table: &mut crate::report::Table, to_files: bool) {
+    use crate::report::ColumnData;
+    for c in &mut table.columns {
+        if !is_integer_column(&c.name) {
+            continue;
+        }
+        let data = match &c.data {
+            ColumnData::F64(v)
+                if to_files && v.iter().all(|x| x.fract() == 0.0 && x.abs() < 9.0e15) =>
+            {
+                ColumnData::I64(v.iter().map(|x| *x as i64).collect())
+            }
+            ColumnData::I64(v) if !to_files => {
+                ColumnData::F64(v.iter().map(|x| *x as f64).collect())
+            }
+            _ => continue,
+        };
+        c.data = data;
+    }
 }
 
 /// `docs/columns.md`'s tables.

@@ -59,12 +59,44 @@ pub fn larger_is_better(metric: &str) -> bool {
         || m == "p_best"
 }
 
+/// Columns that hold a number but are identifiers or flags, not quantities to rank: a
+/// thruster's number (`worst_fault`, `n1_worst_thruster`), the under-actuation flag and axes
+/// bitmask, a criterion's index (`fault.t<j>.missed`). The report neither ranks them nor
+/// lists them among the best cases by metric (docs/columns.md marks them).
+pub fn is_identifier(column: &str) -> bool {
+    matches!(
+        column,
+        "worst_fault" | "n1_worst_thruster" | "under_actuated" | "under_actuated_axes"
+    ) || (column.starts_with("fault.t") && column.ends_with(".missed"))
+}
+
 /// Suffixes of a metric's summary over worlds (`energy_per_metre_mean`, …).
 pub const WORLD_SUFFIXES: [&str; 5] = ["_mean", "_std", "_p05", "_p95", "_worst"];
 
 #[cfg(test)]
 mod tests {
-    use super::larger_is_better;
+    use super::{is_identifier, larger_is_better};
+
+    #[test]
+    fn thruster_numbers_and_flags_are_identifiers_not_metrics() {
+        for c in [
+            "worst_fault",
+            "n1_worst_thruster",
+            "under_actuated",
+            "under_actuated_axes",
+            "fault.t3.missed",
+        ] {
+            assert!(is_identifier(c), "{c}");
+        }
+        for c in [
+            "fault_tolerance",
+            "n1_worst_loss",
+            "fault.t3.change",
+            "n1_loss_t1",
+        ] {
+            assert!(!is_identifier(c), "{c}");
+        }
+    }
 
     #[test]
     fn outcomes_a_design_review_wants_high_rank_larger_first() {

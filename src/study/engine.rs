@@ -222,7 +222,8 @@ pub fn run_sweep(
         &read_csv_typed(&partial, &schema)?,
         Some(&streamed.plan_hashes),
     )?;
-    let table = write_tables(raw, &out, RobustInfo::of(study).as_ref())?;
+    let axes: Vec<&str> = study.axes.iter().map(|a| a.name.as_str()).collect();
+    let table = write_tables(raw, &out, RobustInfo::of(study).as_ref(), &axes)?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;

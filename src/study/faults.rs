@@ -3,7 +3,7 @@
 //! evaluator — once per thruster with that thruster failed (a scenario `[fault]`,
 //! `crate::scenario::fault`), like a validation variant (`super::worlds`). Its row gains
 //!
-//! - per thruster `j`: `fault.t<j>.success` (1/0), `fault.t<j>.objective` (the study's
+//! - per thruster `j` (numbered from 1, like the design's `T1`, `T2`, …): `fault.t<j>.success` (1/0), `fault.t<j>.objective` (the study's
 //!   objective in the faulted run), `fault.t<j>.change` (its relative change from the nominal
 //!   run, `(x − x₀)/|x₀|`) and `fault.t<j>.missed` (the first `[success]` criterion the faulted
 //!   run missed, as its index in `Criterion::ALL`; `no_failure` for a run that failed or could
@@ -103,7 +103,7 @@ pub fn score_faults(
     let nominal = metrics.value(&objective);
     let change = |x: f64| (x - nominal) / nominal.abs();
     for (j, f) in runs.iter().enumerate() {
-        let col = |m: &str| format!("{FAULT_PREFIX}{j}.{m}");
+        let col = |m: &str| format!("{FAULT_PREFIX}{}.{m}", j + 1);
         metrics.set(&col(SUCCESS), f64::from(u8::from(f.ok)));
         metrics.set(&col("objective"), f.objective);
         metrics.set(&col("change"), change(f.objective));
@@ -146,7 +146,8 @@ fn worsening(objective: &str, nominal: f64, x: f64) -> f64 {
     }
 }
 
-/// The worst single fault (see the module docs); NaN without thrusters.
+/// The worst single fault (see the module docs), numbered from 1 like the thrusters (`T1`)
+/// and the `fault.t<j>` columns; NaN without thrusters.
 fn worst_fault(objective: &str, nominal: f64, runs: &[FaultRun]) -> f64 {
     let key = |f: &FaultRun| (!f.ok, worsening(objective, nominal, f.objective));
     let mut best: Option<(usize, (bool, f64))> = None;
@@ -160,7 +161,7 @@ fn worst_fault(objective: &str, nominal: f64, runs: &[FaultRun]) -> f64 {
             best = Some((j, k));
         }
     }
-    best.map_or(f64::NAN, |(j, _)| j as f64)
+    best.map_or(f64::NAN, |(j, _)| (j + 1) as f64)
 }
 
 /// The layouts × single faults table of `summary.md`: one row per ranked (successful) case
@@ -175,15 +176,19 @@ pub fn fault_table(
     let tol = table.f64(FAULT_TOLERANCE).ok()?;
     let worst = table.f64(WORST_FAULT).ok()?;
     let n = (0..)
-        .take_while(|j| table.f64(&format!("{FAULT_PREFIX}{j}.{SUCCESS}")).is_ok())
+        .take_while(|j| {
+            table
+                .f64(&format!("{FAULT_PREFIX}{}.{SUCCESS}", j + 1))
+                .is_ok()
+        })
         .count();
-    let heads: Vec<String> = (0..n).map(|j| format!("t{j}")).collect();
+    let heads: Vec<String> = (1..=n).map(|j| format!("t{j}")).collect();
     let mut t = MarkdownTable::new(
         ["case", FAULT_TOLERANCE, WORST_FAULT]
             .into_iter()
             .chain(heads.iter().map(String::as_str)),
     );
-    let col = |j: usize, m: &str| table.f64(&format!("{FAULT_PREFIX}{j}.{m}")).ok();
+    let col = |j: usize, m: &str| table.f64(&format!("{FAULT_PREFIX}{}.{m}", j + 1)).ok();
     for &r in ranked {
         let mut cells = vec![
             format!("#{}", ids.get(r).copied().unwrap_or(-1)),
@@ -247,24 +252,24 @@ mod tests {
     fn the_worst_fault_is_a_failure_first_then_the_largest_worsening() {
         let e = "energy_per_metre";
         let runs = [run(true, 12.0), run(false, 10.5), run(true, 15.0)];
-        assert_eq!(worst_fault(e, 10.0, &runs), 1.0);
+        assert_eq!(worst_fault(e, 10.0, &runs), 2.0);
         let runs = [run(true, 12.0), run(true, 15.0), run(true, 15.0)];
-        assert_eq!(worst_fault(e, 10.0, &runs), 1.0, "ties: the lowest index");
+        assert_eq!(worst_fault(e, 10.0, &runs), 2.0, "ties: the lowest index");
         let runs = [run(true, 12.0), run(true, f64::NAN)];
         assert_eq!(
             worst_fault(e, 10.0, &runs),
-            1.0,
+            2.0,
             "a NaN objective is the worst"
         );
         let runs = [run(false, 20.0), run(false, 30.0)];
         assert_eq!(
             worst_fault(e, 10.0, &runs),
-            1.0,
+            2.0,
             "among failures, the worsening"
         );
         // A metric where larger is better: the largest drop.
         let runs = [run(true, 0.9), run(true, 0.5)];
-        assert_eq!(worst_fault(SUCCESS, 1.0, &runs), 1.0);
+        assert_eq!(worst_fault(SUCCESS, 1.0, &runs), 2.0);
         assert!(worst_fault(e, 10.0, &[]).is_nan());
     }
 }

@@ -8,6 +8,7 @@ use super::doe::expand;
 use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
 use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use super::rerank::Rerank;
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
@@ -106,16 +107,61 @@ fn rerun_extremes(
 }
 
 /// Regenerate `summary.md` and the plots of an output directory from `cases.parquet` (or
-/// `cases.csv`) and `manifest.json`.
+/// `cases.csv`) and `manifest.json`; returns non-fatal warnings.
 pub fn report(dir: &Path) -> Result<Notes, StudyError> {
-    let m = read_manifest(dir)?;
+    Ok(report_ranked(dir, &Rerank::default())?.warnings)
+}
+
+/// What [`report_ranked`] wrote besides the report.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reported {
+    /// Outputs that could not be written.
+    pub warnings: Notes,
+    /// What the re-ranking changed (see [`super::rerank`]).
+    pub notes: Notes,
+}
+
+/// [`report`] re-ranked by `rerank` (`usm-study report DIR --objective M --pareto A,B`): an
+/// unknown metric is refused (bad input, with the closest name) before anything is written.
+pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError> {
+    let mut m = read_manifest(dir)?;
     let pq = dir.join(CASES_PARQUET);
-    let table = if pq.is_file() {
+    let mut table = if pq.is_file() {
         crate::report::read_parquet(&pq)?
     } else {
         // Reconstruct from the raw rows (typed) when the Parquet file is missing.
         let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
-    Ok(write_report(dir, &table, &m))
+    super::dictionary::integers_for_files(&mut table, false);
+    let notes = if rerank.is_empty() {
+        Notes::new()
+    } else {
+        super::rerank::apply(dir, &mut m, &mut table, rerank)?
+    };
+    Ok(Reported {
+        warnings: write_report(dir, &table, &m),
+        notes,
+    })
+}
+
+/// The terminal's one-line answer of a study output without uncertain worlds (which have a
+/// verdict line instead): the best successful case by the objective, its design and value,
+/// e.g. "best by `mission_cost` (min): #41 (distributed/9/0.14) at 1.2345"; `None` when
+/// no case is ranked or the files cannot be read.
+pub fn best_case_line(dir: &Path) -> Option<String> {
+    let m = read_manifest(dir).ok()?;
+    let mut table = crate::report::read_parquet(&dir.join(CASES_PARQUET)).ok()?;
+    super::dictionary::integers_for_files(&mut table, false);
+    let sel = Selection::new(&table, &m);
+    let o = sel.objective.as_deref()?;
+    let row = sel.best_row(&table, o, false)?;
+    let id = table.i64(CASE_ID).ok()?.get(row).copied()?;
+    let axes: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+    Some(format!(
+        "best by `{o}` ({}): #{id} ({}) at {}",
+        sel.goal(o),
+        super::plots::case_name(&table, &axes, row),
+        super::selection::cell_text(&table, o, row)
+    ))
 }

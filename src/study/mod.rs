@@ -31,6 +31,7 @@
 //! - [`selection`], [`plots`], [`summary`]: the report (`summary.md` and plots);
 //!   [`summary_robust`]: its verdict and sections over uncertain worlds.
 //! - [`finish`]: the report step (best/worst reruns, summary) and `usm-study report`.
+//! - [`rerank`]: `usm-study report --objective/--pareto`, re-ranking without re-running.
 //! - [`engine`]: running, resuming and sharding a sweep.
 //! - [`shards`]: merging shard outputs.
 
@@ -53,6 +54,7 @@ pub mod outdir;
 pub mod parse;
 pub mod plots;
 pub mod records;
+pub mod rerank;
 pub mod robust;
 pub mod runner;
 pub mod schema;
@@ -68,8 +70,9 @@ pub mod worlds;
 
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use error::{InputError, StudyError};
-pub use finish::report;
+pub use finish::{report, report_ranked, Reported};
 pub use parse::load_study;
 pub use records::CaseStatus;
+pub use rerank::Rerank;
 pub use schema::{DoeKind, Study};
 pub use shards::merge;

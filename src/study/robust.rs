@@ -22,7 +22,7 @@ use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
 use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
 use crate::evaluate::disqualified;
-use crate::report::{write_csv_streamed, write_parquet};
+use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
@@ -429,11 +429,13 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
 ///
 /// With uncertain worlds (`robust`), the per-world columns move to
 /// [`WORLDS_CSV`] and the ranking columns are added
-/// ([`add_rank_columns`]).
+/// ([`add_rank_columns`]). `cases.parquet` carries the data dictionary of its columns
+/// (`axes` named as such) in its metadata ([`super::dictionary::parquet_metadata`]).
 pub fn write_tables(
     raw: Table,
     out: &Path,
     robust: Option<&RobustInfo>,
+    axes: &[&str],
 ) -> Result<Table, StudyError> {
     write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
     let mut table = final_table(raw)?;
@@ -446,7 +448,18 @@ pub fn write_tables(
             add_rank_columns(&mut table, &worlds, info);
         }
     }
-    write_csv_streamed(&table, &out.join(CASES_CSV))?;
-    write_parquet(&table, &out.join(CASES_PARQUET))?;
+    write_case_files(&mut table, out, axes)?;
     Ok(table)
+}
+
+/// Write `table` to [`CASES_CSV`] and [`CASES_PARQUET`] in `out`: whole-number columns as
+/// integers ([`super::dictionary::integers_for_files`]; `table` is left as it was), the
+/// dictionary of the columns in the Parquet file's metadata.
+pub fn write_case_files(table: &mut Table, out: &Path, axes: &[&str]) -> Result<(), StudyError> {
+    super::dictionary::integers_for_files(table, true);
+    let meta = super::dictionary::parquet_metadata(table, axes);
+    let written = write_csv_streamed(table, &out.join(CASES_CSV))
+        .and_then(|()| write_parquet_with(table, &out.join(CASES_PARQUET), &meta));
+    super::dictionary::integers_for_files(table, false);
+    Ok(written?)
 }

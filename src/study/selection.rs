@@ -9,7 +9,8 @@
 use std::collections::HashSet;
 
 pub use super::directions::{
-    larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, TRANSPORT_OBJECTIVE, WORLD_SUFFIXES,
+    is_identifier, larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, TRANSPORT_OBJECTIVE,
+    WORLD_SUFFIXES,
 };
 use super::manifest::Manifest;
 use super::records::{CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION};
@@ -31,7 +32,8 @@ pub(crate) fn thin(rows: &[usize]) -> Vec<usize> {
 
 /// Which metrics the report looks at and in which direction.
 pub struct Selection {
-    /// Every metric column (f64, not an axis).
+    /// Every metric column (f64, not an axis, not an identifier or flag:
+    /// [`is_identifier`]).
     pub metrics: Vec<String>,
     /// Metrics where larger is better.
     pub maximise: HashSet<String>,
@@ -52,7 +54,9 @@ impl Selection {
             .iter()
             .filter(|c| c.data.kind() == ColumnKind::F64)
             .map(|c| c.name.clone())
-            .filter(|n| !RAW_HEAD.contains(&n.as_str()) && !axes.contains(n.as_str()))
+            .filter(|n| {
+                !RAW_HEAD.contains(&n.as_str()) && !axes.contains(n.as_str()) && !is_identifier(n)
+            })
             .collect();
         let has = |n: &str| metrics.iter().any(|m| m == n);
         let mut maximise: HashSet<String> = manifest.report.maximise.iter().cloned().collect();

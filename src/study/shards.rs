@@ -69,7 +69,8 @@ pub fn merge(
     };
     warnings.extend(outdir::claim(out, &lock, &claim)?);
     outdir::record_owned(out, lock.created, &outdir::SWEEP_FILES)?;
-    let table = write_tables(raw, out, m0.robust.as_ref())?;
+    let axes: Vec<&str> = m0.axes.iter().map(|a| a.name.as_str()).collect();
+    let table = write_tables(raw, out, m0.robust.as_ref(), &axes)?;
     if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
         std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
     }
