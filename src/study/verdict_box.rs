@@ -143,8 +143,17 @@ pub fn verdict_box(inp: &BoxInput) -> String {
     let mut md = String::new();
     let cav = caveats(inp);
     if let Some(&leader) = inp.ranked.first() {
-        let noise = column(inp.table, "tune_noise").map_or(f64::NAN, |c| c[leader]);
-        if noise > NOISY_TUNING {
+        let noise_col = column(inp.table, "tune_noise");
+        let noise = noise_col.as_ref().map_or(f64::NAN, |c| c[leader]);
+        if noise_col.is_some() && noise.is_nan() {
+            let _ = writeln!(
+                md,
+                "Caveat: fewer than two of the independent tuning starts of {} reached a point \
+                 meeting every tuning constraint, so its tuning noise is not measured \
+                 (`tune_noise` empty); its cost is what one start found.\n",
+                (inp.label)(leader)
+            );
+        } else if noise > NOISY_TUNING {
             let _ = writeln!(
                 md,
                 "Caveat: the tuning of {} did not settle — its independent starts ended {:.0} % \
@@ -234,5 +243,29 @@ mod tests {
             ..inp
         };
         assert!(caveats(&inp).is_empty());
+    }
+
+    #[test]
+    fn a_leader_without_two_feasible_tuning_starts_is_named() {
+        let mut t = table();
+        t.push(
+            "tune_noise",
+            ColumnData::F64(vec![f64::NAN, 0.05, 0.5, 0.02, 0.01]),
+        )
+        .unwrap();
+        let label = |r: usize| format!("#{r}");
+        let inp = BoxInput {
+            table: &t,
+            ranked: &[0, 1, 2, 3, 4],
+            objective: "mission_cost",
+            label: &label,
+        };
+        assert!(verdict_box(&inp).contains("fewer than two of the independent tuning starts of #0"));
+        let inp = BoxInput {
+            ranked: &[2, 0],
+            ..inp
+        };
+        let b = verdict_box(&inp);
+        assert!(b.contains("#2 did not settle") && b.contains("50 %"), "{b}");
     }
 }
