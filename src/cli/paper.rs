@@ -21,7 +21,7 @@ pub enum PaperName {
     /// case 3 (NPS AUV II under current, Table I) and the paper-like figures.
     Antonelli,
     /// The USM paper's transport mode under every reading of its open choices (USM-33/34,
-    /// USM-40/41): `readings.csv` and `readings.md`.
+    /// USM-40/41): `readings.csv`, `readings.md` and `claims.md`.
     Readings,
     /// The USM paper's secondary objectives (manipulability, controllability) on and off, in
     /// work mode and transport: `secondary.csv` and `secondary.md`.

@@ -66,7 +66,9 @@ const INTRO: &str = "# The USM paper's simulations, regenerated\n\n\
      paper's 140 s, which leaves 45 s after the segment commanded at 95 s: a NaN\n\
      convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n\
      `readings/readings.md` compares both transport methods under every reading of the\n\
-     paper's open choices (`paper readings` regenerates only that);\n\
+     paper's open choices (`paper readings` regenerates only that), and\n\
+     `readings/claims.md` judges the paper's transport claims under the printed and the\n\
+     adopted reading, with and without cross-flow lift;\n\
      `secondary/secondary.md` the paper's secondary objectives on and off (`paper secondary`).\n";
 
 /// One finished run, as reported to the caller.
