@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::paper::antonelli_outputs::run_antonelli;
-use usm_study::paper::readings::run_readings;
 use usm_study::paper::secondary::run_secondary_comparison;
+use usm_study::paper::transport_claims::run_readings_and_claims;
 use usm_study::paper::usm::run_paper;
 
 /// Which paper to regenerate.
@@ -79,7 +79,7 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             .out
             .clone()
             .unwrap_or_else(|| "results/paper/readings".into());
-        let outcome = run_readings(&out, &mut |r| {
+        let outcome = run_readings_and_claims(&out, &mut |r| {
             eprintln!(
                 "[paper readings] {} {:?}: {}",
                 r.reading.key(),

@@ -19,14 +19,15 @@
 //! Each run lasts 170 s (the paper's 140 s leave only 45 s after the turn commanded at 95 s).
 //! Beside the scenario metrics, three figures are computed from the trajectory
 //! (`tail_deviation_rms`, `cruise_peak_thrust`, `ee_sway_peak`; defined in
-//! [`super::transport_claims`]). The printed and the adopted reading are also run with
-//! cross-flow lift ([`LIFT_SLOPE`], docs/model.md §2 "Lift"), and `claims.md` judges the
-//! paper's transport claims under those four ([`super::transport_claims::claims_md`]).
+//! [`super::transport_metrics`]). The printed and the adopted reading are also run with
+//! cross-flow lift ([`LIFT_SLOPE`], docs/model.md §2 "Lift"); `claims.md`, written by
+//! `super::transport_claims::run_readings_and_claims`, judges the paper's transport claims
+//! under them.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::transport_claims::{claims_md, cruise_peak_thrust, ee_sway_peak, tail_deviation_rms};
+use super::transport_metrics::{cruise_peak_thrust, ee_sway_peak, tail_deviation_rms};
 use crate::control::transport::{SurgeLaw, TransportGains, TransportMethod, YawRateSource};
 use crate::outcome::run_scenario;
 use crate::pipeline::error::{create_dir, PipelineError};
@@ -197,7 +198,7 @@ fn wire_name<T: serde::Serialize>(x: &T) -> String {
 pub const LIFT_SLOPE: f64 = 2.0;
 
 /// The metrics of one run shown in the tables, in CSV column order (scenario metrics, then the
-/// three computed by [`super::transport_claims`]).
+/// three computed by [`super::transport_metrics`]).
 pub const READING_KEYS: [&str; 14] = [
     "converged",
     "seg0_convergence_time",
@@ -405,7 +406,6 @@ pub fn run_readings(
     };
     atomic_write(&out.join("readings.csv"), readings_csv(&outcome).as_bytes())?;
     atomic_write(&out.join("readings.md"), readings_md(&outcome).as_bytes())?;
-    atomic_write(&out.join("claims.md"), claims_md(&outcome).as_bytes())?;
     Ok(outcome)
 }
 

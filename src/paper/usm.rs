@@ -8,8 +8,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::readings::run_readings;
 use super::secondary::run_secondary_comparison;
+use super::transport_claims::run_readings_and_claims;
 use crate::allocation::Method;
 use crate::outcome::run_scenario;
 use crate::pipeline::error::{create_dir, PipelineError};
@@ -155,7 +155,7 @@ pub fn run_paper(
     }
     write_tables(&mut md, &rows);
     atomic_write(&out.join("README.md"), md.as_bytes())?;
-    run_readings(&out.join("readings"), &mut |_| {})?;
+    run_readings_and_claims(&out.join("readings"), &mut |_| {})?;
     run_secondary_comparison(&out.join("secondary"), &mut |_| {})?;
     Ok(PaperOutcome { failed })
 }
