@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::paper::antonelli_outputs::run_antonelli;
-use usm_study::paper::readings::run_readings;
 use usm_study::paper::secondary::run_secondary_comparison;
+use usm_study::paper::transport_claims::run_readings_and_claims;
 use usm_study::paper::usm::run_paper;
 
 /// Which paper to regenerate.
@@ -21,7 +21,7 @@ pub enum PaperName {
     /// case 3 (NPS AUV II under current, Table I) and the paper-like figures.
     Antonelli,
     /// The USM paper's transport mode under every reading of its open choices (USM-33/34,
-    /// USM-40/41): `readings.csv` and `readings.md`.
+    /// USM-40/41): `readings.csv`, `readings.md` and `claims.md`.
     Readings,
     /// The USM paper's secondary objectives (manipulability, controllability) on and off, in
     /// work mode and transport: `secondary.csv` and `secondary.md`.
@@ -79,7 +79,7 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             .out
             .clone()
             .unwrap_or_else(|| "results/paper/readings".into());
-        let outcome = run_readings(&out, &mut |r| {
+        let outcome = run_readings_and_claims(&out, &mut |r| {
             eprintln!(
                 "[paper readings] {} {:?}: {}",
                 r.reading.key(),

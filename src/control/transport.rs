@@ -47,8 +47,15 @@
 //! all 32 combinations of the open choices (n or not, feedback on the uncommanded axes or not,
 //! front-heading or base yaw rate, with or without `ψ̇_r`, PI or PD surge). Only the default
 //! below (no `n`, feedback, front-heading rate, `ψ̇ − ψ̇_r`, PI: two departures from the
-//! printed text) makes both methods converge; under none is Method 2 the faster one, and with
-//! the two rows' yaw gains and Δ swapped the ordering follows the gains, not the surge source.
+//! printed text) makes both methods converge — it was adopted *for that outcome*, and it
+//! reverses the paper's ranking (Method 1 24.6 / 26.4 s, Method 2 71.7 / 71.4 s). Under the
+//! printed reading, and under two others (PD surge; no `n` with the base yaw rate and no
+//! `ψ̇_r`), only Method 2 converges, on one segment (printed: segment 1 in 74.9 s), while
+//! Method 1 converges on none (printed: a ±1.7 m limit cycle): the paper's ranking, if not its
+//! "both converge". Under the adopted reading the ordering follows the yaw gains, not the
+//! surge source: Method 2 with Method 1's `k_6p = 0.13` alone converges in 20.0 / 30.5 s.
+//! `results/paper/readings/claims.md` judges each of the paper's transport claims under the
+//! printed and the adopted reading, with and without cross-flow lift (`hydro.lift_slope`).
 //!
 //! - **Zero-velocity feedback on the uncommanded axes.** With `n` included and those
 //!   accelerations literally zero, USM-33 makes sway, heave and pitch pure integrators

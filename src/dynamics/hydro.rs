@@ -25,6 +25,39 @@ pub struct CylinderDrag {
     /// Linear damping `[N·s/m ×3, N·m·s/rad ×3]` on the relative twist at the geometric
     /// centre `(l/2, 0, 0)`.
     pub linear: [f64; 6],
+    /// Slender-body lift constant `½ ρ C_Lα π r²` [kg/m] of [`slender_lift`]; 0 = no lift
+    /// (the default: then [`Self::wrench`] is bit-identical to the model without lift).
+    pub k_lift: f64,
+    /// The rear face (`x = 0`) is free: no body is joined behind it (the chain's tail).
+    pub free_rear: bool,
+    /// The front face (`x = l`) is free: no body is joined in front of it (the chain's head).
+    pub free_front: bool,
+}
+
+/// Cross-flow lift of a slender blunt-based cylinder (docs/model.md §2 "Lift"), `[N]`, for the
+/// relative velocity `v` [m/s] (body frame, x along the axis) of the point it acts at, with
+/// `k = ½ ρ C_Lα π r²` [kg/m]:
+///
+/// `f_L = −k (U v⊥ − (|v⊥|² / U) v)`, `U = |v|`, `v⊥ = (0, v_y, v_z)`,
+///
+/// i.e. magnitude `½ ρ π r² U² C_L(α)` with `C_L(α) = C_Lα sin α |cos α|` (α the angle between
+/// the axis and `v`), direction perpendicular to `v` in the plane of the axis and `v`, on the
+/// side that opposes `v⊥` (a fin's lift). At small α this is slender-body theory's
+/// `ρ U² π r² α` for `C_Lα = 2` (Munk 1924; the potential term `(S_b/S) sin 2α cos(α/2)` of
+/// Jorgensen, NASA TR R-474, 1977). `f_L · v = 0` exactly in real arithmetic: lift does no
+/// work. Zero for `v⊥ = 0` (α = 0) and for `U = 0`.
+#[inline]
+pub fn slender_lift(k: f64, v: &Vec3) -> Vec3 {
+    let u2 = v.norm_squared();
+    if u2 == 0.0 {
+        return Vec3::zeros();
+    }
+    let big_u = u2.sqrt();
+    // U v⊥ − (|v⊥|²/U) v = ((U² − |v⊥|²)/U) v⊥ − (|v⊥|²/U) u e_x = (u²/U) v⊥ − (|v⊥|²/U) u e_x:
+    // written so, it is exactly zero at α = 0 (v⊥ = 0) and at α = 90° (u = 0).
+    let axial = v.x * v.x / big_u;
+    let perp = (v.y * v.y + v.z * v.z) / big_u;
+    Vec3::new(k * perp * v.x, -k * axial * v.y, -k * axial * v.z)
 }
 
 impl CylinderDrag {
@@ -50,13 +83,62 @@ impl CylinderDrag {
             length,
             strips,
             linear,
+            k_lift: 0.0,
+            free_rear: false,
+            free_front: false,
         }
+    }
+
+    /// The same cylinder with slender-body lift of slope `lift_slope` = `C_Lα` [1/rad] on
+    /// `π r²` (≥ 0; 0 = none), acting at a *free* trailing face only (`free_rear`,
+    /// `free_front`: whether no body is joined at `x = 0`, `x = l`); see [`Self::lift`].
+    pub fn with_lift(
+        mut self,
+        rho: f64,
+        radius: f64,
+        lift_slope: f64,
+        free_rear: bool,
+        free_front: bool,
+    ) -> Self {
+        self.k_lift = 0.5 * rho * lift_slope * std::f64::consts::PI * radius * radius;
+        self.free_rear = free_rear;
+        self.free_front = free_front;
+        self
+    }
+
+    /// The lift wrench (body frame, moment about the origin) for relative twist `v_r`:
+    /// [`slender_lift`] evaluated with the relative velocity of the **trailing face's centre**
+    /// `p` (`x = 0` when the axial relative velocity `u > 0`, `x = l` when `u < 0`; none at
+    /// `u = 0`, α = 90°, where `C_L = 0`) and applied there, moment `p × f_L`; zero when that
+    /// face is not free. Why there: the Kirchhoff term of the added mass already carries the
+    /// potential-flow loads of slender-body theory, equal and opposite at the two faces (the
+    /// Munk couple); flow separation at a blunt base removes the base's load, and adding
+    /// `f_L` at the trailing face is exactly that removal, leaving the net lift at the
+    /// leading face as slender-body theory has it (docs/model.md §2 "Lift"). Inner faces of the
+    /// chain are joined to the next body, so the flow does not separate there: a straight
+    /// chain behaves as one slender body whose only base is its tail.
+    #[inline]
+    pub fn lift(&self, v_r: &Vec6) -> Vec6 {
+        let u = v_r[0];
+        let s = if u > 0.0 && self.free_rear {
+            0.0
+        } else if u < 0.0 && self.free_front {
+            self.length
+        } else {
+            return Vec6::zeros();
+        };
+        // Velocity of p = (s, 0, 0): v + ω × p = (u, v_y + ω_z s, v_z − ω_y s).
+        let vp = Vec3::new(u, v_r[1] + v_r[5] * s, v_r[2] - v_r[4] * s);
+        let f = slender_lift(self.k_lift, &vp);
+        // p × f = (0, −s f_z, s f_y)
+        Vec6::new(f.x, f.y, f.z, 0.0, -s * f.z, s * f.y)
     }
 
     /// The damping wrench on the body for relative twist `v_r` (docs/model.md §2):
     /// cross-flow `−½ρ C_d,y|z (2r) |v⊥(s)| v⊥(s)` per unit length with
     /// `v⊥(s) = (0, v_y + ω_z s, v_z − ω_y s)` integrated by the midpoint rule (so rotation
-    /// makes moments), axial `−½ρ C_d,x πr² |u| u`, and linear damping at the centre.
+    /// makes moments), axial `−½ρ C_d,x πr² |u| u`, linear damping at the centre, and the
+    /// [`Self::lift`] wrench when `k_lift ≠ 0`.
     #[inline]
     pub fn wrench(&self, v_r: &Vec6) -> Vec6 {
         let (u, vy, vz) = (v_r[0], v_r[1], v_r[2]);
@@ -83,14 +165,19 @@ impl CylinderDrag {
         let (ly, lz) = (-d[1] * (vy + wz * cx), -d[2] * (vz - wy * cx));
         let lx = -d[0] * u;
         // Moment about the origin: m_c + c × f_c, c × (lx, ly, lz) = (0, −cx lz, cx ly).
-        Vec6::new(
+        let w = Vec6::new(
             fx + lx,
             fy + ly,
             fz + lz,
             -d[3] * wx,
             my - d[4] * wy - cx * lz,
             mz - d[5] * wz + cx * ly,
-        )
+        );
+        if self.k_lift == 0.0 {
+            w
+        } else {
+            w + self.lift(v_r)
+        }
     }
 }
 
@@ -121,8 +208,10 @@ pub enum DampingKernel {
 }
 
 impl DampingKernel {
-    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³].
-    pub fn of(body: &Body, rho: f64) -> Self {
+    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³]; `free_rear`
+    /// and `free_front` say whether its faces at `x = 0` and `x = l` are free (no body joined
+    /// there), where a cylinder's lift ([`CylinderDrag::lift`]) may act.
+    pub fn of(body: &Body, rho: f64, free_rear: bool, free_front: bool) -> Self {
         match &body.hydro {
             Hydro::Cylinder {
                 cd_x,
@@ -130,17 +219,33 @@ impl DampingKernel {
                 cd_z,
                 linear_damping,
                 strips,
+                lift_slope,
+                lift_every_body,
                 ..
-            } => DampingKernel::Cylinder(CylinderDrag::new(
-                rho,
-                body.radius,
-                body.length,
-                *cd_x,
-                *cd_y,
-                *cd_z,
-                *linear_damping,
-                *strips,
-            )),
+            } => {
+                let c = CylinderDrag::new(
+                    rho,
+                    body.radius,
+                    body.length,
+                    *cd_x,
+                    *cd_y,
+                    *cd_z,
+                    *linear_damping,
+                    *strips,
+                );
+                DampingKernel::Cylinder(if *lift_slope == 0.0 {
+                    c
+                } else {
+                    let every = *lift_every_body;
+                    c.with_lift(
+                        rho,
+                        body.radius,
+                        *lift_slope,
+                        free_rear || every,
+                        free_front || every,
+                    )
+                })
+            }
             Hydro::Coefficients {
                 linear, quadratic, ..
             } => DampingKernel::Coefficients {
@@ -321,6 +426,114 @@ mod tests {
             for i in 0..6 {
                 let e = -(dl[(i, i)] * v[i] + dq[(i, i)] * v[i].abs() * v[i]);
                 prop_assert!((w[i] - e).abs() < 1e-12);
+            }
+        }
+    }
+
+    /// The paper's link: ρ = 1026, r = 0.085 m, 0.6 m, with slender-body lift `C_Lα = 2` at
+    /// its free rear face.
+    fn lifting() -> CylinderDrag {
+        cyl().with_lift(1026.0, 0.085, 2.0, true, false)
+    }
+
+    #[test]
+    fn lift_is_perpendicular_to_the_flow_zero_at_zero_incidence_and_odd() {
+        let k = lifting().k_lift;
+        let (u, a) = (0.5, 0.1f64);
+        let v = Vec3::new(u * a.cos(), u * a.sin(), 0.0);
+        let f = slender_lift(k, &v);
+        // Hand value: ½ρ πr² U² C_Lα sin α cos α = ½·1026·π·0.085²·0.25·2·sin 0.1·cos 0.1.
+        let hand =
+            0.5 * 1026.0 * std::f64::consts::PI * 0.085f64.powi(2) * 0.25 * 2.0 * a.sin() * a.cos();
+        assert!((hand - 0.5783).abs() < 1e-4, "{hand}");
+        assert!((f.norm() - hand).abs() < 1e-14, "{} {hand}", f.norm());
+        // Perpendicular to the relative velocity (no work), in the plane of the axis and v,
+        // opposing the cross-flow component (a fin's lift).
+        assert!(f.dot(&v).abs() < 1e-15, "{}", f.dot(&v));
+        assert_eq!(f.z, 0.0);
+        assert!(f.y < 0.0 && f.x > 0.0);
+        // Odd in α: mirroring the incidence mirrors the force.
+        let g = slender_lift(k, &Vec3::new(v.x, -v.y, 0.0));
+        assert_eq!((g.x, g.y), (f.x, -f.y));
+        // Zero at α = 0 (pure axial flow), at α = 90° (pure cross-flow) and at rest.
+        assert_eq!(slender_lift(k, &Vec3::new(0.5, 0.0, 0.0)), Vec3::zeros());
+        assert_eq!(slender_lift(k, &Vec3::new(-0.5, 0.0, 0.0)), Vec3::zeros());
+        assert_eq!(slender_lift(k, &Vec3::new(0.0, 0.5, 0.2)), Vec3::zeros());
+        assert_eq!(slender_lift(k, &Vec3::zeros()), Vec3::zeros());
+        // Linear in α at small α: C_L = C_Lα α, i.e. ρ U² πr² α for C_Lα = 2.
+        let small = 1e-4f64;
+        let fs = slender_lift(k, &Vec3::new(u * small.cos(), u * small.sin(), 0.0));
+        let slope = 1026.0 * 0.25 * std::f64::consts::PI * 0.085f64.powi(2) * small;
+        assert!((fs.norm() - slope).abs() < 1e-8 * slope);
+    }
+
+    #[test]
+    fn lift_acts_at_the_free_trailing_face_only() {
+        let c = lifting();
+        let v = Vec6::new(0.5, 0.05, 0.0, 0.0, 0.0, 0.1);
+        // Moving head first (u > 0): the trailing face is the rear one (x = 0), free: the
+        // force is the lift of the rear face's velocity (v_y + ω_z·0) and makes no moment
+        // about the origin, which is that face.
+        let w = c.lift(&v);
+        let f = slender_lift(c.k_lift, &Vec3::new(0.5, 0.05, 0.0));
+        assert_eq!(Vec3::new(w[0], w[1], w[2]), f);
+        assert_eq!((w[3], w[4], w[5]), (0.0, 0.0, 0.0));
+        // The drag wrench with lift is the drag without it plus the lift.
+        assert_eq!(c.wrench(&v), cyl().wrench(&v) + w);
+        // Moving tail first: the trailing face is the front one, joined to the next body
+        // here: no lift. Free, it carries the lift of its own velocity and its moment.
+        let back = Vec6::new(-0.5, 0.05, 0.0, 0.0, 0.0, 0.1);
+        assert_eq!(c.lift(&back), Vec6::zeros());
+        let head = cyl().with_lift(1026.0, 0.085, 2.0, false, true);
+        let wb = head.lift(&back);
+        let fb = slender_lift(head.k_lift, &Vec3::new(-0.5, 0.05 + 0.1 * 0.6, 0.0));
+        assert_eq!(Vec3::new(wb[0], wb[1], wb[2]), fb);
+        assert!((wb[5] - 0.6 * fb.y).abs() < 1e-15);
+        // No lift where no face is free.
+        let inner = cyl().with_lift(1026.0, 0.085, 2.0, false, false);
+        assert_eq!(inner.lift(&v), Vec6::zeros());
+        assert_eq!(inner.lift(&back), Vec6::zeros());
+    }
+
+    #[test]
+    fn a_body_gets_lift_at_its_free_faces_or_at_every_face_when_asked() {
+        let mut body = crate::model::presets::usm_paper().bodies[4].clone();
+        let set = |b: &mut Body, slope: f64, every: bool| {
+            if let Hydro::Cylinder {
+                lift_slope,
+                lift_every_body,
+                ..
+            } = &mut b.hydro
+            {
+                *lift_slope = slope;
+                *lift_every_body = every;
+            }
+        };
+        let flags = |k: &DampingKernel| match k {
+            DampingKernel::Cylinder(c) => (c.k_lift, c.free_rear, c.free_front),
+            _ => panic!("a cylinder"),
+        };
+        // No lift by default, whatever the faces.
+        assert_eq!(flags(&DampingKernel::of(&body, 1026.0, true, true)).0, 0.0);
+        set(&mut body, 2.0, false);
+        let (k, rear, front) = flags(&DampingKernel::of(&body, 1026.0, true, false));
+        let expect = 0.5 * 1026.0 * 2.0 * std::f64::consts::PI * body.radius * body.radius;
+        assert!((k - expect).abs() < 1e-12 * expect);
+        assert_eq!((rear, front), (true, false));
+        assert!(!flags(&DampingKernel::of(&body, 1026.0, false, false)).1);
+        set(&mut body, 2.0, true);
+        let (_, rear, front) = flags(&DampingKernel::of(&body, 1026.0, false, false));
+        assert_eq!((rear, front), (true, true));
+    }
+
+    proptest! {
+        #[test]
+        fn lift_does_no_work(v in proptest::array::uniform6(-2.0f64..2.0)) {
+            // Vᵀ W_lift = f · (v + ω × p) = f · v_p = 0 for any twist, rotation included.
+            let v = Vec6::from_row_slice(&v);
+            for c in [lifting(), cyl().with_lift(1026.0, 0.085, 2.0, false, true)] {
+                let w = c.lift(&v);
+                prop_assert!(v.dot(&w).abs() <= 1e-12 * (1.0 + w.norm() * v.norm()));
             }
         }
     }

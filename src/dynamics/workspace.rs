@@ -95,7 +95,14 @@ impl DynWorkspace {
             i_rb,
             m_a,
             i_tot,
-            damping: v.bodies.iter().map(|b| DampingKernel::of(b, rho)).collect(),
+            // A serial chain, tail to head: only the tail's rear face and the head's front
+            // face are free (where lift may act, `CylinderDrag::lift`).
+            damping: v
+                .bodies
+                .iter()
+                .enumerate()
+                .map(|(i, b)| DampingKernel::of(b, rho, i == 0, i + 1 == nb))
+                .collect(),
             restoring: v
                 .bodies
                 .iter()

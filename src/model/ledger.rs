@@ -123,6 +123,20 @@ pub const LEDGER: &[Assumption] = &[
                the model's level",
     },
     Assumption {
+        key: "hydro.lift_slope",
+        name: "cross-flow lift of the chain (slender-body, at the free trailing face)",
+        value: "C_Lα = 0 (off); 2 /rad on πr² when on",
+        source: Source::Paper(
+            "slender-body theory (Munk 1924); potential term (S_b/S) sin 2α cos(α/2) of Jorgensen, NASA TR R-474 (1977): C_Lα = 2 on the base area",
+        ),
+        range: Some((0.0, 2.0)),
+        note: "off by default: the source is for one blunt-based body, and how far a jointed \
+               chain with thrusters and gaps separates like one is not known; 2 is the \
+               theory's value, 0 no lift (results/paper/FINDINGS.md §1 shows both); \
+               `hydro.lift_every_body = true` puts it at every body's trailing face, an upper \
+               bound",
+    },
+    Assumption {
         key: "hydro.added_mass_scale",
         name: "added mass, lateral and rotational",
         value: "M_A22 = M_A33 = πρr²l, M_A55 = M_A66 = πρr²l³/12, M_A44 = 0",

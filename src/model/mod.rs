@@ -74,6 +74,14 @@ pub enum Hydro {
         /// Factor on the whole added-mass matrix of the formulas above (1 = the paper's
         /// formulas; an uncertain world's `hydro.added_mass_scale`, docs/assumptions.md).
         added_mass_scale: f64,
+        /// Slender-body lift slope `C_Lα` [1/rad] on the cross-section `π r²` (docs/model.md
+        /// §2 "Lift"; `crate::dynamics::hydro::slender_lift`), acting at a free trailing face
+        /// only. 0 = no lift (the default); set for every cylinder by the scenario key
+        /// `hydro.lift_slope` (a world property, not written to design files).
+        lift_slope: f64,
+        /// Lift at the trailing face of *every* body, each its own blunt base, not only at
+        /// the chain's free faces: an upper bound (`hydro.lift_every_body`; default false).
+        lift_every_body: bool,
     },
     /// Hydrodynamic derivatives in matrix form about the body frame's origin:
     /// added mass `M_A` (6×6, symmetric PSD), linear damping `D_l` and quadratic damping
@@ -105,6 +113,8 @@ impl Hydro {
             strips: 5,
             axial_added_mass_ratio: 0.1,
             added_mass_scale: 1.0,
+            lift_slope: 0.0,
+            lift_every_body: false,
         }
     }
 }
@@ -368,12 +378,15 @@ impl Vehicle {
                     strips,
                     axial_added_mass_ratio,
                     added_mass_scale,
+                    lift_slope,
+                    lift_every_body: _,
                 } => {
                     for (name, v) in [
                         ("cd_x", cd_x),
                         ("cd_y", cd_y),
                         ("cd_z", cd_z),
                         ("added_mass_scale", added_mass_scale),
+                        ("lift_slope", lift_slope),
                     ] {
                         if !v.is_finite() || *v < 0.0 {
                             return Err(ModelError::new(

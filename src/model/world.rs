@@ -25,6 +25,13 @@ pub struct ModelScales {
     pub buoyancy_offset: f64,
     /// Factor on every thrust limit `u_min`, `u_max` (derating). Nominal 1.
     pub thrust_limit: f64,
+    /// Slender-body lift slope `C_Lα` [1/rad] set on every cylinder body (`Hydro::Cylinder`
+    /// `lift_slope`; docs/model.md §2 "Lift"). Not a factor: nominal 0, no lift. Bodies given
+    /// by coefficient matrices take no lift.
+    pub lift_slope: f64,
+    /// Lift at every body's trailing face, not only at the chain's free faces
+    /// (`Hydro::Cylinder` `lift_every_body`). Nominal false.
+    pub lift_every_body: bool,
 }
 
 impl Default for ModelScales {
@@ -36,6 +43,8 @@ impl Default for ModelScales {
             added_mass: 1.0,
             buoyancy_offset: 0.0,
             thrust_limit: 1.0,
+            lift_slope: 0.0,
+            lift_every_body: false,
         }
     }
 }
@@ -47,6 +56,8 @@ impl ModelScales {
             && self.roll_damping == 1.0
             && self.drag == 1.0
             && self.added_mass == 1.0
+            && self.lift_slope == 0.0
+            && !self.lift_every_body
     }
 
     /// Check the factors: finite, the damping, drag and added-mass factors ≥ 0, the thrust
@@ -57,6 +68,7 @@ impl ModelScales {
             (keys.roll_damping, self.roll_damping),
             (keys.drag, self.drag),
             (keys.added_mass, self.added_mass),
+            (keys.lift_slope, self.lift_slope),
         ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(ModelError::new(
@@ -96,6 +108,8 @@ pub struct ScaleKeys {
     pub buoyancy_offset: &'static str,
     /// Name of [`ModelScales::thrust_limit`].
     pub thrust_limit: &'static str,
+    /// Name of [`ModelScales::lift_slope`].
+    pub lift_slope: &'static str,
 }
 
 impl Vehicle {
@@ -119,6 +133,8 @@ impl Vehicle {
                     cd_z,
                     linear_damping,
                     added_mass_scale,
+                    lift_slope,
+                    lift_every_body,
                     ..
                 } => {
                     for d in linear_damping.iter_mut() {
@@ -129,6 +145,8 @@ impl Vehicle {
                         *c *= s.drag;
                     }
                     *added_mass_scale *= s.added_mass;
+                    *lift_slope = s.lift_slope;
+                    *lift_every_body = s.lift_every_body;
                 }
                 Hydro::Coefficients {
                     added_mass,
@@ -143,8 +161,8 @@ impl Vehicle {
                 Hydro::Manoeuvring(_) => {
                     return Err(ModelError::new(
                         format!("body[{i}].hydro"),
-                        "the hydrodynamic scale factors (damping, drag, added mass) do not \
-                         apply to a hull given by manoeuvring derivatives",
+                        "the hydrodynamic scale factors (damping, drag, added mass) and the \
+                         lift slope do not apply to a hull given by manoeuvring derivatives",
                     ))
                 }
             }
@@ -216,6 +234,7 @@ mod tests {
         added_mass: "am",
         buoyancy_offset: "bo",
         thrust_limit: "tl",
+        lift_slope: "ls",
     };
 
     #[test]
@@ -237,6 +256,8 @@ mod tests {
             added_mass: 1.5,
             buoyancy_offset: 0.01,
             thrust_limit: 0.8,
+            lift_slope: 2.0,
+            lift_every_body: true,
         };
         v.apply_scales(&s, &KEYS).unwrap();
         for (b, b0) in v.bodies.iter().zip(&v0.bodies) {
@@ -244,6 +265,8 @@ mod tests {
                 Hydro::Cylinder {
                     cd_x,
                     linear_damping,
+                    lift_slope,
+                    lift_every_body,
                     ..
                 },
                 Hydro::Cylinder {
@@ -259,6 +282,8 @@ mod tests {
             assert_eq!(linear_damping[3], 6.0 * ld0[3]);
             assert_eq!(linear_damping[4], 2.0 * ld0[4]);
             assert_eq!(*cd_x, 0.5 * cd_x0);
+            assert_eq!(*lift_slope, 2.0, "set, not scaled");
+            assert!(*lift_every_body);
             let (ma, ma0) = (b.added_mass(1026.0), b0.added_mass(1026.0));
             assert!((ma - 1.5 * ma0).abs().max() <= 1e-12 * ma0.abs().max());
             assert_eq!(b.volume, b0.volume * 1.01);
@@ -283,6 +308,11 @@ mod tests {
             ..ModelScales::default()
         };
         assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "drag");
+        let s = ModelScales {
+            lift_slope: -1.0,
+            ..ModelScales::default()
+        };
+        assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "ls");
     }
     #[test]
     fn a_payload_adds_its_mass_moment_and_volume_at_the_end_effector() {

@@ -2,6 +2,9 @@
 //!
 //! - [`usm`]: the USM paper's simulations (`usm-study paper`), their files and comparison
 //!   tables; [`readings`]: transport mode under every reading of the paper's open choices;
+//!   [`transport_claims`]: the paper's transport claims under the printed and the adopted
+//!   reading, with and without cross-flow lift, from the trajectory figures of
+//!   [`transport_metrics`];
 //!   [`secondary`]: the paper's secondary objectives on and off;
 //! - [`antonelli`]: Antonelli & Chiaverini's kinematic case studies 1, 1b, 2 and
 //!   ([`antonelli::dynamic`]) case 3 on the NPS AUV II ([`nps_auv2`]) under the sliding-mode
@@ -18,4 +21,6 @@ pub mod nps_auv2;
 pub mod readings;
 pub mod secondary;
 pub mod sliding;
+pub mod transport_claims;
+pub mod transport_metrics;
 pub mod usm;

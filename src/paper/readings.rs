@@ -2,8 +2,8 @@
 //! paper's text leaves several choices of transport mode's base control (USM-33/34) and yaw law
 //! (USM-40/41) open; this pipeline runs both Table III methods under every combination of them
 //! (a [`TransportReading`]) with the Table III gains unchanged, and writes
-//! `readings.csv` (one row per reading and method) and `readings.md` (one row per reading, the
-//! two methods side by side, the reading adopted as default marked).
+//! `readings.csv` (one row per reading and method), `readings.md` (one row per reading, the
+//! two methods side by side, the reading adopted as default marked) and `claims.md`.
 //!
 //! The choices (the printed text first):
 //! - **n in USM-33**: `τ_c = M_11 a^b + n` as printed ("we apply the dynamic control law in
@@ -17,24 +17,22 @@
 //! - **USM-40**: PI as printed, or PD as the OCR'd Table III header "k_1p, k_1d" suggests.
 //!
 //! Each run lasts 170 s (the paper's 140 s leave only 45 s after the turn commanded at 95 s).
-//! Beside the scenario metrics, two figures are computed here from the trajectory:
-//! - `tail_deviation_rms` [m]: how closely the back end follows the *track of the front end*
-//!   (the paper's Fig. 8a/b remark): on the first segment, the RMS of the base's lateral offset
-//!   minus the front's lateral offset when the front was at the same along-track position
-//!   (samples before the base reaches the front's starting position are skipped);
-//! - `cruise_peak_thrust` [N]: the largest `|u_j|` outside the two commanded transients, i.e.
-//!   over `2 s ≤ t < t_turn` and `t ≥ t_turn + 30 s` (`t_turn` the first segment switch).
+//! Beside the scenario metrics, three figures are computed from the trajectory
+//! (`tail_deviation_rms`, `cruise_peak_thrust`, `ee_sway_peak`; defined in
+//! [`super::transport_metrics`]). The printed and the adopted reading are also run with
+//! cross-flow lift ([`LIFT_SLOPE`], docs/model.md §2 "Lift"); `claims.md`, written by
+//! `super::transport_claims::run_readings_and_claims`, judges the paper's transport claims
+//! under them.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::control::guidance::PathSpec;
+use super::transport_metrics::{cruise_peak_thrust, ee_sway_peak, tail_deviation_rms};
 use crate::control::transport::{SurgeLaw, TransportGains, TransportMethod, YawRateSource};
-use crate::outcome::{run_scenario, RunResult};
+use crate::outcome::run_scenario;
 use crate::pipeline::error::{create_dir, PipelineError};
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
-use crate::scenario::channels::Pose;
-use crate::scenario::{load_table, parse_table, resolve_design, Channel};
+use crate::scenario::{load_table, parse_table, resolve_design};
 
 /// Simulated time of each readings run [s].
 pub const READINGS_DURATION: f64 = 170.0;
@@ -195,9 +193,13 @@ fn wire_name<T: serde::Serialize>(x: &T) -> String {
         .unwrap_or_default()
 }
 
+/// The lift slope `hydro.lift_slope` of the runs with lift (slender-body theory's `C_Lα`,
+/// docs/model.md §2 "Lift"): the printed and the adopted reading are also run with it.
+pub const LIFT_SLOPE: f64 = 2.0;
+
 /// The metrics of one run shown in the tables, in CSV column order (scenario metrics, then the
-/// two computed by this module).
-pub const READING_KEYS: [&str; 13] = [
+/// three computed by [`super::transport_metrics`]).
+pub const READING_KEYS: [&str; 14] = [
     "converged",
     "seg0_convergence_time",
     "seg1_convergence_time",
@@ -208,6 +210,7 @@ pub const READING_KEYS: [&str; 13] = [
     "final_cross_track",
     "peak_thrust",
     "cruise_peak_thrust",
+    "ee_sway_peak",
     "saturation_fraction",
     "effort_abs",
     "thruster_energy",
@@ -223,6 +226,10 @@ pub struct ReadingRun {
     /// The Table III row whose yaw gains `k_6p`, `k_6d` and look-ahead Δ the run used (the
     /// method's own, except in the gain-swap runs).
     pub yaw_gains_of: TransportMethod,
+    /// `hydro.lift_slope` of the run (0: no lift, the default model).
+    pub lift_slope: f64,
+    /// `hydro.lift_every_body` of the run (lift at every body's trailing face).
+    pub lift_every_body: bool,
     /// Whether the run stopped early (then its metrics cover the run up to the failure).
     pub failed: bool,
     /// `(key, value)` in the order of [`READING_KEYS`]; NaN where undefined.
@@ -256,69 +263,10 @@ pub struct ReadingsOutcome {
     /// The reading closest to the printed text (fewest departures; ties: the earlier in
     /// [`TransportReading::all`]) under which both methods converge, if any.
     pub adopted: Option<TransportReading>,
-}
-
-/// The first segment of a path: start point and unit direction.
-fn first_segment(path: &PathSpec) -> Option<([f64; 2], [f64; 2])> {
-    let (a, b) = match (path.segments.first(), path.waypoints.get(..2)) {
-        (Some(s), _) => (s.from, s.to),
-        (None, Some(w)) => (w[0], w[1]),
-        _ => return None,
-    };
-    let l = (b[0] - a[0]).hypot(b[1] - a[1]);
-    (l > 0.0).then(|| (a, [(b[0] - a[0]) / l, (b[1] - a[1]) / l]))
-}
-
-/// `tail_deviation_rms` of the module docs; NaN when no sample qualifies.
-fn tail_deviation_rms(r: &RunResult, path: &PathSpec) -> f64 {
-    let tr = &r.trajectory;
-    let (Some(seg), Some(s_e), Some(l_e), Some(xb), Some(yb), Some((a, d))) = (
-        tr.get(Channel::Segment),
-        tr.get(Channel::AlongTrack),
-        tr.get(Channel::CrossTrack),
-        tr.get(Channel::BasePose(Pose::X)),
-        tr.get(Channel::BasePose(Pose::Y)),
-        first_segment(path),
-    ) else {
-        return f64::NAN;
-    };
-    let n = seg.iter().take_while(|s| **s == 0.0).count();
-    let (mut sum, mut count) = (0.0, 0usize);
-    for i in 0..n {
-        let (rx, ry) = (xb[i] - a[0], yb[i] - a[1]);
-        let s_b = d[0] * rx + d[1] * ry;
-        let l_b = -d[1] * rx + d[0] * ry;
-        // The front's lateral offset where it passed s_b, from its track so far.
-        let hit = (0..i).find(|&j| s_e[j] <= s_b && s_b < s_e[j + 1]);
-        if let Some(j) = hit {
-            let f = (s_b - s_e[j]) / (s_e[j + 1] - s_e[j]);
-            let gap = l_b - (l_e[j] + f * (l_e[j + 1] - l_e[j]));
-            sum += gap * gap;
-            count += 1;
-        }
-    }
-    if count == 0 {
-        f64::NAN
-    } else {
-        (sum / count as f64).sqrt()
-    }
-}
-
-/// `cruise_peak_thrust` of the module docs.
-fn cruise_peak_thrust(r: &RunResult) -> f64 {
-    let tr = &r.trajectory;
-    let (Some(t), Some(seg)) = (tr.get(Channel::T), tr.get(Channel::Segment)) else {
-        return f64::NAN;
-    };
-    let t_turn = seg
-        .iter()
-        .position(|s| *s != seg[0])
-        .map_or(f64::INFINITY, |i| t[i]);
-    let u = tr.indexed(Channel::U);
-    (0..t.len())
-        .filter(|&i| (t[i] >= 2.0 && t[i] < t_turn) || t[i] >= t_turn + 30.0)
-        .flat_map(|i| u.iter().map(move |c| c[i].abs()))
-        .fold(0.0, f64::max)
+    /// The printed reading, then the adopted one (or [`TransportReading::DEFAULT`]), each
+    /// method, with cross-flow lift of slope [`LIFT_SLOPE`] at the chain's free trailing face,
+    /// then the same at every body's trailing face (`hydro.lift_every_body`, an upper bound).
+    pub lifted: Vec<ReadingRun>,
 }
 
 /// The preset of a Table III method.
@@ -336,6 +284,17 @@ pub fn run_reading(
     reading: TransportReading,
     method: TransportMethod,
     yaw_gains_of: Option<TransportMethod>,
+) -> Result<ReadingRun, PipelineError> {
+    run_reading_with(reading, method, yaw_gains_of, &[])
+}
+
+/// [`run_reading`] with further scenario keys `(section, key, value)` set last (e.g.
+/// `("hydro", "lift_slope", 2.0.into())`, `("control", "k_6p", 0.13.into())`).
+pub fn run_reading_with(
+    reading: TransportReading,
+    method: TransportMethod,
+    yaw_gains_of: Option<TransportMethod>,
+    overrides: &[(&str, &str, toml::Value)],
 ) -> Result<ReadingRun, PipelineError> {
     let (mut table, src) = load_table(preset(method))?;
     if let Some(s) = table.get_mut("scenario").and_then(|s| s.as_table_mut()) {
@@ -355,6 +314,15 @@ pub fn run_reading(
             c.insert(k.into(), toml::Value::Float(v));
         }
     }
+    for (section, key, value) in overrides {
+        if let Some(t) = table
+            .entry(*section)
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            .as_table_mut()
+        {
+            t.insert((*key).into(), value.clone());
+        }
+    }
     let file = parse_table(&table, &src)?;
     let v = resolve_design(&file, &src)?;
     let r = run_scenario(&v, &file)?;
@@ -365,6 +333,7 @@ pub fn run_reading(
             let x = match k {
                 "tail_deviation_rms" => tail_deviation_rms(&r, &path),
                 "cruise_peak_thrust" => cruise_peak_thrust(&r),
+                "ee_sway_peak" => ee_sway_peak(&r),
                 _ => r.metric(k).unwrap_or(f64::NAN),
             };
             (k, x)
@@ -374,6 +343,8 @@ pub fn run_reading(
         reading,
         method,
         yaw_gains_of: yaw_gains_of.unwrap_or(method),
+        lift_slope: file.hydro.lift_slope,
+        lift_every_body: file.hydro.lift_every_body,
         failed: r.failure.is_some(),
         metrics,
     })
@@ -410,10 +381,28 @@ pub fn run_readings(
         on_run(&run);
         gain_swaps.push(run);
     }
+    let mut lifted = Vec::new();
+    for every in [false, true] {
+        let lift = [
+            ("hydro", "lift_slope", toml::Value::Float(LIFT_SLOPE)),
+            ("hydro", "lift_every_body", toml::Value::Boolean(every)),
+        ];
+        for reading in [
+            TransportReading::PRINTED,
+            adopted.unwrap_or(TransportReading::DEFAULT),
+        ] {
+            for method in methods {
+                let run = run_reading_with(reading, method, None, &lift)?;
+                on_run(&run);
+                lifted.push(run);
+            }
+        }
+    }
     let outcome = ReadingsOutcome {
         runs,
         gain_swaps,
         adopted,
+        lifted,
     };
     atomic_write(&out.join("readings.csv"), readings_csv(&outcome).as_bytes())?;
     atomic_write(&out.join("readings.md"), readings_md(&outcome).as_bytes())?;
@@ -424,17 +413,17 @@ pub fn run_readings(
 pub fn readings_csv(o: &ReadingsOutcome) -> String {
     let mut s = String::from(
         "reading,departures,nonlinear,uncommanded_feedback,yaw_rate_source,\
-         yaw_rate_reference,surge_law,method,yaw_gains_of,failed",
+         yaw_rate_reference,surge_law,method,yaw_gains_of,lift_slope,lift_every_body,failed",
     );
     for k in READING_KEYS {
         let _ = write!(s, ",{k}");
     }
     s.push('\n');
-    for r in o.runs.iter().chain(&o.gain_swaps) {
+    for r in o.runs.iter().chain(&o.gain_swaps).chain(&o.lifted) {
         let g = r.reading;
         let _ = write!(
             s,
-            "{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{}",
             g.key(),
             g.departures().len(),
             g.nonlinear,
@@ -444,6 +433,8 @@ pub fn readings_csv(o: &ReadingsOutcome) -> String {
             wire_name(&g.surge_law),
             wire_name(&r.method),
             wire_name(&r.yaw_gains_of),
+            r.lift_slope,
+            r.lift_every_body,
             r.failed
         );
         for (_, v) in &r.metrics {
@@ -455,7 +446,7 @@ pub fn readings_csv(o: &ReadingsOutcome) -> String {
 }
 
 /// A number with three significant digits (no exponent below 1e5; `–` for NaN, `0` for 0).
-fn short(x: f64) -> String {
+pub(crate) fn short(x: f64) -> String {
     if x.is_nan() {
         return "–".into();
     }
@@ -467,7 +458,7 @@ fn short(x: f64) -> String {
 }
 
 /// `a / b`, each [`short`].
-fn pair(a: f64, b: f64) -> String {
+pub(crate) fn pair(a: f64, b: f64) -> String {
     format!("{} / {}", short(a), short(b))
 }
 

@@ -8,8 +8,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::readings::run_readings;
 use super::secondary::run_secondary_comparison;
+use super::transport_claims::run_readings_and_claims;
 use crate::allocation::Method;
 use crate::outcome::run_scenario;
 use crate::pipeline::error::{create_dir, PipelineError};
@@ -66,7 +66,9 @@ const INTRO: &str = "# The USM paper's simulations, regenerated\n\n\
      paper's 140 s, which leaves 45 s after the segment commanded at 95 s: a NaN\n\
      convergence time means \"not within the run\" (see FINDINGS.md for 170 s runs).\n\
      `readings/readings.md` compares both transport methods under every reading of the\n\
-     paper's open choices (`paper readings` regenerates only that);\n\
+     paper's open choices (`paper readings` regenerates only that), and\n\
+     `readings/claims.md` judges the paper's transport claims under the printed and the\n\
+     adopted reading, with and without cross-flow lift;\n\
      `secondary/secondary.md` the paper's secondary objectives on and off (`paper secondary`).\n";
 
 /// One finished run, as reported to the caller.
@@ -153,7 +155,7 @@ pub fn run_paper(
     }
     write_tables(&mut md, &rows);
     atomic_write(&out.join("README.md"), md.as_bytes())?;
-    run_readings(&out.join("readings"), &mut |_| {})?;
+    run_readings_and_claims(&out.join("readings"), &mut |_| {})?;
     run_secondary_comparison(&out.join("secondary"), &mut |_| {})?;
     Ok(PaperOutcome { failed })
 }

@@ -429,6 +429,8 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
                 strips,
                 axial_added_mass_ratio,
                 added_mass_scale,
+                lift_slope,
+                lift_every_body,
             } = Hydro::cylinder(0.1, 1.0)
             else {
                 return Err(ctx.schema(&key("kind"), "internal: cylinder defaults"));
@@ -448,6 +450,8 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
                 strips,
                 axial_added_mass_ratio: h.axial_added_mass_ratio.unwrap_or(axial_added_mass_ratio),
                 added_mass_scale: h.added_mass_scale.unwrap_or(added_mass_scale),
+                lift_slope,
+                lift_every_body,
             })
         }
         "coefficients" => {

@@ -139,6 +139,9 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 strips,
                 axial_added_mass_ratio,
                 added_mass_scale,
+                // A world property (scenario key `hydro.lift_slope`), not a design one.
+                lift_slope: _,
+                lift_every_body: _,
             } => {
                 let _ = writeln!(o, "kind = \"cylinder\"");
                 let _ = writeln!(o, "cd_x = {}", fnum(*cd_x));

@@ -92,6 +92,13 @@ pub struct HydroScaleSpec {
     pub added_mass_scale: f64,
     /// Relative buoyancy offset: displaced volumes × (1 + offset) (> −1).
     pub buoyancy_offset: f64,
+    /// Slender-body lift slope `C_Lα` [1/rad] on `π r²` of every cylinder body, acting at the
+    /// chain's free trailing face (docs/model.md §2 "Lift"; ≥ 0). Default 0: no lift; 2 is
+    /// slender-body theory's value for a blunt-based body.
+    pub lift_slope: f64,
+    /// Apply that lift at every body's trailing face (each body its own blunt base), not only
+    /// at the chain's free faces: an upper bound on the lift (default false).
+    pub lift_every_body: bool,
 }
 
 impl Default for HydroScaleSpec {
@@ -102,6 +109,8 @@ impl Default for HydroScaleSpec {
             drag_scale: 1.0,
             added_mass_scale: 1.0,
             buoyancy_offset: 0.0,
+            lift_slope: 0.0,
+            lift_every_body: false,
         }
     }
 }
@@ -114,6 +123,7 @@ pub const SCALE_KEYS: crate::model::world::ScaleKeys = crate::model::world::Scal
     added_mass: "hydro.added_mass_scale",
     buoyancy_offset: "hydro.buoyancy_offset",
     thrust_limit: "thrusters.limit_scale",
+    lift_slope: "hydro.lift_slope",
 };
 
 impl HydroScaleSpec {
@@ -126,6 +136,8 @@ impl HydroScaleSpec {
             added_mass: self.added_mass_scale,
             buoyancy_offset: self.buoyancy_offset,
             thrust_limit: limit_scale,
+            lift_slope: self.lift_slope,
+            lift_every_body: self.lift_every_body,
         }
     }
 }

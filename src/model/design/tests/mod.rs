@@ -110,6 +110,8 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 strips,
                 axial_added_mass_ratio,
                 added_mass_scale,
+                lift_slope,
+                lift_every_body,
             },
             Hydro::Cylinder {
                 cd_x: cx,
@@ -119,13 +121,16 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 strips: s,
                 axial_added_mass_ratio: ar,
                 added_mass_scale: ams,
+                lift_slope: ls,
+                lift_every_body: le,
             },
         ) => {
             nums(&k("cd"), &[*cd_x, *cd_y, *cd_z], &[*cx, *cy, *cz], tol)?;
             nums(&k("linear_damping"), linear_damping, ld, tol)?;
             num(&k("axial"), *axial_added_mass_ratio, *ar, tol)?;
             num(&k("added_mass_scale"), *added_mass_scale, *ams, tol)?;
-            if strips != s {
+            num(&k("lift_slope"), *lift_slope, *ls, tol)?;
+            if strips != s || lift_every_body != le {
                 return Err(k("strips"));
             }
         }
