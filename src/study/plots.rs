@@ -19,8 +19,8 @@ use super::records::{Extreme, CASE_ID, STATUS};
 use super::selection::{levels, mean, thin, Front};
 use crate::report::file_stem_safe;
 use crate::report::{
-    heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind, Figure,
-    LabelledPoint, Panel, PanelKind, Series, Table,
+    fmt_short, heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind,
+    Figure, LabelledPoint, Panel, PanelKind, Scale, Series, Table,
 };
 
 /// Units of metric and design columns, by name or by name suffix (docs/model.md §6 and the design
@@ -51,27 +51,56 @@ const UNITS: [(&str, &str); 23] = [
     ("singularity_exposure", "fraction of time, 0–1"),
 ];
 
-/// A column name as an axis title: words instead of underscores and dots, and its unit in
-/// brackets when known (`thruster_energy` → `thruster energy [J]`,
-/// `design.longitudinal_offset` → `longitudinal offset [m]`).
+/// A column name as an axis title: the name as in the tables, with its unit in brackets from
+/// the data dictionary ([`super::dictionary::unit_of`]; design axes from their key's unit)
+/// when known (`mission_cost` → `mission_cost [J/m]`, `design.longitudinal_offset` →
+/// `design.longitudinal_offset [m]`).
 pub fn metric_title(name: &str) -> String {
-    // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
-    let short = name.strip_prefix("design.").unwrap_or(name);
-    let words = short
-        .trim_end_matches("_m")
-        .trim_end_matches("_kg")
-        .replace(['_', '.'], " ");
-    let unit = UNITS
-        .iter()
-        .find(|(key, _)| name == *key || name.ends_with(key))
-        .map(|(_, u)| *u)
-        .or_else(|| {
-            // Singular values and condition numbers of the scaled T(q) (docs/model.md §6).
-            (name.contains("sigma_min") || name.contains("kappa")).then_some("scaled, –")
-        });
+    let unit = super::dictionary::unit_of(name).or_else(|| {
+        // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
+        UNITS
+            .iter()
+            .find(|(key, _)| name == *key || name.ends_with(key))
+            .map(|(_, u)| *u)
+    });
     match unit {
-        Some(u) => format!("{words} [{u}]"),
-        None => words,
+        Some(u) => format!("{name} [{u}]"),
+        None => name.to_string(),
+    }
+}
+
+/// The scale of an axis over values `v` at `rows`: integers when every finite value is whole
+/// (link counts, thruster numbers), plain numbers otherwise.
+fn number_scale(v: &[f64], rows: &[usize]) -> Scale {
+    let mut finite = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .peekable();
+    if finite.peek().is_some() && finite.all(|x| x.fract() == 0.0 && x.abs() < 1e15) {
+        Scale::Integer
+    } else {
+        Scale::Linear
+    }
+}
+
+/// The value of `v` at `rows` when it is the same at every row (finite values within a
+/// relative 1e-9, or no finite value at all: `NaN`); `None` when it varies.
+fn constant_value(v: &[f64], rows: &[usize]) -> Option<f64> {
+    let finite: Vec<f64> = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .collect();
+    let (lo, hi) = finite
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if finite.is_empty() {
+        Some(f64::NAN)
+    } else {
+        (hi - lo <= 1e-9 * lo.abs().max(hi.abs()).max(1e-300)).then_some(lo)
     }
 }
 
@@ -122,16 +151,16 @@ fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Option<Series> {
     })
 }
 
-/// An axis label: the axis name, with the numbering of its levels for a text axis.
-fn axis_label(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> String {
-    if matches!(
-        table.column(a).map(|c| c.data.kind()),
-        Some(ColumnKind::Str)
-    ) {
-        let names: Vec<String> = lv.iter().map(|l| format!("{}={}", l.1, l.0)).collect();
-        format!("{} ({})", metric_title(a), names.join(", "))
-    } else {
-        metric_title(a)
+/// The scale of axis `a` over its levels `lv`: the level names for a text axis, integers for
+/// whole-numbered axes.
+fn axis_scale(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> Scale {
+    match table.column(a).map(|c| &c.data) {
+        Some(ColumnData::Str(_)) => Scale::Categories(lv.iter().map(|l| l.0.clone()).collect()),
+        Some(ColumnData::F64(v)) => {
+            let rows: Vec<usize> = lv.iter().flat_map(|l| l.2.iter().copied()).collect();
+            number_scale(v, &rows)
+        }
+        _ => Scale::Linear,
     }
 }
 
@@ -207,8 +236,11 @@ pub(crate) fn axis_plots(
     plots: &Path,
     warnings: &mut Vec<String>,
 ) {
+    let all: Vec<usize> = (0..table.n_rows()).collect();
+    let bad = unsuccessful_rows(table);
     for a in axes {
-        let lv = levels(table, a, ok_rows);
+        // Levels over every case, so that a text axis has the same categories in every plot.
+        let lv = levels(table, a, &all);
         let xv: Vec<f64> = match table.column(a).map(|c| &c.data) {
             Some(ColumnData::F64(v)) => v.clone(),
             Some(ColumnData::Str(v)) => v
@@ -217,29 +249,46 @@ pub(crate) fn axis_plots(
                 .collect(),
             _ => continue,
         };
-        let x_label = axis_label(table, a, &lv);
+        let x_scale = match table.column(a).map(|c| &c.data) {
+            Some(ColumnData::F64(v)) => number_scale(v, &all),
+            _ => axis_scale(table, a, &lv),
+        };
         let mut fig = Figure::new(format!("key metrics against {}", metric_title(a)));
         let plotted = thin(ok_rows);
-        let bad = unsuccessful_rows(table);
+        let mut constant = Vec::new();
         for k in key {
             let Ok(yv) = table.f64(k) else { continue };
+            if let Some(c) = constant_value(yv, &all) {
+                constant.push(format!("{k} = {}", fmt_short(c)));
+                continue;
+            }
             let s = Series::new(
                 "successful cases",
                 plotted.iter().map(|&r| xv[r]).collect(),
                 plotted.iter().map(|&r| yv[r]).collect(),
             );
-            let mut p = Panel::new(metric_title(k), x_label.clone(), metric_title(k))
+            let mut p = Panel::new(k.as_str(), metric_title(a), metric_title(k))
                 .kind(PanelKind::Scatter)
                 .with_series(s);
+            p.x_scale = x_scale.clone();
+            p.y_scale = number_scale(yv, &all);
             match unsuccessful_series(&bad, &xv, yv) {
                 Some(u) => p.series.push(u),
                 None => p.legend = false,
             }
             fig.panels.push(p);
         }
-        let cols = (fig.panels.len() as f64).sqrt().ceil().max(1.0) as u32;
-        let rows = (fig.panels.len() as u32).div_ceil(cols).max(1);
-        fig.size = (420 * cols, 320 * rows + 40);
+        if !constant.is_empty() {
+            fig.note = format!("Left out, the same in every case: {}", constant.join(", "));
+        }
+        let n = fig.panels.len() as u32;
+        let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
+        let rows = n.div_ceil(cols).max(1);
+        fig.layout = (rows as usize, cols as usize);
+        fig.size = (
+            400 * cols.max(2),
+            320 * rows + 40 + 26 * u32::from(!constant.is_empty()),
+        );
         if let Err(e) = fig.write_svg(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
             warnings.push(e.to_string());
         }
@@ -293,11 +342,16 @@ pub(crate) fn heatmaps(
                 lb.iter().map(|l| l.1).collect(),
                 zz,
                 &format!("mean {} over {over}", metric_title(objective)),
-                &axis_label(table, axes[i], &la),
-                &axis_label(table, axes[j], &lb),
+                &metric_title(axes[i]),
+                &metric_title(axes[j]),
                 &metric_title(objective),
                 ColourScale::Viridis,
-            );
+            )
+            .map(|mut h| {
+                h.x_scale = axis_scale(table, axes[i], &la);
+                h.y_scale = axis_scale(table, axes[j], &lb);
+                h
+            });
             let path = plots.join(format!(
                 "heatmap_{}__{}.svg",
                 file_stem_safe(axes[i]),
@@ -367,23 +421,101 @@ mod tests {
     use super::*;
 
     #[test]
-    fn axis_titles_say_what_and_in_which_unit() {
-        assert_eq!(metric_title("thruster_energy"), "thruster energy [J]");
-        assert_eq!(metric_title("energy_per_metre"), "energy per metre [J/m]");
+    fn axis_titles_carry_the_column_name_and_its_unit_from_the_dictionary() {
+        assert_eq!(metric_title("thruster_energy"), "thruster_energy [J]");
+        assert_eq!(metric_title("mission_cost"), "mission_cost [J/m]");
+        assert_eq!(metric_title("mission_cost_p95"), "mission_cost_p95 [J/m]");
         assert_eq!(
             metric_title("design.longitudinal_offset"),
-            "longitudinal offset [m]"
+            "design.longitudinal_offset [m]"
         );
-        assert_eq!(metric_title("design_mass_kg"), "design mass [kg]");
+        assert_eq!(metric_title("design_mass_kg"), "design_mass_kg [kg]");
         assert_eq!(
             metric_title("seg1_convergence_time"),
-            "seg1 convergence time [s]"
+            "seg1_convergence_time [s]"
         );
+        assert_eq!(metric_title("wrench_peak_sway"), "wrench_peak_sway [N]");
+        assert_eq!(metric_title("wrench_peak_yaw"), "wrench_peak_yaw [N·m]");
+        assert_eq!(metric_title("base_yaw"), "base_yaw [rad]");
+        assert_eq!(metric_title("q_3"), "q_3 [rad]");
         assert_eq!(
             metric_title("singularity_exposure"),
-            "singularity exposure [fraction of time, 0–1]"
+            "singularity_exposure [–]"
         );
-        assert_eq!(metric_title("design.links"), "links");
+        assert_eq!(metric_title("design.links"), "design.links");
+    }
+
+    /// A sweep table: a text axis, an integer axis, a varying and a constant metric.
+    fn sweep_table() -> Table {
+        let mut t = Table::default();
+        let rule = ["paper", "ends", "paper", "ends", "even", "even"];
+        t.push(
+            "design.rule",
+            ColumnData::Str(rule.map(String::from).to_vec()),
+        )
+        .unwrap();
+        t.push("design.links", vec![3.0, 3.0, 4.0, 4.0, 5.0, 5.0])
+            .unwrap();
+        t.push("mission_cost", vec![2.0, 2.5, 1.5, 1.8, 1.2, f64::NAN])
+            .unwrap();
+        t.push("design_thrusters", vec![8.0; 6]).unwrap();
+        let status = ["ok", "ok", "ok", "unsuccessful", "ok", "failed"];
+        t.push(STATUS, ColumnData::Str(status.map(String::from).to_vec()))
+            .unwrap();
+        t
+    }
+
+    fn texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| t.split_once('>').and_then(|(_, r)| r.split_once("</text>")))
+            .map(|(inner, _)| inner.trim().to_string())
+            .collect()
+    }
+
+    #[test]
+    fn axis_plots_draw_categories_integers_units_and_leave_constants_out() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = sweep_table();
+        let key = ["mission_cost".to_string(), "design_thrusters".to_string()];
+        let mut warnings = Vec::new();
+        let axes = ["design.rule", "design.links"];
+        axis_plots(&t, &axes, &key, &[0, 1, 2, 4], dir.path(), &mut warnings);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let rule = std::fs::read_to_string(dir.path().join("axis_design.rule.svg"))
+            .or_else(|_| std::fs::read_to_string(dir.path().join("axis_design_rule.svg")))
+            .unwrap();
+        let words = texts(&rule);
+        for name in ["paper", "ends", "even"] {
+            assert!(words.iter().any(|w| w == name), "{name} not in {words:?}");
+        }
+        assert!(
+            !words
+                .iter()
+                .any(|w| w == "-0.5" || w == "0.5" || w == "2.5"),
+            "{words:?}"
+        );
+        assert!(words.iter().any(|w| w == "mission_cost [J/m]"), "{words:?}");
+        // The constant metric has no panel; the note names it and its value.
+        assert!(!words.iter().any(|w| w == "design_thrusters"), "{words:?}");
+        assert!(
+            words.iter().any(|w| w.contains("design_thrusters = 8")),
+            "{words:?}"
+        );
+        let links = std::fs::read_to_string(dir.path().join("axis_design_links.svg"))
+            .or_else(|_| std::fs::read_to_string(dir.path().join("axis_design.links.svg")))
+            .unwrap();
+        let words = texts(&links);
+        assert!(
+            words.iter().any(|w| w == "3") && words.iter().any(|w| w == "5"),
+            "{words:?}"
+        );
+        assert!(!words.iter().any(|w| w == "3.0" || w == "3.5"), "{words:?}");
+        // Text is at least 11 px at the figure's natural size.
+        for size in links.split("font-size=\"").skip(1) {
+            let px: f64 = size.split('"').next().unwrap().parse().unwrap();
+            assert!(px >= 11.0, "font-size {px}");
+        }
     }
 
     #[test]
