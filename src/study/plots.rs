@@ -16,7 +16,7 @@ use std::collections::HashSet;
 use std::path::Path;
 
 use super::records::{Extreme, CASE_ID, STATUS};
-use super::selection::{levels, mean, thin, Front};
+use super::selection::{levels, mean, thin, Front, Selection};
 use crate::report::file_stem_safe;
 use crate::report::{
     fmt_short, heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind,
@@ -285,10 +285,8 @@ pub(crate) fn axis_plots(
         let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
         let rows = n.div_ceil(cols).max(1);
         fig.layout = (rows as usize, cols as usize);
-        fig.size = (
-            400 * cols.max(2),
-            320 * rows + 40 + 26 * u32::from(!constant.is_empty()),
-        );
+        fig.size = (400 * cols.max(2), 320 * rows + 40);
+        fig.size.1 += fig.note_height();
         if let Err(e) = fig.write_svg(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
             warnings.push(e.to_string());
         }
@@ -364,15 +362,41 @@ pub(crate) fn heatmaps(
     }
 }
 
+/// The legend names of the best and worst case (`best: case #44, mission_cost = 1.58`) by
+/// the objective of `sel`, in [`Extreme::BOTH`]'s order; `best case` / `worst case` when the
+/// table does not say.
+pub(crate) fn extreme_names(table: &Table, sel: &Selection) -> [String; 2] {
+    let ids = table.i64(CASE_ID).unwrap_or(&[]);
+    let found = sel.objective.as_ref().zip(sel.extremes(table));
+    let name = |e: Extreme, row: Option<usize>| match (found, row) {
+        (Some((o, _)), Some(r)) => {
+            let v = table.f64(o).map_or(f64::NAN, |v| v[r]);
+            let id = ids.get(r).copied().unwrap_or(r as i64);
+            format!("{}: case #{id}, {o} = {}", e.label(), fmt_short(v))
+        }
+        _ => format!("{} case", e.label()),
+    };
+    [
+        name(Extreme::Best, found.map(|f| f.1 .0)),
+        name(Extreme::Worst, found.map(|f| f.1 .1)),
+    ]
+}
+
 /// `timeseries.svg` from `trajectory_best.csv` / `trajectory_worst.csv` in `dir`, when
-/// either exists.
-pub(crate) fn timeseries_plot(dir: &Path, plots: &Path, warnings: &mut Vec<String>) {
+/// either exists; `names` are their legend entries ([`extreme_names`]).
+pub(crate) fn timeseries_plot(
+    dir: &Path,
+    names: &[String; 2],
+    plots: &Path,
+    warnings: &mut Vec<String>,
+) {
     let trajs: Vec<(&str, Table)> = Extreme::BOTH
         .iter()
-        .filter_map(|e| {
+        .zip(names)
+        .filter_map(|(e, name)| {
             let p = dir.join(e.trajectory_file());
             p.is_file()
-                .then(|| read_csv(&p).ok().map(|t| (e.label(), t)))
+                .then(|| read_csv(&p).ok().map(|t| (name.as_str(), t)))
                 .flatten()
         })
         .collect();
@@ -383,6 +407,41 @@ pub(crate) fn timeseries_plot(dir: &Path, plots: &Path, warnings: &mut Vec<Strin
     }
 }
 
+/// Channels (or `prefix_` families) drawn first in `timeseries.svg`, in this order.
+const FIRST: [&str; 12] = [
+    "cross_track",
+    "heading_error",
+    "surge_error",
+    "ee_position_error",
+    "ee_x",
+    "ee_y",
+    "ee_z",
+    "base_yaw",
+    "q_",
+    "u_",
+    "base_u",
+    "tau_",
+];
+
+/// Whether a logged channel is flat: its finite values span at most 1e-5 (in its unit) plus
+/// 1e-9 of their magnitude, so that numerical noise (a base heave of 3e-6 m in a planar
+/// run) does not take a panel.
+fn is_flat(v: &[f64]) -> bool {
+    let (lo, hi) = v
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    !(hi - lo > 1e-5 + 1e-9 * lo.abs().max(hi.abs()))
+}
+
+/// Most panels of `timeseries.svg`; further moving channels are named in the note.
+const MAX_CHANNELS: usize = 12;
+
+/// The figure of `timeseries.svg`: one panel per channel that moves in any of `trajs`
+/// (`max − min` above 1e-9 of its magnitude), units from the dictionary; the flat channels
+/// (and any beyond [`MAX_CHANNELS`]) are named in the note.
 fn timeseries(trajs: &[(&str, Table)]) -> Figure {
     let t0 = &trajs[0].1;
     let f64_cols: Vec<&str> = t0
@@ -397,22 +456,59 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
         .find(|n| *n == "t" || *n == "time" || n.starts_with("t_") || n.starts_with("time_"))
         .or(f64_cols.first().copied())
         .unwrap_or("t");
-    let mut fig = Figure::new("best and worst case");
-    for c in f64_cols.iter().filter(|c| **c != time).take(12) {
-        let mut p = Panel::new(c.to_string(), format!("{time} [s]"), c.to_string());
+    let mut fig = Figure::new("best and worst case by the objective");
+    let (mut flat, mut more) = (Vec::new(), Vec::new());
+    let mut channels: Vec<&str> = f64_cols.iter().copied().filter(|c| *c != time).collect();
+    // The tracking errors and the end effector first, the base's many states last.
+    channels.sort_by_key(|c| {
+        FIRST
+            .iter()
+            .position(|p| c == p || (p.ends_with('_') && c.starts_with(p)))
+            .unwrap_or(FIRST.len())
+    });
+    for c in channels {
+        let moves = trajs
+            .iter()
+            .any(|(_, t)| t.f64(c).is_ok_and(|v| !is_flat(v)));
+        if !moves {
+            flat.push(c);
+            continue;
+        }
+        if fig.panels.len() == MAX_CHANNELS {
+            more.push(c);
+            continue;
+        }
+        let mut p = Panel::new(c, metric_title(time), metric_title(c));
         for (k, (label, t)) in trajs.iter().enumerate() {
             if let (Ok(x), Ok(y)) = (t.f64(time), t.f64(c)) {
                 p.series.push(
-                    Series::new(format!("{label} case"), x.to_vec(), y.to_vec())
+                    Series::new(*label, x.to_vec(), y.to_vec())
                         .colour(crate::report::Colour::Palette(k)),
                 );
             }
         }
         fig.panels.push(p);
     }
-    let cols = (fig.panels.len() as f64).sqrt().ceil().max(1.0) as u32;
-    let rows = (fig.panels.len() as u32).div_ceil(cols).max(1);
-    fig.size = (420 * cols, 300 * rows + 40);
+    let mut note = Vec::new();
+    if !flat.is_empty() {
+        note.push(format!(
+            "Left out as flat (max − min ≈ 0): {}.",
+            flat.join(", ")
+        ));
+    }
+    if !more.is_empty() {
+        note.push(format!(
+            "Not drawn (the first {MAX_CHANNELS} moving channels are): {}.",
+            more.join(", ")
+        ));
+    }
+    fig.note = note.join(" ");
+    let n = fig.panels.len() as u32;
+    let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
+    let rows = n.div_ceil(cols).max(1);
+    fig.layout = (rows as usize, cols as usize);
+    fig.size = (400 * cols.max(2), 300 * rows + 40);
+    fig.size.1 += fig.note_height();
     fig
 }
 
@@ -516,6 +612,49 @@ mod tests {
             let px: f64 = size.split('"').next().unwrap().parse().unwrap();
             assert!(px >= 11.0, "font-size {px}");
         }
+    }
+
+    #[test]
+    fn timeseries_draws_moving_channels_with_units_and_names_the_flat_ones_and_the_cases() {
+        let mut t = Table::default();
+        t.push("t", vec![0.0, 0.1, 0.2]).unwrap();
+        t.push("base_yaw", vec![0.0, 0.05, 0.1]).unwrap();
+        t.push("u_3", vec![0.0, 0.0, 0.0]).unwrap();
+        t.push("q_0", vec![0.2, 0.2, 0.2]).unwrap();
+        t.push("base_z", vec![0.0, -1e-6, -3e-6]).unwrap();
+        let fig = timeseries(&[("best: case #4, mission_cost = 1.58", t)]);
+        assert_eq!(fig.panels.len(), 1);
+        assert_eq!(fig.panels[0].y_label, "base_yaw [rad]");
+        assert_eq!(fig.panels[0].x_label, "t [s]");
+        assert!(fig.note.contains("q_0, u_3, base_z"), "{}", fig.note);
+        let svg = fig.render_svg().unwrap();
+        let words = texts(&svg);
+        assert!(words
+            .iter()
+            .any(|w| w == "best: case #4, mission_cost = 1.58"));
+        assert!(
+            words.iter().any(|w| w.contains("q_0, u_3, base_z")),
+            "{words:?}"
+        );
+    }
+
+    #[test]
+    fn extremes_are_named_by_case_and_objective() {
+        let t = sweep_table();
+        let sel = Selection {
+            metrics: vec!["mission_cost".into()],
+            maximise: HashSet::new(),
+            magnitude: HashSet::new(),
+            objective: Some("mission_cost".into()),
+            pareto: None,
+        };
+        let mut t = t;
+        t.push(CASE_ID, ColumnData::I64(vec![10, 11, 12, 13, 14, 15]))
+            .unwrap();
+        let [best, worst] = extreme_names(&t, &sel);
+        // Among the `ok` cases (#10, #11, #12, #14): lowest and highest mission cost.
+        assert_eq!(best, "best: case #14, mission_cost = 1.2");
+        assert_eq!(worst, "worst: case #11, mission_cost = 2.5");
     }
 
     #[test]

@@ -43,13 +43,16 @@ fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
     } else {
         root.titled(&fig.title, (FONT, 22))?
     };
-    let body = if fig.note.is_empty() {
+    let note = fig.note_lines();
+    let body = if note.is_empty() {
         body
     } else {
         let (_, h) = body.dim_in_pixel();
-        let (top, bottom) = body.split_vertically(h as i32 - NOTE_HEIGHT);
+        let (top, bottom) = body.split_vertically(h as i32 - fig.note_height() as i32);
         let style = TextStyle::from((FONT, NOTE_FONT).into_font()).color(&NOTE_RGB);
-        bottom.draw(&Text::new(fig.note.clone(), (12, 4), style))?;
+        for (k, line) in note.into_iter().enumerate() {
+            bottom.draw(&Text::new(line, (12, 4 + 18 * k as i32), style.clone()))?;
+        }
         top
     };
     let areas = body.split_evenly(fig.grid());
@@ -59,8 +62,6 @@ fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
     Ok(())
 }
 
-/// Height of the strip under the panels holding a figure's note [px].
-const NOTE_HEIGHT: i32 = 26;
 /// Font size of a figure's note as given to plotters (written as 15 / 1.24 ≈ 12.1 px).
 const NOTE_FONT: u32 = 15;
 const NOTE_RGB: RGBColor = RGBColor(70, 70, 70);

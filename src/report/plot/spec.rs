@@ -220,6 +220,32 @@ impl Figure {
         self
     }
 
+    /// The note wrapped to the figure's width: one string per line (none without a note).
+    pub(super) fn note_lines(&self) -> Vec<String> {
+        // About 0.6 em per character of the 12.1 px note font.
+        let per_line = ((self.size.0 as usize).saturating_sub(24) / 7).max(20);
+        let mut lines: Vec<String> = Vec::new();
+        for word in self.note.split_whitespace() {
+            match lines.last_mut() {
+                Some(l) if l.chars().count() + 1 + word.chars().count() <= per_line => {
+                    l.push(' ');
+                    l.push_str(word);
+                }
+                _ => lines.push(word.to_string()),
+            }
+        }
+        lines
+    }
+
+    /// The height [px] of the strip under the panels that holds the note (0 without one):
+    /// add it to the height the panels need.
+    pub fn note_height(&self) -> u32 {
+        match self.note_lines().len() {
+            0 => 0,
+            n => 8 + 18 * n as u32,
+        }
+    }
+
     pub(super) fn invalid(&self, detail: String) -> ReportError {
         ReportError::InvalidFigure {
             figure: self.title.clone(),
