@@ -433,7 +433,7 @@ fn is_flat(v: &[f64]) -> bool {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
             (a.min(x), b.max(x))
         });
-    !(hi - lo > 1e-5 + 1e-9 * lo.abs().max(hi.abs()))
+    hi - lo <= 1e-5 + 1e-9 * lo.abs().max(hi.abs())
 }
 
 /// Most panels of `timeseries.svg`; further moving channels are named in the note.

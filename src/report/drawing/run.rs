@@ -52,6 +52,8 @@ const PAD: f64 = 22.0;
 const LINE: f64 = 18.0;
 /// Smallest extent of a view [m], so that a flat run still gets a readable strip.
 const MIN_EXTENT: f64 = 1.0;
+/// Length of the animation's time bar [px].
+const TIME_BAR: f64 = 240.0;
 /// The two views drawn.
 const VIEWS: [View; 2] = [View::Top, View::Side];
 
@@ -200,16 +202,27 @@ fn snapshot(
     for a in &snap.scene.arrows {
         let p1 = t.to_svg(view.project(&a.start));
         let p2 = t.to_svg(view.project(&(a.start + a.direction * a.length)));
-        if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
-            continue;
-        }
         s.open(
             "g",
             &[
                 ("class", "thruster".into()),
                 ("data-thruster", a.name.as_str().into()),
+                ("data-length-m", a.length.into()),
             ],
         );
+        if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
+            // No thrust (or seen end-on): the thruster as a dot.
+            s.empty(
+                "circle",
+                &[
+                    ("cx", p1[0].into()),
+                    ("cy", p1[1].into()),
+                    ("r", 1.2.into()),
+                ],
+            );
+            s.close("g");
+            continue;
+        }
         s.empty(
             "line",
             &[
@@ -316,7 +329,7 @@ fn caption_and_legend(s: &mut Svg, d: &RunDrawing, scale: f64, top: f64) {
             ("y2", (y(3) - 4.0).into()),
         ],
     );
-    text(s, 3, "thrust direction (length ∝ limit)");
+    text(s, 3, "thrust at that time (length ∝ thrust, signed)");
     let len = nice_length(120.0 / scale);
     s.empty(
         "rect",
@@ -403,6 +416,20 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
         open_view(&mut s, view, &ts[k], boxes[k], Vec::new());
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
+        if view == View::Top {
+            s.empty(
+                "rect",
+                &[
+                    ("class", "time-bar-frame".into()),
+                    ("x", (boxes[0][0] + 110.0).into()),
+                    ("y", (boxes[0][1] + 8.0).into()),
+                    ("width", TIME_BAR.into()),
+                    ("height", 8.0.into()),
+                    ("fill", "none".into()),
+                    ("stroke", "#888".into()),
+                ],
+            );
+        }
         for (i, snap) in d.snapshots.iter().enumerate() {
             let (values, times) = visible_during(i, n);
             let anim = [
@@ -432,6 +459,24 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
                         ("y", (boxes[0][1] + 18.0).into()),
                     ],
                     &format!("t = {} s", num(snap.t)),
+                );
+                // The time bar: filled to this frame's share of the run.
+                let (t0, t1) = (d.snapshots[0].t, d.snapshots[n - 1].t);
+                let f = if t1 > t0 {
+                    (snap.t - t0) / (t1 - t0)
+                } else {
+                    1.0
+                };
+                s.empty(
+                    "rect",
+                    &[
+                        ("class", "time-bar".into()),
+                        ("x", (boxes[0][0] + 110.0).into()),
+                        ("y", (boxes[0][1] + 8.0).into()),
+                        ("width", (TIME_BAR * f.clamp(0.0, 1.0)).into()),
+                        ("height", 8.0.into()),
+                        ("fill", ACCENT.into()),
+                    ],
                 );
                 s.close("g");
             }
