@@ -12,7 +12,8 @@ use plotters::prelude::{
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult, FONT,
+    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult,
+    DESC_FONT, FONT, TICK_FONT,
 };
 use super::labels::{place_labels, LABEL_FONT};
 use super::scale::Scale;
@@ -65,10 +66,7 @@ fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
 /// Font size of a figure's note as given to plotters (written as 15 / 1.24 ≈ 12.1 px).
 const NOTE_FONT: u32 = 15;
 const NOTE_RGB: RGBColor = RGBColor(70, 70, 70);
-/// Font sizes as given to plotters, which writes them into the SVG divided by 1.24: tick
-/// labels and legends 14 (11.3 px), axis titles 15 (12.1 px), panel captions 17 (13.7 px).
-pub(super) const TICK_FONT: u32 = 14;
-pub(super) const DESC_FONT: u32 = 15;
+/// Panel captions as given to plotters (written as 17 / 1.24 ≈ 13.7 px).
 const CAPTION_FONT: u32 = 17;
 
 /// The panel in drawn coordinates: data (and fixed ranges) of a log axis as log10.

@@ -6,9 +6,9 @@ use plotters::prelude::{ChartBuilder, RGBColor, Rectangle, WHITE};
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, check_size, render_to_svg, widen, Area, DrawResult, FONT, LIMIT,
+    auto_range, bounds, check_size, render_to_svg, widen, Area, DrawResult, DESC_FONT, FONT, LIMIT,
+    TICK_FONT,
 };
-use super::draw::{DESC_FONT, TICK_FONT};
 use super::scale::Scale;
 use crate::report::atomic::atomic_write;
 use crate::report::error::{ReportError, Result};

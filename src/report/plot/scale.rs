@@ -1,7 +1,7 @@
 //! How an axis maps values to ticks: plain numbers, integers, named categories or a
 //! logarithmic scale.
 
-/// The scale of one axis of a [`super::Panel`] or [`super::Heatmap`].
+/// The scale of one axis of a panel or a heat map.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub enum Scale {
     /// Numbers, "nice" ticks chosen by plotters.
@@ -114,7 +114,7 @@ pub(super) fn trim_number(v: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{trim_number, Scale};
 
     #[test]
     fn integers_print_without_a_decimal_point_and_only_at_integers() {
