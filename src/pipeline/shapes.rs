@@ -47,6 +47,23 @@ fn state_at(r: &RunResult, v: &Vehicle, k: usize) -> Option<VehicleState> {
     Some(s)
 }
 
+/// Metres of arrow per newton for a run: the largest logged |thrust| drawn about a quarter of
+/// the vehicle length (a 1–2–5 value), so that the thrusts a run actually uses are visible;
+/// the design's limit-based [`arrow_scale`] when no thrust was logged.
+fn thrust_scale(v: &Vehicle, thrust: &[&[f64]]) -> f64 {
+    let peak = thrust
+        .iter()
+        .flat_map(|c| c.iter())
+        .filter(|x| x.is_finite())
+        .fold(0.0_f64, |a, x| a.max(x.abs()));
+    let m = 0.25 * v.total_length() / peak;
+    if peak > 0.0 && m.is_finite() && m > 0.0 {
+        crate::report::drawing::nice_length(m)
+    } else {
+        arrow_scale(v)
+    }
+}
+
 /// Sets each thrust arrow to the thrust `u[j]` [N] logged for it: length `|u| · m_per_n`,
 /// pointing along the thrust direction for `u > 0` and against it for `u < 0` (a thruster
 /// without a logged finite thrust gets no arrow: length 0).
@@ -96,7 +113,7 @@ pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawin
         .collect();
     picks.dedup();
     let thrust = r.trajectory.indexed(Channel::U);
-    let m_per_n = arrow_scale(v);
+    let m_per_n = thrust_scale(v, &thrust);
     let snapshots = picks
         .into_iter()
         .filter_map(|k| {

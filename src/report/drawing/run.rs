@@ -509,7 +509,8 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
         }
         s.close("g");
     }
-    caption_and_legend(&mut s, d, ts[0].scale, cap);
+    // The scale bar at the camera's zoom.
+    caption_and_legend(&mut s, d, ts[0].scale * zoom, cap);
     s.finish()
 }
 
