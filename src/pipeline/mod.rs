@@ -20,6 +20,7 @@ pub mod draw;
 pub mod error;
 pub mod inspect;
 pub mod optimise;
+mod optimise_plots;
 pub mod review;
 mod review_top;
 pub mod shapes;

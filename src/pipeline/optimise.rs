@@ -11,17 +11,17 @@ use std::path::Path;
 use serde_json::json;
 
 use super::error::PipelineError;
+use super::optimise_plots::{parameter_figure, progress_figure};
 use crate::control::transport::yaw_joint_mask;
 use crate::evaluate::static_table::STATIC_TABLE;
 use crate::model::design::parse_design_table;
 use crate::optimise::evaluate::CaseEvaluator;
-use crate::optimise::history::{best_so_far, history_table, Record};
+use crate::optimise::history::{history_table, Record};
 use crate::optimise::score::mean_of;
 use crate::optimise::{Outcome, Problem};
 use crate::report::figures::run_figure;
 use crate::report::{
-    atomic_write, file_stem_safe, fmt_num, write_csv, write_parquet, Colour, Figure, MarkdownTable,
-    Panel, PanelKind, Series,
+    atomic_write, file_stem_safe, fmt_num, write_csv, write_parquet, Figure, MarkdownTable, Panel,
 };
 use crate::scenario::Mode;
 use crate::study::cases::Resolved;
@@ -82,7 +82,8 @@ pub fn write_outputs(
     atomic_write(&out.join("manifest.json"), manifest.as_bytes())?;
     if files.plots {
         progress_figure(outcome).write_svg(&out.join("progress.svg"))?;
-        parameter_figure(&params, &outcome.records).write_svg(&out.join("parameters.svg"))?;
+        parameter_figure(&problem.spec.space.params, &outcome.records, outcome.best)
+            .write_svg(&out.join("parameters.svg"))?;
         if let Some(fig) = runs_figure(problem, &ev, outcome)? {
             fig.write_svg(&out.join("runs.svg"))?;
         }
@@ -323,42 +324,6 @@ fn constraints_md(problem: &Problem, o: &Outcome) -> String {
     }
     md.push_str(&t.finish());
     md
-}
-
-/// Objective of every feasible evaluation (points), infeasible ones at the top of the
-/// range (crosses are not drawn: they would squash the scale), and the best so far (line).
-fn progress_figure(o: &Outcome) -> Figure {
-    let (mut xf, mut yf) = (Vec::new(), Vec::new());
-    for r in o.records.iter().filter(|r| r.score.feasible && !r.repeat) {
-        xf.push(r.index as f64);
-        yf.push(r.score.objective);
-    }
-    let best = best_so_far(&o.records);
-    let (xb, yb): (Vec<f64>, Vec<f64>) = best
-        .iter()
-        .enumerate()
-        .filter(|(_, y)| y.is_finite())
-        .map(|(i, y)| (i as f64, *y))
-        .unzip();
-    let mut panel = Panel::new("objective against evaluations", "evaluation", "objective")
-        .with_series(Series::new("feasible evaluations", xf, yf).kind(PanelKind::Scatter))
-        .with_series(Series::new("best so far", xb, yb).colour(Colour::Palette(3)));
-    panel.legend = true;
-    Figure::new("optimisation progress").with_panel(panel)
-}
-
-fn parameter_figure(params: &[String], records: &[Record]) -> Figure {
-    let x: Vec<f64> = records.iter().map(|r| r.index as f64).collect();
-    let mut fig = Figure::new("parameter traces");
-    for (k, p) in params.iter().enumerate() {
-        let y: Vec<f64> = records.iter().map(|r| r.x[k]).collect();
-        fig = fig.with_panel(
-            Panel::new(p.as_str(), "evaluation", p.as_str())
-                .with_series(Series::new("", x.clone(), y).kind(PanelKind::Scatter)),
-        );
-    }
-    fig.size = (900, (260 * params.len().div_ceil(2)).max(300) as u32);
-    fig
 }
 
 /// The start and the best run of the first scenario, rerun with logging, panel by panel:

@@ -222,7 +222,8 @@ tr.bad td{background:#fde2e2;color:#7f1d1d}code{font-size:12px}.r-scroll{overflo
 .r-grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(380px,1fr));gap:14px}\
 .r-card{border:2px solid #999;padding:6px;margin:0;break-inside:avoid}\
 .r-card.bad{border-color:#b91c1c;background:#fff5f5}.r-card:target{grid-column:1/-1;\
-border-color:#1d4ed8}.r-card svg,.r-plot svg{width:100%;height:auto;display:block}\
+border-color:#1d4ed8}.r-card svg{width:100%;height:auto;display:block}\
+.r-plot svg{max-width:100%;height:auto;display:block}\
 .r-card figcaption{font-size:13px;margin-top:4px}.r-plot{margin:14px 0;break-inside:avoid}\
 .r-plot figcaption{font-size:13px;color:#333}.r-kv td:first-child{font-weight:bold}\
 @media print{body{max-width:none}.r-grid{display:block}.r-card{margin-bottom:12px}}";

@@ -7,13 +7,14 @@ use std::path::Path;
 
 use nalgebra::UnitQuaternion;
 
-use super::draw::vehicle_scene;
+use super::draw::{arrow_scale, vehicle_scene};
 use super::error::PipelineError;
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
 use crate::outcome::RunResult;
 use crate::report::atomic_write;
 use crate::report::drawing::run::{render_animation_svg, render_shapes_svg, RunDrawing, Snapshot};
+use crate::report::drawing::Arrow;
 use crate::scenario::channels::{Channel, Pose};
 use crate::spatial::Vec3;
 use crate::state::VehicleState;
@@ -44,6 +45,36 @@ fn state_at(r: &RunResult, v: &Vehicle, k: usize) -> Option<VehicleState> {
     };
     s.q = q;
     Some(s)
+}
+
+/// Metres of arrow per newton for a run: the largest logged |thrust| drawn about a quarter of
+/// the vehicle length (a 1–2–5 value), so that the thrusts a run actually uses are visible;
+/// the design's limit-based [`arrow_scale`] when no thrust was logged.
+fn thrust_scale(v: &Vehicle, thrust: &[&[f64]]) -> f64 {
+    let peak = thrust
+        .iter()
+        .flat_map(|c| c.iter())
+        .filter(|x| x.is_finite())
+        .fold(0.0_f64, |a, x| a.max(x.abs()));
+    let m = 0.25 * v.total_length() / peak;
+    if peak > 0.0 && m.is_finite() && m > 0.0 {
+        crate::report::drawing::nice_length(m)
+    } else {
+        arrow_scale(v)
+    }
+}
+
+/// Sets each thrust arrow to the thrust `u[j]` [N] logged for it: length `|u| · m_per_n`,
+/// pointing along the thrust direction for `u > 0` and against it for `u < 0` (a thruster
+/// without a logged finite thrust gets no arrow: length 0).
+fn set_thrust(arrows: &mut [Arrow], u: &[f64], m_per_n: f64) {
+    for (j, a) in arrows.iter_mut().enumerate() {
+        let f = u.get(j).copied().filter(|x| x.is_finite()).unwrap_or(0.0);
+        a.length = f.abs() * m_per_n;
+        if f < 0.0 {
+            a.direction = -a.direction;
+        }
+    }
 }
 
 /// A channel triple as points, e.g. the base or end-effector position.
@@ -81,12 +112,16 @@ pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawin
         })
         .collect();
     picks.dedup();
+    let thrust = r.trajectory.indexed(Channel::U);
+    let m_per_n = thrust_scale(v, &thrust);
     let snapshots = picks
         .into_iter()
         .filter_map(|k| {
-            state_at(r, v, k).map(|s| Snapshot {
-                t: t[k],
-                scene: vehicle_scene(v, &s),
+            state_at(r, v, k).map(|s| {
+                let mut scene = vehicle_scene(v, &s);
+                let u: Vec<f64> = thrust.iter().map(|c| c[k]).collect();
+                set_thrust(&mut scene.arrows, &u, m_per_n);
+                Snapshot { t: t[k], scene }
             })
         })
         .collect();
@@ -100,6 +135,10 @@ pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawin
             format!(
                 "{} s simulated, {outcome}; base and end-effector traces over every logged sample",
                 t[n - 1]
+            ),
+            format!(
+                "arrows: each thruster's thrust at that time, signed, {} m per N",
+                crate::report::fmt_short(m_per_n)
             ),
         ],
         snapshots,
@@ -119,4 +158,27 @@ pub fn write_shapes(r: &RunResult, v: &Vehicle, out: &Path) -> Result<(), Pipeli
         atomic_write(&out.join("animation.svg"), svg.as_bytes())?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thrust_arrows_scale_with_the_thrust_and_flip_with_its_sign() {
+        let arrow = |name: &str| Arrow {
+            name: name.into(),
+            start: Vec3::zeros(),
+            direction: Vec3::new(1.0, 0.0, 0.0),
+            length: 9.0,
+        };
+        let mut arrows = vec![arrow("T1"), arrow("T2"), arrow("T3")];
+        set_thrust(&mut arrows, &[20.0, -10.0], 0.01);
+        assert_eq!(arrows[0].length, 0.2);
+        assert_eq!(arrows[0].direction, Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(arrows[1].length, 0.1);
+        assert_eq!(arrows[1].direction, Vec3::new(-1.0, 0.0, 0.0));
+        // No logged thrust: no arrow.
+        assert_eq!(arrows[2].length, 0.0);
+    }
 }

@@ -44,7 +44,8 @@ pub use number::{fmt_num, fmt_short, fmt_value, format_f64};
 pub use pareto::pareto_front;
 pub use plot::{
     heatmap, histogram, rank_interval_svg, scatter_labelled, tornado_svg, Colour, ColourScale,
-    Figure, Heatmap, LabelledPoint, LineStyle, Panel, PanelKind, RankRow, Series, TornadoRow,
+    Figure, Heatmap, LabelledPoint, LineStyle, Panel, PanelKind, RankRow, Scale, Series,
+    TornadoRow,
 };
 pub use table::{Column, ColumnData, ColumnKind, Table, Value};
 pub use table_io::{

@@ -663,6 +663,63 @@ pub fn integers_for_files(table: &mut crate::report::Table, to_files: bool) {
     }
 }
 
+/// The unit of concrete column `name` as the dictionary gives it (`mission_cost` → `J/m`,
+/// `q_3` → `rad`, `base_yaw` → `rad`, `wrench_peak_sway` → `N`, `thruster_energy_mean` →
+/// `J`; `–` for dimensionless), for axis titles. `None` when the dictionary does not fix one
+/// (axis names and `tuned.<param>`, whose unit is the key's).
+pub fn unit_of(name: &str) -> Option<&'static str> {
+    const AXES: [&str; 6] = crate::metrics::singularity::AXIS_NAMES;
+    for suffix in ["_mean", "_std", "_p05", "_p95", "_worst"] {
+        if let Some(u) = name.strip_suffix(suffix).and_then(unit_of) {
+            return Some(u);
+        }
+    }
+    // Families whose unit depends on the member: poses, twists, base axes.
+    let last = name.rsplit('_').next().unwrap_or(name);
+    let prefix = name.split('_').next().unwrap_or(name);
+    if ["base", "ee", "sp", "ref"].contains(&prefix) && name.matches('_').count() == 1 {
+        let unit = match last {
+            "x" | "y" | "z" => Some("m"),
+            "roll" | "pitch" | "yaw" => Some("rad"),
+            "u" | "v" | "w" => Some("m/s"),
+            "p" | "q" | "r" => Some("rad/s"),
+            _ => None,
+        };
+        if unit.is_some() {
+            return unit;
+        }
+    }
+    let axis = AXES
+        .iter()
+        .position(|a| name.split('_').any(|w| w == *a) && !name.starts_with("tcm_lost_"));
+    if let Some(k) =
+        axis.filter(|_| name.starts_with("wrench_peak_") || name.starts_with("authority_"))
+    {
+        return Some(if k < 3 { "N" } else { "N·m" });
+    }
+    let seg = name
+        .strip_prefix("seg")
+        .and_then(|r| r.split_once('_'))
+        .filter(|(k, _)| k.parse::<usize>().is_ok())
+        .map(|(_, rest)| format!("seg{{k}}_{rest}"));
+    let family = channel_family(name);
+    DICTIONARY
+        .iter()
+        .flat_map(|(_, cols)| cols.iter())
+        .find(|c| {
+            c.name == name || seg.as_deref() == Some(c.name) || family.as_deref() == Some(c.name)
+        })
+        .map(|c| c.unit)
+        .or_else(|| {
+            let lost = name.starts_with("tcm_lost_")
+                || name
+                    .strip_prefix("n1_loss_t")
+                    .is_some_and(|i| i.parse::<usize>().is_ok());
+            lost.then_some("–")
+        })
+        .filter(|u| !u.starts_with("as "))
+}
+
 /// `docs/columns.md`'s tables.
 pub fn columns_markdown() -> String {
     let mut out = String::new();

@@ -16,11 +16,11 @@ use std::collections::HashSet;
 use std::path::Path;
 
 use super::records::{Extreme, CASE_ID, STATUS};
-use super::selection::{levels, mean, thin, Front};
+use super::selection::{levels, mean, thin, Front, Selection};
 use crate::report::file_stem_safe;
 use crate::report::{
-    heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind, Figure,
-    LabelledPoint, Panel, PanelKind, Series, Table,
+    fmt_short, heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind,
+    Figure, LabelledPoint, Panel, PanelKind, Scale, Series, Table,
 };
 
 /// Units of metric and design columns, by name or by name suffix (docs/model.md §6 and the design
@@ -51,27 +51,56 @@ const UNITS: [(&str, &str); 23] = [
     ("singularity_exposure", "fraction of time, 0–1"),
 ];
 
-/// A column name as an axis title: words instead of underscores and dots, and its unit in
-/// brackets when known (`thruster_energy` → `thruster energy [J]`,
-/// `design.longitudinal_offset` → `longitudinal offset [m]`).
+/// A column name as an axis title: the name as in the tables, with its unit in brackets from
+/// the data dictionary ([`super::dictionary::unit_of`]; design axes from their key's unit)
+/// when known (`mission_cost` → `mission_cost [J/m]`, `design.longitudinal_offset` →
+/// `design.longitudinal_offset [m]`).
 pub fn metric_title(name: &str) -> String {
-    // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
-    let short = name.strip_prefix("design.").unwrap_or(name);
-    let words = short
-        .trim_end_matches("_m")
-        .trim_end_matches("_kg")
-        .replace(['_', '.'], " ");
-    let unit = UNITS
-        .iter()
-        .find(|(key, _)| name == *key || name.ends_with(key))
-        .map(|(_, u)| *u)
-        .or_else(|| {
-            // Singular values and condition numbers of the scaled T(q) (docs/model.md §6).
-            (name.contains("sigma_min") || name.contains("kappa")).then_some("scaled, –")
-        });
+    let unit = super::dictionary::unit_of(name).or_else(|| {
+        // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
+        UNITS
+            .iter()
+            .find(|(key, _)| name == *key || name.ends_with(key))
+            .map(|(_, u)| *u)
+    });
     match unit {
-        Some(u) => format!("{words} [{u}]"),
-        None => words,
+        Some(u) => format!("{name} [{u}]"),
+        None => name.to_string(),
+    }
+}
+
+/// The scale of an axis over values `v` at `rows`: integers when every finite value is whole
+/// (link counts, thruster numbers), plain numbers otherwise.
+fn number_scale(v: &[f64], rows: &[usize]) -> Scale {
+    let mut finite = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .peekable();
+    if finite.peek().is_some() && finite.all(|x| x.fract() == 0.0 && x.abs() < 1e15) {
+        Scale::Integer
+    } else {
+        Scale::Linear
+    }
+}
+
+/// The value of `v` at `rows` when it is the same at every row (finite values within a
+/// relative 1e-9, or no finite value at all: `NaN`); `None` when it varies.
+fn constant_value(v: &[f64], rows: &[usize]) -> Option<f64> {
+    let finite: Vec<f64> = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .collect();
+    let (lo, hi) = finite
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if finite.is_empty() {
+        Some(f64::NAN)
+    } else {
+        (hi - lo <= 1e-9 * lo.abs().max(hi.abs()).max(1e-300)).then_some(lo)
     }
 }
 
@@ -122,16 +151,16 @@ fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Option<Series> {
     })
 }
 
-/// An axis label: the axis name, with the numbering of its levels for a text axis.
-fn axis_label(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> String {
-    if matches!(
-        table.column(a).map(|c| c.data.kind()),
-        Some(ColumnKind::Str)
-    ) {
-        let names: Vec<String> = lv.iter().map(|l| format!("{}={}", l.1, l.0)).collect();
-        format!("{} ({})", metric_title(a), names.join(", "))
-    } else {
-        metric_title(a)
+/// The scale of axis `a` over its levels `lv`: the level names for a text axis, integers for
+/// whole-numbered axes.
+fn axis_scale(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> Scale {
+    match table.column(a).map(|c| &c.data) {
+        Some(ColumnData::Str(_)) => Scale::Categories(lv.iter().map(|l| l.0.clone()).collect()),
+        Some(ColumnData::F64(v)) => {
+            let rows: Vec<usize> = lv.iter().flat_map(|l| l.2.iter().copied()).collect();
+            number_scale(v, &rows)
+        }
+        _ => Scale::Linear,
     }
 }
 
@@ -207,8 +236,11 @@ pub(crate) fn axis_plots(
     plots: &Path,
     warnings: &mut Vec<String>,
 ) {
+    let all: Vec<usize> = (0..table.n_rows()).collect();
+    let bad = unsuccessful_rows(table);
     for a in axes {
-        let lv = levels(table, a, ok_rows);
+        // Levels over every case, so that a text axis has the same categories in every plot.
+        let lv = levels(table, a, &all);
         let xv: Vec<f64> = match table.column(a).map(|c| &c.data) {
             Some(ColumnData::F64(v)) => v.clone(),
             Some(ColumnData::Str(v)) => v
@@ -217,29 +249,44 @@ pub(crate) fn axis_plots(
                 .collect(),
             _ => continue,
         };
-        let x_label = axis_label(table, a, &lv);
+        let x_scale = match table.column(a).map(|c| &c.data) {
+            Some(ColumnData::F64(v)) => number_scale(v, &all),
+            _ => axis_scale(table, a, &lv),
+        };
         let mut fig = Figure::new(format!("key metrics against {}", metric_title(a)));
         let plotted = thin(ok_rows);
-        let bad = unsuccessful_rows(table);
+        let mut constant = Vec::new();
         for k in key {
             let Ok(yv) = table.f64(k) else { continue };
+            if let Some(c) = constant_value(yv, &all) {
+                constant.push(format!("{k} = {}", fmt_short(c)));
+                continue;
+            }
             let s = Series::new(
                 "successful cases",
                 plotted.iter().map(|&r| xv[r]).collect(),
                 plotted.iter().map(|&r| yv[r]).collect(),
             );
-            let mut p = Panel::new(metric_title(k), x_label.clone(), metric_title(k))
+            let mut p = Panel::new(k.as_str(), metric_title(a), metric_title(k))
                 .kind(PanelKind::Scatter)
                 .with_series(s);
+            p.x_scale = x_scale.clone();
+            p.y_scale = number_scale(yv, &all);
             match unsuccessful_series(&bad, &xv, yv) {
                 Some(u) => p.series.push(u),
                 None => p.legend = false,
             }
             fig.panels.push(p);
         }
-        let cols = (fig.panels.len() as f64).sqrt().ceil().max(1.0) as u32;
-        let rows = (fig.panels.len() as u32).div_ceil(cols).max(1);
-        fig.size = (420 * cols, 320 * rows + 40);
+        if !constant.is_empty() {
+            fig.note = format!("Left out, the same in every case: {}", constant.join(", "));
+        }
+        let n = fig.panels.len() as u32;
+        let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
+        let rows = n.div_ceil(cols).max(1);
+        fig.layout = (rows as usize, cols as usize);
+        fig.size = (400 * cols.max(2), 320 * rows + 40);
+        fig.size.1 += fig.note_height();
         if let Err(e) = fig.write_svg(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
             warnings.push(e.to_string());
         }
@@ -293,11 +340,16 @@ pub(crate) fn heatmaps(
                 lb.iter().map(|l| l.1).collect(),
                 zz,
                 &format!("mean {} over {over}", metric_title(objective)),
-                &axis_label(table, axes[i], &la),
-                &axis_label(table, axes[j], &lb),
+                &metric_title(axes[i]),
+                &metric_title(axes[j]),
                 &metric_title(objective),
                 ColourScale::Viridis,
-            );
+            )
+            .map(|mut h| {
+                h.x_scale = axis_scale(table, axes[i], &la);
+                h.y_scale = axis_scale(table, axes[j], &lb);
+                h
+            });
             let path = plots.join(format!(
                 "heatmap_{}__{}.svg",
                 file_stem_safe(axes[i]),
@@ -310,15 +362,41 @@ pub(crate) fn heatmaps(
     }
 }
 
+/// The legend names of the best and worst case (`best: case #44, mission_cost = 1.58`) by
+/// the objective of `sel`, in [`Extreme::BOTH`]'s order; `best case` / `worst case` when the
+/// table does not say.
+pub(crate) fn extreme_names(table: &Table, sel: &Selection) -> [String; 2] {
+    let ids = table.i64(CASE_ID).unwrap_or(&[]);
+    let found = sel.objective.as_ref().zip(sel.extremes(table));
+    let name = |e: Extreme, row: Option<usize>| match (found, row) {
+        (Some((o, _)), Some(r)) => {
+            let v = table.f64(o).map_or(f64::NAN, |v| v[r]);
+            let id = ids.get(r).copied().unwrap_or(r as i64);
+            format!("{}: case #{id}, {o} = {}", e.label(), fmt_short(v))
+        }
+        _ => format!("{} case", e.label()),
+    };
+    [
+        name(Extreme::Best, found.map(|f| f.1 .0)),
+        name(Extreme::Worst, found.map(|f| f.1 .1)),
+    ]
+}
+
 /// `timeseries.svg` from `trajectory_best.csv` / `trajectory_worst.csv` in `dir`, when
-/// either exists.
-pub(crate) fn timeseries_plot(dir: &Path, plots: &Path, warnings: &mut Vec<String>) {
+/// either exists; `names` are their legend entries ([`extreme_names`]).
+pub(crate) fn timeseries_plot(
+    dir: &Path,
+    names: &[String; 2],
+    plots: &Path,
+    warnings: &mut Vec<String>,
+) {
     let trajs: Vec<(&str, Table)> = Extreme::BOTH
         .iter()
-        .filter_map(|e| {
+        .zip(names)
+        .filter_map(|(e, name)| {
             let p = dir.join(e.trajectory_file());
             p.is_file()
-                .then(|| read_csv(&p).ok().map(|t| (e.label(), t)))
+                .then(|| read_csv(&p).ok().map(|t| (name.as_str(), t)))
                 .flatten()
         })
         .collect();
@@ -329,6 +407,41 @@ pub(crate) fn timeseries_plot(dir: &Path, plots: &Path, warnings: &mut Vec<Strin
     }
 }
 
+/// Channels (or `prefix_` families) drawn first in `timeseries.svg`, in this order.
+const FIRST: [&str; 12] = [
+    "cross_track",
+    "heading_error",
+    "surge_error",
+    "ee_position_error",
+    "ee_x",
+    "ee_y",
+    "ee_z",
+    "base_yaw",
+    "q_",
+    "u_",
+    "base_u",
+    "tau_",
+];
+
+/// Whether a logged channel is flat: its finite values span at most 1e-5 (in its unit) plus
+/// 1e-9 of their magnitude, so that numerical noise (a base heave of 3e-6 m in a planar
+/// run) does not take a panel.
+fn is_flat(v: &[f64]) -> bool {
+    let (lo, hi) = v
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    hi - lo <= 1e-5 + 1e-9 * lo.abs().max(hi.abs())
+}
+
+/// Most panels of `timeseries.svg`; further moving channels are named in the note.
+const MAX_CHANNELS: usize = 12;
+
+/// The figure of `timeseries.svg`: one panel per channel that moves in any of `trajs`
+/// (`max − min` above 1e-9 of its magnitude), units from the dictionary; the flat channels
+/// (and any beyond [`MAX_CHANNELS`]) are named in the note.
 fn timeseries(trajs: &[(&str, Table)]) -> Figure {
     let t0 = &trajs[0].1;
     let f64_cols: Vec<&str> = t0
@@ -343,22 +456,59 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
         .find(|n| *n == "t" || *n == "time" || n.starts_with("t_") || n.starts_with("time_"))
         .or(f64_cols.first().copied())
         .unwrap_or("t");
-    let mut fig = Figure::new("best and worst case");
-    for c in f64_cols.iter().filter(|c| **c != time).take(12) {
-        let mut p = Panel::new(c.to_string(), format!("{time} [s]"), c.to_string());
+    let mut fig = Figure::new("best and worst case by the objective");
+    let (mut flat, mut more) = (Vec::new(), Vec::new());
+    let mut channels: Vec<&str> = f64_cols.iter().copied().filter(|c| *c != time).collect();
+    // The tracking errors and the end effector first, the base's many states last.
+    channels.sort_by_key(|c| {
+        FIRST
+            .iter()
+            .position(|p| c == p || (p.ends_with('_') && c.starts_with(p)))
+            .unwrap_or(FIRST.len())
+    });
+    for c in channels {
+        let moves = trajs
+            .iter()
+            .any(|(_, t)| t.f64(c).is_ok_and(|v| !is_flat(v)));
+        if !moves {
+            flat.push(c);
+            continue;
+        }
+        if fig.panels.len() == MAX_CHANNELS {
+            more.push(c);
+            continue;
+        }
+        let mut p = Panel::new(c, metric_title(time), metric_title(c));
         for (k, (label, t)) in trajs.iter().enumerate() {
             if let (Ok(x), Ok(y)) = (t.f64(time), t.f64(c)) {
                 p.series.push(
-                    Series::new(format!("{label} case"), x.to_vec(), y.to_vec())
+                    Series::new(*label, x.to_vec(), y.to_vec())
                         .colour(crate::report::Colour::Palette(k)),
                 );
             }
         }
         fig.panels.push(p);
     }
-    let cols = (fig.panels.len() as f64).sqrt().ceil().max(1.0) as u32;
-    let rows = (fig.panels.len() as u32).div_ceil(cols).max(1);
-    fig.size = (420 * cols, 300 * rows + 40);
+    let mut note = Vec::new();
+    if !flat.is_empty() {
+        note.push(format!(
+            "Left out as flat (max − min ≈ 0): {}.",
+            flat.join(", ")
+        ));
+    }
+    if !more.is_empty() {
+        note.push(format!(
+            "Not drawn (the first {MAX_CHANNELS} moving channels are): {}.",
+            more.join(", ")
+        ));
+    }
+    fig.note = note.join(" ");
+    let n = fig.panels.len() as u32;
+    let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
+    let rows = n.div_ceil(cols).max(1);
+    fig.layout = (rows as usize, cols as usize);
+    fig.size = (400 * cols.max(2), 300 * rows + 40);
+    fig.size.1 += fig.note_height();
     fig
 }
 
@@ -367,23 +517,144 @@ mod tests {
     use super::*;
 
     #[test]
-    fn axis_titles_say_what_and_in_which_unit() {
-        assert_eq!(metric_title("thruster_energy"), "thruster energy [J]");
-        assert_eq!(metric_title("energy_per_metre"), "energy per metre [J/m]");
+    fn axis_titles_carry_the_column_name_and_its_unit_from_the_dictionary() {
+        assert_eq!(metric_title("thruster_energy"), "thruster_energy [J]");
+        assert_eq!(metric_title("mission_cost"), "mission_cost [J/m]");
+        assert_eq!(metric_title("mission_cost_p95"), "mission_cost_p95 [J/m]");
         assert_eq!(
             metric_title("design.longitudinal_offset"),
-            "longitudinal offset [m]"
+            "design.longitudinal_offset [m]"
         );
-        assert_eq!(metric_title("design_mass_kg"), "design mass [kg]");
+        assert_eq!(metric_title("design_mass_kg"), "design_mass_kg [kg]");
         assert_eq!(
             metric_title("seg1_convergence_time"),
-            "seg1 convergence time [s]"
+            "seg1_convergence_time [s]"
         );
+        assert_eq!(metric_title("wrench_peak_sway"), "wrench_peak_sway [N]");
+        assert_eq!(metric_title("wrench_peak_yaw"), "wrench_peak_yaw [N·m]");
+        assert_eq!(metric_title("base_yaw"), "base_yaw [rad]");
+        assert_eq!(metric_title("q_3"), "q_3 [rad]");
         assert_eq!(
             metric_title("singularity_exposure"),
-            "singularity exposure [fraction of time, 0–1]"
+            "singularity_exposure [–]"
         );
-        assert_eq!(metric_title("design.links"), "links");
+        assert_eq!(metric_title("design.links"), "design.links");
+    }
+
+    /// A sweep table: a text axis, an integer axis, a varying and a constant metric.
+    fn sweep_table() -> Table {
+        let mut t = Table::default();
+        let rule = ["paper", "ends", "paper", "ends", "even", "even"];
+        t.push(
+            "design.rule",
+            ColumnData::Str(rule.map(String::from).to_vec()),
+        )
+        .unwrap();
+        t.push("design.links", vec![3.0, 3.0, 4.0, 4.0, 5.0, 5.0])
+            .unwrap();
+        t.push("mission_cost", vec![2.0, 2.5, 1.5, 1.8, 1.2, f64::NAN])
+            .unwrap();
+        t.push("design_thrusters", vec![8.0; 6]).unwrap();
+        let status = ["ok", "ok", "ok", "unsuccessful", "ok", "failed"];
+        t.push(STATUS, ColumnData::Str(status.map(String::from).to_vec()))
+            .unwrap();
+        t
+    }
+
+    fn texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| t.split_once('>').and_then(|(_, r)| r.split_once("</text>")))
+            .map(|(inner, _)| inner.trim().to_string())
+            .collect()
+    }
+
+    #[test]
+    fn axis_plots_draw_categories_integers_units_and_leave_constants_out() {
+        let dir = tempfile::tempdir().unwrap();
+        let t = sweep_table();
+        let key = ["mission_cost".to_string(), "design_thrusters".to_string()];
+        let mut warnings = Vec::new();
+        let axes = ["design.rule", "design.links"];
+        axis_plots(&t, &axes, &key, &[0, 1, 2, 4], dir.path(), &mut warnings);
+        assert!(warnings.is_empty(), "{warnings:?}");
+        let rule = std::fs::read_to_string(dir.path().join("axis_design.rule.svg"))
+            .or_else(|_| std::fs::read_to_string(dir.path().join("axis_design_rule.svg")))
+            .unwrap();
+        let words = texts(&rule);
+        for name in ["paper", "ends", "even"] {
+            assert!(words.iter().any(|w| w == name), "{name} not in {words:?}");
+        }
+        assert!(
+            !words
+                .iter()
+                .any(|w| w == "-0.5" || w == "0.5" || w == "2.5"),
+            "{words:?}"
+        );
+        assert!(words.iter().any(|w| w == "mission_cost [J/m]"), "{words:?}");
+        // The constant metric has no panel; the note names it and its value.
+        assert!(!words.iter().any(|w| w == "design_thrusters"), "{words:?}");
+        assert!(
+            words.iter().any(|w| w.contains("design_thrusters = 8")),
+            "{words:?}"
+        );
+        let links = std::fs::read_to_string(dir.path().join("axis_design_links.svg"))
+            .or_else(|_| std::fs::read_to_string(dir.path().join("axis_design.links.svg")))
+            .unwrap();
+        let words = texts(&links);
+        assert!(
+            words.iter().any(|w| w == "3") && words.iter().any(|w| w == "5"),
+            "{words:?}"
+        );
+        assert!(!words.iter().any(|w| w == "3.0" || w == "3.5"), "{words:?}");
+        // Text is at least 11 px at the figure's natural size.
+        for size in links.split("font-size=\"").skip(1) {
+            let px: f64 = size.split('"').next().unwrap().parse().unwrap();
+            assert!(px >= 11.0, "font-size {px}");
+        }
+    }
+
+    #[test]
+    fn timeseries_draws_moving_channels_with_units_and_names_the_flat_ones_and_the_cases() {
+        let mut t = Table::default();
+        t.push("t", vec![0.0, 0.1, 0.2]).unwrap();
+        t.push("base_yaw", vec![0.0, 0.05, 0.1]).unwrap();
+        t.push("u_3", vec![0.0, 0.0, 0.0]).unwrap();
+        t.push("q_0", vec![0.2, 0.2, 0.2]).unwrap();
+        t.push("base_z", vec![0.0, -1e-6, -3e-6]).unwrap();
+        let fig = timeseries(&[("best: case #4, mission_cost = 1.58", t)]);
+        assert_eq!(fig.panels.len(), 1);
+        assert_eq!(fig.panels[0].y_label, "base_yaw [rad]");
+        assert_eq!(fig.panels[0].x_label, "t [s]");
+        assert!(fig.note.contains("q_0, u_3, base_z"), "{}", fig.note);
+        let svg = fig.render_svg().unwrap();
+        let words = texts(&svg);
+        assert!(words
+            .iter()
+            .any(|w| w == "best: case #4, mission_cost = 1.58"));
+        assert!(
+            words.iter().any(|w| w.contains("q_0, u_3, base_z")),
+            "{words:?}"
+        );
+    }
+
+    #[test]
+    fn extremes_are_named_by_case_and_objective() {
+        let t = sweep_table();
+        let sel = Selection {
+            metrics: vec!["mission_cost".into()],
+            maximise: HashSet::new(),
+            magnitude: HashSet::new(),
+            objective: Some("mission_cost".into()),
+            pareto: None,
+        };
+        let mut t = t;
+        t.push(CASE_ID, ColumnData::I64(vec![10, 11, 12, 13, 14, 15]))
+            .unwrap();
+        let [best, worst] = extreme_names(&t, &sel);
+        // Among the `ok` cases (#10, #11, #12, #14): lowest and highest mission cost.
+        assert_eq!(best, "best: case #14, mission_cost = 1.2");
+        assert_eq!(worst, "worst: case #11, mission_cost = 2.5");
     }
 
     #[test]

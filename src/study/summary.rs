@@ -16,7 +16,7 @@ use std::path::Path;
 
 use super::faults::{fault_table, FAULT_PREFIX};
 use super::manifest::Manifest;
-use super::plots::{axis_plots, heatmaps, pareto_plot, timeseries_plot};
+use super::plots::{axis_plots, extreme_names, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
@@ -119,7 +119,8 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
             );
         }
     }
-    timeseries_plot(dir, &plots, &mut warnings);
+    let names = extreme_names(table, &c.sel);
+    timeseries_plot(dir, &names, &plots, &mut warnings);
     warnings
 }
 

@@ -17,6 +17,7 @@
 //! projected start and `data-x2 data-y2` the projected tip, in SVG px; when the arrow is not
 //! along the view's normal it holds a `<line>` with the same coordinates.
 
+mod camera;
 mod labels;
 mod page;
 mod render;

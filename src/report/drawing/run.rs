@@ -11,6 +11,7 @@
 
 use std::fmt::Write as _;
 
+use super::camera::{body_centre, follow_zoom, open_camera};
 use super::labels::Labeller;
 use super::page::{nice_length, ACCENT};
 use super::scene::Scene;
@@ -52,6 +53,8 @@ const PAD: f64 = 22.0;
 const LINE: f64 = 18.0;
 /// Smallest extent of a view [m], so that a flat run still gets a readable strip.
 const MIN_EXTENT: f64 = 1.0;
+/// Length of the animation's time bar [px].
+const TIME_BAR: f64 = 240.0;
 /// The two views drawn.
 const VIEWS: [View; 2] = [View::Top, View::Side];
 
@@ -60,7 +63,8 @@ const STYLE: &str = "text{font-family:'DejaVu Sans',Arial,Helvetica,sans-serif;f
 .body{fill:#fff;fill-opacity:0.55;stroke-width:1.3}.thruster{stroke:#c2410c;fill:#c2410c}\
 .thruster line{stroke-width:1.2}.frame{fill:none;stroke:#bbb;stroke-width:0.8}\
 .base{fill:none;stroke:#777;stroke-width:1.2;stroke-dasharray:6 4}\
-.ee{fill:none;stroke:#15803d;stroke-width:1.4}.leader{stroke:#888;stroke-width:0.6}";
+.ee{fill:none;stroke:#15803d;stroke-width:1.4}.leader{stroke:#888;stroke-width:0.6}\
+.camera *{vector-effect:non-scaling-stroke}";
 
 /// The colour of time fraction `f` ∈ [0, 1]: light blue (start) to dark navy (end).
 pub fn time_colour(f: f64) -> String {
@@ -200,16 +204,27 @@ fn snapshot(
     for a in &snap.scene.arrows {
         let p1 = t.to_svg(view.project(&a.start));
         let p2 = t.to_svg(view.project(&(a.start + a.direction * a.length)));
-        if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
-            continue;
-        }
         s.open(
             "g",
             &[
                 ("class", "thruster".into()),
                 ("data-thruster", a.name.as_str().into()),
+                ("data-length-m", a.length.into()),
             ],
         );
+        if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
+            // No thrust (or seen end-on): the thruster as a dot.
+            s.empty(
+                "circle",
+                &[
+                    ("cx", p1[0].into()),
+                    ("cy", p1[1].into()),
+                    ("r", 1.2.into()),
+                ],
+            );
+            s.close("g");
+            continue;
+        }
         s.empty(
             "line",
             &[
@@ -316,7 +331,7 @@ fn caption_and_legend(s: &mut Svg, d: &RunDrawing, scale: f64, top: f64) {
             ("y2", (y(3) - 4.0).into()),
         ],
     );
-    text(s, 3, "thrust direction (length ∝ limit)");
+    text(s, 3, "thrust at that time (length ∝ thrust, signed)");
     let len = nice_length(120.0 / scale);
     s.empty(
         "rect",
@@ -399,8 +414,19 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
     let mut s = Svg::new(WIDTH, page_height(cap, d.caption.len()), STYLE);
     let n = d.snapshots.len().max(1);
     let dur = format!("{}s", num(duration));
+    let body_length: f64 = d
+        .snapshots
+        .first()
+        .map_or(0.0, |s| s.scene.cylinders.iter().map(|c| c.length).sum());
+    let zoom = follow_zoom(body_length, ts[0].scale, boxes[0][2]);
     for (k, view) in VIEWS.into_iter().enumerate() {
         open_view(&mut s, view, &ts[k], boxes[k], Vec::new());
+        let centres: Vec<[f64; 2]> = d
+            .snapshots
+            .iter()
+            .map(|snap| ts[k].to_svg(view.project(&body_centre(&snap.scene))))
+            .collect();
+        open_camera(&mut s, &centres, boxes[k], zoom, &dur);
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
         for (i, snap) in d.snapshots.iter().enumerate() {
@@ -421,6 +447,33 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
                 &time_colour(i as f64 / (n.max(2) - 1) as f64),
                 &anim,
             );
+        }
+        s.close("g");
+        s.close("svg");
+        if view == View::Top {
+            s.empty(
+                "rect",
+                &[
+                    ("class", "time-bar-frame".into()),
+                    ("x", (boxes[0][0] + 110.0).into()),
+                    ("y", (boxes[0][1] + 8.0).into()),
+                    ("width", TIME_BAR.into()),
+                    ("height", 8.0.into()),
+                    ("fill", "none".into()),
+                    ("stroke", "#888".into()),
+                ],
+            );
+        }
+        for (i, snap) in d.snapshots.iter().enumerate() {
+            let (values, times) = visible_during(i, n);
+            let anim = [
+                ("attributeName", "opacity".into()),
+                ("calcMode", "discrete".into()),
+                ("values", values.into()),
+                ("keyTimes", times.into()),
+                ("dur", dur.clone().into()),
+                ("repeatCount", "indefinite".into()),
+            ];
             if view == View::Top {
                 // The clock: one text per frame, shown with its frame.
                 s.open("g", &[("class", "clock".into())]);
@@ -433,12 +486,31 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
                     ],
                     &format!("t = {} s", num(snap.t)),
                 );
+                // The time bar: filled to this frame's share of the run.
+                let (t0, t1) = (d.snapshots[0].t, d.snapshots[n - 1].t);
+                let f = if t1 > t0 {
+                    (snap.t - t0) / (t1 - t0)
+                } else {
+                    1.0
+                };
+                s.empty(
+                    "rect",
+                    &[
+                        ("class", "time-bar".into()),
+                        ("x", (boxes[0][0] + 110.0).into()),
+                        ("y", (boxes[0][1] + 8.0).into()),
+                        ("width", (TIME_BAR * f.clamp(0.0, 1.0)).into()),
+                        ("height", 8.0.into()),
+                        ("fill", ACCENT.into()),
+                    ],
+                );
                 s.close("g");
             }
         }
         s.close("g");
     }
-    caption_and_legend(&mut s, d, ts[0].scale, cap);
+    // The scale bar at the camera's zoom.
+    caption_and_legend(&mut s, d, ts[0].scale * zoom, cap);
     s.finish()
 }
 
@@ -469,5 +541,79 @@ mod tests {
         assert_eq!(visible_during(3, 4), ("0;1".into(), "0;0.750000".into()));
         assert_eq!(time_colour(0.0), "#7db9e6");
         assert_eq!(time_colour(1.0), "#081d58");
+    }
+
+    /// A straight 60 m run of a 3 m body (one cylinder) in `frames` frames.
+    fn long_run(frames: usize) -> RunDrawing {
+        use super::super::scene::{Cylinder, Scene};
+        let snap = |k: usize| {
+            let x = 60.0 * k as f64 / (frames - 1) as f64;
+            Snapshot {
+                t: k as f64,
+                scene: Scene {
+                    caption: Vec::new(),
+                    cylinders: vec![Cylinder {
+                        name: "link".into(),
+                        pose: crate::spatial::Se3 {
+                            r: crate::spatial::Mat3::identity(),
+                            p: Vec3::new(x, 0.0, 0.0),
+                        },
+                        length: 3.0,
+                        radius: 0.2,
+                        module: false,
+                    }],
+                    joints: Vec::new(),
+                    arrows: Vec::new(),
+                    triads: Vec::new(),
+                    arrow_legend: String::new(),
+                },
+            }
+        };
+        RunDrawing {
+            caption: vec!["run".into()],
+            snapshots: (0..frames).map(snap).collect(),
+            base_trace: vec![Vec3::zeros(), Vec3::new(63.0, 0.0, 0.0)],
+            ee_trace: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_camera_follows_the_body_and_a_time_bar_fills() {
+        let d = long_run(4);
+        let svg = render_animation_svg(&d, 4.0);
+        // Zoomed so that the window spans about three body lengths of the 63 m path.
+        let (ts, boxes, _) = layout(&d);
+        let z = follow_zoom(3.0, ts[0].scale, boxes[0][2]);
+        assert!(z > 5.0, "{z}");
+        // One camera per view, moving to each frame's body centre.
+        assert_eq!(svg.matches("class=\"camera\"").count(), 2);
+        let values: Vec<&str> = svg
+            .split("type=\"translate\"")
+            .nth(1)
+            .and_then(|r| r.split("values=\"").nth(1))
+            .and_then(|r| r.split('"').next())
+            .unwrap()
+            .split(';')
+            .collect();
+        assert_eq!(values.len(), 4);
+        let xs: Vec<f64> = values
+            .iter()
+            .map(|v| v.split(',').next().unwrap().parse().unwrap())
+            .collect();
+        let c0 = ts[0].to_svg([1.5, 0.0]);
+        assert!((xs[0] + c0[0]).abs() < 0.01, "{xs:?} vs {c0:?}");
+        assert!(xs.windows(2).all(|w| w[1] < w[0]), "{xs:?}");
+        // The time bar: empty at the start, full at the end.
+        let bars: Vec<f64> = svg
+            .split("class=\"time-bar\"")
+            .skip(1)
+            .map(|r| {
+                let w = r.split("width=\"").nth(1).unwrap();
+                w.split('"').next().unwrap().parse().unwrap()
+            })
+            .collect();
+        assert_eq!(bars.len(), 4);
+        assert_eq!(bars[0], 0.0);
+        assert_eq!(bars[3], TIME_BAR);
     }
 }

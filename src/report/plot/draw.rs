@@ -7,14 +7,16 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::{
     Cartesian2d, ChartBuilder, ChartContext, Circle, DashedLineSeries, EmptyElement, IntoFont,
     LineSeries, PathElement, RGBColor, Rectangle, SVGBackend, SeriesLabelPosition, ShapeStyle,
-    Text, BLACK, WHITE,
+    Text, TextStyle, BLACK, WHITE,
 };
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult, FONT,
+    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult,
+    DESC_FONT, FONT, TICK_FONT,
 };
 use super::labels::{place_labels, LABEL_FONT};
+use super::scale::Scale;
 use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
 
 /// A chart with `f64` axes on an SVG canvas.
@@ -42,11 +44,49 @@ fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
     } else {
         root.titled(&fig.title, (FONT, 22))?
     };
+    let note = fig.note_lines();
+    let body = if note.is_empty() {
+        body
+    } else {
+        let (_, h) = body.dim_in_pixel();
+        let (top, bottom) = body.split_vertically(h as i32 - fig.note_height() as i32);
+        let style = TextStyle::from((FONT, NOTE_FONT).into_font()).color(&NOTE_RGB);
+        for (k, line) in note.into_iter().enumerate() {
+            bottom.draw(&Text::new(line, (12, 4 + 18 * k as i32), style.clone()))?;
+        }
+        top
+    };
     let areas = body.split_evenly(fig.grid());
     for (panel, area) in fig.panels.iter().zip(&areas) {
         draw_panel(panel, area)?;
     }
     Ok(())
+}
+
+/// Font size of a figure's note as given to plotters (written as 15 / 1.24 ≈ 12.1 px).
+const NOTE_FONT: u32 = 15;
+const NOTE_RGB: RGBColor = RGBColor(70, 70, 70);
+/// Panel captions as given to plotters (written as 17 / 1.24 ≈ 13.7 px).
+const CAPTION_FONT: u32 = 17;
+
+/// The panel in drawn coordinates: data (and fixed ranges) of a log axis as log10.
+fn drawn(panel: &Panel) -> std::borrow::Cow<'_, Panel> {
+    if panel.x_scale != Scale::Log && panel.y_scale != Scale::Log {
+        return std::borrow::Cow::Borrowed(panel);
+    }
+    let mut p = panel.clone();
+    let (xs, ys) = (panel.x_scale.clone(), panel.y_scale.clone());
+    for s in &mut p.series {
+        s.x.iter_mut().for_each(|v| *v = xs.forward(*v));
+        s.y.iter_mut().for_each(|v| *v = ys.forward(*v));
+    }
+    let map = |r: Option<(f64, f64)>, sc: &Scale| {
+        r.map(|r| (sc.forward(r.0), sc.forward(r.1)))
+            .filter(|r| r.0.is_finite() && r.1.is_finite() && r.0 < r.1)
+    };
+    p.x_range = map(panel.x_range, &xs);
+    p.y_range = map(panel.y_range, &ys);
+    std::borrow::Cow::Owned(p)
 }
 
 fn panel_ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
@@ -66,8 +106,12 @@ fn panel_ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
             yb = merge_bounds(yb, sy);
         }
     }
-    let x = panel.x_range.map(widen).unwrap_or_else(|| auto_range(xb));
-    let y = panel.y_range.map(widen).unwrap_or_else(|| auto_range(yb));
+    let x = (panel.x_range.or(panel.x_scale.fixed_range()))
+        .map(widen)
+        .unwrap_or_else(|| auto_range(xb));
+    let y = (panel.y_range.or(panel.y_scale.fixed_range()))
+        .map(widen)
+        .unwrap_or_else(|| auto_range(yb));
     (x, y)
 }
 
@@ -172,28 +216,31 @@ fn polylines(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64)) -> Vec<Vec<(f
 }
 
 fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
+    let panel = &*drawn(panel);
     let (xr, yr) = panel_ranges(panel);
     // Tick counts from the panel size (plotters rounds them to "nice" steps).
     let (w, h) = area.dim_in_pixel();
-    let x_ticks = (w as usize / 50).clamp(3, 12);
-    let y_ticks = (h as usize / 40).clamp(3, 12);
+    let x_ticks = panel.x_scale.tick_count(xr, (w as usize / 60).clamp(3, 12));
+    let y_ticks = panel.y_scale.tick_count(yr, (h as usize / 40).clamp(3, 12));
     let mut chart = ChartBuilder::on(area)
-        .caption(&panel.title, (FONT, 16))
+        .caption(&panel.title, (FONT, CAPTION_FONT))
         .margin(10)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
+        .x_label_area_size(50)
+        .y_label_area_size(78)
         .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
-    chart
-        .configure_mesh()
-        .x_desc(panel.x_label.as_str())
+    let x_fmt = |v: &f64| panel.x_scale.label(*v);
+    let y_fmt = |v: &f64| panel.y_scale.label(*v);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
+        .label_style((FONT, TICK_FONT))
+        .axis_desc_style((FONT, DESC_FONT))
         .x_labels(x_ticks)
         .y_labels(y_ticks)
         .max_light_lines(0)
-        .bold_line_style(RGBColor(225, 225, 225))
-        .draw()?;
+        .bold_line_style(RGBColor(225, 225, 225));
+    mesh.x_label_formatter(&x_fmt).y_label_formatter(&y_fmt);
+    mesh.draw()?;
 
     let mut named = 0;
     for s in &panel.series {
@@ -233,7 +280,7 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
         chart
             .configure_series_labels()
             .position(legend_corner(panel, (xr, yr)))
-            .label_font((FONT, 12))
+            .label_font((FONT, TICK_FONT))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()?;

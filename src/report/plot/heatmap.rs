@@ -6,8 +6,10 @@ use plotters::prelude::{ChartBuilder, RGBColor, Rectangle, WHITE};
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, check_size, render_to_svg, widen, Area, DrawResult, FONT, LIMIT,
+    auto_range, bounds, check_size, render_to_svg, widen, Area, DrawResult, DESC_FONT, FONT, LIMIT,
+    TICK_FONT,
 };
+use super::scale::Scale;
 use crate::report::atomic::atomic_write;
 use crate::report::error::{ReportError, Result};
 
@@ -76,6 +78,11 @@ pub struct Heatmap {
     pub z_range: Option<(f64, f64)>,
     /// Size in pixels.
     pub size: (u32, u32),
+    /// Scale of the x axis: [`Scale::Categories`] names the cells (`x` must then be `0, 1, …`),
+    /// [`Scale::Integer`] prints whole numbers.
+    pub x_scale: Scale,
+    /// Scale of the y axis.
+    pub y_scale: Scale,
 }
 
 /// Builds a [`Heatmap`] (800 × 600 px, automatic colour range), checking the grid.
@@ -105,6 +112,8 @@ pub fn heatmap(
         scale,
         z_range: None,
         size: (800, 600),
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
     };
     h.validate()?;
     Ok(h)
@@ -206,17 +215,22 @@ impl Heatmap {
         let yr = widen((ye[0], ye[ye.len() - 1]));
         let mut chart = ChartBuilder::on(&main)
             .margin(10)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
+            .x_label_area_size(50)
+            .y_label_area_size(78)
             .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
+        let x_fmt = |v: &f64| self.x_scale.label(*v);
+        let y_fmt = |v: &f64| self.y_scale.label(*v);
+        let mut mesh = chart.configure_mesh();
+        mesh.disable_mesh()
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 14))
-            .draw()?;
+            .label_style((FONT, TICK_FONT))
+            .axis_desc_style((FONT, DESC_FONT));
+        mesh.x_labels(self.x_scale.tick_count(xr, 10))
+            .y_labels(self.y_scale.tick_count(yr, 10))
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt);
+        mesh.draw()?;
         let nx = self.x.len();
         let cells: Vec<Rectangle<(f64, f64)>> = (0..self.y.len())
             .flat_map(|j| (0..nx).map(move |i| (i, j)))
@@ -239,16 +253,17 @@ impl Heatmap {
             .margin_top(10)
             .margin_bottom(10)
             .margin_right(5)
-            .caption(caption, (FONT, 11))
+            .caption(caption, (FONT, TICK_FONT))
             .x_label_area_size(45)
-            .y_label_area_size(65)
+            .y_label_area_size(72)
             .build_cartesian_2d(0.0..1.0, zr.0..zr.1)?;
         cb.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
+            .y_label_formatter(&|v| Scale::Linear.label(*v))
             .y_desc(self.z_label.as_str())
-            .label_style((FONT, 11))
-            .axis_desc_style((FONT, 13))
+            .label_style((FONT, TICK_FONT))
+            .axis_desc_style((FONT, DESC_FONT))
             .draw()?;
         let n = 64;
         let dz = (zr.1 - zr.0) / n as f64;

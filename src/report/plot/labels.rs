@@ -4,8 +4,8 @@
 //! a leader line. Greedy and deterministic (labels are placed in input order).
 
 /// Font size of point labels as given to plotters, which writes it into the SVG divided by
-/// 1.24 (13 → 10.5 px).
-pub(super) const LABEL_FONT: u32 = 13;
+/// 1.24 (14 → 11.3 px).
+pub(super) const LABEL_FONT: u32 = 14;
 /// The rendered font size [px].
 const RENDERED: f64 = LABEL_FONT as f64 / 1.24;
 /// Estimated advance of one character [px] (about 0.6 em for a sans-serif font).

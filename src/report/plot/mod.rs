@@ -22,11 +22,13 @@ mod charts;
 mod draw;
 mod heatmap;
 mod labels;
+mod scale;
 mod spec;
 mod uncertainty;
 
 pub use charts::{histogram, scatter_labelled, LabelledPoint};
 pub use heatmap::{heatmap, ColourScale, Heatmap};
+pub use scale::Scale;
 pub use spec::{Colour, Figure, LineStyle, Panel, PanelKind, Series};
 pub use uncertainty::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
 

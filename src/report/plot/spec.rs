@@ -3,6 +3,7 @@
 use plotters::prelude::RGBColor;
 
 use super::canvas::check_size;
+use super::scale::Scale;
 use crate::report::error::{ReportError, Result};
 
 const GREY_RGB: RGBColor = RGBColor(170, 170, 170);
@@ -146,6 +147,10 @@ pub struct Panel {
     pub y_range: Option<(f64, f64)>,
     /// Draw a legend of the named series (when there is at least one).
     pub legend: bool,
+    /// Scale of the x axis (categories, integers, log, …).
+    pub x_scale: Scale,
+    /// Scale of the y axis.
+    pub y_scale: Scale,
 }
 
 impl Panel {
@@ -164,6 +169,8 @@ impl Panel {
             x_range: None,
             y_range: None,
             legend: true,
+            x_scale: Scale::Linear,
+            y_scale: Scale::Linear,
         }
     }
 
@@ -191,6 +198,8 @@ pub struct Figure {
     pub layout: (usize, usize),
     /// Size in pixels `(width, height)`, each at least 50.
     pub size: (u32, u32),
+    /// A line of text under the panels (e.g. what was left out and why; empty: none).
+    pub note: String,
 }
 
 impl Figure {
@@ -201,6 +210,7 @@ impl Figure {
             panels: Vec::new(),
             layout: (0, 0),
             size: (800, 600),
+            note: String::new(),
         }
     }
 
@@ -208,6 +218,32 @@ impl Figure {
     pub fn with_panel(mut self, panel: Panel) -> Self {
         self.panels.push(panel);
         self
+    }
+
+    /// The note wrapped to the figure's width: one string per line (none without a note).
+    pub(super) fn note_lines(&self) -> Vec<String> {
+        // About 0.6 em per character of the 12.1 px note font.
+        let per_line = ((self.size.0 as usize).saturating_sub(24) / 7).max(20);
+        let mut lines: Vec<String> = Vec::new();
+        for word in self.note.split_whitespace() {
+            match lines.last_mut() {
+                Some(l) if l.chars().count() + 1 + word.chars().count() <= per_line => {
+                    l.push(' ');
+                    l.push_str(word);
+                }
+                _ => lines.push(word.to_string()),
+            }
+        }
+        lines
+    }
+
+    /// The height [px] of the strip under the panels that holds the note (0 without one):
+    /// add it to the height the panels need.
+    pub fn note_height(&self) -> u32 {
+        match self.note_lines().len() {
+            0 => 0,
+            n => 8 + 18 * n as u32,
+        }
     }
 
     pub(super) fn invalid(&self, detail: String) -> ReportError {

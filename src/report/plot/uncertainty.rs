@@ -79,7 +79,8 @@ fn row_y(k: usize, n: usize) -> f64 {
 
 /// Writes `text` right-aligned just left of the chart's left edge at row height `y`.
 fn row_label(root: &Area<'_>, at: (i32, i32), text: &str) -> DrawResult {
-    let style = TextStyle::from((FONT, 13).into_font()).pos(Pos::new(HPos::Right, VPos::Center));
+    let style = TextStyle::from((FONT, super::canvas::TICK_FONT).into_font())
+        .pos(Pos::new(HPos::Right, VPos::Center));
     root.draw(&Text::new(text.to_owned(), (at.0 - 8, at.1), style))?;
     Ok(())
 }
@@ -142,8 +143,8 @@ pub fn tornado_svg(title: &str, metric: &str, rows: &[TornadoRow]) -> Result<Str
             .disable_y_mesh()
             .disable_y_axis()
             .x_desc(metric)
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 14))
+            .label_style((FONT, super::canvas::TICK_FONT))
+            .axis_desc_style((FONT, super::canvas::DESC_FONT))
             .draw()?;
         chart.draw_series(std::iter::once(PathElement::new(
             vec![(0.0, 0.0), (0.0, n as f64)],
@@ -225,8 +226,8 @@ pub fn rank_interval_svg(title: &str, rows: &[RankRow], n_cases: usize) -> Resul
             .x_labels(ticks)
             .x_label_formatter(&integer)
             .x_desc("rank over the worlds (1 = best): 5–95 % interval, median dot")
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 14))
+            .label_style((FONT, super::canvas::TICK_FONT))
+            .axis_desc_style((FONT, super::canvas::DESC_FONT))
             .draw()?;
         for (k, r) in rows.iter().enumerate() {
             let y = row_y(k, n);
