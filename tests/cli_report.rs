@@ -419,7 +419,7 @@ fn report_re_ranks_a_finished_study_by_another_objective() {
         serde_json::json!(["peak_thrust", "saturation_fraction"])
     );
     let pareto = String::from_utf8(read(&out.join("plots/pareto.svg"))).unwrap();
-    assert!(pareto.contains("Pareto front: peak thrust [N] vs saturation fraction"));
+    assert!(pareto.contains("Pareto front: peak_thrust [N] vs saturation_fraction"));
     let html = String::from_utf8(read(&out.join("report.html"))).unwrap();
     assert!(html.contains("peak_thrust"));
     // A later report without options keeps the recorded ranking.
