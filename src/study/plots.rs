@@ -84,6 +84,25 @@ fn number_scale(v: &[f64], rows: &[usize]) -> Scale {
     }
 }
 
+/// The scale of a metric's values at `rows`: logarithmic when every finite value is positive and
+/// they span two to nine decades (a few saturating designs at 10⁵ J/m would squash the rest
+/// into one line; a wider span is a rounding-level "zero", e.g. σ_min = 1e-45), else
+/// [`number_scale`].
+fn value_scale(v: &[f64], rows: &[usize]) -> Scale {
+    let (lo, hi, all_positive) = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY, true), |(a, b, p), x| {
+            (a.min(x), b.max(x), p && x > 0.0)
+        });
+    if all_positive && lo.is_finite() && hi >= 100.0 * lo && hi <= 1e9 * lo {
+        Scale::Log
+    } else {
+        number_scale(v, rows)
+    }
+}
+
 /// The value of `v` at `rows` when it is the same at every row (finite values within a
 /// relative 1e-9, or no finite value at all: `NaN`); `None` when it varies.
 fn constant_value(v: &[f64], rows: &[usize]) -> Option<f64> {
@@ -271,7 +290,7 @@ pub(crate) fn axis_plots(
                 .kind(PanelKind::Scatter)
                 .with_series(s);
             p.x_scale = x_scale.clone();
-            p.y_scale = number_scale(yv, &all);
+            p.y_scale = value_scale(yv, &all);
             match unsuccessful_series(&bad, &xv, yv) {
                 Some(u) => p.series.push(u),
                 None => p.legend = false,
@@ -515,6 +534,16 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn metrics_spanning_decades_get_a_log_axis() {
+        let all = [0, 1, 2];
+        assert_eq!(value_scale(&[60.0, 70.0, 4.4e5], &all), Scale::Log);
+        assert_eq!(value_scale(&[60.5, 70.0, 5000.0], &all), Scale::Linear);
+        assert_eq!(value_scale(&[-1.5, 70.0, 4.4e5], &all), Scale::Linear);
+        assert_eq!(value_scale(&[3.0, 4.0, 5.0], &all), Scale::Integer);
+        assert_eq!(value_scale(&[1e-45, 0.5, 0.7], &all), Scale::Linear);
+    }
 
     #[test]
     fn axis_titles_carry_the_column_name_and_its_unit_from_the_dictionary() {
