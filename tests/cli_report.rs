@@ -445,6 +445,9 @@ fn the_case_table_parquet_carries_units_types_and_meanings() {
     assert_eq!(kind("peak_thrust"), ColumnKind::F64);
     // Counts are whole numbers in every case here: stored as integers, "3" in the CSV.
     assert_eq!(kind("design_thrusters"), ColumnKind::I64);
+    // Flags with a value in every case: booleans, "true"/"false" in the CSV.
+    assert_eq!(kind("success"), ColumnKind::Bool);
+    assert_eq!(kind("completed"), ColumnKind::Bool);
     let csv = String::from_utf8(read(&out.join("cases.csv"))).unwrap();
     let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let k = head.iter().position(|h| *h == "design_joints").unwrap();
@@ -476,6 +479,12 @@ fn the_case_table_parquet_carries_units_types_and_meanings() {
     assert_eq!(col("peak_thrust")["type"], "f64");
     assert_eq!(col("case_id")["type"], "i64");
     assert_eq!(col("design_thrusters")["type"], "i64");
+    assert_eq!(col("success")["type"], "bool");
+    let k = head.iter().position(|h| *h == "success").unwrap();
+    assert!(csv
+        .lines()
+        .skip(1)
+        .all(|l| matches!(l.split(',').nth(k), Some("true" | "false"))));
     assert!(col("design.links")["meaning"]
         .as_str()
         .unwrap()

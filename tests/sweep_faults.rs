@@ -69,7 +69,7 @@ fn every_thruster_fails_once_and_the_summary_tables_the_outcome() {
     // path: objective change 0).
     for j in 1..=7 {
         let ok = column(&csv, &format!("fault.t{j}.success"));
-        let want = if j == 2 { "0.0" } else { "1.0" };
+        let want = if j == 2 { "false" } else { "true" };
         assert_eq!(ok, [want, want], "thruster T{j}");
     }
     assert!(!csv.contains("fault.t0.") && !csv.contains("fault.t8."));

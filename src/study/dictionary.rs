@@ -89,7 +89,7 @@ const AUTHORITY: &[ColumnDoc] = &[
     c("authority_straight_min_moment", "N·m", "f64", "smallest commanded moment at q = 0"),
     c("authority_mission_min_force", "N", "f64", "as authority_min_force over the declared mission range (`static.joint_range` / `joint_ranges`); NaN without one"),
     c("authority_mission_min_moment", "N·m", "f64", "as authority_min_moment over the declared mission range; NaN without one"),
-    c("under_actuated", "0/1", "f64", "a flag, not ranked: 1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
+    c("under_actuated", "0/1", "bool", "a flag, not ranked: 1 when a commanded axis is unattainable (≤ 1e-6 × the largest thrust limit, either sign) at every sampled configuration"),
     c("under_actuated_axes", "bitmask", "i64", "an identifier, not ranked: bitmask of those axes: surge 1, sway 2, heave 4, roll 8, pitch 16, yaw 32 (0: none)"),
     c("n1_worst_force", "N", "f64", "N−1: smallest commanded force with one thruster removed (held at zero thrust), over thrusters and the N−1 configurations (q = 0 and the first `static.n1_samples` samples)"),
     c("n1_worst_moment", "N·m", "f64", "N−1: smallest commanded moment with one thruster removed"),
@@ -103,13 +103,13 @@ const AUTHORITY: &[ColumnDoc] = &[
 const TUNING: &[ColumnDoc] = &[
     c("tuned.<param>", "as the key", "f64", "the tuned value of each `[[tune.param]]` (e.g. `tuned.control.k_psi`), at which the case is scored"),
     c("tune_evaluations", "–", "i64", "fresh closed-loop runs the tuning used"),
-    c("tune_feasible", "0/1", "f64", "1 when the tuned point met every `[[tune.constraint]]`"),
+    c("tune_feasible", "0/1", "bool", "1 when the tuned point met every `[[tune.constraint]]`"),
     c("tune_noise", "–", "f64", "relative spread (max − min)/min of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start"),
     c("tune_bound_hits", "–", "i64", "tuned parameters within 0.1 % of a bound of their box"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
-    c("completed", "0/1", "f64", "the run reached its duration without a numerical failure"),
+    c("completed", "0/1", "bool", "the run reached its duration without a numerical failure"),
     c("simulated_time", "s", "f64", "simulated time reached"),
     c("thruster_energy", "J", "f64", "thruster shaft energy by actuator-disk momentum theory with each thruster's axial inflow"),
     c("thruster_energy_static", "J", "f64", "the same thrusts at zero inflow"),
@@ -133,7 +133,7 @@ const RUN_COMMON: &[ColumnDoc] = &[
     c("wrench_peak_<axis>", "N or N·m", "f64", "largest |τ_c| the base controller commanded along surge, sway, heave (N), roll, pitch, yaw (N·m) at a control tick, base frame: the required wrench of `authority_margin`"),
     c("authority_margin", "–", "f64", "smallest ratio, over the commanded axes the run asked something of, of the wrench the thrusters can deliver within their limits about the base origin (least over 15 configurations of the nominal run's log) to the peak commanded wrench `wrench_peak_<axis>`; ≥ 1: every peak demand was deliverable (static analysis and a closed loop)"),
     c("reach", "m", "f64", "distance from the base frame's origin to the end effector at q = 0 (a `[mission] reach` requirement is judged on it)"),
-    c("success", "0/1", "f64", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
+    c("success", "0/1", "bool", "1 when the run met every `[success]` criterion (then `status` is `ok`)"),
 ];
 
 const RUN_TRANSPORT: &[ColumnDoc] = &[
@@ -141,7 +141,7 @@ const RUN_TRANSPORT: &[ColumnDoc] = &[
     c("seg{k}_overshoot", "m", "f64", "largest cross-track excursion past the path on segment k after the first crossing"),
     c("seg{k}_cross_track_rms", "m", "f64", "RMS cross-track error on segment k after convergence"),
     c("segments_reached", "–", "f64", "segments that became active"),
-    c("converged", "0/1", "f64", "every reached segment converged"),
+    c("converged", "0/1", "bool", "every reached segment converged"),
     c("convergence_time", "s", "f64", "convergence time of segment 0"),
     c("overshoot", "m", "f64", "largest overshoot over the segments"),
     c("cross_track_rms", "m", "f64", "RMS cross-track error of the head after convergence"),
@@ -214,7 +214,7 @@ const WORLDS: &[ColumnDoc] = &[
     c("p_best", "–", "f64", "fraction of the paired worlds in which the case is best on the objective among the ranked cases (ties share); NaN when not ranked"),
     c("rank_p05, rank_p50, rank_p95", "–", "f64", "5 %, 50 % and 95 % quantiles of the case's rank (1 = best) over the worlds among the ranked cases"),
     c("validate.<v>.<objective>", "as the objective", "f64", "the objective in held-out variant <v> at the tuned values"),
-    c("validate.<v>.success", "0/1", "f64", "the run in variant <v> met every `[success]` criterion"),
+    c("validate.<v>.success", "0/1", "bool", "the run in variant <v> met every `[success]` criterion"),
     c("validate.<v>.gap", "–", "f64", "relative change of the objective from the nominal run in variant <v>: the generalisation gap"),
 ];
 
@@ -222,7 +222,7 @@ const FAULTS: &[ColumnDoc] = &[
     c("fault_time", "s", "f64", "a run with a scenario `[fault]`: the simulation time the fault struck (NaN if the run ended before `fault.at`)"),
     c("fault_tolerance", "–", "f64", "fraction of the design's thrusters whose single fault (`[faults]`, re-run at the case's values in the nominal world) still leaves the run successful"),
     c("worst_fault", "index", "i64", "number (from 1: thruster `T1` is 1) of the thruster whose fault hurts most: an unsuccessful faulted run first, then the largest worsening of the objective (NaN objective worst), then the lowest number; an identifier, not ranked"),
-    c("fault.t<j>.success", "0/1", "f64", "the run with thruster `T<j>` (j from 1) failed met every `[success]` criterion (NaN: the design has no thruster `T<j>`)"),
+    c("fault.t<j>.success", "0/1", "bool", "the run with thruster `T<j>` (j from 1) failed met every `[success]` criterion (NaN: the design has no thruster `T<j>`)"),
     c("fault.t<j>.objective", "as the objective", "f64", "the study's objective (`study.objective`, else the worlds' objective, else `energy_per_metre`) with thruster <j> failed"),
     c("fault.t<j>.change", "–", "f64", "relative change of the objective from the nominal run with thruster <j> failed, `(x − x₀)/|x₀|`"),
     c("fault.t<j>.missed", "–", "f64", "an identifier, not ranked: the first `[success]` criterion the run with thruster <j> failed missed, as its index (from 0) in the criterion list (`no_failure` for a failed run; NaN when it met all)"),
@@ -406,6 +406,13 @@ fn named_doc(name: &str) -> Option<&'static ColumnDoc> {
         .find(|c| c.name == name)
 }
 
+/// Whether `column` is a flag the dictionary stores as a boolean (`kind` `bool`: `success`,
+/// `completed`, `fault.t<j>.success`, …) — written as `true`/`false` when every case has a 0/1
+/// value ([`integers_for_files`]; a NaN keeps the column f64).
+pub fn is_bool_column(column: &str) -> bool {
+    describe(column).is_some_and(|d| d.kind == "bool")
+}
+
 /// Whether `column` holds whole numbers (counts, numbers of things, bitmasks): the dictionary
 /// types it `i64`. The case tables are computed in `f64` (NaN where a case has no value); their
 /// files store such a column as integers when every value is one ([`integers_for_files`]).
@@ -418,12 +425,26 @@ pub fn is_integer_column(column: &str) -> bool {
 }
 
 /// Store the integer columns of a case table (see [`is_integer_column`]) as `i64` when every
-/// value is a whole number (`to_files`), or back as `f64` after reading a file (`!to_files`),
+/// value is a whole number, and its flags ([`is_bool_column`]) as `bool` when every value is 0
+/// or 1 (`to_files`), or both back as `f64` after reading a file (`!to_files`),
 /// so that the report computes on `f64` and the files say "3", not "3.0". A column holding a
 /// NaN (a case that did not build or run) stays `f64`. Exact both ways for |x| < 2⁵³.
 pub fn integers_for_files(table: &mut crate::report::Table, to_files: bool) {
     use crate::report::ColumnData;
     for c in &mut table.columns {
+        if is_bool_column(&c.name) {
+            let data = match &c.data {
+                ColumnData::F64(v) if to_files && v.iter().all(|x| *x == 0.0 || *x == 1.0) => {
+                    ColumnData::Bool(v.iter().map(|x| *x == 1.0).collect())
+                }
+                ColumnData::Bool(v) if !to_files => {
+                    ColumnData::F64(v.iter().map(|&x| f64::from(u8::from(x))).collect())
+                }
+                _ => continue,
+            };
+            c.data = data;
+            continue;
+        }
         if !is_integer_column(&c.name) {
             continue;
         }

@@ -9,7 +9,7 @@ pub struct ColumnDoc {
     pub name: &'static str,
     /// The unit (`–` for dimensionless, `0/1` for a flag).
     pub unit: &'static str,
-    /// The type as stored: `f64`, `i64` or `str`.
+    /// The type as stored: `f64`, `i64`, `bool` or `str`.
     pub kind: &'static str,
     /// What it means.
     pub meaning: &'static str,
