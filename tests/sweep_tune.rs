@@ -87,7 +87,14 @@ fn column(head: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
         .iter()
         .position(|h| h == name)
         .unwrap_or_else(|| panic!("{name}: {head:?}"));
-    rows.iter().map(|r| r[c].parse().unwrap()).collect()
+    // Flags (`success`, `tune_feasible`, …) are written as true/false when every case has one.
+    rows.iter()
+        .map(|r| match r[c].as_str() {
+            "true" => 1.0,
+            "false" => 0.0,
+            x => x.parse().unwrap(),
+        })
+        .collect()
 }
 
 fn sweep(study: &Path, out: &Path, extra: &[&str]) {
