@@ -226,7 +226,9 @@ border-color:#1d4ed8}.r-card svg{width:100%;height:auto;display:block}\
 .r-plot svg{max-width:100%;height:auto;display:block}\
 .r-card figcaption{font-size:13px;margin-top:4px}.r-plot{margin:14px 0;break-inside:avoid}\
 .r-plot figcaption{font-size:13px;color:#333}.r-kv td:first-child{font-weight:bold}\
-@media print{body{max-width:none}.r-grid{display:block}.r-card{margin-bottom:12px}}";
+@media print{body{max-width:none}.r-grid{display:block}.r-card{margin-bottom:12px}\
+.r-scroll{overflow:visible}table{font-size:8px;width:100%}th,td{padding:1px 3px;\
+overflow-wrap:anywhere}table code{font-size:8px}}";
 
 /// Writes `report.html` into `dir` (an existing output directory).
 pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {

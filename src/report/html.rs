@@ -24,7 +24,7 @@ pub struct CaseLink {
     pub name: Option<String>,
 }
 
-/// Inline Markdown: `` `code` ``, `**bold**`, and (when `link` is given) case references `#N`
+/// Inline Markdown: `` `code` ``, `**bold**`, links, images `![alt](src)`, and (when `link` is given) case references `#N`
 /// turned into links by `link`. Returns the HTML and whether an unsuccessful case was named.
 fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String, bool) {
     let mut out = String::new();
@@ -39,6 +39,16 @@ fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String
                 rest = &rest[end + 2..];
                 continue;
             }
+        }
+        if let Some((label, url, len)) = rest.strip_prefix('!').and_then(md_link) {
+            let _ = write!(
+                out,
+                "<img src=\"{}\" alt=\"{}\" style=\"max-width:100%\">",
+                escape(url),
+                escape(label)
+            );
+            rest = &rest[1 + len..];
+            continue;
         }
         if let Some((label, url, len)) = md_link(rest) {
             let _ = write!(
@@ -273,6 +283,12 @@ mod tests {
         assert!(h.contains("<h2 id=\"cases-left-out\">"), "{h}");
         assert!(
             h.contains("<a href=\"#cases-left-out\">the cases left out</a>"),
+            "{h}"
+        );
+        // An image is drawn, not shown as "!" and a link.
+        let h = super::markdown_to_html("![rank intervals](plots/r.svg)\n", 0, &|_| None);
+        assert!(
+            h.contains("<img src=\"plots/r.svg\" alt=\"rank intervals\"") && !h.contains('!'),
             "{h}"
         );
         // Not a link: brackets without a target stay text.

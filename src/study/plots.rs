@@ -84,10 +84,8 @@ fn number_scale(v: &[f64], rows: &[usize]) -> Scale {
     }
 }
 
-/// The scale of a metric's values at `rows`: logarithmic when every finite value is positive and
-/// they span two to nine decades (a few saturating designs at 10⁵ J/m would squash the rest
-/// into one line; a wider span is a rounding-level "zero", e.g. σ_min = 1e-45), else
-/// [`number_scale`].
+/// The scale of a metric's values at `rows`: log when all are positive and span 2–9 decades
+/// (saturating designs at 10⁵ J/m; wider is a rounding "zero"), else [`number_scale`].
 fn value_scale(v: &[f64], rows: &[usize]) -> Scale {
     let (lo, hi, all_positive) = rows
         .iter()
@@ -236,6 +234,9 @@ pub(crate) fn pareto_plot(
             .map(|a| a.rsplit('.').next().unwrap_or(a))
             .collect();
         p.series[2].name = format!("Pareto-optimal: #case {}", short.join("/"));
+        let drawn: Vec<usize> = (0..f.xs.len().min(f.ys.len())).collect();
+        p.x_scale = value_scale(f.xs, &drawn);
+        p.y_scale = value_scale(f.ys, &drawn);
         if let Some(s) = unsuccessful_series(&unsuccessful_rows(table), f.xs, f.ys) {
             p.series.push(s);
         }
