@@ -301,12 +301,7 @@ pub(crate) fn axis_plots(
         if !constant.is_empty() {
             fig.note = format!("Left out, the same in every case: {}", constant.join(", "));
         }
-        let n = fig.panels.len() as u32;
-        let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
-        let rows = n.div_ceil(cols).max(1);
-        fig.layout = (rows as usize, cols as usize);
-        fig.size = (400 * cols.max(2), 320 * rows + 40);
-        fig.size.1 += fig.note_height();
+        fig.grid_layout(3, 320);
         if let Err(e) = fig.write_svg(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
             warnings.push(e.to_string());
         }
@@ -523,12 +518,7 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
         ));
     }
     fig.note = note.join(" ");
-    let n = fig.panels.len() as u32;
-    let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, 3);
-    let rows = n.div_ceil(cols).max(1);
-    fig.layout = (rows as usize, cols as usize);
-    fig.size = (400 * cols.max(2), 300 * rows + 40);
-    fig.size.1 += fig.note_height();
+    fig.grid_layout(3, 300);
     fig
 }
 

@@ -246,6 +246,20 @@ impl Figure {
         }
     }
 
+    /// Lay the panels out in a near-square grid of at most `max_cols` columns: 400 px a column
+    /// (the width of two at least), `row_height` px a row, 40 px for the title and the note's
+    /// strip ([`Figure::note_height`]; set the note first).
+    pub fn grid_layout(&mut self, max_cols: u32, row_height: u32) {
+        let n = self.panels.len() as u32;
+        let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, max_cols.max(1));
+        let rows = n.div_ceil(cols).max(1);
+        self.layout = (rows as usize, cols as usize);
+        self.size = (
+            400 * cols.max(2),
+            row_height * rows + 40 + self.note_height(),
+        );
+    }
+
     pub(super) fn invalid(&self, detail: String) -> ReportError {
         ReportError::InvalidFigure {
             figure: self.title.clone(),
