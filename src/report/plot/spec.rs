@@ -254,10 +254,9 @@ impl Figure {
         let cols = ((n as f64).sqrt().ceil() as u32).clamp(1, max_cols.max(1));
         let rows = n.div_ceil(cols).max(1);
         self.layout = (rows as usize, cols as usize);
-        self.size = (
-            400 * cols.max(2),
-            row_height * rows + 40 + self.note_height(),
-        );
+        // The note wraps at the figure's width: set the width before measuring it.
+        self.size = (400 * cols.max(2), row_height * rows + 40);
+        self.size.1 += self.note_height();
     }
 
     pub(super) fn invalid(&self, detail: String) -> ReportError {
@@ -321,5 +320,28 @@ impl Figure {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_grid_measures_its_note_at_the_grid_width() {
+        // 120 words of 9 characters: at the default 800 px they wrap into more lines than at the
+        // 1200 px of a three-column grid, and the height must follow the final width.
+        let mut fig = Figure::new("t");
+        for k in 0..9 {
+            fig.panels.push(Panel::new(format!("p{k}"), "x", "y"));
+        }
+        fig.note = vec!["abcdefgh,"; 120].join(" ");
+        fig.grid_layout(3, 300);
+        assert_eq!(fig.layout, (3, 3));
+        assert_eq!(fig.size.0, 1200);
+        let lines = fig.note_lines().len() as u32;
+        assert_eq!(fig.size.1, 300 * 3 + 40 + 8 + 18 * lines);
+        fig.size.0 = 800;
+        assert!(fig.note_lines().len() as u32 > lines);
     }
 }
