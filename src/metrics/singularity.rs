@@ -13,8 +13,8 @@ use nalgebra::{Matrix6xX, Vector6};
 use serde::Serialize;
 
 use super::small_svd::{
-    extreme_eigenvalues, givens_add_row, min_max, one_sided_jacobi_sq, shifted_inverse_iteration,
-    tridiagonal_eigenvalues,
+    extreme_eigenvalues, extreme_eigenvalues_pair, givens_add_row, min_max, one_sided_jacobi_sq,
+    shifted_inverse_iteration, tridiagonal_eigenvalues,
 };
 use crate::allocation::{attainable_wrench, AllocError, AttainableWrench};
 
@@ -444,9 +444,41 @@ pub fn commanded_extremes_with(
     }
     let rows = selected_rows(dofs);
     let mut gram = g.select(&rows, k);
-    let (lo, hi) = extreme_eigenvalues(&mut gram, k);
+    let ev = extreme_eigenvalues(&mut gram, k);
+    extremes_from(g, t, &rows, k, ev, rank_rel_tol)
+}
+
+/// [`commanded_extremes_with`] for two axis selections of one configuration (the static
+/// analysis' all six rows and its commanded ones), each equal to its own call bit for bit: the
+/// two Gram blocks' Laguerre iterations share one loop ([`extreme_eigenvalues_pair`]).
+pub fn commanded_extremes_pair_with(
+    g: &ScaledGram,
+    t: &Matrix6xX<f64>,
+    dofs: [CommandedDofs; 2],
+    rank_rel_tol: f64,
+) -> [SigmaExtremes; 2] {
+    let ks = dofs.map(CommandedDofs::len);
+    if !(g.valid && ks[0] > 0 && ks[1] > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO) {
+        return dofs.map(|d| commanded_extremes_with(g, t, d, rank_rel_tol));
+    }
+    let rows = dofs.map(selected_rows);
+    let (mut ga, mut gb) = (g.select(&rows[0], ks[0]), g.select(&rows[1], ks[1]));
+    let ev = extreme_eigenvalues_pair(&mut ga, ks[0], &mut gb, ks[1]);
+    std::array::from_fn(|i| extremes_from(g, t, &rows[i], ks[i], ev[i], rank_rel_tol))
+}
+
+/// The [`SigmaExtremes`] of the rows `rows[..k]` whose Gram block has the extreme eigenvalues
+/// `(lo, hi)`: the QR + Jacobi route below [`EXTREMES_MIN_RATIO`].
+fn extremes_from(
+    g: &ScaledGram,
+    t: &Matrix6xX<f64>,
+    rows: &[usize; 6],
+    k: usize,
+    (lo, hi): (f64, f64),
+    rank_rel_tol: f64,
+) -> SigmaExtremes {
     if lo < EXTREMES_MIN_RATIO * hi {
-        return from_squares(&triangle_sigma_sq(g, t, &rows, k), k).extremes(rank_rel_tol);
+        return from_squares(&triangle_sigma_sq(g, t, rows, k), k).extremes(rank_rel_tol);
     }
     let (sigma_min, sigma_max) = (lo.max(0.0).sqrt(), hi.max(0.0).sqrt());
     SigmaExtremes {

@@ -290,6 +290,23 @@ fn commanded_sigma_matches_svd_over_random_configurations() {
             // just as well, and its rank is the full route's.
             check_extremes(&t, l, dofs, &format!("{n}"));
         }
+        // Two selections at once (the static analysis' all-six and commanded rows) equal the
+        // two single calls bit for bit.
+        let g = ScaledGram::new(&t, l);
+        for pair in [[sets[0], sets[1]], [sets[1], sets[2]], [sets[2], sets[2]]] {
+            let both = commanded_extremes_pair_with(&g, &t, pair, DEFAULT_RANK_REL_TOL);
+            for (got, dofs) in both.iter().zip(pair) {
+                let one = commanded_extremes_with(&g, &t, dofs, DEFAULT_RANK_REL_TOL);
+                let bits = |e: &SigmaExtremes| {
+                    [e.sigma_min, e.sigma_max, e.condition_number].map(f64::to_bits)
+                };
+                assert_eq!(
+                    (bits(got), got.rank),
+                    (bits(&one), one.rank),
+                    "{n} {dofs:?}"
+                );
+            }
+        }
     }
 }
 

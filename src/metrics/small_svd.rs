@@ -120,97 +120,145 @@ pub(crate) fn tridiagonal_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> [f64; 
 /// does not settle. Same absolute accuracy (about `ε‖a‖`) as [`tridiagonal_eigenvalues`] at about a
 /// third of its cost: only the two extreme roots are sought.
 pub(crate) fn extreme_eigenvalues(a: &mut [[f64; 6]; 6], k: usize) -> (f64, f64) {
-    let mut d = [0.0; 6];
-    let mut e = [0.0; 6];
-    householder_tridiagonal(a, k, &mut d, &mut e);
-    let mut e2 = [0.0; 6];
-    let (mut lo_bound, mut hi_bound) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut scale = 0.0_f64;
-    for i in 0..k {
-        let left = if i > 0 { e[i - 1].abs() } else { 0.0 };
-        let right = if i + 1 < k { e[i].abs() } else { 0.0 };
-        lo_bound = lo_bound.min(d[i] - left - right);
-        hi_bound = hi_bound.max(d[i] + left + right);
-        scale = scale.max(d[i].abs() + left + right);
-        if i + 1 < k {
-            e2[i] = e[i] * e[i];
+    let mut t = Tridiagonal::of(a, k);
+    if k <= 1 {
+        return (t.d[0], t.d[0]);
+    }
+    let [r] = laguerre_extremes([&t]);
+    t.settle(r)
+}
+
+/// [`extreme_eigenvalues`] of two Gram blocks at once (`a`'s leading `ka×ka`, `b`'s `kb×kb`;
+/// both destroyed), each result equal to its own call bit for bit: the four Laguerre
+/// iterations share one loop (more independent chains for the processor to overlap).
+pub(crate) fn extreme_eigenvalues_pair(
+    a: &mut [[f64; 6]; 6],
+    ka: usize,
+    b: &mut [[f64; 6]; 6],
+    kb: usize,
+) -> [(f64, f64); 2] {
+    if ka <= 1 || kb <= 1 {
+        return [extreme_eigenvalues(a, ka), extreme_eigenvalues(b, kb)];
+    }
+    let (mut ta, mut tb) = (Tridiagonal::of(a, ka), Tridiagonal::of(b, kb));
+    let [ra, rb] = laguerre_extremes([&ta, &tb]);
+    [ta.settle(ra), tb.settle(rb)]
+}
+
+/// The tridiagonal form of a Gram block and where Laguerre's iteration starts on it.
+struct Tridiagonal {
+    k: usize,
+    d: [f64; 6],
+    e: [f64; 6],
+    e2: [f64; 6],
+    /// A bound below and a bound above the spectrum.
+    starts: [f64; 2],
+    /// ≥ ‖T‖ (Gershgorin).
+    scale: f64,
+}
+
+impl Tridiagonal {
+    /// Householder reduction of the `k×k` block of `a` (destroyed) and the spectrum's bounds.
+    fn of(a: &mut [[f64; 6]; 6], k: usize) -> Self {
+        let mut d = [0.0; 6];
+        let mut e = [0.0; 6];
+        householder_tridiagonal(a, k, &mut d, &mut e);
+        let mut e2 = [0.0; 6];
+        let (mut lo_bound, mut hi_bound) = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut scale = 0.0_f64;
+        for i in 0..k {
+            let left = if i > 0 { e[i - 1].abs() } else { 0.0 };
+            let right = if i + 1 < k { e[i].abs() } else { 0.0 };
+            lo_bound = lo_bound.min(d[i] - left - right);
+            hi_bound = hi_bound.max(d[i] + left + right);
+            scale = scale.max(d[i].abs() + left + right);
+            if i + 1 < k {
+                e2[i] = e[i] * e[i];
+            }
+        }
+        // A Gram matrix is positive semi-definite: its spectrum lies in [0, trace] up to
+        // rounding, often much tighter than Gershgorin's discs.
+        let slack = 4.0 * f64::EPSILON * scale;
+        lo_bound = lo_bound.max(-slack);
+        hi_bound = hi_bound.min(d[..k].iter().sum::<f64>() + slack);
+        Self {
+            k,
+            d,
+            e,
+            e2,
+            starts: [lo_bound, hi_bound],
+            scale,
         }
     }
-    if k == 1 {
-        return (d[0], d[0]);
-    }
-    // A Gram matrix is positive semi-definite: its spectrum lies in [0, trace] up to
-    // rounding, often much tighter than Gershgorin's discs.
-    let slack = 4.0 * f64::EPSILON * scale;
-    lo_bound = lo_bound.max(-slack);
-    hi_bound = hi_bound.min(d[..k].iter().sum::<f64>() + slack);
-    let starts = [lo_bound, hi_bound];
-    let both = match k {
-        6 => laguerre_extremes::<6>(&d, &e2, starts, scale),
-        5 => laguerre_extremes::<5>(&d, &e2, starts, scale),
-        4 => laguerre_extremes::<4>(&d, &e2, starts, scale),
-        3 => laguerre_extremes::<3>(&d, &e2, starts, scale),
-        _ => laguerre_extremes::<2>(&d, &e2, starts, scale),
-    };
-    match (both[0], both[1]) {
-        (Some(lo), Some(hi)) => (lo, hi),
-        _ => {
-            implicit_ql(&mut d, &mut e, k);
-            min_max(&d[..k])
+
+    /// The extremes from Laguerre's results, or by the implicit QL algorithm when either side
+    /// did not settle.
+    fn settle(&mut self, r: [Option<f64>; 2]) -> (f64, f64) {
+        match r {
+            [Some(lo), Some(hi)] => (lo, hi),
+            _ => {
+                implicit_ql(&mut self.d, &mut self.e, self.k);
+                min_max(&self.d[..self.k])
+            }
         }
     }
 }
 
-/// The smallest and largest eigenvalues of the symmetric tridiagonal matrix `(d, e)`
-/// (`e2[i] = e[i]²`, `K` entries, `K ≥ 2`), from `starts = [a bound below, a bound above]`
-/// the spectrum (Gershgorin): Laguerre's iteration on `p(λ) = det(T − λI)` (three-term
-/// recurrences for `p`, `p'`, `p''`). With all roots real it moves monotonically from an
-/// outer bound to the extreme root and converges cubically to a simple one (Wilkinson, *The
-/// Algebraic Eigenvalue Problem*, §7.6). A side stops when its step falls below `4ε·scale`
-/// (`scale` ≥ ‖T‖) or stops moving outward-in; `None` after 40 iterations (a multiple root
-/// converges only linearly).
+/// The smallest and largest eigenvalues of each symmetric tridiagonal matrix of `tris`
+/// (`k ≥ 2` entries), from its `starts` (a bound below and a bound above the spectrum):
+/// Laguerre's iteration on `p(λ) = det(T − λI)` (three-term recurrences for `p`, `p'`, `p''`).
+/// With all roots real it moves monotonically from an outer bound to the extreme root and
+/// converges cubically to a simple one (Wilkinson, *The Algebraic Eigenvalue Problem*, §7.6).
+/// A side stops when its step falls below `4ε·scale` (`scale` ≥ ‖T‖) or stops moving
+/// outward-in; `None` after 40 iterations (a multiple root converges only linearly).
 ///
-/// The two sides are independent iterations run in the same loop, so that the processor
+/// The `2M` sides are independent iterations run in the same loop, so that the processor
 /// overlaps their dependency chains (the recurrence is latency-bound); each side's arithmetic
 /// is exactly that of iterating it alone (`interleaved_equals_one_side_at_a_time` below).
-fn laguerre_extremes<const K: usize>(
-    d: &[f64; 6],
-    e2: &[f64; 6],
-    starts: [f64; 2],
-    scale: f64,
-) -> [Option<f64>; 2] {
-    let n = K as f64;
-    let tiny = 4.0 * f64::EPSILON * scale.max(f64::MIN_POSITIVE);
-    let mut x = starts;
+fn laguerre_extremes<const M: usize>(tris: [&Tridiagonal; M]) -> [[Option<f64>; 2]; M] {
+    let mut x: [[f64; 2]; M] = std::array::from_fn(|m| tris[m].starts);
     // Per side: `None` while iterating, `Some(result)` once settled.
-    let mut out: [Option<Option<f64>>; 2] = [None, None];
+    let mut out = [[None::<Option<f64>>; 2]; M];
     for _ in 0..40 {
         // p_j(x) = (d_j − x) p_{j−1} − e²_{j−1} p_{j−2}, and its first two derivatives.
-        let (mut p0, mut p1) = ([1.0; 2], [d[0] - x[0], d[0] - x[1]]);
-        let (mut dp0, mut dp1) = ([0.0; 2], [-1.0; 2]);
-        let (mut ddp0, mut ddp1) = ([0.0; 2], [0.0; 2]);
-        for j in 1..K {
-            let b = e2[j - 1];
+        let mut p0 = [[1.0; 2]; M];
+        let mut p1: [[f64; 2]; M] =
+            std::array::from_fn(|m| [tris[m].d[0] - x[m][0], tris[m].d[0] - x[m][1]]);
+        let (mut dp0, mut dp1) = ([[0.0; 2]; M], [[-1.0; 2]; M]);
+        let (mut ddp0, mut ddp1) = ([[0.0; 2]; M], [[0.0; 2]; M]);
+        for j in 1..6 {
+            for m in 0..M {
+                let t = tris[m];
+                if j >= t.k {
+                    continue;
+                }
+                let b = t.e2[j - 1];
+                for s in 0..2 {
+                    let a = t.d[j] - x[m][s];
+                    let p2 = a * p1[m][s] - b * p0[m][s];
+                    let dp2 = a * dp1[m][s] - b * dp0[m][s] - p1[m][s];
+                    let ddp2 = a * ddp1[m][s] - b * ddp0[m][s] - 2.0 * dp1[m][s];
+                    (p0[m][s], p1[m][s]) = (p1[m][s], p2);
+                    (dp0[m][s], dp1[m][s]) = (dp1[m][s], dp2);
+                    (ddp0[m][s], ddp1[m][s]) = (ddp1[m][s], ddp2);
+                }
+            }
+        }
+        for m in 0..M {
+            let n = tris[m].k as f64;
+            let tiny = 4.0 * f64::EPSILON * tris[m].scale.max(f64::MIN_POSITIVE);
             for s in 0..2 {
-                let a = d[j] - x[s];
-                let p2 = a * p1[s] - b * p0[s];
-                let dp2 = a * dp1[s] - b * dp0[s] - p1[s];
-                let ddp2 = a * ddp1[s] - b * ddp0[s] - 2.0 * dp1[s];
-                (p0[s], p1[s]) = (p1[s], p2);
-                (dp0[s], dp1[s]) = (dp1[s], dp2);
-                (ddp0[s], ddp1[s]) = (ddp1[s], ddp2);
+                if out[m][s].is_none() {
+                    let pd = [p1[m][s], dp1[m][s], ddp1[m][s]];
+                    out[m][s] = laguerre_update(&mut x[m][s], pd, n, s == 0, tiny);
+                }
             }
         }
-        for s in 0..2 {
-            if out[s].is_none() {
-                out[s] = laguerre_update(&mut x[s], [p1[s], dp1[s], ddp1[s]], n, s == 0, tiny);
-            }
-        }
-        if out[0].is_some() && out[1].is_some() {
+        if out.iter().all(|o| o[0].is_some() && o[1].is_some()) {
             break;
         }
     }
-    [out[0].flatten(), out[1].flatten()]
+    std::array::from_fn(|m| [out[m][0].flatten(), out[m][1].flatten()])
 }
 
 /// One Laguerre step of [`laguerre_extremes`] at `x` from `[p, p', p'']`: `None` to go on
@@ -310,9 +358,14 @@ fn householder_k<const K: usize>(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mu
         for i in lo..K {
             p[i] -= half * v[i];
         }
+        // The block stays exactly symmetric (the Gram matrices are built so, and entry (l, i)
+        // gets the same two products summed the other way round, which rounds the same):
+        // update one triangle and mirror it.
         for i in lo..K {
-            for l in lo..K {
-                a[i][l] -= v[i] * p[l] + p[i] * v[l];
+            for l in i..K {
+                let x = a[i][l] - (v[i] * p[l] + p[i] * v[l]);
+                a[i][l] = x;
+                a[l][i] = x;
             }
         }
         e[j] = alpha;
@@ -477,24 +530,38 @@ mod tests {
                 }
             });
             let (lo, hi) = (-3.0, 8.0);
-            let both = laguerre_extremes::<6>(&d, &e2, [lo, hi], 10.0);
-            assert_eq!(
-                both[0].map(f64::to_bits),
-                one_side::<6>(&d, &e2, lo, true).map(f64::to_bits)
-            );
-            assert_eq!(
-                both[1].map(f64::to_bits),
-                one_side::<6>(&d, &e2, hi, false).map(f64::to_bits)
-            );
-            let both = laguerre_extremes::<5>(&d, &e2, [lo, hi], 10.0);
-            assert_eq!(
-                both[0].map(f64::to_bits),
-                one_side::<5>(&d, &e2, lo, true).map(f64::to_bits)
-            );
-            assert_eq!(
-                both[1].map(f64::to_bits),
-                one_side::<5>(&d, &e2, hi, false).map(f64::to_bits)
-            );
+            let tri = |k| Tridiagonal {
+                k,
+                d,
+                e: [0.0; 6],
+                e2,
+                starts: [lo, hi],
+                scale: 10.0,
+            };
+            let (t6, t5, t3) = (tri(6), tri(5), tri(3));
+            let alone = |k| match k {
+                6 => [
+                    one_side::<6>(&d, &e2, lo, true),
+                    one_side::<6>(&d, &e2, hi, false),
+                ],
+                5 => [
+                    one_side::<5>(&d, &e2, lo, true),
+                    one_side::<5>(&d, &e2, hi, false),
+                ],
+                _ => [
+                    one_side::<3>(&d, &e2, lo, true),
+                    one_side::<3>(&d, &e2, hi, false),
+                ],
+            };
+            let bits = |r: [Option<f64>; 2]| r.map(|x| x.map(f64::to_bits));
+            let [r6] = laguerre_extremes([&t6]);
+            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
+            let [r6, r5] = laguerre_extremes([&t6, &t5]);
+            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
+            assert_eq!(bits(r5), bits(alone(5)), "trial {trial}");
+            let [r3, r6] = laguerre_extremes([&t3, &t6]);
+            assert_eq!(bits(r3), bits(alone(3)), "trial {trial}");
+            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
         }
     }
 }

@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{
-    commanded_extremes_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs, ScaledGram,
-    SingularityError, AXIS_NAMES,
+    commanded_extremes_pair_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs,
+    ScaledGram, SingularityError, AXIS_NAMES,
 };
 use crate::model::Vehicle;
 
@@ -91,7 +91,8 @@ impl<'a> Eval<'a> {
         forward_kinematics(self.v, &s.q, &mut s.ws);
         thruster_matrix(self.v, &s.ws, &mut s.t);
         let g = ScaledGram::new(&s.t, self.l);
-        let full = commanded_extremes_with(&g, &s.t, CommandedDofs::ALL, self.tol);
+        let [full, cmd] =
+            commanded_extremes_pair_with(&g, &s.t, [CommandedDofs::ALL, self.commanded], self.tol);
         let rank = full.rank;
         let flagged = rank < 6 || full.sigma_min < self.threshold;
         let lost_axis = (flagged && full.sigma_min.is_finite()).then(|| {
@@ -99,7 +100,6 @@ impl<'a> Eval<'a> {
             let imax = (0..6).fold(0, |m, i| if d[i].abs() > d[m].abs() { i } else { m });
             AXIS_NAMES[imax]
         });
-        let cmd = commanded_extremes_with(&g, &s.t, self.commanded, self.tol);
         let rank_commanded = cmd.rank;
         SampleMetrics {
             sigma_min: full.sigma_min,
