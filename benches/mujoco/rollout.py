@@ -51,7 +51,7 @@ SERVO_WN, SERVO_ZETA = 5.0, 1.0
 # Joint armature [kg m^2] that makes MuJoCo's position servos behave like ideal ones: with
 # kp = A wn^2 and kv = 2 zeta wn A the joint obeys the filter up to O(M_qq / A) while the
 # base feels the reaction -M_12 q'' of the hybrid dynamics (see README.md).
-ARMATURE = 1e5
+ARMATURE = 1e6
 WATER_VISCOSITY = 0.0009  # dynamic viscosity [Pa s], MuJoCo's Stokes term (negligible here)
 # (name, integrator, dt [s]); every dt divides the 50 ms control period.
 SETTINGS = [
