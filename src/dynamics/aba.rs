@@ -18,6 +18,7 @@ use super::passes::{
     backward_pass, body_forces, composites, forward_pass, inertia_to_parent, needs_orientation,
     orientation_pass,
 };
+use super::structure::{inertia_to_parent_joint, twist_to_child, wrench_to_parent};
 use super::workspace::DynWorkspace;
 use super::{check_finite, DynError, DynOptions};
 use crate::kinematics::{forward_kinematics, BasePose};
@@ -91,7 +92,7 @@ fn velocity_pass(v: &Vehicle, ws: &mut DynWorkspace, zeta: &[f64]) {
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
         let w_j = j.axis * zeta[6 + k];
-        let mut vi = ws.kin.g_up[i].twist_to_child(&ws.twist[i - 1]);
+        let mut vi = twist_to_child(&ws.kin.g_up[i], ws.kin.shape[k], &ws.twist[i - 1]);
         vi[3] += w_j.x;
         vi[4] += w_j.y;
         vi[5] += w_j.z;
@@ -133,9 +134,9 @@ fn aba_backward(
         ws.aba_dinv[i] = dinv;
         ws.aba_force[i] = u;
         let g = ws.kin.g_up[i];
-        let to_parent = inertia_to_parent(&g, &ia_a);
+        let to_parent = inertia_to_parent_joint(&g, ws.kin.shape[k], &ia_a);
         ws.art_inertia[i - 1] += to_parent;
-        let fp = g.wrench_to_parent(&pa);
+        let fp = wrench_to_parent(&g, ws.kin.shape[k], &pa);
         ws.force[i - 1] += fp;
     }
     Ok(())
@@ -162,7 +163,8 @@ fn aba_forward(v: &Vehicle, ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), Dy
     ws.accel[0] = g0.twist_to_child(&vdot);
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
-        let mut a = ws.kin.g_up[i].twist_to_child(&ws.accel[i - 1]) + ws.vp_accel[i];
+        let mut a =
+            twist_to_child(&ws.kin.g_up[i], ws.kin.shape[k], &ws.accel[i - 1]) + ws.vp_accel[i];
         let qdd = (ws.aba_force[i] - ws.aba_u[i].dot(&a)) * ws.aba_dinv[i];
         let dw = j.axis * qdd;
         a[3] += dw.x;

@@ -5,6 +5,9 @@
 //! The public algorithms of [`super::algorithms`] chain them; names and frames as in
 //! [`super::workspace`].
 
+use super::structure::{
+    inertia_to_parent_axial, mul_inertia, mul_inertia_linear, twist_to_child, wrench_to_parent,
+};
 use super::workspace::DynWorkspace;
 use super::DynOptions;
 use crate::kinematics::BasePose;
@@ -85,12 +88,17 @@ pub(super) fn crba(ws: &mut DynWorkspace, added_mass: bool) {
 pub(super) fn composites(ws: &mut DynWorkspace, added_mass: bool) {
     let nb = ws.kin.g_up.len();
     for i in (0..nb).rev() {
-        let inertia = if added_mass {
-            &ws.i_tot[i]
+        let (inertia, axial) = if added_mass {
+            (&ws.i_tot[i], ws.axial[i].total)
         } else {
-            &ws.i_rb[i]
+            (&ws.i_rb[i], ws.axial[i].rigid)
         };
-        let ib = inertia_to_parent(&ws.kin.g_b[i], inertia);
+        let g = &ws.kin.g_b[i];
+        let ib = if axial {
+            inertia_to_parent_axial(g, inertia)
+        } else {
+            inertia_to_parent(g, inertia)
+        };
         ws.composite[i] = if i + 1 < nb {
             ib + ws.composite[i + 1]
         } else {
@@ -125,14 +133,15 @@ pub(super) fn forward_pass(
     };
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
+        let (g, shape) = (&ws.kin.g_up[i], ws.kin.shape[k]);
         let w_j = j.axis * zeta[6 + k];
-        let mut vi = ws.kin.g_up[i].twist_to_child(&ws.twist[i - 1]);
+        let mut vi = twist_to_child(g, shape, &ws.twist[i - 1]);
         vi[3] += w_j.x;
         vi[4] += w_j.y;
         vi[5] += w_j.z;
         let (vl, va) = (lin(&vi), ang(&vi));
-        let mut ai = ws.kin.g_up[i].twist_to_child(&ws.accel[i - 1])
-            + stack(&vl.cross(&w_j), &va.cross(&w_j));
+        let mut ai =
+            twist_to_child(g, shape, &ws.accel[i - 1]) + stack(&vl.cross(&w_j), &va.cross(&w_j));
         if let Some(a) = zeta_dot {
             let dw = j.axis * a[6 + k];
             ai[3] += dw.x;
@@ -190,6 +199,7 @@ pub(super) fn uses_current(v: &Vehicle, opts: &DynOptions) -> bool {
 pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions, with_accel: bool) {
     let current = uses_current(v, opts);
     for i in 0..ws.twist.len() {
+        let axial = ws.axial[i];
         let vi = ws.twist[i];
         let ai = if with_accel {
             ws.accel[i]
@@ -203,32 +213,33 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions,
         };
         let vr = relative_twist(&vi, &vc);
         let mut f;
+        let rigid_vi = || mul_inertia(&ws.i_rb[i], axial.rigid, &vi);
         if opts.added_mass {
             f = if with_accel {
-                ws.i_tot[i] * ai
+                mul_inertia(&ws.i_tot[i], axial.total, &ai)
             } else {
                 Vec6::zeros()
             };
             if !ws.damping[i].kirchhoff() {
                 // Manoeuvring derivatives carry the added mass's velocity forces themselves.
-                f += cross_force(&vi, &(ws.i_rb[i] * vi));
+                f += cross_force(&vi, &rigid_vi());
                 if current {
                     let wv = ang(&vi).cross(&vc);
-                    f += ws.m_a[i].fixed_view::<6, 3>(0, 0) * wv;
+                    f += mul_inertia_linear(&ws.m_a[i], axial.added, &wv);
                 }
             } else if current {
                 let ma = &ws.m_a[i];
-                f += cross_force(&vi, &(ws.i_rb[i] * vi));
-                f += cross_force(&vr, &(ma * vr));
+                f += cross_force(&vi, &rigid_vi());
+                f += cross_force(&vr, &mul_inertia(ma, axial.added, &vr));
                 let wv = ang(&vi).cross(&vc);
-                f += ma.fixed_view::<6, 3>(0, 0) * wv;
+                f += mul_inertia_linear(ma, axial.added, &wv);
             } else {
-                f += cross_force(&vi, &(ws.i_tot[i] * vi));
+                f += cross_force(&vi, &mul_inertia(&ws.i_tot[i], axial.total, &vi));
             }
         } else if with_accel {
-            f = ws.i_rb[i] * ai + cross_force(&vi, &(ws.i_rb[i] * vi));
+            f = mul_inertia(&ws.i_rb[i], axial.rigid, &ai) + cross_force(&vi, &rigid_vi());
         } else {
-            f = cross_force(&vi, &(ws.i_rb[i] * vi));
+            f = cross_force(&vi, &rigid_vi());
         }
         if opts.drag {
             f -= ws.damping[i].wrench(&vr);
@@ -248,7 +259,7 @@ pub(super) fn backward_pass(v: &Vehicle, ws: &mut DynWorkspace, out: &mut [f64])
     for i in (1..ws.force.len()).rev() {
         let f = ws.force[i];
         out[6 + i - 1] = v.joints[i - 1].axis.dot(&ang(&f));
-        let fp = ws.kin.g_up[i].wrench_to_parent(&f);
+        let fp = wrench_to_parent(&ws.kin.g_up[i], ws.kin.shape[i - 1], &f);
         ws.force[i - 1] += fp;
     }
     let fb = ws.kin.g_up[0].wrench_to_parent(&ws.force[0]);
