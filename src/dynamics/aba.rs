@@ -18,7 +18,9 @@ use super::passes::{
     backward_pass, body_forces, composites, forward_pass, inertia_to_parent, needs_orientation,
     orientation_pass,
 };
-use super::structure::{inertia_to_parent_joint, twist_to_child, wrench_to_parent};
+use super::structure::{
+    cholesky6_solve, inertia_to_parent_joint, twist_to_child, wrench_to_parent,
+};
 use super::workspace::DynWorkspace;
 use super::{check_finite, DynError, DynOptions};
 use crate::kinematics::{forward_kinematics, BasePose};
@@ -68,7 +70,7 @@ pub(super) fn aba_after_position(
 ) -> Result<(), DynError> {
     check_finite("generalized_forces", tau)?;
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     velocity_pass(v, ws, zeta);
     body_forces(v, ws, opts, false);
@@ -152,13 +154,12 @@ fn aba_forward(v: &Vehicle, ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), Dy
     let ia_b = Matrix6::from_fn(|r, c| 0.5 * (ia_b[(r, c)] + ia_b[(c, r)]));
     let pb = g0.wrench_to_parent(&ws.force[0]);
     let rhs = Vec6::from_fn(|r, _| tau[r] - pb[r]);
-    let chol = ia_b.cholesky().ok_or_else(|| {
+    let vdot = cholesky6_solve(&ia_b, &rhs).ok_or_else(|| {
         DynError::new(
             "articulated_inertia_base",
             "is singular or not positive definite",
         )
     })?;
-    let vdot = chol.solve(&rhs);
     ws.zeta_dot[..6].copy_from_slice(vdot.as_slice());
     ws.accel[0] = g0.twist_to_child(&vdot);
     for (k, j) in v.joints.iter().enumerate() {
@@ -203,7 +204,7 @@ pub fn hybrid_terms(
         *f = ws.composite[k + 1] * ws.kin.joint_twist_b[k];
     }
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     forward_pass(v, ws, zeta, None);
     body_forces(v, ws, opts, true);
@@ -244,13 +245,12 @@ pub fn solve_hybrid_on(ws: &mut DynWorkspace, q_ext: &[f64], qdd: &[f64]) -> Res
     }
     let m11 = Matrix6::from_fn(|r, c| ws.mass[(r, c)]);
     let rhs = Vec6::from_fn(|r, _| q_ext[r] - ws.bias[r] - w0[r]);
-    let chol = m11.cholesky().ok_or_else(|| {
+    let vdot = cholesky6_solve(&m11, &rhs).ok_or_else(|| {
         DynError::new(
             "mass_matrix_base_block",
             "M_11 is singular or not positive definite",
         )
     })?;
-    let vdot = chol.solve(&rhs);
     ws.zeta_dot[..6].copy_from_slice(vdot.as_slice());
     ws.zeta_dot[6..].copy_from_slice(qdd);
     // v_l + V̇_b by a running sum from the base.

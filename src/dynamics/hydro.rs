@@ -315,7 +315,14 @@ impl Restoring {
     #[inline]
     pub fn wrench(&self, r_ii: &Mat3) -> Vec6 {
         // Inertial up e_z in body coordinates: the third row of R_Ii.
-        let up = Vec3::new(r_ii[(2, 0)], r_ii[(2, 1)], r_ii[(2, 2)]);
+        self.wrench_up(&Vec3::new(r_ii[(2, 0)], r_ii[(2, 1)], r_ii[(2, 2)]))
+    }
+
+    /// [`Self::wrench`] from the inertial vertical `up = R_Iiᵀ e_z` in body coordinates (the
+    /// third row of `R_Ii`) alone.
+    #[inline]
+    pub fn wrench_up(&self, up: &Vec3) -> Vec6 {
+        let up = *up;
         let f_w = up * (-self.weight);
         let f_b = up * self.buoyancy;
         let f = f_w + f_b;

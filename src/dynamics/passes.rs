@@ -17,11 +17,27 @@ use crate::spatial::{ang, cross_force, lin, skew, stack, Mat6, Se3, Vec3, Vec6};
 // ---------------------------------------------------------------------------------------
 // Position stage (after `forward_kinematics` into `ws.kin`).
 
-/// Body orientations in the inertial frame, `R_Ii = R_Ib R_bi`.
-pub(super) fn orientation_pass(ws: &mut DynWorkspace, pose: &BasePose) {
+/// Body orientations in the inertial frame, `R_Ii = R_Ib R_bi`, into `ws.r_ii` when `full`
+/// (the current needs them), and always their last rows, the inertial vertical in body
+/// coordinates, into `ws.up` (all the restoring forces need: 9 products a body instead of 27,
+/// the same bits as the last row of the full product).
+pub(super) fn orientation_pass(ws: &mut DynWorkspace, pose: &BasePose, full: bool) {
     let r_ib = *pose.orientation.to_rotation_matrix().matrix();
-    for (r, g) in ws.r_ii.iter_mut().zip(&ws.kin.g_b) {
-        *r = r_ib * g.r;
+    if full {
+        for ((r, u), g) in ws.r_ii.iter_mut().zip(&mut ws.up).zip(&ws.kin.g_b) {
+            *r = r_ib * g.r;
+            *u = Vec3::new(r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+        }
+    } else {
+        let (a, b, c) = (r_ib[(2, 0)], r_ib[(2, 1)], r_ib[(2, 2)]);
+        for (u, g) in ws.up.iter_mut().zip(&ws.kin.g_b) {
+            let r = &g.r;
+            *u = Vec3::new(
+                a * r[(0, 0)] + b * r[(1, 0)] + c * r[(2, 0)],
+                a * r[(0, 1)] + b * r[(1, 1)] + c * r[(2, 1)],
+                a * r[(0, 2)] + b * r[(1, 2)] + c * r[(2, 2)],
+            );
+        }
     }
 }
 
@@ -245,7 +261,7 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions,
             f -= ws.damping[i].wrench(&vr);
         }
         if opts.restoring {
-            f -= ws.restoring[i].wrench(&ws.r_ii[i]);
+            f -= ws.restoring[i].wrench_up(&ws.up[i]);
         }
         ws.force[i] = f;
     }

@@ -7,6 +7,8 @@
 //!   cylinder, its centre of gravity and added-mass centre on the axis, principal axes along
 //!   the body axes — has at most ten nonzero entries of 36), in the body wrenches and in the
 //!   composite inertias `Ad⁻ᵀ I Ad⁻¹`.
+//! - the 6×6 Cholesky solve of the base block (`M_11` of the hybrid dynamics, the base's
+//!   articulated inertia of the ABA): nalgebra's algorithm on the stack, unrolled.
 //!
 //! Every kernel sums the same nonzero products in the same order as the dense nalgebra
 //! product it replaces (`(A B)_ij = ((A_i0 B_0j + A_i1 B_1j) + A_i2 B_2j)`, a product
@@ -262,6 +264,49 @@ fn inertia_to_parent_joint_axial<const A: usize>(g: &Se3, m: &Mat6) -> Mat6 {
     out
 }
 
+/// `m.cholesky()?.solve(rhs)` of nalgebra for a 6×6 `m` (only its lower triangle read),
+/// unrolled on the stack: the same operations in the same order — the left-looking column
+/// updates `a_ij ← (−l_jk) l_ik + a_ij`, the pivot `√a_jj` accepted when `a_jj ≠ 0` and
+/// `a_jj ≥ 0`, the division of the column below it, forward substitution by columns,
+/// back substitution `x_i = (y_i − Σ_{k>i} l_ki x_k) / l_ii` with the sum from `+0` in
+/// increasing `k` — so the same bits (tested); `None` where nalgebra's factorisation fails.
+pub(crate) fn cholesky6_solve(m: &Mat6, rhs: &Vec6) -> Option<Vec6> {
+    let mut a = *m;
+    for j in 0..6 {
+        for k in 0..j {
+            let factor = -a[(j, k)];
+            for i in j..6 {
+                a[(i, j)] = factor * a[(i, k)] + a[(i, j)];
+            }
+        }
+        let diag = a[(j, j)];
+        if diag == 0.0 || !(diag >= 0.0) {
+            return None;
+        }
+        let d = diag.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..6 {
+            a[(i, j)] /= d;
+        }
+    }
+    let mut b = *rhs;
+    for i in 0..6 {
+        let coeff = b[i] / a[(i, i)];
+        b[i] = coeff;
+        for r in i + 1..6 {
+            b[r] = -coeff * a[(r, i)] + b[r];
+        }
+    }
+    for i in (0..6).rev() {
+        let mut dot = 0.0;
+        for k in i + 1..6 {
+            dot += a[(k, i)] * b[k];
+        }
+        b[i] = (b[i] - dot) / a[(i, i)];
+    }
+    Some(b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::passes::inertia_to_parent;
@@ -374,6 +419,33 @@ mod tests {
                 inertia_to_parent_joint(&g, shape, &full).as_slice(),
                 inertia_to_parent(&g, &full).as_slice(),
             );
+        }
+    }
+
+    #[test]
+    fn cholesky6_is_nalgebras_bit_for_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(43);
+        for t in 0..2000 {
+            let b = Mat6::from_fn(|_, _| rng.random_range(-2.0..2.0));
+            // SPD, ill-conditioned, indefinite and singular matrices.
+            let m = match t % 4 {
+                0 => b * b.transpose() + Mat6::identity(),
+                1 => b * b.transpose() + Mat6::identity() * 1e-9,
+                2 => b + b.transpose(),
+                _ => {
+                    let mut m = b * b.transpose();
+                    m.fixed_view_mut::<1, 6>(5, 0).fill(0.0);
+                    m.fixed_view_mut::<6, 1>(0, 5).fill(0.0);
+                    m
+                }
+            };
+            let rhs = Vec6::from_fn(|_, _| rng.random_range(-10.0..10.0));
+            let dense = m.cholesky().map(|c| c.solve(&rhs));
+            match (cholesky6_solve(&m, &rhs), dense) {
+                (Some(x), Some(y)) => same("cholesky solve", x.as_slice(), y.as_slice()),
+                (None, None) => {}
+                (x, y) => panic!("case {t}: {x:?} vs {y:?}"),
+            }
         }
     }
 }

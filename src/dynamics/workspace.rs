@@ -11,7 +11,7 @@ use super::hydro::{DampingKernel, Restoring};
 use super::structure::is_axial;
 use crate::kinematics::KinWorkspace;
 use crate::model::Vehicle;
-use crate::spatial::{Mat3, Mat6, Vec6};
+use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 use faer::Mat;
 use nalgebra::{Matrix6, Vector6};
 
@@ -28,8 +28,11 @@ pub struct DynWorkspace {
     /// parent's frame), `g_b`, joint twists in `F_b`, `g_be`.
     pub kin: KinWorkspace,
     /// Body orientations in the inertial frame `R_Ii = R_Ib R_bi` (refreshed only by calls
-    /// that take a base pose and need it: restoring forces or current).
+    /// that take a base pose and use the current; the restoring forces need only the last
+    /// rows, which every call with restoring forces refreshes in `up`).
     pub r_ii: Vec<Mat3>,
+    /// The inertial vertical `e_z` in each body's frame, the last row of `R_Ii`.
+    pub(super) up: Vec<Vec3>,
     /// Rigid-body spatial inertia `I_RB,i` about body `i`'s origin, in its frame.
     pub i_rb: Vec<Mat6>,
     /// Added-mass spatial inertia `M_A,i` about body `i`'s origin, in its frame.
@@ -104,6 +107,7 @@ impl DynWorkspace {
         Self {
             kin: KinWorkspace::new(v),
             r_ii: vec![Mat3::identity(); nb],
+            up: vec![Vec3::z(); nb],
             i_rb,
             m_a,
             i_tot,
