@@ -19,13 +19,14 @@ use super::passes::{
     orientation_pass,
 };
 use super::structure::{
-    cholesky6_solve, inertia_to_parent_joint, twist_to_child, wrench_to_parent,
+    add_joint_accel, add_joint_rate, cholesky6_solve, inertia_times_joint, inertia_to_parent_joint,
+    joint_component, twist_to_child, wrench_to_parent,
 };
 use super::workspace::DynWorkspace;
 use super::{check_finite, DynError, DynOptions};
 use crate::kinematics::{forward_kinematics, BasePose};
 use crate::model::Vehicle;
-use crate::spatial::{ang, lin, stack, Mat6, Vec6};
+use crate::spatial::{Mat6, Vec6};
 use nalgebra::Matrix6;
 
 /// Forward dynamics by the articulated-body algorithm, O(n): `ζ̇ = M⁻¹(τ − h)` into
@@ -93,12 +94,9 @@ fn velocity_pass(v: &Vehicle, ws: &mut DynWorkspace, zeta: &[f64]) {
     ws.vp_accel[0] = Vec6::zeros();
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
-        let w_j = j.axis * zeta[6 + k];
-        let mut vi = twist_to_child(&ws.kin.g_up[i], ws.kin.shape[k], &ws.twist[i - 1]);
-        vi[3] += w_j.x;
-        vi[4] += w_j.y;
-        vi[5] += w_j.z;
-        ws.vp_accel[i] = stack(&lin(&vi).cross(&w_j), &ang(&vi).cross(&w_j));
+        let shape = ws.kin.shape[k];
+        let mut vi = twist_to_child(&ws.kin.g_up[i], shape, &ws.twist[i - 1]);
+        ws.vp_accel[i] = add_joint_rate(shape, &j.axis, &mut vi, zeta[6 + k]);
         ws.twist[i] = vi;
     }
 }
@@ -116,10 +114,10 @@ fn aba_backward(
     ws.art_inertia.copy_from_slice(inertia);
     for i in (1..nb).rev() {
         let k = i - 1;
-        let axis = v.joints[k].axis;
+        let (axis, shape) = (v.joints[k].axis, ws.kin.shape[k]);
         let ia = &ws.art_inertia[i];
-        let u_vec: Vec6 = ia.fixed_view::<6, 3>(0, 3) * axis;
-        let d = axis.dot(&ang(&u_vec));
+        let u_vec = inertia_times_joint(shape, &axis, ia);
+        let d = joint_component(shape, &axis, &u_vec);
         if !(d > 0.0 && d.is_finite()) {
             return Err(DynError::new(
                 format!("articulated_inertia[{i}]"),
@@ -128,7 +126,7 @@ fn aba_backward(
         }
         let dinv = 1.0 / d;
         let p = ws.force[i];
-        let u = tau[6 + k] - axis.dot(&ang(&p));
+        let u = tau[6 + k] - joint_component(shape, &axis, &p);
         // I^a = I^A − U Uᵀ / D;  p^a = p^A + I^a c + U u / D.
         let ia_a: Mat6 = ia - u_vec * (u_vec.transpose() * dinv);
         let pa = p + ia_a * ws.vp_accel[i] + u_vec * (u * dinv);
@@ -136,9 +134,9 @@ fn aba_backward(
         ws.aba_dinv[i] = dinv;
         ws.aba_force[i] = u;
         let g = ws.kin.g_up[i];
-        let to_parent = inertia_to_parent_joint(&g, ws.kin.shape[k], &ia_a);
+        let to_parent = inertia_to_parent_joint(&g, shape, &ia_a);
         ws.art_inertia[i - 1] += to_parent;
-        let fp = wrench_to_parent(&g, ws.kin.shape[k], &pa);
+        let fp = wrench_to_parent(&g, shape, &pa);
         ws.force[i - 1] += fp;
     }
     Ok(())
@@ -167,10 +165,7 @@ fn aba_forward(v: &Vehicle, ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), Dy
         let mut a =
             twist_to_child(&ws.kin.g_up[i], ws.kin.shape[k], &ws.accel[i - 1]) + ws.vp_accel[i];
         let qdd = (ws.aba_force[i] - ws.aba_u[i].dot(&a)) * ws.aba_dinv[i];
-        let dw = j.axis * qdd;
-        a[3] += dw.x;
-        a[4] += dw.y;
-        a[5] += dw.z;
+        add_joint_accel(ws.kin.shape[k], &j.axis, &mut a, qdd);
         ws.accel[i] = a;
         ws.zeta_dot[6 + k] = qdd;
     }

@@ -6,13 +6,14 @@
 //! [`super::workspace`].
 
 use super::structure::{
-    inertia_to_parent_axial, mul_inertia, mul_inertia_linear, twist_to_child, wrench_to_parent,
+    add_joint_accel, add_joint_rate, inertia_to_parent_axial, joint_component, mul_inertia,
+    mul_inertia_linear, twist_to_child, wrench_to_parent,
 };
 use super::workspace::DynWorkspace;
 use super::DynOptions;
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
-use crate::spatial::{ang, cross_force, lin, skew, stack, Mat6, Se3, Vec3, Vec6};
+use crate::spatial::{ang, cross_force, skew, Mat6, Se3, Vec3, Vec6};
 
 // ---------------------------------------------------------------------------------------
 // Position stage (after `forward_kinematics` into `ws.kin`).
@@ -150,19 +151,11 @@ pub(super) fn forward_pass(
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
         let (g, shape) = (&ws.kin.g_up[i], ws.kin.shape[k]);
-        let w_j = j.axis * zeta[6 + k];
         let mut vi = twist_to_child(g, shape, &ws.twist[i - 1]);
-        vi[3] += w_j.x;
-        vi[4] += w_j.y;
-        vi[5] += w_j.z;
-        let (vl, va) = (lin(&vi), ang(&vi));
-        let mut ai =
-            twist_to_child(g, shape, &ws.accel[i - 1]) + stack(&vl.cross(&w_j), &va.cross(&w_j));
+        let vp = add_joint_rate(shape, &j.axis, &mut vi, zeta[6 + k]);
+        let mut ai = twist_to_child(g, shape, &ws.accel[i - 1]) + vp;
         if let Some(a) = zeta_dot {
-            let dw = j.axis * a[6 + k];
-            ai[3] += dw.x;
-            ai[4] += dw.y;
-            ai[5] += dw.z;
+            add_joint_accel(shape, &j.axis, &mut ai, a[6 + k]);
         }
         ws.twist[i] = vi;
         ws.accel[i] = ai;
@@ -274,7 +267,7 @@ pub(super) fn backward_pass(v: &Vehicle, ws: &mut DynWorkspace, out: &mut [f64])
     assert_eq!(out.len(), v.n_dof(), "generalised force length");
     for i in (1..ws.force.len()).rev() {
         let f = ws.force[i];
-        out[6 + i - 1] = v.joints[i - 1].axis.dot(&ang(&f));
+        out[6 + i - 1] = joint_component(ws.kin.shape[i - 1], &v.joints[i - 1].axis, &f);
         let fp = wrench_to_parent(&ws.kin.g_up[i], ws.kin.shape[i - 1], &f);
         ws.force[i - 1] += fp;
     }

@@ -110,6 +110,74 @@ pub(crate) fn twist_to_child(g: &Se3, shape: JointShape, v: &Vec6) -> Vec6 {
     }
 }
 
+/// The joint's rate terms of the forward passes: adds `ω_j = axis q̇` to the angular part of
+/// the body twist `v` and returns `v × [0; ω_j] = [v_lin × ω_j; v_ang × ω_j]` of the updated
+/// twist. For an axial joint `ω_j = q̇ e_a`: one entry added, and each cross product
+/// `u × q̇ e_a` is `(u_c q̇, −u_b q̇)` at `(b, c)` and zero at `a`.
+#[inline]
+pub(crate) fn add_joint_rate(shape: JointShape, axis: &Vec3, v: &mut Vec6, qd: f64) -> Vec6 {
+    match shape {
+        JointShape::Axial(0) => add_joint_rate_axial::<0>(v, qd),
+        JointShape::Axial(1) => add_joint_rate_axial::<1>(v, qd),
+        JointShape::Axial(2) => add_joint_rate_axial::<2>(v, qd),
+        _ => {
+            let w = axis * qd;
+            v[3] += w.x;
+            v[4] += w.y;
+            v[5] += w.z;
+            stack(&lin(v).cross(&w), &ang(v).cross(&w))
+        }
+    }
+}
+
+/// [`add_joint_rate`] for an axial joint about `e_A`.
+#[inline(always)]
+fn add_joint_rate_axial<const A: usize>(v: &mut Vec6, qd: f64) -> Vec6 {
+    let (b, c) = cyclic(A);
+    v[3 + A] += qd;
+    let mut out = [0.0; 6];
+    out[b] = v[c] * qd;
+    out[c] = 0.0 - v[b] * qd;
+    out[3 + b] = v[3 + c] * qd;
+    out[3 + c] = 0.0 - v[3 + b] * qd;
+    Vec6::from(out)
+}
+
+/// Adds `axis q̈` to the angular part of the body acceleration `a` (one entry for an axial
+/// joint).
+#[inline]
+pub(crate) fn add_joint_accel(shape: JointShape, axis: &Vec3, a: &mut Vec6, qdd: f64) {
+    match shape {
+        JointShape::Axial(k) => a[3 + k] += qdd,
+        JointShape::General => {
+            let dw = axis * qdd;
+            a[3] += dw.x;
+            a[4] += dw.y;
+            a[5] += dw.z;
+        }
+    }
+}
+
+/// `axis · ang(f)`, the joint's component of a wrench (or of `I s`): `f[3 + a]` for an axial
+/// joint.
+#[inline]
+pub(crate) fn joint_component(shape: JointShape, axis: &Vec3, f: &Vec6) -> f64 {
+    match shape {
+        JointShape::Axial(a) => f[3 + a],
+        JointShape::General => axis.dot(&ang(f)),
+    }
+}
+
+/// `I s` for the joint's unit twist `s = [0; axis]`: column `3 + a` of `I` for an axial
+/// joint.
+#[inline]
+pub(crate) fn inertia_times_joint(shape: JointShape, axis: &Vec3, m: &Mat6) -> Vec6 {
+    match shape {
+        JointShape::Axial(a) => m.column(3 + a).into_owned(),
+        JointShape::General => m.fixed_view::<6, 3>(0, 3) * axis,
+    }
+}
+
 /// [`wrench_to_parent`] for an axial joint about `e_A`.
 #[inline(always)]
 fn wrench_to_parent_axial<const A: usize>(g: &Se3, f: &Vec6) -> Vec6 {
