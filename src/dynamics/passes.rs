@@ -5,6 +5,7 @@
 //! The public algorithms of [`super::algorithms`] chain them; names and frames as in
 //! [`super::workspace`].
 
+pub(super) use super::structure::inertia_to_parent;
 use super::structure::{
     add_joint_accel, add_joint_rate, inertia_to_parent_axial, joint_component, mul_inertia,
     mul_inertia_linear, twist_to_child, wrench_to_parent,
@@ -13,7 +14,7 @@ use super::workspace::DynWorkspace;
 use super::DynOptions;
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
-use crate::spatial::{ang, cross_force, skew, Mat6, Se3, Vec3, Vec6};
+use crate::spatial::{ang, cross_force, Vec3, Vec6};
 
 // ---------------------------------------------------------------------------------------
 // Position stage (after `forward_kinematics` into `ws.kin`).
@@ -40,30 +41,6 @@ pub(super) fn orientation_pass(ws: &mut DynWorkspace, pose: &BasePose, full: boo
             );
         }
     }
-}
-
-/// `Ad_g⁻ᵀ I Ad_g⁻¹`: a spatial inertia about the child origin in the child frame, moved to
-/// the parent frame, for `g = (R, p)` — by 3×3 blocks (about 60 % of the cost of two 6×6
-/// products). With `I = [[A, B], [Bᵀ, C]]` and `A' = RARᵀ`, `B' = RBRᵀ`, `C' = RCRᵀ`:
-/// `[[A', B' − A'p̂], [·ᵀ, C' + p̂B' − B'ᵀp̂ − p̂A'p̂]]`.
-#[inline]
-pub(super) fn inertia_to_parent(g: &Se3, i: &Mat6) -> Mat6 {
-    let r = &g.r;
-    let rt = r.transpose();
-    let a = r * i.fixed_view::<3, 3>(0, 0) * rt;
-    let b = r * i.fixed_view::<3, 3>(0, 3) * rt;
-    let c = r * i.fixed_view::<3, 3>(3, 3) * rt;
-    let ph = skew(&g.p);
-    let aph = a * ph;
-    let ur = b - aph;
-    let pb = ph * b;
-    let lr = c + pb + pb.transpose() - ph * aph;
-    let mut out = Mat6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&ur);
-    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&ur.transpose());
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&lr);
-    out
 }
 
 /// Composite-rigid-body algorithm on the floating base, after the position pass

@@ -226,7 +226,31 @@ fn skew_mul(ph: &Mat3, y: &Mat3) -> Mat3 {
     })
 }
 
-/// `Ad_g⁻ᵀ I Ad_g⁻¹` (the 3×3 block form of `passes::inertia_to_parent`) for an axial `I`
+/// `Ad_g⁻ᵀ I Ad_g⁻¹`: a spatial inertia about the child origin in the child frame, moved to
+/// the parent frame, for `g = (R, p)` — by 3×3 blocks (about 60 % of the cost of two 6×6
+/// products). With `I = [[A, B], [Bᵀ, C]]` and `A' = RARᵀ`, `B' = RBRᵀ`, `C' = RCRᵀ`:
+/// `[[A', B' − A'p̂], [·ᵀ, C' + p̂B' − B'ᵀp̂ − p̂A'p̂]]`.
+#[inline]
+pub(crate) fn inertia_to_parent(g: &Se3, i: &Mat6) -> Mat6 {
+    let r = &g.r;
+    let rt = r.transpose();
+    let a = r * i.fixed_view::<3, 3>(0, 0) * rt;
+    let b = r * i.fixed_view::<3, 3>(0, 3) * rt;
+    let c = r * i.fixed_view::<3, 3>(3, 3) * rt;
+    let ph = skew(&g.p);
+    let aph = a * ph;
+    let ur = b - aph;
+    let pb = ph * b;
+    let lr = c + pb + pb.transpose() - ph * aph;
+    let mut out = Mat6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&ur);
+    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&ur.transpose());
+    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&lr);
+    out
+}
+
+/// `Ad_g⁻ᵀ I Ad_g⁻¹` (the 3×3 block form of [`inertia_to_parent`]) for an axial `I`
 /// ([`is_axial`]) and any `g`: the blocks `A = diag`, `B` with `B_12`, `B_21` only and
 /// `C = diag` enter `R A Rᵀ`, `R B Rᵀ`, `R C Rᵀ` without their zero products, and the
 /// products with `p̂` skip its zero diagonal.
@@ -280,7 +304,7 @@ fn congruence_axial_rotation<const A: usize>(r: &Mat3, x: &Mat3) -> Mat3 {
     out
 }
 
-/// `Ad_g⁻ᵀ I Ad_g⁻¹` (`passes::inertia_to_parent`) for joint `g` of shape `shape` and any
+/// `Ad_g⁻ᵀ I Ad_g⁻¹` ([`inertia_to_parent`]) for joint `g` of shape `shape` and any
 /// `I` (the articulated inertias): for an axial joint `R = Rot(e_a, q)` and `p̂` of
 /// `p = (x, 0, 0)` has two entries, `p̂_12 = −x`, `p̂_21 = x`.
 pub(crate) fn inertia_to_parent_joint(g: &Se3, shape: JointShape, m: &Mat6) -> Mat6 {
@@ -288,7 +312,7 @@ pub(crate) fn inertia_to_parent_joint(g: &Se3, shape: JointShape, m: &Mat6) -> M
         JointShape::Axial(0) => inertia_to_parent_joint_axial::<0>(g, m),
         JointShape::Axial(1) => inertia_to_parent_joint_axial::<1>(g, m),
         JointShape::Axial(2) => inertia_to_parent_joint_axial::<2>(g, m),
-        _ => super::passes::inertia_to_parent(g, m),
+        _ => inertia_to_parent(g, m),
     }
 }
 
@@ -344,11 +368,12 @@ pub(crate) fn cholesky6_solve(m: &Mat6, rhs: &Vec6) -> Option<Vec6> {
         for k in 0..j {
             let factor = -a[(j, k)];
             for i in j..6 {
-                a[(i, j)] = factor * a[(i, k)] + a[(i, j)];
+                a[(i, j)] += factor * a[(i, k)];
             }
         }
         let diag = a[(j, j)];
-        if diag == 0.0 || !(diag >= 0.0) {
+        // nalgebra accepts `diag ≠ 0` with `diag ≥ 0`, i.e. `diag > 0` (NaN fails).
+        if diag.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let d = diag.sqrt();
@@ -362,7 +387,7 @@ pub(crate) fn cholesky6_solve(m: &Mat6, rhs: &Vec6) -> Option<Vec6> {
         let coeff = b[i] / a[(i, i)];
         b[i] = coeff;
         for r in i + 1..6 {
-            b[r] = -coeff * a[(r, i)] + b[r];
+            b[r] += -coeff * a[(r, i)];
         }
     }
     for i in (0..6).rev() {
@@ -377,7 +402,6 @@ pub(crate) fn cholesky6_solve(m: &Mat6, rhs: &Vec6) -> Option<Vec6> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::passes::inertia_to_parent;
     use super::*;
     use crate::model::presets::{usm_paper, uvms_planar};
     use crate::model::Vehicle;
