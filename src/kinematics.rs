@@ -5,8 +5,8 @@
 //! allocates once the workspace exists. Names say the frame: `g_b[i]` is body `i` in the base
 //! frame `F_b`, `g_be` the end-effector in `F_b`.
 
-use crate::model::Vehicle;
-use crate::spatial::{rot_axis_angle, stack, Se3, Vec3, Vec6};
+use crate::model::{Joint, Vehicle};
+use crate::spatial::{rot_axis_angle, stack, Mat3, Se3, Vec3, Vec6};
 use faer::Mat;
 use nalgebra::{Matrix6xX, UnitQuaternion};
 
@@ -38,9 +38,101 @@ impl BasePose {
     }
 }
 
+/// The structure of joint `k`'s transform `g_(k)(k+1)(q) = placement · Rot(axis, q)` that the
+/// position pass and the dynamics passes exploit (issue 23).
+///
+/// When the placement is a pure translation along the parent's x axis and the axis is a
+/// coordinate axis `e_a` (every preset and generated design), `g = (Rot(e_a, q), (x, 0, 0))`:
+/// the rotation has a unit entry and four exact zeros, the translation two exact zeros.
+/// Products with it skip the multiplications by those zeros and ones. They sum the same
+/// nonzero terms in the same order as the dense products, so every result is the dense
+/// result bit for bit (a skipped `±0` can only change the sign of a result that is zero).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointShape {
+    /// Any other placement or axis: the dense products.
+    General,
+    /// Placement `(I, (x, 0, 0))`, axis `e_a` with `a` = 0, 1, 2 for x, y, z.
+    Axial(usize),
+}
+
+impl JointShape {
+    /// The shape of `joint` (exact comparisons: only exact zeros and ones are skipped).
+    pub fn of(joint: &Joint) -> Self {
+        let pl = &joint.placement;
+        if pl.r != Mat3::identity() || pl.p.y != 0.0 || pl.p.z != 0.0 {
+            return JointShape::General;
+        }
+        (0..3)
+            .find(|&a| joint.axis == Vec3::ith(a, 1.0))
+            .map_or(JointShape::General, JointShape::Axial)
+    }
+}
+
+/// The two axes after `a` in cyclic order: `Rot(e_a, θ)` has `cos θ` at `(b, b)` and `(c, c)`,
+/// `−sin θ` at `(b, c)` and `sin θ` at `(c, b)`.
+#[inline(always)]
+pub(crate) const fn cyclic(a: usize) -> (usize, usize) {
+    ((a + 1) % 3, (a + 2) % 3)
+}
+
+/// `Rot(e_a, angle)` with exactly the bits of [`rot_axis_angle`]`(e_a, angle)` for a finite
+/// `angle`: Rodrigues' `I + k̂ s + k̂²(1 − c)` with `k̂ = ê_a` gives `1` at `(a, a)`,
+/// `1 − (1 − c)` on the other two diagonal entries, `0 ∓ s` off them and `+0` elsewhere.
+#[inline(always)]
+fn axial_rotation<const A: usize>(angle: f64) -> Mat3 {
+    let (s, c) = angle.sin_cos();
+    let d = 1.0 - (1.0 - c);
+    let (b, c_) = cyclic(A);
+    let mut r = Mat3::identity();
+    r[(b, b)] = d;
+    r[(c_, c_)] = d;
+    r[(b, c_)] = 0.0 - s;
+    r[(c_, b)] = 0.0 + s;
+    r
+}
+
+/// `g_b ∘ g` for `g = (Rot(e_a, q), (x, 0, 0))` of an [`JointShape::Axial`] joint: column `a`
+/// of the rotation is `g_b`'s, the other two mix two columns; `p = R_b (x, 0, 0) + p_b`.
+#[inline(always)]
+fn compose_axial<const A: usize>(gb: &Se3, g: &Se3) -> Se3 {
+    let (a, (b, c)) = (A, cyclic(A));
+    let (rb, r) = (&gb.r, &g.r);
+    let mut out = Mat3::zeros();
+    for i in 0..3 {
+        out[(i, a)] = rb[(i, a)];
+        out[(i, b)] = rb[(i, b)] * r[(b, b)] + rb[(i, c)] * r[(c, b)];
+        out[(i, c)] = rb[(i, b)] * r[(b, c)] + rb[(i, c)] * r[(c, c)];
+    }
+    let x = g.p.x;
+    let p = Vec3::new(
+        rb[(0, 0)] * x + gb.p.x,
+        rb[(1, 0)] * x + gb.p.y,
+        rb[(2, 0)] * x + gb.p.z,
+    );
+    Se3::new(out, p)
+}
+
+/// The position pass of joint `k`, an axial joint about `e_A` at angle `q` (finite): `g_up`,
+/// `g_b` and the joint twist in `F_b`, `[p × R e_A; R e_A]` of `g_b = (R, p)`.
+#[inline(always)]
+fn axial_joint<const A: usize>(j: &Joint, q: f64, k: usize, ws: &mut KinWorkspace) {
+    let g = Se3::new(
+        axial_rotation::<A>(q),
+        Vec3::new(0.0 + j.placement.p.x, 0.0, 0.0),
+    );
+    ws.g_up[k + 1] = g;
+    let gb = compose_axial::<A>(&ws.g_b[k], &g);
+    let w = Vec3::new(gb.r[(0, A)], gb.r[(1, A)], gb.r[(2, A)]);
+    ws.joint_twist_b[k] = stack(&gb.p.cross(&w), &w);
+    ws.g_b[k + 1] = gb;
+}
+
 /// Configuration-dependent kinematic quantities, refreshed by [`forward_kinematics`]
 /// (Pinocchio's `Data` placements: one forward pass fills them, every later algorithm —
 /// Jacobians, `T(q)`, the dynamics passes — reuses them).
+///
+/// A workspace belongs to the vehicle it was built for: the joints' [`JointShape`]s are
+/// resolved then.
 #[derive(Clone, Debug)]
 pub struct KinWorkspace {
     /// Body `i` frame in its parent body's frame, `g_(i-1)i(q) = placement · Rot(axis, q)`
@@ -52,6 +144,8 @@ pub struct KinWorkspace {
     pub g_be: Se3,
     /// Unit twist of joint `k` expressed in the base frame, `Ad_{g_b,k+1} [0; axis_k]`.
     pub joint_twist_b: Vec<Vec6>,
+    /// The structure of each joint's transform `g_up[k + 1]` (resolved from the vehicle).
+    pub(crate) shape: Vec<JointShape>,
 }
 
 impl KinWorkspace {
@@ -62,10 +156,19 @@ impl KinWorkspace {
             g_b: vec![Se3::identity(); v.bodies.len()],
             g_be: Se3::identity(),
             joint_twist_b: vec![Vec6::zeros(); v.joints.len()],
+            shape: v.joints.iter().map(JointShape::of).collect(),
         };
         let q = vec![0.0; v.joints.len()];
         forward_kinematics(v, &q, &mut ws);
         ws
+    }
+
+    /// The same workspace with every joint treated as [`JointShape::General`] (the dense
+    /// products; for tests of the structured ones).
+    #[cfg(test)]
+    pub(crate) fn dense(mut self) -> Self {
+        self.shape.fill(JointShape::General);
+        self
     }
 }
 
@@ -74,23 +177,36 @@ impl KinWorkspace {
 /// `g_(k)(k+1)(q) = placement_k · Rot(axis_k, q)` into `ws.g_up`, their products
 /// `g_bi = g_b(i-1) g_(i-1)i` (so `g_bi = g_b0 g_01(q_1) ⋯ g_(i-1)i(q_i)`) into `ws.g_b`, the
 /// joint unit twists in the base frame `F_b` and the end-effector `g_be`. `q` in radians, one
-/// per joint.
+/// per joint. Axial joints ([`JointShape`]) skip the products with exact zeros and ones.
 ///
 /// # Panics
 /// If `q.len()` differs from the joint count (a programming error; inputs from users are
 /// checked where they are parsed).
 pub fn forward_kinematics(v: &Vehicle, q: &[f64], ws: &mut KinWorkspace) {
     assert_eq!(q.len(), v.joints.len(), "joint vector length");
+    assert_eq!(
+        ws.shape.len(),
+        v.joints.len(),
+        "workspace of another vehicle"
+    );
     let g0 = v.base.inverse();
     ws.g_up[0] = g0;
     ws.g_b[0] = g0;
     for (k, j) in v.joints.iter().enumerate() {
-        let rot = Se3::new(rot_axis_angle(&j.axis, q[k]), Vec3::zeros());
-        let g = j.placement.compose(&rot);
-        ws.g_up[k + 1] = g;
-        let gb = ws.g_b[k].compose(&g);
-        ws.joint_twist_b[k] = gb.twist_to_parent(&stack(&Vec3::zeros(), &j.axis));
-        ws.g_b[k + 1] = gb;
+        match ws.shape[k] {
+            // A non-finite angle takes the dense route, whose NaNs fill the whole rotation.
+            JointShape::Axial(0) if q[k].is_finite() => axial_joint::<0>(j, q[k], k, ws),
+            JointShape::Axial(1) if q[k].is_finite() => axial_joint::<1>(j, q[k], k, ws),
+            JointShape::Axial(2) if q[k].is_finite() => axial_joint::<2>(j, q[k], k, ws),
+            _ => {
+                let rot = Se3::new(rot_axis_angle(&j.axis, q[k]), Vec3::zeros());
+                let g = j.placement.compose(&rot);
+                ws.g_up[k + 1] = g;
+                let gb = ws.g_b[k].compose(&g);
+                ws.joint_twist_b[k] = gb.twist_to_parent(&stack(&Vec3::zeros(), &j.axis));
+                ws.g_b[k + 1] = gb;
+            }
+        }
     }
     let last = v.bodies.len() - 1;
     ws.g_be = ws.g_b[last].compose(&v.end_effector);

@@ -18,11 +18,15 @@ use super::passes::{
     backward_pass, body_forces, composites, forward_pass, inertia_to_parent, needs_orientation,
     orientation_pass,
 };
+use super::structure::{
+    add_joint_accel, add_joint_rate, cholesky6_solve, inertia_times_joint, inertia_to_parent_joint,
+    joint_component, twist_to_child, wrench_to_parent,
+};
 use super::workspace::DynWorkspace;
 use super::{check_finite, DynError, DynOptions};
 use crate::kinematics::{forward_kinematics, BasePose};
 use crate::model::Vehicle;
-use crate::spatial::{ang, lin, stack, Mat6, Vec6};
+use crate::spatial::{Mat6, Vec6};
 use nalgebra::Matrix6;
 
 /// Forward dynamics by the articulated-body algorithm, O(n): `ζ̇ = M⁻¹(τ − h)` into
@@ -67,7 +71,7 @@ pub(super) fn aba_after_position(
 ) -> Result<(), DynError> {
     check_finite("generalized_forces", tau)?;
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     velocity_pass(v, ws, zeta);
     body_forces(v, ws, opts, false);
@@ -90,12 +94,9 @@ fn velocity_pass(v: &Vehicle, ws: &mut DynWorkspace, zeta: &[f64]) {
     ws.vp_accel[0] = Vec6::zeros();
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
-        let w_j = j.axis * zeta[6 + k];
-        let mut vi = ws.kin.g_up[i].twist_to_child(&ws.twist[i - 1]);
-        vi[3] += w_j.x;
-        vi[4] += w_j.y;
-        vi[5] += w_j.z;
-        ws.vp_accel[i] = stack(&lin(&vi).cross(&w_j), &ang(&vi).cross(&w_j));
+        let shape = ws.kin.shape[k];
+        let mut vi = twist_to_child(&ws.kin.g_up[i], shape, &ws.twist[i - 1]);
+        ws.vp_accel[i] = add_joint_rate(shape, &j.axis, &mut vi, zeta[6 + k]);
         ws.twist[i] = vi;
     }
 }
@@ -113,10 +114,10 @@ fn aba_backward(
     ws.art_inertia.copy_from_slice(inertia);
     for i in (1..nb).rev() {
         let k = i - 1;
-        let axis = v.joints[k].axis;
+        let (axis, shape) = (v.joints[k].axis, ws.kin.shape[k]);
         let ia = &ws.art_inertia[i];
-        let u_vec: Vec6 = ia.fixed_view::<6, 3>(0, 3) * axis;
-        let d = axis.dot(&ang(&u_vec));
+        let u_vec = inertia_times_joint(shape, &axis, ia);
+        let d = joint_component(shape, &axis, &u_vec);
         if !(d > 0.0 && d.is_finite()) {
             return Err(DynError::new(
                 format!("articulated_inertia[{i}]"),
@@ -125,7 +126,7 @@ fn aba_backward(
         }
         let dinv = 1.0 / d;
         let p = ws.force[i];
-        let u = tau[6 + k] - axis.dot(&ang(&p));
+        let u = tau[6 + k] - joint_component(shape, &axis, &p);
         // I^a = I^A − U Uᵀ / D;  p^a = p^A + I^a c + U u / D.
         let ia_a: Mat6 = ia - u_vec * (u_vec.transpose() * dinv);
         let pa = p + ia_a * ws.vp_accel[i] + u_vec * (u * dinv);
@@ -133,9 +134,9 @@ fn aba_backward(
         ws.aba_dinv[i] = dinv;
         ws.aba_force[i] = u;
         let g = ws.kin.g_up[i];
-        let to_parent = inertia_to_parent(&g, &ia_a);
+        let to_parent = inertia_to_parent_joint(&g, shape, &ia_a);
         ws.art_inertia[i - 1] += to_parent;
-        let fp = g.wrench_to_parent(&pa);
+        let fp = wrench_to_parent(&g, shape, &pa);
         ws.force[i - 1] += fp;
     }
     Ok(())
@@ -151,23 +152,20 @@ fn aba_forward(v: &Vehicle, ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), Dy
     let ia_b = Matrix6::from_fn(|r, c| 0.5 * (ia_b[(r, c)] + ia_b[(c, r)]));
     let pb = g0.wrench_to_parent(&ws.force[0]);
     let rhs = Vec6::from_fn(|r, _| tau[r] - pb[r]);
-    let chol = ia_b.cholesky().ok_or_else(|| {
+    let vdot = cholesky6_solve(&ia_b, &rhs).ok_or_else(|| {
         DynError::new(
             "articulated_inertia_base",
             "is singular or not positive definite",
         )
     })?;
-    let vdot = chol.solve(&rhs);
     ws.zeta_dot[..6].copy_from_slice(vdot.as_slice());
     ws.accel[0] = g0.twist_to_child(&vdot);
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
-        let mut a = ws.kin.g_up[i].twist_to_child(&ws.accel[i - 1]) + ws.vp_accel[i];
+        let mut a =
+            twist_to_child(&ws.kin.g_up[i], ws.kin.shape[k], &ws.accel[i - 1]) + ws.vp_accel[i];
         let qdd = (ws.aba_force[i] - ws.aba_u[i].dot(&a)) * ws.aba_dinv[i];
-        let dw = j.axis * qdd;
-        a[3] += dw.x;
-        a[4] += dw.y;
-        a[5] += dw.z;
+        add_joint_accel(ws.kin.shape[k], &j.axis, &mut a, qdd);
         ws.accel[i] = a;
         ws.zeta_dot[6 + k] = qdd;
     }
@@ -201,7 +199,7 @@ pub fn hybrid_terms(
         *f = ws.composite[k + 1] * ws.kin.joint_twist_b[k];
     }
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     forward_pass(v, ws, zeta, None);
     body_forces(v, ws, opts, true);
@@ -242,13 +240,12 @@ pub fn solve_hybrid_on(ws: &mut DynWorkspace, q_ext: &[f64], qdd: &[f64]) -> Res
     }
     let m11 = Matrix6::from_fn(|r, c| ws.mass[(r, c)]);
     let rhs = Vec6::from_fn(|r, _| q_ext[r] - ws.bias[r] - w0[r]);
-    let chol = m11.cholesky().ok_or_else(|| {
+    let vdot = cholesky6_solve(&m11, &rhs).ok_or_else(|| {
         DynError::new(
             "mass_matrix_base_block",
             "M_11 is singular or not positive definite",
         )
     })?;
-    let vdot = chol.solve(&rhs);
     ws.zeta_dot[..6].copy_from_slice(vdot.as_slice());
     ws.zeta_dot[6..].copy_from_slice(qdd);
     // v_l + V̇_b by a running sum from the base.

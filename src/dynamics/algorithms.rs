@@ -61,7 +61,7 @@ fn bias_after_position(
     opts: &DynOptions,
 ) {
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     forward_pass(v, ws, zeta, None);
     body_forces(v, ws, opts, true);
@@ -102,7 +102,7 @@ pub fn inverse_dynamics(
 ) {
     forward_kinematics(v, q, &mut ws.kin);
     if needs_orientation(opts) {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, opts.current);
     }
     forward_pass(v, ws, zeta, Some(zeta_dot));
     body_forces(v, ws, opts, true);
@@ -302,9 +302,9 @@ pub fn restoring_generalized(
     out: &mut [f64],
 ) {
     forward_kinematics(v, q, &mut ws.kin);
-    orientation_pass(ws, pose);
+    orientation_pass(ws, pose, false);
     for i in 0..ws.force.len() {
-        ws.force[i] = ws.restoring[i].wrench(&ws.r_ii[i]);
+        ws.force[i] = ws.restoring[i].wrench_up(&ws.up[i]);
     }
     backward_pass(v, ws, out);
 }
@@ -323,7 +323,7 @@ pub fn damping_generalized(
 ) {
     forward_kinematics(v, q, &mut ws.kin);
     if opts.current {
-        orientation_pass(ws, pose);
+        orientation_pass(ws, pose, true);
     }
     forward_pass(v, ws, zeta, None);
     for i in 0..ws.force.len() {

@@ -22,6 +22,9 @@ pub struct CylinderDrag {
     pub length: f64,
     /// Number of strips `N` (midpoint rule, strip centres at `(k + ½) l / N`).
     pub strips: usize,
+    /// The strip width `l / N` [m], derived from `length` and `strips` by [`Self::new`] (so
+    /// change those two only through a new kernel).
+    ds: f64,
     /// Linear damping `[N·s/m ×3, N·m·s/rad ×3]` on the relative twist at the geometric
     /// centre `(l/2, 0, 0)`.
     pub linear: [f64; 6],
@@ -82,6 +85,7 @@ impl CylinderDrag {
             k_strip_z: 0.5 * rho * cd_z * 2.0 * radius * ds,
             length,
             strips,
+            ds,
             linear,
             k_lift: 0.0,
             free_rear: false,
@@ -143,7 +147,7 @@ impl CylinderDrag {
     pub fn wrench(&self, v_r: &Vec6) -> Vec6 {
         let (u, vy, vz) = (v_r[0], v_r[1], v_r[2]);
         let (wx, wy, wz) = (v_r[3], v_r[4], v_r[5]);
-        let ds = self.length / self.strips as f64;
+        let ds = self.ds;
         let (mut fy, mut fz, mut my, mut mz) = (0.0, 0.0, 0.0, 0.0);
         for k in 0..self.strips {
             let s = (k as f64 + 0.5) * ds;
@@ -315,7 +319,14 @@ impl Restoring {
     #[inline]
     pub fn wrench(&self, r_ii: &Mat3) -> Vec6 {
         // Inertial up e_z in body coordinates: the third row of R_Ii.
-        let up = Vec3::new(r_ii[(2, 0)], r_ii[(2, 1)], r_ii[(2, 2)]);
+        self.wrench_up(&Vec3::new(r_ii[(2, 0)], r_ii[(2, 1)], r_ii[(2, 2)]))
+    }
+
+    /// [`Self::wrench`] from the inertial vertical `up = R_Iiᵀ e_z` in body coordinates (the
+    /// third row of `R_Ii`) alone.
+    #[inline]
+    pub fn wrench_up(&self, up: &Vec3) -> Vec6 {
+        let up = *up;
         let f_w = up * (-self.weight);
         let f_b = up * self.buoyancy;
         let f = f_w + f_b;

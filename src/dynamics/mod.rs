@@ -44,6 +44,7 @@ mod integrator;
 pub mod manoeuvring;
 mod passes;
 pub mod sim;
+mod structure;
 mod thruster_lag;
 pub mod workspace;
 

@@ -5,45 +5,42 @@
 //! The public algorithms of [`super::algorithms`] chain them; names and frames as in
 //! [`super::workspace`].
 
+pub(super) use super::structure::inertia_to_parent;
+use super::structure::{
+    add_joint_accel, add_joint_rate, inertia_to_parent_axial, joint_component, mul_inertia,
+    mul_inertia_linear, twist_to_child, wrench_to_parent,
+};
 use super::workspace::DynWorkspace;
 use super::DynOptions;
 use crate::kinematics::BasePose;
 use crate::model::Vehicle;
-use crate::spatial::{ang, cross_force, lin, skew, stack, Mat6, Se3, Vec3, Vec6};
+use crate::spatial::{ang, cross_force, Vec3, Vec6};
 
 // ---------------------------------------------------------------------------------------
 // Position stage (after `forward_kinematics` into `ws.kin`).
 
-/// Body orientations in the inertial frame, `R_Ii = R_Ib R_bi`.
-pub(super) fn orientation_pass(ws: &mut DynWorkspace, pose: &BasePose) {
+/// Body orientations in the inertial frame, `R_Ii = R_Ib R_bi`, into `ws.r_ii` when `full`
+/// (the current needs them), and always their last rows, the inertial vertical in body
+/// coordinates, into `ws.up` (all the restoring forces need: 9 products a body instead of 27,
+/// the same bits as the last row of the full product).
+pub(super) fn orientation_pass(ws: &mut DynWorkspace, pose: &BasePose, full: bool) {
     let r_ib = *pose.orientation.to_rotation_matrix().matrix();
-    for (r, g) in ws.r_ii.iter_mut().zip(&ws.kin.g_b) {
-        *r = r_ib * g.r;
+    if full {
+        for ((r, u), g) in ws.r_ii.iter_mut().zip(&mut ws.up).zip(&ws.kin.g_b) {
+            *r = r_ib * g.r;
+            *u = Vec3::new(r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+        }
+    } else {
+        let (a, b, c) = (r_ib[(2, 0)], r_ib[(2, 1)], r_ib[(2, 2)]);
+        for (u, g) in ws.up.iter_mut().zip(&ws.kin.g_b) {
+            let r = &g.r;
+            *u = Vec3::new(
+                a * r[(0, 0)] + b * r[(1, 0)] + c * r[(2, 0)],
+                a * r[(0, 1)] + b * r[(1, 1)] + c * r[(2, 1)],
+                a * r[(0, 2)] + b * r[(1, 2)] + c * r[(2, 2)],
+            );
+        }
     }
-}
-
-/// `Ad_g⁻ᵀ I Ad_g⁻¹`: a spatial inertia about the child origin in the child frame, moved to
-/// the parent frame, for `g = (R, p)` — by 3×3 blocks (about 60 % of the cost of two 6×6
-/// products). With `I = [[A, B], [Bᵀ, C]]` and `A' = RARᵀ`, `B' = RBRᵀ`, `C' = RCRᵀ`:
-/// `[[A', B' − A'p̂], [·ᵀ, C' + p̂B' − B'ᵀp̂ − p̂A'p̂]]`.
-#[inline]
-pub(super) fn inertia_to_parent(g: &Se3, i: &Mat6) -> Mat6 {
-    let r = &g.r;
-    let rt = r.transpose();
-    let a = r * i.fixed_view::<3, 3>(0, 0) * rt;
-    let b = r * i.fixed_view::<3, 3>(0, 3) * rt;
-    let c = r * i.fixed_view::<3, 3>(3, 3) * rt;
-    let ph = skew(&g.p);
-    let aph = a * ph;
-    let ur = b - aph;
-    let pb = ph * b;
-    let lr = c + pb + pb.transpose() - ph * aph;
-    let mut out = Mat6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&ur);
-    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&ur.transpose());
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&lr);
-    out
 }
 
 /// Composite-rigid-body algorithm on the floating base, after the position pass
@@ -85,12 +82,17 @@ pub(super) fn crba(ws: &mut DynWorkspace, added_mass: bool) {
 pub(super) fn composites(ws: &mut DynWorkspace, added_mass: bool) {
     let nb = ws.kin.g_up.len();
     for i in (0..nb).rev() {
-        let inertia = if added_mass {
-            &ws.i_tot[i]
+        let (inertia, axial) = if added_mass {
+            (&ws.i_tot[i], ws.axial[i].total)
         } else {
-            &ws.i_rb[i]
+            (&ws.i_rb[i], ws.axial[i].rigid)
         };
-        let ib = inertia_to_parent(&ws.kin.g_b[i], inertia);
+        let g = &ws.kin.g_b[i];
+        let ib = if axial {
+            inertia_to_parent_axial(g, inertia)
+        } else {
+            inertia_to_parent(g, inertia)
+        };
         ws.composite[i] = if i + 1 < nb {
             ib + ws.composite[i + 1]
         } else {
@@ -125,19 +127,12 @@ pub(super) fn forward_pass(
     };
     for (k, j) in v.joints.iter().enumerate() {
         let i = k + 1;
-        let w_j = j.axis * zeta[6 + k];
-        let mut vi = ws.kin.g_up[i].twist_to_child(&ws.twist[i - 1]);
-        vi[3] += w_j.x;
-        vi[4] += w_j.y;
-        vi[5] += w_j.z;
-        let (vl, va) = (lin(&vi), ang(&vi));
-        let mut ai = ws.kin.g_up[i].twist_to_child(&ws.accel[i - 1])
-            + stack(&vl.cross(&w_j), &va.cross(&w_j));
+        let (g, shape) = (&ws.kin.g_up[i], ws.kin.shape[k]);
+        let mut vi = twist_to_child(g, shape, &ws.twist[i - 1]);
+        let vp = add_joint_rate(shape, &j.axis, &mut vi, zeta[6 + k]);
+        let mut ai = twist_to_child(g, shape, &ws.accel[i - 1]) + vp;
         if let Some(a) = zeta_dot {
-            let dw = j.axis * a[6 + k];
-            ai[3] += dw.x;
-            ai[4] += dw.y;
-            ai[5] += dw.z;
+            add_joint_accel(shape, &j.axis, &mut ai, a[6 + k]);
         }
         ws.twist[i] = vi;
         ws.accel[i] = ai;
@@ -190,6 +185,7 @@ pub(super) fn uses_current(v: &Vehicle, opts: &DynOptions) -> bool {
 pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions, with_accel: bool) {
     let current = uses_current(v, opts);
     for i in 0..ws.twist.len() {
+        let axial = ws.axial[i];
         let vi = ws.twist[i];
         let ai = if with_accel {
             ws.accel[i]
@@ -203,38 +199,39 @@ pub(super) fn body_forces(v: &Vehicle, ws: &mut DynWorkspace, opts: &DynOptions,
         };
         let vr = relative_twist(&vi, &vc);
         let mut f;
+        let rigid_vi = || mul_inertia(&ws.i_rb[i], axial.rigid, &vi);
         if opts.added_mass {
             f = if with_accel {
-                ws.i_tot[i] * ai
+                mul_inertia(&ws.i_tot[i], axial.total, &ai)
             } else {
                 Vec6::zeros()
             };
             if !ws.damping[i].kirchhoff() {
                 // Manoeuvring derivatives carry the added mass's velocity forces themselves.
-                f += cross_force(&vi, &(ws.i_rb[i] * vi));
+                f += cross_force(&vi, &rigid_vi());
                 if current {
                     let wv = ang(&vi).cross(&vc);
-                    f += ws.m_a[i].fixed_view::<6, 3>(0, 0) * wv;
+                    f += mul_inertia_linear(&ws.m_a[i], axial.added, &wv);
                 }
             } else if current {
                 let ma = &ws.m_a[i];
-                f += cross_force(&vi, &(ws.i_rb[i] * vi));
-                f += cross_force(&vr, &(ma * vr));
+                f += cross_force(&vi, &rigid_vi());
+                f += cross_force(&vr, &mul_inertia(ma, axial.added, &vr));
                 let wv = ang(&vi).cross(&vc);
-                f += ma.fixed_view::<6, 3>(0, 0) * wv;
+                f += mul_inertia_linear(ma, axial.added, &wv);
             } else {
-                f += cross_force(&vi, &(ws.i_tot[i] * vi));
+                f += cross_force(&vi, &mul_inertia(&ws.i_tot[i], axial.total, &vi));
             }
         } else if with_accel {
-            f = ws.i_rb[i] * ai + cross_force(&vi, &(ws.i_rb[i] * vi));
+            f = mul_inertia(&ws.i_rb[i], axial.rigid, &ai) + cross_force(&vi, &rigid_vi());
         } else {
-            f = cross_force(&vi, &(ws.i_rb[i] * vi));
+            f = cross_force(&vi, &rigid_vi());
         }
         if opts.drag {
             f -= ws.damping[i].wrench(&vr);
         }
         if opts.restoring {
-            f -= ws.restoring[i].wrench(&ws.r_ii[i]);
+            f -= ws.restoring[i].wrench_up(&ws.up[i]);
         }
         ws.force[i] = f;
     }
@@ -247,8 +244,8 @@ pub(super) fn backward_pass(v: &Vehicle, ws: &mut DynWorkspace, out: &mut [f64])
     assert_eq!(out.len(), v.n_dof(), "generalised force length");
     for i in (1..ws.force.len()).rev() {
         let f = ws.force[i];
-        out[6 + i - 1] = v.joints[i - 1].axis.dot(&ang(&f));
-        let fp = ws.kin.g_up[i].wrench_to_parent(&f);
+        out[6 + i - 1] = joint_component(ws.kin.shape[i - 1], &v.joints[i - 1].axis, &f);
+        let fp = wrench_to_parent(&ws.kin.g_up[i], ws.kin.shape[i - 1], &f);
         ws.force[i - 1] += fp;
     }
     let fb = ws.kin.g_up[0].wrench_to_parent(&ws.force[0]);

@@ -8,17 +8,19 @@
 //! about its origin). Generalised vectors are ordered `[base (6, in F_b); joints (n)]`.
 
 use super::hydro::{DampingKernel, Restoring};
+use super::structure::is_axial;
 use crate::kinematics::KinWorkspace;
 use crate::model::Vehicle;
-use crate::spatial::{Mat3, Mat6, Vec6};
+use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 use faer::Mat;
 use nalgebra::{Matrix6, Vector6};
 
 /// Preallocated workspace of the dynamics algorithms for one vehicle (Pinocchio's `Data`).
 ///
 /// Built by [`DynWorkspace::new`] from a vehicle; constant per-body quantities (spatial
-/// inertias, hydrodynamic kernels) are resolved then, so rebuild the workspace if the
-/// vehicle changes. Results of the last call stay readable in the public fields.
+/// inertias and their sparsity, hydrodynamic kernels, the joints' shapes) are resolved then,
+/// so rebuild the workspace if the vehicle changes, and treat the per-body inertias as
+/// read-only. Results of the last call stay readable in the public fields.
 #[derive(Clone, Debug)]
 pub struct DynWorkspace {
     /// Kinematic quantities at the last configuration, filled by the one position pass
@@ -26,14 +28,20 @@ pub struct DynWorkspace {
     /// parent's frame), `g_b`, joint twists in `F_b`, `g_be`.
     pub kin: KinWorkspace,
     /// Body orientations in the inertial frame `R_Ii = R_Ib R_bi` (refreshed only by calls
-    /// that take a base pose and need it: restoring forces or current).
+    /// that take a base pose and use the current; the restoring forces need only the last
+    /// rows, which every call with restoring forces refreshes in `up`).
     pub r_ii: Vec<Mat3>,
+    /// The inertial vertical `e_z` in each body's frame, the last row of `R_Ii`.
+    pub(super) up: Vec<Vec3>,
     /// Rigid-body spatial inertia `I_RB,i` about body `i`'s origin, in its frame.
     pub i_rb: Vec<Mat6>,
     /// Added-mass spatial inertia `M_A,i` about body `i`'s origin, in its frame.
     pub m_a: Vec<Mat6>,
     /// `I_RB,i + M_A,i`.
     pub i_tot: Vec<Mat6>,
+    /// Whether `i_rb[i]`, `m_a[i]`, `i_tot[i]` are axial (`structure::is_axial`: the passes
+    /// skip their exact zeros).
+    pub(super) axial: Vec<AxialInertias>,
     /// Damping kernel of each body.
     pub damping: Vec<DampingKernel>,
     /// Hydrostatic parameters of each body.
@@ -88,13 +96,22 @@ impl DynWorkspace {
         let rho = v.fluid.rho;
         let i_rb: Vec<Mat6> = v.bodies.iter().map(|b| b.rigid_spatial_inertia()).collect();
         let m_a: Vec<Mat6> = v.bodies.iter().map(|b| b.added_mass(rho)).collect();
-        let i_tot = i_rb.iter().zip(&m_a).map(|(a, b)| a + b).collect();
+        let i_tot: Vec<Mat6> = i_rb.iter().zip(&m_a).map(|(a, b)| a + b).collect();
+        let axial = (0..nb)
+            .map(|i| AxialInertias {
+                rigid: is_axial(&i_rb[i]),
+                added: is_axial(&m_a[i]),
+                total: is_axial(&i_tot[i]),
+            })
+            .collect();
         Self {
             kin: KinWorkspace::new(v),
             r_ii: vec![Mat3::identity(); nb],
+            up: vec![Vec3::z(); nb],
             i_rb,
             m_a,
             i_tot,
+            axial,
             // A serial chain, tail to head: only the tail's rear face and the head's front
             // face are free (where lift may act, `CylinderDrag::lift`).
             damping: v
@@ -128,6 +145,15 @@ impl DynWorkspace {
         }
     }
 
+    /// The same workspace with the dense products everywhere (no axial inertia or joint),
+    /// for tests of the structured kernels.
+    #[cfg(test)]
+    pub(crate) fn dense(mut self) -> Self {
+        self.axial.fill(AxialInertias::default());
+        self.kin = self.kin.dense();
+        self
+    }
+
     /// Number of generalised velocities `6 + n`.
     pub fn n_dof(&self) -> usize {
         self.bias.len()
@@ -143,4 +169,15 @@ impl DynWorkspace {
     pub fn bias_base(&self) -> Vector6<f64> {
         Vector6::from_column_slice(&self.bias[..6])
     }
+}
+
+/// Which of a body's spatial inertias are axial (`structure::is_axial`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct AxialInertias {
+    /// `I_RB`.
+    pub rigid: bool,
+    /// `M_A`.
+    pub added: bool,
+    /// `I_RB + M_A`.
+    pub total: bool,
 }

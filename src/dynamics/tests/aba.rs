@@ -165,3 +165,117 @@ fn aba_reports_a_massless_chain_instead_of_dividing_by_zero() {
     .unwrap_err();
     assert!(err.quantity.starts_with("articulated_inertia"), "{err}");
 }
+
+/// `a` and `b` have the same bits, or are both zero (a skipped exact-zero term may flip the
+/// sign of a zero result, nothing else).
+fn same_bits(name: &str, a: &[f64], b: &[f64]) {
+    assert_eq!(a.len(), b.len(), "{name}");
+    for (r, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!(
+            x.to_bits() == y.to_bits() || (*x == 0.0 && *y == 0.0),
+            "{name}[{r}]: {x:e} vs {y:e}"
+        );
+    }
+}
+
+#[test]
+fn structured_passes_equal_the_dense_products_bit_for_bit() {
+    // Axial joints and inertias (structure.rs) skip exact zeros only: every output of the
+    // position pass and of the three O(n) and dense routes has the dense route's bits, on
+    // random states, at rest in the straight configuration (many exact zeros) and in plane.
+    let mut rng = ChaCha8Rng::seed_from_u64(26);
+    for v in all_designs() {
+        let (nv, n) = (v.n_dof(), v.n_joints());
+        let mut ws = DynWorkspace::new(&v);
+        let mut dense = DynWorkspace::new(&v).dense();
+        for opts in all_options() {
+            for t in 0..12 {
+                let mut s = sample(&v, &mut rng, 1.0);
+                if t == 0 {
+                    s.pose = BasePose::default();
+                    s.q.fill(0.0);
+                    s.zeta.fill(0.0);
+                } else if t == 1 {
+                    s.pose.orientation = UnitQuaternion::from_euler_angles(0.0, 0.0, 0.7);
+                    s.zeta[2..5].fill(0.0);
+                }
+                let tau: Vec<f64> = (0..nv).map(|_| rng.random_range(-30.0..30.0)).collect();
+                let qdd: Vec<f64> = (0..n).map(|_| rng.random_range(-5.0..5.0)).collect();
+                let name = format!("{} {opts:?} state {t}", v.name);
+                for w in [&mut ws, &mut dense] {
+                    hybrid_dynamics_on(&v, w, &s.pose, &s.q, &s.zeta, &tau, &qdd, &opts).unwrap();
+                }
+                for (i, (a, b)) in ws.kin.g_b.iter().zip(&dense.kin.g_b).enumerate() {
+                    same_bits(
+                        &format!("{name} g_b[{i}].r"),
+                        a.r.as_slice(),
+                        b.r.as_slice(),
+                    );
+                    same_bits(
+                        &format!("{name} g_b[{i}].p"),
+                        a.p.as_slice(),
+                        b.p.as_slice(),
+                    );
+                    let (a, b) = (&ws.kin.g_up[i], &dense.kin.g_up[i]);
+                    same_bits(
+                        &format!("{name} g_up[{i}].r"),
+                        a.r.as_slice(),
+                        b.r.as_slice(),
+                    );
+                    same_bits(
+                        &format!("{name} g_up[{i}].p"),
+                        a.p.as_slice(),
+                        b.p.as_slice(),
+                    );
+                }
+                for (k, (a, b)) in ws
+                    .kin
+                    .joint_twist_b
+                    .iter()
+                    .zip(&dense.kin.joint_twist_b)
+                    .enumerate()
+                {
+                    same_bits(
+                        &format!("{name} joint_twist_b[{k}]"),
+                        a.as_slice(),
+                        b.as_slice(),
+                    );
+                }
+                same_bits(
+                    &format!("{name} hybrid zeta_dot"),
+                    &ws.zeta_dot,
+                    &dense.zeta_dot,
+                );
+                same_bits(
+                    &format!("{name} hybrid torque"),
+                    &ws.joint_torque,
+                    &dense.joint_torque,
+                );
+                same_bits(&format!("{name} hybrid bias"), &ws.bias, &dense.bias);
+                same_bits(
+                    &format!("{name} M_11"),
+                    ws.mass_base_block().as_slice(),
+                    dense.mass_base_block().as_slice(),
+                );
+                for w in [&mut ws, &mut dense] {
+                    forward_dynamics_aba(&v, w, &s.pose, &s.q, &s.zeta, &tau, &opts).unwrap();
+                }
+                same_bits(
+                    &format!("{name} aba zeta_dot"),
+                    &ws.zeta_dot,
+                    &dense.zeta_dot,
+                );
+                for w in [&mut ws, &mut dense] {
+                    dynamics_terms(&v, w, &s.pose, &s.q, &s.zeta, &opts);
+                }
+                same_bits(&format!("{name} bias"), &ws.bias, &dense.bias);
+                for c in 0..nv {
+                    let (a, b) = (ws.mass.col(c), dense.mass.col(c));
+                    let a: Vec<f64> = a.iter().copied().collect();
+                    let b: Vec<f64> = b.iter().copied().collect();
+                    same_bits(&format!("{name} M column {c}"), &a, &b);
+                }
+            }
+        }
+    }
+}
