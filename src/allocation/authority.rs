@@ -129,7 +129,7 @@ pub struct AuthoritySolver {
     u_max: Vec<f64>,
     /// Whether the dedicated solver applies (`u_min ≤ 0 ≤ u_max` for every thruster).
     dedicated: bool,
-    /// The dedicated solver's workspace (one row fewer than the commanded axes).
+    /// The dedicated solver's workspace.
     lp: BoxLp,
     /// The fallback and reference solver.
     clarabel: ClarabelProgrammes,
@@ -164,7 +164,7 @@ impl AuthoritySolver {
             .all(|(&lo, &hi)| lo <= 0.0 && 0.0 <= hi);
         Ok(Self {
             n_thrusters,
-            lp: BoxLp::new(n_thrusters, rows.len().saturating_sub(1)),
+            lp: BoxLp::new(n_thrusters, rows.len()),
             clarabel: ClarabelProgrammes::new(&t_ref, &rows, u_min, u_max),
             rows,
             u_min: u_min.to_vec(),
@@ -223,24 +223,14 @@ impl AuthoritySolver {
             return out;
         }
         if self.dedicated {
-            for j in 0..self.n_thrusters {
-                let (lo, hi) = if self.removed == Some(j) {
-                    (0.0, 0.0)
-                } else {
-                    (self.u_min[j], self.u_max[j])
-                };
-                self.lp.set_bounds(j, lo, hi);
-            }
+            self.load();
         }
         for r in 0..self.rows.len() {
             let axis = self.rows[r];
-            if self.dedicated {
-                self.load_equalities(r);
-            }
             for sign in [1.0, -1.0] {
                 let alpha = self
                     .dedicated
-                    .then(|| self.dedicated_programme(axis, sign))
+                    .then(|| self.lp.solve(r, sign))
                     .flatten()
                     .unwrap_or_else(|| {
                         self.clarabel.solve(
@@ -260,23 +250,22 @@ impl AuthoritySolver {
         out
     }
 
-    /// `E` = the commanded rows of `T_r` other than row `r`.
-    fn load_equalities(&mut self, r: usize) {
+    /// The dedicated solver's data: `M = S T_r`, the boxes (the removed thruster's `[0, 0]`),
+    /// and its crash basis.
+    fn load(&mut self) {
         for j in 0..self.n_thrusters {
             let col = self.lp.column(j);
-            let others = self.rows.iter().enumerate().filter(|&(i, _)| i != r);
-            for (slot, (_, &axis)) in others.enumerate() {
-                col[slot] = self.t_ref[(axis, j)];
+            for (slot, &axis) in col.iter_mut().zip(&self.rows) {
+                *slot = self.t_ref[(axis, j)];
             }
+            let (lo, hi) = if self.removed == Some(j) {
+                (0.0, 0.0)
+            } else {
+                (self.u_min[j], self.u_max[j])
+            };
+            self.lp.set_bounds(j, lo, hi);
         }
-    }
-
-    /// `max α` along `sign · e_axis` by the dedicated solver, `None` when not certified.
-    fn dedicated_programme(&mut self, axis: usize, sign: f64) -> Option<f64> {
-        for (j, g) in self.lp.objective().iter_mut().enumerate() {
-            *g = sign * self.t_ref[(axis, j)];
-        }
-        self.lp.solve()
+        self.lp.crash();
     }
 }
 

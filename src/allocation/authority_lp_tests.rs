@@ -7,17 +7,19 @@ use super::*;
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
 
-/// A workspace holding `e` (p rows of m), `g` and the box.
+/// A workspace for `max g·u` s.t. `e u = 0` and the box: `M = [g; e]`, row 0, sign +1.
 fn lp(e: &[Vec<f64>], g: &[f64], lo: &[f64], hi: &[f64]) -> BoxLp {
     let m = g.len();
-    let mut s = BoxLp::new(m, e.len());
+    let mut s = BoxLp::new(m, e.len() + 1);
     for j in 0..m {
+        let col = s.column(j);
+        col[0] = g[j];
         for (i, row) in e.iter().enumerate() {
-            s.column(j)[i] = row[j];
+            col[i + 1] = row[j];
         }
         s.set_bounds(j, lo[j], hi[j]);
     }
-    s.objective().copy_from_slice(g);
+    s.crash();
     s
 }
 
@@ -69,7 +71,7 @@ fn no_equality_rows_give_the_box_support() {
         &[-1.0, -5.0, -4.0],
         &[3.0, 5.0, 2.0],
     );
-    assert_eq!(s.solve(), Some(10.0));
+    assert_eq!(s.solve(0, 1.0), Some(10.0));
     assert!(s.last.certified && s.last.dual_bound == 10.0);
 }
 
@@ -79,11 +81,16 @@ fn two_surge_thrusters_with_yaw_held_at_zero() {
     // limits [−10, 30]: surge+ 60, surge− 20; with thruster 1 removed nothing is left.
     let e = [vec![-0.5, 0.5]];
     let (lo, hi) = ([-10.0; 2], [30.0; 2]);
-    assert_eq!(lp(&e, &[1.0, 1.0], &lo, &hi).solve(), Some(60.0));
-    assert_eq!(lp(&e, &[-1.0, -1.0], &lo, &hi).solve(), Some(20.0));
     let mut s = lp(&e, &[1.0, 1.0], &lo, &hi);
+    assert_eq!(s.solve(0, 1.0), Some(60.0));
+    assert_eq!(s.solve(0, -1.0), Some(20.0));
+    // Yaw (row 1) with surge held at zero: u1 = −u0 = v, |v| ≤ 10, yaw = v: 10 both ways.
+    assert_eq!(s.solve(1, 1.0), Some(10.0));
+    assert_eq!(s.solve(1, -1.0), Some(10.0));
     s.set_bounds(1, 0.0, 0.0);
-    assert_eq!(s.solve(), Some(0.0));
+    s.crash();
+    assert_eq!(s.solve(0, 1.0), Some(0.0));
+    assert_eq!(s.solve(1, -1.0), Some(0.0));
 }
 
 #[test]
@@ -96,12 +103,12 @@ fn dependent_rows_and_an_objective_in_their_span_give_zero() {
     ];
     let g = [1.0, 1.0, 2.0, 1.0];
     let mut s = lp(&e, &g, &[-1.0; 4], &[1.0; 4]);
-    let a = s.solve().unwrap();
+    let a = s.solve(0, 1.0).unwrap();
     assert!(a.abs() < 1e-12, "{a} {:?}", s.last);
     // An objective outside the span: the brute force's answer.
     let g = [1.0, -1.0, 0.5, 0.0];
     let want = brute_force(&e, &g, &[-1.0; 4], &[1.0; 4]);
-    let got = lp(&e, &g, &[-1.0; 4], &[1.0; 4]).solve().unwrap();
+    let got = lp(&e, &g, &[-1.0; 4], &[1.0; 4]).solve(0, 1.0).unwrap();
     assert!((got - want).abs() < 1e-12, "{got} {want}");
 }
 
@@ -120,10 +127,10 @@ fn beales_degenerate_programme() {
     let lo = [0.0; 6];
     let hi = [100.0, 100.0, 100.0, 100.0, 1.0, 100.0];
     let mut s = lp(&e, &g, &lo, &hi);
-    let a = s.solve().unwrap();
+    let a = s.solve(0, 1.0).unwrap();
     assert!((a - 0.05).abs() < 1e-12, "{a} {:?}", s.last);
     s.degenerate_limit = 0;
-    let a = s.solve().unwrap();
+    let a = s.solve(0, 1.0).unwrap();
     assert!((a - 0.05).abs() < 1e-12 && s.last.bland, "{a} {:?}", s.last);
     assert!((brute_force(&e, &g, &lo, &hi) - 0.05).abs() < 1e-12);
 }
@@ -137,14 +144,16 @@ fn a_solve_carries_no_state_from_the_one_before() {
     let g = [0.9, 0.1, -0.6, 0.4, 1.1];
     let (lo, hi) = ([-20.0; 5], [30.0; 5]);
     let mut s = lp(&e, &g, &lo, &hi);
-    let first = s.solve().unwrap();
+    let first = s.solve(0, 1.0).unwrap();
     // Another programme in the same workspace, then the first again: bit-identical.
-    s.objective().copy_from_slice(&[-1.0, 0.5, 0.5, -0.2, 0.0]);
+    s.solve(2, -1.0).unwrap();
     s.set_bounds(2, 0.0, 0.0);
-    s.solve().unwrap();
-    s.objective().copy_from_slice(&g);
+    s.crash();
+    s.solve(1, 1.0).unwrap();
     s.set_bounds(2, -20.0, 30.0);
-    assert_eq!(s.solve().unwrap().to_bits(), first.to_bits());
+    s.crash();
+    s.solve(0, -1.0).unwrap();
+    assert_eq!(s.solve(0, 1.0).unwrap().to_bits(), first.to_bits());
     assert!((first - brute_force(&e, &g, &lo, &hi)).abs() < 1e-10);
 }
 
@@ -182,20 +191,35 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(600))]
 
     #[test]
-    fn equals_brute_force_vertex_enumeration((e, g, lo, hi) in programme(), bland in any::<bool>()) {
-        let want = brute_force(&e, &g, &lo, &hi);
+    fn equals_brute_force_vertex_enumeration(
+        (e, g, lo, hi) in programme(),
+        bland in any::<bool>(),
+        pick in 0usize..5,
+        negative in any::<bool>(),
+    ) {
+        // M = [g; e]; the programme of row r = pick mod c, sign ±: brute force on
+        // max ±M_r u s.t. the other rows = 0.
         let mut s = lp(&e, &g, &lo, &hi);
         if bland {
             // Bland's rule from the start: the anti-cycling path on every kind of programme.
             s.degenerate_limit = 0;
         }
-        let got = s.solve();
+        let mut rows = vec![g.clone()];
+        rows.extend(e.iter().cloned());
+        let r = pick % rows.len();
+        let sign = if negative { -1.0 } else { 1.0 };
+        let obj: Vec<f64> = rows[r].iter().map(|x| sign * x).collect();
+        let others: Vec<Vec<f64>> =
+            rows.iter().enumerate().filter(|&(i, _)| i != r).map(|(_, x)| x.clone()).collect();
+        let want = brute_force(&others, &obj, &lo, &hi);
+        let got = s.solve(r, sign);
         prop_assert!(got.is_some(), "not certified: {:?}", s.last);
         let got = got.unwrap();
-        prop_assert!((got - want).abs() <= 1e-9 * (1.0 + want.abs()), "{} vs {} {:?}", got, want, s.last);
+        let tol = 1e-9 * (1.0 + want.abs());
+        prop_assert!((got - want).abs() <= tol, "{} vs {} {:?}", got, want, s.last);
         // The dual bound is an upper bound on the optimum and the certificate's gap is tight.
-        prop_assert!(s.last.dual_bound >= want - 1e-9 * (1.0 + want.abs()));
-        prop_assert!(s.last.dual_bound - s.last.primal <= 1e-9 * (1.0 + want.abs()));
+        prop_assert!(s.last.dual_bound >= want - tol);
+        prop_assert!(s.last.dual_bound - s.last.primal <= tol);
         prop_assert!(s.last.residual <= 1e-12 && s.last.violation <= 1e-12, "{:?}", s.last);
     }
 }

@@ -39,12 +39,12 @@ impl Tally {
         scale: f64,
         at: &str,
     ) {
-        for k in 0..6 {
+        for (k, &on) in m.iter().enumerate() {
             for (x, y) in [
                 (a.positive[k], b.positive[k]),
                 (a.negative[k], b.negative[k]),
             ] {
-                if !m[k] {
+                if !on {
                     assert!(x.is_nan() && y.is_nan());
                     continue;
                 }
