@@ -14,12 +14,13 @@
 //! moment [N·m] for roll/pitch/yaw: the support of the thrust box mapped through `S T_r` along
 //! `±e_k`.
 //!
-//! **Solvers.** Row `k` is eliminated (`α = ±(T_r u)_k`), leaving `max ±(T_r u)_k` subject to the
-//! other commanded rows `= 0` and the box: a programme with at most 5 equality rows that the
-//! dedicated bounded-variable simplex of `authority_lp` solves exactly from `u = 0` (feasible
-//! whenever every box contains zero thrust), with a duality-gap certificate, in a fraction of a
-//! microsecond and without allocating. Each programme starts from the same state, so its answer
-//! is a function of its own data: bit-identical for any order and any number of workers.
+//! **Solvers.** Each programme — `max α` s.t. `S T_r u − s α e_k = 0`, the box, `α ≥ 0`, at most
+//! 6 equality rows — is solved exactly by the dedicated bounded-variable simplex of
+//! `authority_lp`, started from `u = 0` (feasible whenever every box contains zero thrust) and a
+//! crash basis shared by the `2k` programmes of a configuration, with a duality-gap
+//! certificate, in about a microsecond and without allocating. Each programme starts from the
+//! same crash, a function of the configuration's data, so its answer is a function of its own
+//! data: bit-identical for any order and any number of workers.
 //!
 //! Clarabel is the fallback: for a programme the simplex cannot certify, and for every programme
 //! when some box excludes zero (the programme may then be infeasible: NaN). One Clarabel solver
@@ -117,7 +118,7 @@ pub fn transport_moments(t: &Matrix6xX<f64>, reference: &Vector3<f64>, out: &mut
 /// [`AuthoritySolver::solve_without`] per removed thruster.
 ///
 /// Each programme is solved by the dedicated simplex of `authority_lp` (exact vertex, no
-/// allocation, ≈ 0.2–0.5 µs) when every box contains zero thrust; a programme whose answer that
+/// allocation, ≈ 1 µs) when every box contains zero thrust; a programme whose answer that
 /// solver cannot certify (the duality gap, residual or clamp above its tolerances, or its
 /// iteration cap), and every programme when a box excludes zero thrust, goes to Clarabel
 /// ([`AuthoritySolver::clarabel_programmes`] counts them).
