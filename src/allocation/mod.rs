@@ -38,6 +38,7 @@
 mod allocator;
 mod attainable;
 mod authority;
+mod authority_lp;
 mod conic;
 mod error;
 mod interior;
