@@ -23,7 +23,6 @@ mod common;
 use common::ALLOCS;
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::Matrix6xX;
-use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
 use usm_study::allocation::AuthoritySolver;
 use usm_study::kinematics::{centre_of_mass, forward_kinematics, thruster_matrix, KinWorkspace};
@@ -48,15 +47,7 @@ fn per_configuration(
 
 fn bench_authority(c: &mut Criterion) {
     let v = usm_paper();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
-    let qs: Vec<Vec<f64>> = (0..64)
-        .map(|_| {
-            v.joints
-                .iter()
-                .map(|j| rng.random_range(j.min..j.max))
-                .collect()
-        })
-        .collect();
+    let qs = common::random_configurations(&v, 23, 64);
     let (lo, hi): (Vec<f64>, Vec<f64>) = v.thrusters.iter().map(|t| (t.u_min, t.u_max)).unzip();
     let mut ws = KinWorkspace::new(&v);
     let mut t = Matrix6xX::zeros(v.n_thrusters());

@@ -22,7 +22,6 @@ mod common;
 use common::ALLOCS;
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::Matrix6xX;
-use rand::{Rng, SeedableRng};
 use std::sync::atomic::Ordering;
 use usm_study::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use usm_study::metrics::singularity::{
@@ -35,15 +34,7 @@ use usm_study::statics::{analyse, StaticSpec};
 fn bench_static(c: &mut Criterion) {
     let v = usm_paper();
     let l = v.characteristic_length();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-    let qs: Vec<Vec<f64>> = (0..64)
-        .map(|_| {
-            v.joints
-                .iter()
-                .map(|j| rng.random_range(j.min..j.max))
-                .collect()
-        })
-        .collect();
+    let qs = common::random_configurations(&v, 11, 64);
     let mut ws = KinWorkspace::new(&v);
     let ts: Vec<Matrix6xX<f64>> = qs
         .iter()

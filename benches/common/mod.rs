@@ -26,3 +26,19 @@ unsafe impl GlobalAlloc for Counting {
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
+
+/// `n` joint configurations of `v` drawn uniformly within its joint limits from `seed` (the
+/// static benches' workload: each iteration takes the next one).
+#[allow(dead_code)] // not every bench that shares this module samples configurations
+pub fn random_configurations(v: &usm_study::model::Vehicle, seed: u64, n: usize) -> Vec<Vec<f64>> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            v.joints
+                .iter()
+                .map(|j| rng.random_range(j.min..j.max))
+                .collect()
+        })
+        .collect()
+}
