@@ -293,7 +293,13 @@ fn commanded_sigma_matches_svd_over_random_configurations() {
         // Two selections at once (the static analysis' all-six and commanded rows) equal the
         // two single calls bit for bit.
         let g = ScaledGram::new(&t, l);
-        for pair in [[sets[0], sets[1]], [sets[1], sets[2]], [sets[2], sets[2]]] {
+        let pairs = [
+            [sets[0], sets[1]],
+            [sets[0], sets[0]],
+            [sets[1], sets[2]],
+            [sets[2], sets[2]],
+        ];
+        for pair in pairs {
             let both = commanded_extremes_pair_with(&g, &t, pair, DEFAULT_RANK_REL_TOL);
             for (got, dofs) in both.iter().zip(pair) {
                 let one = commanded_extremes_with(&g, &t, dofs, DEFAULT_RANK_REL_TOL);

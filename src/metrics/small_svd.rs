@@ -140,7 +140,7 @@ pub(crate) fn extreme_eigenvalues_pair(
     if ka <= 1 || kb <= 1 {
         return [extreme_eigenvalues(a, ka), extreme_eigenvalues(b, kb)];
     }
-    let (mut ta, mut tb) = (Tridiagonal::of(a, ka), Tridiagonal::of(b, kb));
+    let [mut ta, mut tb] = Tridiagonal::of_pair(a, ka, b, kb);
     let [ra, rb] = laguerre_extremes([&ta, &tb]);
     [ta.settle(ra), tb.settle(rb)]
 }
@@ -163,6 +163,23 @@ impl Tridiagonal {
         let mut d = [0.0; 6];
         let mut e = [0.0; 6];
         householder_tridiagonal(a, k, &mut d, &mut e);
+        Self::bounded(k, d, e)
+    }
+
+    /// [`Tridiagonal::of`] two blocks, the transport-mode pair (6 and 5 rows) and the all-six
+    /// pair by [`householder_pair`], equal to two calls bit for bit.
+    fn of_pair(a: &mut [[f64; 6]; 6], ka: usize, b: &mut [[f64; 6]; 6], kb: usize) -> [Self; 2] {
+        let (mut da, mut ea, mut db, mut eb) = ([0.0; 6], [0.0; 6], [0.0; 6], [0.0; 6]);
+        match (ka, kb) {
+            (6, 5) => householder_pair::<6, 5>(a, (&mut da, &mut ea), b, (&mut db, &mut eb)),
+            (6, 6) => householder_pair::<6, 6>(a, (&mut da, &mut ea), b, (&mut db, &mut eb)),
+            _ => return [Self::of(a, ka), Self::of(b, kb)],
+        }
+        [Self::bounded(ka, da, ea), Self::bounded(kb, db, eb)]
+    }
+
+    /// The tridiagonal `(d, e)` of `k` entries with the spectrum's bounds.
+    fn bounded(k: usize, d: [f64; 6], e: [f64; 6]) -> Self {
         let mut e2 = [0.0; 6];
         let (mut lo_bound, mut hi_bound) = (f64::INFINITY, f64::NEG_INFINITY);
         let mut scale = 0.0_f64;
@@ -323,53 +340,87 @@ fn householder_tridiagonal(a: &mut [[f64; 6]; 6], k: usize, d: &mut [f64; 6], e:
 /// `v = x − α e_1` unnormalised and `β = 2/(vᵀv) = 1/(‖x‖(‖x‖ + |x_1|))`.
 fn householder_k<const K: usize>(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6]) {
     for j in 0..K.saturating_sub(2) {
-        let lo = j + 1;
-        let mut norm2 = 0.0;
-        for i in lo..K {
-            norm2 += a[i][j] * a[i][j];
-        }
-        if norm2 == 0.0 {
-            e[j] = 0.0;
-            continue;
-        }
-        let norm = norm2.sqrt();
-        let alpha = if a[lo][j] > 0.0 { -norm } else { norm };
-        let mut v = [0.0; 6];
-        for i in lo..K {
-            v[i] = a[i][j];
-        }
-        v[lo] -= alpha;
-        let beta = 1.0 / (norm * (norm + a[lo][j].abs()));
-        // A ← H A H on the trailing block: p = β A v, q = p − (β vᵀp / 2) v,
-        // A ← A − v qᵀ − q vᵀ.
-        let mut p = [0.0; 6];
-        for i in lo..K {
-            let mut acc = 0.0;
-            for l in lo..K {
-                acc += a[i][l] * v[l];
-            }
-            p[i] = beta * acc;
-        }
-        let mut vp = 0.0;
-        for i in lo..K {
-            vp += v[i] * p[i];
-        }
-        let half = 0.5 * beta * vp;
-        for i in lo..K {
-            p[i] -= half * v[i];
-        }
-        // The block stays exactly symmetric (the Gram matrices are built so, and entry (l, i)
-        // gets the same two products summed the other way round, which rounds the same):
-        // update one triangle and mirror it.
-        for i in lo..K {
-            for l in i..K {
-                let x = a[i][l] - (v[i] * p[l] + p[i] * v[l]);
-                a[i][l] = x;
-                a[l][i] = x;
-            }
-        }
-        e[j] = alpha;
+        householder_step::<K>(a, j, e);
     }
+    householder_finish::<K>(a, d, e);
+}
+
+/// [`householder_k`] of two blocks (`KA×KA` of `a`, `KB×KB` of `b`), their reflections taken in
+/// turns so that the processor overlaps the two latency-bound chains (`sqrt`, division, the
+/// dot products); each block's operations are exactly those of its own call.
+fn householder_pair<const KA: usize, const KB: usize>(
+    a: &mut [[f64; 6]; 6],
+    ta: (&mut [f64; 6], &mut [f64; 6]),
+    b: &mut [[f64; 6]; 6],
+    tb: (&mut [f64; 6], &mut [f64; 6]),
+) {
+    for j in 0..KA.max(KB).saturating_sub(2) {
+        if j + 2 < KA {
+            householder_step::<KA>(a, j, ta.1);
+        }
+        if j + 2 < KB {
+            householder_step::<KB>(b, j, tb.1);
+        }
+    }
+    householder_finish::<KA>(a, ta.0, ta.1);
+    householder_finish::<KB>(b, tb.0, tb.1);
+}
+
+/// Reflection `j` of [`householder_k`]: zero column `j` below its subdiagonal, `e[j]` the
+/// subdiagonal entry.
+#[inline(always)]
+fn householder_step<const K: usize>(a: &mut [[f64; 6]; 6], j: usize, e: &mut [f64; 6]) {
+    let lo = j + 1;
+    let mut norm2 = 0.0;
+    for i in lo..K {
+        norm2 += a[i][j] * a[i][j];
+    }
+    if norm2 == 0.0 {
+        e[j] = 0.0;
+        return;
+    }
+    let norm = norm2.sqrt();
+    let alpha = if a[lo][j] > 0.0 { -norm } else { norm };
+    let mut v = [0.0; 6];
+    for i in lo..K {
+        v[i] = a[i][j];
+    }
+    v[lo] -= alpha;
+    let beta = 1.0 / (norm * (norm + a[lo][j].abs()));
+    // A ← H A H on the trailing block: p = β A v, q = p − (β vᵀp / 2) v,
+    // A ← A − v qᵀ − q vᵀ.
+    let mut p = [0.0; 6];
+    for i in lo..K {
+        let mut acc = 0.0;
+        for l in lo..K {
+            acc += a[i][l] * v[l];
+        }
+        p[i] = beta * acc;
+    }
+    let mut vp = 0.0;
+    for i in lo..K {
+        vp += v[i] * p[i];
+    }
+    let half = 0.5 * beta * vp;
+    for i in lo..K {
+        p[i] -= half * v[i];
+    }
+    // The block stays exactly symmetric (the Gram matrices are built so, and entry (l, i)
+    // gets the same two products summed the other way round, which rounds the same):
+    // update one triangle and mirror it.
+    for i in lo..K {
+        for l in i..K {
+            let x = a[i][l] - (v[i] * p[l] + p[i] * v[l]);
+            a[i][l] = x;
+            a[l][i] = x;
+        }
+    }
+    e[j] = alpha;
+}
+
+/// The diagonal and the last subdiagonal entry of [`householder_k`]'s reduced block.
+#[inline(always)]
+fn householder_finish<const K: usize>(a: &[[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6]) {
     for i in 0..K {
         d[i] = a[i][i];
     }
