@@ -201,16 +201,7 @@ fn straight_vehicle_runs_straight_at_the_drag_balance_speed() {
     // Σ ½ρ C_d,x πr² u² + Σ d_x u = 26.8 u² + 9 u balances 11.2 N at u = 0.500 m/s.
     let v = usm_paper();
     let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
-    let zero = [0.0; 8];
-    let thrust = [0.0, 0.0, 5.6, 5.6, 0.0, 0.0, 0.0];
-    let cmd = ActuatorCommand {
-        thrust: &thrust,
-        joint_ref: &zero,
-        joint_rate_ref: &zero,
-    };
-    for _ in 0..6000 {
-        sim.step(0.01, &cmd).unwrap();
-    }
+    cruise(&mut sim, 6000);
     let s = sim.state();
     assert!(
         (s.base_twist[0] - 0.500).abs() < 2e-3,
@@ -228,15 +219,34 @@ fn straight_vehicle_runs_straight_at_the_drag_balance_speed() {
 
     // Munk instability of the bare body (physical): a small yaw disturbance grows into a
     // steady turn instead of decaying, and the turn is to the side of the disturbance.
-    let mut st = sim.state().clone();
-    st.base_twist[5] = 0.02;
-    st.base_twist[1] = -0.02 * 1.65; // rotation about the centre
-    sim.set_state(st).unwrap();
-    for _ in 0..3000 {
-        sim.step(0.01, &cmd).unwrap();
-    }
+    disturb_yaw(&mut sim);
+    cruise(&mut sim, 3000);
     let r = sim.state().base_twist[5];
     assert!(r > 0.045 && r < 0.06, "yaw rate {r}");
+}
+
+/// `steps` × 0.01 s of the straight-running tests' command: 2 × 5.6 N from the longitudinal
+/// thrusters, the joints held straight.
+fn cruise(sim: &mut Simulator, steps: usize) {
+    let zero = [0.0; 8];
+    let thrust = [0.0, 0.0, 5.6, 5.6, 0.0, 0.0, 0.0];
+    let cmd = ActuatorCommand {
+        thrust: &thrust,
+        joint_ref: &zero,
+        joint_rate_ref: &zero,
+    };
+    for _ in 0..steps {
+        sim.step(0.01, &cmd).unwrap();
+    }
+}
+
+/// A 0.02 rad/s yaw-rate disturbance about the straight body's centre (1.65 m ahead of the
+/// base at the tail).
+fn disturb_yaw(sim: &mut Simulator) {
+    let mut st = sim.state().clone();
+    st.base_twist[5] = 0.02;
+    st.base_twist[1] = -0.02 * 1.65;
+    sim.set_state(st).unwrap();
 }
 
 #[test]
@@ -286,24 +296,10 @@ fn paper_with_lift(lift: f64) -> usm_study::model::Vehicle {
 fn disturbed(lift: f64, steps: usize) -> (f64, f64, f64) {
     let v = paper_with_lift(lift);
     let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
-    let zero = [0.0; 8];
-    let thrust = [0.0, 0.0, 5.6, 5.6, 0.0, 0.0, 0.0];
-    let cmd = ActuatorCommand {
-        thrust: &thrust,
-        joint_ref: &zero,
-        joint_rate_ref: &zero,
-    };
-    for _ in 0..6000 {
-        sim.step(0.01, &cmd).unwrap();
-    }
+    cruise(&mut sim, 6000);
     let u = sim.state().base_twist[0];
-    let mut st = sim.state().clone();
-    st.base_twist[5] = 0.02;
-    st.base_twist[1] = -0.02 * 1.65;
-    sim.set_state(st).unwrap();
-    for _ in 0..steps {
-        sim.step(0.01, &cmd).unwrap();
-    }
+    disturb_yaw(&mut sim);
+    cruise(&mut sim, steps);
     let s = sim.state();
     (u, s.base_twist[5], s.base_twist[1])
 }

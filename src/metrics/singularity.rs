@@ -438,8 +438,7 @@ pub fn commanded_extremes_with(
     rank_rel_tol: f64,
 ) -> SigmaExtremes {
     let k = dofs.len();
-    if !(g.valid && k > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO) {
-        // Invalid input, nothing commanded, or a rank tolerance the Gram route cannot certify.
+    if !extremes_route_applies(g, k, rank_rel_tol) {
         return commanded_sigma_with(g, t, dofs).extremes(rank_rel_tol);
     }
     let rows = selected_rows(dofs);
@@ -458,13 +457,22 @@ pub fn commanded_extremes_pair_with(
     rank_rel_tol: f64,
 ) -> [SigmaExtremes; 2] {
     let ks = dofs.map(CommandedDofs::len);
-    if !(g.valid && ks[0] > 0 && ks[1] > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO) {
+    if !ks
+        .iter()
+        .all(|&k| extremes_route_applies(g, k, rank_rel_tol))
+    {
         return dofs.map(|d| commanded_extremes_with(g, t, d, rank_rel_tol));
     }
     let rows = dofs.map(selected_rows);
     let (mut ga, mut gb) = (g.select(&rows[0], ks[0]), g.select(&rows[1], ks[1]));
     let ev = extreme_eigenvalues_pair(&mut ga, ks[0], &mut gb, ks[1]);
     std::array::from_fn(|i| extremes_from(g, t, &rows[i], ks[i], ev[i], rank_rel_tol))
+}
+
+/// Whether [`commanded_extremes_with`]'s Gram route may score `k` commanded rows of `g`: not
+/// for invalid input, nothing commanded, or a rank tolerance the route cannot certify.
+fn extremes_route_applies(g: &ScaledGram, k: usize, rank_rel_tol: f64) -> bool {
+    g.valid && k > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO
 }
 
 /// The [`SigmaExtremes`] of the rows `rows[..k]` whose Gram block has the extreme eigenvalues
