@@ -96,7 +96,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .and_then(|b| b.parse().ok())
         .unwrap_or(DEFAULT_BUDGET);
     let chosen = std::env::var("SOLVERS").ok();
-    // (label, settings, seeds): Nelder–Mead is deterministic, the others get three seeds.
+    // DESIGNS=nine: the 9 designs of the first table (offset 0.10 m, links 3/5/7); default all.
+    let nine = std::env::var("DESIGNS").is_ok_and(|d| d == "nine");
+    // SHARD=i/n: only the cases whose id is i modulo n (to split the work across processes).
+    let shard = std::env::var("SHARD")
+        .ok()
+        .and_then(|s| {
+            let (i, n) = s.split_once('/')?;
+            Some((i.parse::<usize>().ok()?, n.parse::<usize>().ok()?))
+        })
+        .filter(|(i, n)| i < n)
+        .unwrap_or((0, 1));
+    // SEEDS: seeds per seeded solver (default 3).
+    let seeds: u64 = std::env::var("SEEDS")
+        .ok()
+        .and_then(|b| b.parse().ok())
+        .unwrap_or(3);
+    // REFERENCE_SWARM=0 leaves the 300-evaluation swarm out of the reference search.
+    let swarm_ref = std::env::var("REFERENCE_SWARM").map_or(true, |v| v != "0");
+    // (label, settings, seeds): Nelder–Mead is deterministic, the others get `SEEDS`.
     let mut solvers: Vec<(&str, SolverSettings, u64)> = vec![
         (
             "nelder-mead",
@@ -106,21 +124,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (
             "particle-swarm",
             settings(Method::ParticleSwarm, budget, 0, 0.1, seed),
-            3,
+            seeds,
         ),
-        ("cmaes", settings(Method::Cmaes, budget, 3, 0.3, seed), 3),
+        (
+            "cmaes",
+            settings(Method::Cmaes, budget, 3, 0.3, seed),
+            seeds,
+        ),
         (
             "cmaes-0.2",
             settings(Method::Cmaes, budget, 3, 0.2, seed),
-            3,
+            seeds,
         ),
-        ("bayes", settings(Method::Bayes, budget, 0, 0.1, seed), 3),
+        (
+            "bayes",
+            settings(Method::Bayes, budget, 0, 0.1, seed),
+            seeds,
+        ),
     ];
     if let Some(list) = &chosen {
         solvers.retain(|(name, _, _)| list.split(',').any(|c| c.trim() == *name));
     }
-    let mut csv =
-        String::from("design,solver,seed,evaluations,best,best_at_30,reference,evals_to_1pct\n");
+    let mut csv = String::from(
+        "design,solver,seed,evaluations,best,best_at_30,reference,evals_to_1pct,seconds\n",
+    );
     let mut hits: Vec<(String, Option<usize>, f64)> = Vec::new();
     let t0 = Instant::now();
     for case in &cases {
@@ -132,10 +159,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .unwrap_or_default(),
             case.values[2].as_float().unwrap_or_default(),
         );
-        if ![3, 5, 7].contains(&links) || (offset - 0.10).abs() > 1e-9 {
+        if nine && (![3, 5, 7].contains(&links) || (offset - 0.10).abs() > 1e-9) {
             continue;
         }
-        let design = format!("{rule}-{links}");
+        if case.id % shard.1 != shard.0 {
+            continue;
+        }
+        let design = if nine {
+            format!("{rule}-{links}")
+        } else {
+            format!("{rule}-{links}-{offset:.2}")
+        };
         let r = resolve_case(&study, case)?;
         let problem = tuner.case_problem(&study, &r);
         let ev = CaseEvaluator::new(&problem).for_case(case.id, Deadline::NONE);
@@ -153,6 +187,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut runs = Vec::new();
         for (name, s, seeds) in &solvers {
             for k in 0..*seeds {
+                let t = Instant::now();
                 let o = run(
                     SolverSettings {
                         seed: s.seed + k,
@@ -160,20 +195,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     },
                     None,
                 )?;
-                runs.push((*name, k, curve(&o.records), o.best().x.clone()));
+                let secs = t.elapsed().as_secs_f64();
+                runs.push((*name, k, curve(&o.records), o.best().x.clone(), secs));
             }
         }
         // The reference: the best of every run above, a 300-evaluation swarm, and a
         // Nelder–Mead polish (120 evaluations, restarts) from the best point found.
-        let swarm = run(
-            settings(Method::ParticleSwarm, 300, 0, 0.1, seed ^ 0xA5),
-            None,
-        )?;
-        let mut best_x = swarm.best().x.clone();
-        if swarm.best().score.feasible {
-            reference = swarm.best().score.objective;
+        let mut best_x = problem.spec.space.params.iter().map(|p| p.start).collect();
+        if swarm_ref {
+            let swarm = run(
+                settings(Method::ParticleSwarm, 300, 0, 0.1, seed ^ 0xA5),
+                None,
+            )?;
+            if swarm.best().score.feasible {
+                reference = swarm.best().score.objective;
+                best_x = swarm.best().x.clone();
+            }
         }
-        for (_, _, c, x) in &runs {
+        for (_, _, c, x, _) in &runs {
             if let Some(b) = c.last().filter(|b| b.is_finite() && **b < reference) {
                 reference = *b;
                 best_x = x.clone();
@@ -192,13 +231,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             eprintln!("{design:16} no feasible point in any run: left out");
             continue;
         }
-        for (name, k, c, _) in &runs {
+        for (name, k, c, _, secs) in &runs {
             let hit = c.iter().position(|b| *b <= reference * 1.01).map(|i| i + 1);
             let best = c.last().copied().unwrap_or(f64::NAN);
             let at30 = c.get(29).or(c.last()).copied().unwrap_or(f64::NAN);
             writeln!(
                 csv,
-                "{design},{name},{k},{},{best},{at30},{reference},{}",
+                "{design},{name},{k},{},{best},{at30},{reference},{},{secs:.2}",
                 c.len(),
                 hit.map_or("".into(), |h| h.to_string())
             )?;
@@ -208,11 +247,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             hits.push((name.to_string(), hit, at30 / reference - 1.0));
         }
         eprintln!("  ({:.0} s so far)", t0.elapsed().as_secs_f64());
+        std::fs::write(&out, &csv)?;
     }
     std::fs::write(&out, csv)?;
     eprintln!("wrote {out} in {:.0} s", t0.elapsed().as_secs_f64());
-    println!("| solver | runs | reached 1 % within {budget} | median | 90th percentile | median gap at 30 |");
-    println!("|---|---|---|---|---|---|");
+    println!("| solver | runs | reached 1 % within 40 | within {budget} | median | 90th percentile | median gap at 30 |");
+    println!("|---|---|---|---|---|---|---|");
     let show = |x: Option<usize>| x.map_or(format!("> {budget}"), |v| v.to_string());
     for (name, _, _) in &solvers {
         let h: Vec<Option<usize>> = hits.iter().filter(|x| x.0 == *name).map(|x| x.1).collect();
@@ -220,8 +260,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gaps.sort_by(|a, b| a.total_cmp(b));
         let gap = gaps.get(gaps.len() / 2).copied().unwrap_or(f64::NAN);
         println!(
-            "| {name} | {} | {} | {} | {} | {:.1} % |",
+            "| {name} | {} | {} | {} | {} | {} | {:.1} % |",
             h.len(),
+            h.iter().filter(|x| x.is_some_and(|v| v <= 40)).count(),
             h.iter().filter(|x| x.is_some()).count(),
             show(quantile(&h, 0.5)),
             show(quantile(&h, 0.9)),

@@ -155,6 +155,33 @@ fn tuned_sweep_rows_carry_tuned_values_and_do_not_depend_on_jobs_or_resume() {
     assert!(md.contains("`control.k_psi` = "), "{md}");
 }
 
+/// One design tuned in three independent starts: the starts run side by side when threads
+/// are free (issue 23 item 3), and the row, the tuning noise and the summary are the same as
+/// when they run one after another.
+#[test]
+fn tuning_starts_side_by_side_give_the_one_thread_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!("{BASE}{TUNE}")
+        .replace("values = [3, 4]", "values = [4]")
+        .replace("[tune]\n", "[tune]\nstarts = 3\n")
+        .replace("max_evals = 6", "max_evals = 9");
+    let study = write(dir.path(), "starts.toml", &text);
+    let (j1, j2) = (dir.path().join("j1"), dir.path().join("j2"));
+    sweep(&study, &j1, &["--jobs", "1"]);
+    sweep(&study, &j2, &["--jobs", "2"]);
+    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
+    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
+    let (head, rows) = table(&j1);
+    assert_eq!(rows.len(), 1);
+    // Three starts of three evaluations each; their spread is the tuning noise.
+    let evals = column(&head, &rows, "tune_evaluations");
+    assert!(evals[0] > 3.0 && evals[0] <= 9.0, "{evals:?}");
+    let noise = column(&head, &rows, "tune_noise");
+    assert!(noise[0].is_finite() && noise[0] >= 0.0, "{noise:?}");
+    let summary = |d: &Path| std::fs::read_to_string(d.join("summary.md")).unwrap();
+    assert_eq!(summary(&j1), summary(&j2));
+}
+
 #[test]
 fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
     let dir = tempfile::tempdir().unwrap();

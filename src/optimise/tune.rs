@@ -28,6 +28,7 @@ use crate::study::doe::Case;
 use crate::study::error::InputError;
 use crate::study::schema::{Study, Target};
 use crate::study::tune::{CaseTuner, TuneError, Tuned, TuningHook};
+use rayon::prelude::*;
 
 /// The hook wiring this tuner into sweeps, merges and reports.
 pub const HOOK: TuningHook = TuningHook(boxed);
@@ -170,16 +171,30 @@ impl CaseTuner for Tuner {
         )
         .map_err(TuneError::from_error)?;
         spec.solver.max_evals = self.spec.solver.max_evals / self.starts;
-        let (mut best, mut bests, mut curve, mut evaluations) = (None, Vec::new(), Vec::new(), 0);
-        for k in 0..self.starts {
-            if k > 0 {
-                let mut u = vec![0.0; d];
-                sobol.point(k - 1, &mut u);
-                for (p, u) in spec.space.params.iter_mut().zip(&u) {
-                    p.start = p.value(*u);
+        // The starts' points depend only on the Sobol stream, so the starts are independent
+        // runs: side by side (a case tuned last, or alone, keeps every thread busy), their
+        // outcomes combined in start order so nothing depends on the thread count.
+        let specs: Vec<_> = (0..self.starts)
+            .map(|k| {
+                let mut s = spec.clone();
+                if k > 0 {
+                    let mut u = vec![0.0; d];
+                    sobol.point(k - 1, &mut u);
+                    for (p, u) in s.space.params.iter_mut().zip(&u) {
+                        p.start = p.value(*u);
+                    }
                 }
-            }
-            let out = minimise(&spec, &ev, &study.hash, &opts).map_err(TuneError::from_error)?;
+                s
+            })
+            .collect();
+        let outs: Vec<_> = specs
+            .par_iter()
+            .with_max_len(1)
+            .map(|s| minimise(s, &ev, &study.hash, &opts))
+            .collect();
+        let (mut best, mut bests, mut curve, mut evaluations) = (None, Vec::new(), Vec::new(), 0);
+        for out in outs {
+            let out = out.map_err(TuneError::from_error)?;
             evaluations += out.fresh_evaluations();
             best_so_far(&out.records, &mut curve);
             // Each start normalises its objective by its own start point: compare starts by
