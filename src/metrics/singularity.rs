@@ -326,10 +326,9 @@ impl ScaledGram {
     /// non-finite `t`).
     pub fn new(t: &Matrix6xX<f64>, char_length: f64) -> Self {
         let valid = char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite());
-        let all = selected_rows(CommandedDofs::ALL);
         Self {
             gram: if valid {
-                commanded_gram(t, char_length, &all, 6)
+                full_gram(t, char_length)
             } else {
                 [[0.0; 6]; 6]
             },
@@ -340,6 +339,10 @@ impl ScaledGram {
 
     /// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]`.
     fn select(&self, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
+        if k == 6 {
+            // Six rows of six are all of them, in order.
+            return self.gram;
+        }
         let mut g = [[0.0; 6]; 6];
         for (ga, &ra) in g.iter_mut().zip(rows).take(k) {
             for (gab, &rb) in ga.iter_mut().zip(rows).take(k) {
@@ -548,6 +551,7 @@ pub fn weakest_direction_with(g: &ScaledGram, dofs: CommandedDofs, sigma_min: f6
 }
 
 /// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]` (moments divided by `l`).
+#[cfg(test)]
 #[allow(clippy::needless_range_loop)] // a symmetric fill reads clearest with indices
 fn commanded_gram(t: &Matrix6xX<f64>, l: f64, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
     let mut gram = [[0.0; 6]; 6];
@@ -560,6 +564,28 @@ fn commanded_gram(t: &Matrix6xX<f64>, l: f64, rows: &[usize; 6], k: usize) -> [[
         }
     }
     for a in 0..k {
+        for b in 0..a {
+            gram[b][a] = gram[a][b];
+        }
+    }
+    gram
+}
+
+/// [`commanded_gram`] of all six rows with the row count and order known at compile time:
+/// the same operations in the same order (so the same bits), unrolled.
+#[allow(clippy::needless_range_loop)] // a symmetric fill reads clearest with indices
+fn full_gram(t: &Matrix6xX<f64>, l: f64) -> [[f64; 6]; 6] {
+    let mut gram = [[0.0; 6]; 6];
+    for col in t.column_iter() {
+        let c = col.as_slice();
+        let x = [c[0], c[1], c[2], c[3] / l, c[4] / l, c[5] / l];
+        for a in 0..6 {
+            for b in 0..=a {
+                gram[a][b] += x[a] * x[b];
+            }
+        }
+    }
+    for a in 0..6 {
         for b in 0..a {
             gram[b][a] = gram[a][b];
         }

@@ -474,3 +474,31 @@ fn tridiagonal_eigenvalues_match_nalgebra() {
         }
     }
 }
+
+/// The unrolled Gram matrix of all six rows is the generic one's, bit for bit (so the static
+/// analysis' outputs did not move when it was unrolled), and selecting all six rows returns it.
+#[test]
+fn full_gram_is_the_generic_gram_bit_for_bit() {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut unit = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let all = selected_rows(CommandedDofs::ALL);
+    for n in [1, 5, 7, 9, 16] {
+        for _ in 0..50 {
+            let t = Matrix6xX::from_fn(n, |_, _| 40.0 * unit());
+            let l = 0.5 + unit().abs() * 3.0;
+            let (a, b) = (full_gram(&t, l), commanded_gram(&t, l, &all, 6));
+            for i in 0..6 {
+                for j in 0..6 {
+                    assert_eq!(a[i][j].to_bits(), b[i][j].to_bits(), "n {n} ({i},{j})");
+                }
+            }
+            let g = ScaledGram::new(&t, l);
+            assert_eq!(g.select(&all, 6), b);
+        }
+    }
+}
