@@ -11,7 +11,8 @@
 //! objective is normalised at the case's own start point. Reported: the evaluations (simulated
 //! runs, the start included) each run needs to come within 1 % of the reference with a
 //! feasible point, its gap to the reference after 30 evaluations and at the end, and its
-//! seconds. A design with no feasible point in any run is left out. One thread per process,
+//! seconds. A design with no feasible point in any run, or one that cannot reach the mission (the sweep
+//! tunes neither), is left out. One thread per process,
 //! deterministic; `SHARD=i/n` runs the cases whose id is `i` modulo `n` (one process per core).
 //!
 //! ```sh
@@ -30,7 +31,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use usm_study::evaluate::Deadline;
+use usm_study::evaluate::{out_of_reach, Deadline};
 use usm_study::optimise::evaluate::CaseEvaluator;
 use usm_study::optimise::history::Record;
 use usm_study::optimise::problem::{Method, SolverSettings};
@@ -180,6 +181,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             format!("{rule}-{links}-{offset:.2}")
         };
         let r = resolve_case(&study, case)?;
+        // The sweep neither tunes nor scores a design that cannot reach the mission: its
+        // tuning problem has no feasible point.
+        if out_of_reach(&r.design, &r.scenario, &study.name) {
+            eprintln!("{design:16} cannot reach the mission: left out");
+            continue;
+        }
         let problem = tuner.case_problem(&study, &r);
         let ev = CaseEvaluator::new(&problem).for_case(case.id, Deadline::NONE);
         let run = |s: SolverSettings, start: Option<&[f64]>| {
