@@ -174,19 +174,7 @@ impl CaseTuner for Tuner {
         // The starts' points depend only on the Sobol stream, so the starts are independent
         // runs: side by side (a case tuned last, or alone, keeps every thread busy), their
         // outcomes combined in start order so nothing depends on the thread count.
-        let specs: Vec<_> = (0..self.starts)
-            .map(|k| {
-                let mut s = spec.clone();
-                if k > 0 {
-                    let mut u = vec![0.0; d];
-                    sobol.point(k - 1, &mut u);
-                    for (p, u) in s.space.params.iter_mut().zip(&u) {
-                        p.start = p.value(*u);
-                    }
-                }
-                s
-            })
-            .collect();
+        let specs = start_specs(&spec, self.starts, &sobol);
         let outs: Vec<_> = specs
             .par_iter()
             .with_max_len(1)
@@ -245,6 +233,30 @@ impl CaseTuner for Tuner {
     }
 }
 
+/// The specs of a tuning's `starts` independent starts: start 0 from `spec` as it is, start
+/// `k > 0` from the `k−1`-th point of `sobol` (the unit box of the parameters) and, for a
+/// seeded solver (swarm, CMA-ES, Bayesian optimisation), its own seed `derive_seed(seed, k)`.
+/// With the study's seed in every start, Bayesian optimisation drew the same Latin hypercube
+/// in each and its tuning noise (the spread of the starts' bests) read 0; Nelder–Mead uses no
+/// seed, so its tunings are unchanged.
+fn start_specs(spec: &Spec, starts: usize, sobol: &Sampler) -> Vec<Spec> {
+    let d = spec.space.dim();
+    (0..starts)
+        .map(|k| {
+            let mut s = spec.clone();
+            if k > 0 {
+                s.solver.seed = derive_seed(spec.solver.seed, k as u64);
+                let mut u = vec![0.0; d];
+                sobol.point(k - 1, &mut u);
+                for (p, u) in s.space.params.iter_mut().zip(&u) {
+                    p.start = p.value(*u);
+                }
+            }
+            s
+        })
+        .collect()
+}
+
 /// Append the best feasible objective so far after each fresh evaluation of `records` to
 /// `curve` (NaN until one is feasible); a later start carries the earlier starts' best on.
 fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
@@ -301,7 +313,39 @@ fn case_value(target: &Target, r: &Resolved) -> Option<f64> {
 mod tests {
     use super::super::problem::{Combine, Objective, Term};
     use super::super::score::{Score, Scorer};
-    use super::{raw_objective, Record};
+    use super::{raw_objective, start_specs, Record, Tuner};
+    use crate::sampling::{Sampler, Sampling};
+
+    /// Independent starts are independent for seeded solvers too: each start after the first
+    /// has its own seed (before, Bayesian optimisation drew the same Latin hypercube in every
+    /// start and its tuning noise read 0), while start 0 keeps the study's seed and start
+    /// point, so a one-start tuning and Nelder–Mead (no seed) are unchanged.
+    #[test]
+    fn each_tuning_start_after_the_first_has_its_own_seed_and_start_point() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/thrusters.toml");
+        let study = crate::study::parse::load_study(&path).unwrap();
+        let tuner = Tuner::new(&study).unwrap().unwrap();
+        let spec = &tuner.spec;
+        let d = spec.space.dim();
+        let sobol = Sampler::new(Sampling::Sobol, 3, d, 11).unwrap();
+        let specs = start_specs(spec, 4, &sobol);
+        assert_eq!(specs.len(), 4);
+        assert_eq!(specs[0].solver.seed, spec.solver.seed);
+        let starts = |s: &super::Spec| s.space.params.iter().map(|p| p.start).collect::<Vec<_>>();
+        assert_eq!(starts(&specs[0]), starts(spec));
+        for (i, a) in specs.iter().enumerate() {
+            for b in &specs[i + 1..] {
+                assert_ne!(a.solver.seed, b.solver.seed);
+                assert_ne!(starts(a), starts(b));
+            }
+            for p in &a.space.params {
+                assert!(p.start >= p.lower && p.start <= p.upper, "{}: {}", p.name, p.start);
+            }
+            // Only the seed and the start point differ between starts.
+            assert_eq!(a.solver.max_evals, spec.solver.max_evals);
+            assert_eq!(a.solver.method, spec.solver.method);
+        }
+    }
 
     #[test]
     fn starts_normalised_at_different_points_compare_by_their_raw_objective() {
