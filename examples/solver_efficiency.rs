@@ -27,6 +27,8 @@
 //! `SOLVERS` (comma-separated labels: nelder-mead, particle-swarm, cmaes, cmaes-0.2, bayes;
 //! default all) and `BUDGET` (evaluations per run, default 120) cut the work.
 
+mod common;
+
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -107,14 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // DESIGNS=nine: the 9 designs of the first table (offset 0.10 m, links 3/5/7); default all.
     let nine = std::env::var("DESIGNS").is_ok_and(|d| d == "nine");
     // SHARD=i/n: only the cases whose id is i modulo n (to split the work across processes).
-    let shard = std::env::var("SHARD")
-        .ok()
-        .and_then(|s| {
-            let (i, n) = s.split_once('/')?;
-            Some((i.parse::<usize>().ok()?, n.parse::<usize>().ok()?))
-        })
-        .filter(|(i, n)| i < n)
-        .unwrap_or((0, 1));
+    let shard = common::shard()?;
     // SEEDS: seeds per seeded solver (default 3).
     let seeds: u64 = std::env::var("SEEDS")
         .ok()
@@ -161,14 +156,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut hits: Vec<(String, Option<usize>, f64)> = Vec::new();
     let t0 = Instant::now();
     for case in &cases {
-        let (rule, links, offset) = (
-            case.values[0].as_str().unwrap_or_default().to_string(),
-            case.values[1]
-                .as_integer()
-                .or(case.values[1].as_float().map(|v| v as i64))
-                .unwrap_or_default(),
-            case.values[2].as_float().unwrap_or_default(),
-        );
+        let (rule, links, offset) = common::design_axes(case);
         if nine && (![3, 5, 7].contains(&links) || (offset - 0.10).abs() > 1e-9) {
             continue;
         }

@@ -15,6 +15,8 @@
 //! `nelder-mead:3x25,particle-swarm:3x25,bayes:3x25,bayes:1x75`); `SHARD=i/n` takes the cases
 //! whose id is `i` modulo `n`.
 
+mod common;
+
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -31,30 +33,29 @@ use usm_study::study::tune::CaseTuner;
 
 const STUDY: &str = "studies/thrusters.toml";
 
-/// The study's text with `[tune] starts` and `[tune.solver]` set for one protocol.
+/// The study's text with `[tune] starts` and the keys of `[tune.solver]` (up to the blank line
+/// that ends the section) set for one protocol; `None` when the study has no such sections.
 fn protocol_text(text: &str, method: &str, starts: usize, evals: usize) -> Option<String> {
-    let starts_line = "[tune]\nstarts = 3\n";
-    let solver = "[tune.solver]\nmethod = \"nelder-mead\"\nmax_evals = 75\nstep = 0.2\n";
-    if !text.contains(starts_line) || !text.contains(solver) {
-        return None;
-    }
+    let starts_line = "[tune]\nstarts = ";
+    let a = text.find(starts_line)? + starts_line.len();
+    let a_end = a + text[a..].find('\n')?;
+    let solver = "[tune.solver]\n";
+    let b = text.find(solver)? + solver.len();
+    let b_end = text[b..].find("\n\n").map_or(text.len(), |e| b + e + 1);
     // Each solver with the settings of examples/solver_efficiency.rs: Nelder–Mead's step is
-    // the study's own, the swarm has 12 particles, the others their defaults.
+    // the study's own (0.2), the swarm has 12 particles, the others their defaults.
     let extra = match method {
         "nelder-mead" => "step = 0.2\n",
         "particle-swarm" => "particles = 12\n",
         _ => "",
     };
-    Some(
-        text.replace(starts_line, &format!("[tune]\nstarts = {starts}\n"))
-            .replace(
-                solver,
-                &format!(
-                    "[tune.solver]\nmethod = \"{method}\"\nmax_evals = {}\n{extra}",
-                    starts * evals
-                ),
-            ),
-    )
+    Some(format!(
+        "{}{starts}{}method = \"{method}\"\nmax_evals = {}\n{extra}{}",
+        &text[..a],
+        &text[a_end..b],
+        starts * evals,
+        &text[b_end..]
+    ))
 }
 
 /// Mean over the scenario rows of metric column `c`.
@@ -94,14 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect::<Option<_>>()
         .ok_or("PROTOCOLS: method:STARTSxEVALS, comma-separated")?;
-    let shard = std::env::var("SHARD")
-        .ok()
-        .and_then(|s| {
-            let (i, n) = s.split_once('/')?;
-            Some((i.parse::<usize>().ok()?, n.parse::<usize>().ok()?))
-        })
-        .filter(|(i, n)| i < n)
-        .unwrap_or((0, 1));
+    let shard = common::shard()?;
     let text = std::fs::read_to_string(STUDY)?;
     let mut csv =
         String::from("design,protocol,evaluations,feasible,tuned,reference,gap,noise,seconds\n");
@@ -109,19 +103,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (method, starts, evals) in &protocols {
         let label = format!("{method}:{starts}x{evals}");
         let t = protocol_text(&text, method, *starts, *evals)
-            .ok_or("studies/thrusters.toml's [tune] is not the one this harness edits")?;
+            .ok_or("studies/thrusters.toml has no `[tune] starts = …` or no [tune.solver]")?;
         let study = parse_study(&t, Path::new(STUDY))?;
         let tuner = Tuner::new(&study)?.ok_or("no [tune]")?;
         for case in expand(&study, None)? {
             if case.id % shard.1 != shard.0 {
                 continue;
             }
-            let rule = case.values[0].as_str().unwrap_or_default();
-            let links = case.values[1]
-                .as_integer()
-                .or(case.values[1].as_float().map(|v| v as i64))
-                .unwrap_or_default();
-            let offset = case.values[2].as_float().unwrap_or_default();
+            let (rule, links, offset) = common::design_axes(&case);
             let design = format!("{rule}-{links}-{offset:.2}");
             let Some(&reference) = reference.get(&design) else {
                 continue;

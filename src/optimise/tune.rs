@@ -339,7 +339,12 @@ mod tests {
                 assert_ne!(starts(a), starts(b));
             }
             for p in &a.space.params {
-                assert!(p.start >= p.lower && p.start <= p.upper, "{}: {}", p.name, p.start);
+                assert!(
+                    p.start >= p.lower && p.start <= p.upper,
+                    "{}: {}",
+                    p.name,
+                    p.start
+                );
             }
             // Only the seed and the start point differ between starts.
             assert_eq!(a.solver.max_evals, spec.solver.max_evals);
