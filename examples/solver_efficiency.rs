@@ -11,9 +11,9 @@
 //! objective is normalised at the case's own start point. Reported: the evaluations (simulated
 //! runs, the start included) each run needs to come within 1 % of the reference with a
 //! feasible point, its gap to the reference after 30 evaluations and at the end, and its
-//! seconds. A design with no feasible point in any run, or one that cannot reach the mission (the sweep
-//! tunes neither), is left out. One thread per process,
-//! deterministic; `SHARD=i/n` runs the cases whose id is `i` modulo `n` (one process per core).
+//! seconds. A design with no feasible point in any run, or one that cannot reach the mission
+//! (the sweep tunes neither), is left out. One thread per process, deterministic; `SHARD=i/n`
+//! runs the cases whose id is `i` modulo `n` (one process per core).
 //!
 //! ```sh
 //! cargo run --release --example solver_efficiency [OUT.csv]   # default benches/solver_efficiency.csv

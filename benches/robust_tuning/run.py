@@ -18,14 +18,14 @@ tuned against perturbed worlds too: for each (design, tuning seed) it
     cargo build --release
     python3 benches/robust_tuning/run.py [--bin target/release/usm-study] [--out /tmp/robust]
 
-Prints one row per run and writes results.csv in the output folder. About 40 s per row on one
+Prints one row per run and writes results.csv in the output folder. Nothing is deleted: a
+rerun overwrites the files the tool wrote in its own `optimise-*` and `score-*` folders. About 40 s per row on one
 core (75 evaluations x 8 worlds of the 140 s scenario, then the scoring sweep).
 """
 import argparse
 import csv
 import os
 import re
-import shutil
 import subprocess
 import sys
 
@@ -93,7 +93,6 @@ def main():
             p = os.path.join(a.out, f"problem-{tag}.toml")
             open(p, "w").write(problem(src, rule, links, off, seed, WORLDS))
             o = os.path.join(a.out, f"optimise-{tag}")
-            shutil.rmtree(o, ignore_errors=True)
             r = subprocess.run([a.bin, "optimise", p, "--out", o, "--no-plots", "--jobs", "1"],
                                capture_output=True, text=True)
             if r.returncode != 0:
@@ -104,7 +103,6 @@ def main():
             sp = os.path.join(a.out, f"score-{tag}.toml")
             open(sp, "w").write(scoring(src, rule, links, off, gains))
             so = os.path.join(a.out, f"score-{tag}")
-            shutil.rmtree(so, ignore_errors=True)
             r = subprocess.run([a.bin, "sweep", sp, "--out", so], capture_output=True, text=True)
             if r.returncode != 0:
                 sys.exit(f"sweep {sp}: {r.stderr}")
