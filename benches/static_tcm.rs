@@ -24,9 +24,9 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughpu
 use nalgebra::Matrix6xX;
 use std::sync::atomic::Ordering;
 use usm_study::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
+use usm_study::metrics::extremes::commanded_extremes_with;
 use usm_study::metrics::singularity::{
-    commanded_extremes_with, commanded_sigma, tcm_svd_metrics, CommandedDofs, ScaledGram,
-    DEFAULT_RANK_REL_TOL,
+    commanded_sigma, tcm_svd_metrics, CommandedDofs, ScaledGram, DEFAULT_RANK_REL_TOL,
 };
 use usm_study::model::presets::usm_paper;
 use usm_study::statics::{analyse, StaticSpec};

@@ -4,6 +4,7 @@
 //! integrals of a trajectory ([`trajectory`]). A run's summary and success checks, which read
 //! scenario types, are in [`crate::outcome`].
 
+pub mod extremes;
 pub mod singularity;
 mod small_svd;
 pub mod trajectory;

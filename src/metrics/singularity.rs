@@ -13,8 +13,8 @@ use nalgebra::{Matrix6xX, Vector6};
 use serde::Serialize;
 
 use super::small_svd::{
-    extreme_eigenvalues, extreme_eigenvalues_pair, givens_add_row, min_max, one_sided_jacobi_sq,
-    shifted_inverse_iteration, tridiagonal_eigenvalues,
+    givens_add_row, min_max, one_sided_jacobi_sq, shifted_inverse_iteration,
+    tridiagonal_eigenvalues,
 };
 use crate::allocation::{attainable_wrench, AllocError, AttainableWrench};
 
@@ -272,7 +272,7 @@ impl CommandedSigma {
 }
 
 /// `σ_max/σ_min`, `+inf` unless `σ_min > 0`.
-fn condition(sigma_max: f64, sigma_min: f64) -> f64 {
+pub(super) fn condition(sigma_max: f64, sigma_min: f64) -> f64 {
     if sigma_min > 0.0 {
         sigma_max / sigma_min
     } else {
@@ -318,27 +318,40 @@ pub struct ScaledGram {
     gram: [[f64; 6]; 6],
     char_length: f64,
     /// L finite and > 0 and every entry of `T` finite.
-    valid: bool,
+    pub(super) valid: bool,
 }
 
 impl ScaledGram {
     /// The Gram matrix of `t` scaled by `char_length` (zero, and invalid, for a bad L or a
-    /// non-finite `t`).
+    /// non-finite `t`, or a `t` so large that the sums of squares overflow).
     pub fn new(t: &Matrix6xX<f64>, char_length: f64) -> Self {
-        let valid = char_length.is_finite() && char_length > 0.0 && t.iter().all(|x| x.is_finite());
+        let l_ok = char_length.is_finite() && char_length > 0.0;
+        let mut gram = if l_ok {
+            full_gram(t, char_length)
+        } else {
+            [[0.0; 6]; 6]
+        };
+        // A non-finite entry of `t` makes its row's diagonal entry (a sum of squares) infinite
+        // or NaN, so the six diagonal entries stand for the 6·n entries of `t`.
+        let valid = l_ok && (0..6).all(|i| gram[i][i].is_finite());
+        if !valid {
+            gram = [[0.0; 6]; 6];
+        }
         Self {
-            gram: if valid {
-                full_gram(t, char_length)
-            } else {
-                [[0.0; 6]; 6]
-            },
+            gram,
             char_length,
             valid,
         }
     }
 
+    /// The whole Gram matrix with its rows and columns in the order `order` (a permutation of
+    /// `0..6`).
+    pub(super) fn permuted(&self, order: &[usize; 6]) -> [[f64; 6]; 6] {
+        std::array::from_fn(|a| std::array::from_fn(|b| self.gram[order[a]][order[b]]))
+    }
+
     /// The `k×k` Gram matrix `S T_L T_Lᵀ Sᵀ` of the rows `rows[..k]`.
-    fn select(&self, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
+    pub(super) fn select(&self, rows: &[usize; 6], k: usize) -> [[f64; 6]; 6] {
         if k == 6 {
             // Six rows of six are all of them, in order.
             return self.gram;
@@ -389,7 +402,7 @@ pub fn commanded_sigma_with(
 
 /// The [`CommandedSigma`] of `k` squared singular values `ev[..k]` (any order; negative
 /// rounding clipped to 0).
-fn from_squares(ev: &[f64; 6], k: usize) -> CommandedSigma {
+pub(super) fn from_squares(ev: &[f64; 6], k: usize) -> CommandedSigma {
     let mut sv = [0.0; 6];
     for (s, e) in sv.iter_mut().zip(&ev[..k]) {
         *s = e.max(0.0).sqrt();
@@ -421,90 +434,15 @@ pub struct SigmaExtremes {
     pub rank: usize,
 }
 
-/// Below this ratio `λ_min/λ_max` (κ > 1000) [`commanded_extremes_with`] leaves the Gram
-/// route: its σ_min then carries a relative error up to about `ε κ²/2` ≤ 5.6e-11, within
-/// the static analysis' 1e-10 (a hundredfold looser than [`GRAM_MIN_RATIO`]'s, for a third
-/// fewer trips through the QR + Jacobi route on the paper's design).
-pub const EXTREMES_MIN_RATIO: f64 = 1e-6;
-
-/// [`commanded_sigma_with`] reduced to σ_min, σ_max, κ and the rank under `rank_rel_tol`,
-/// equal to it to rounding: on the well-conditioned (Gram) route only the two extreme
-/// eigenvalues of the Gram matrix are sought (Laguerre's iteration on its tridiagonal form,
-/// no QL sweeps) while `λ_min ≥ EXTREMES_MIN_RATIO·λ_max`, and every singular value then
-/// exceeds `rank_rel_tol · σ_max` (rank `k`) as long as `rank_rel_tol² < EXTREMES_MIN_RATIO`;
-/// otherwise, and on the ill-conditioned route,
-/// all singular values as [`commanded_sigma_with`] computes them. Allocation-free.
-pub fn commanded_extremes_with(
-    g: &ScaledGram,
-    t: &Matrix6xX<f64>,
-    dofs: CommandedDofs,
-    rank_rel_tol: f64,
-) -> SigmaExtremes {
-    let k = dofs.len();
-    if !extremes_route_applies(g, k, rank_rel_tol) {
-        return commanded_sigma_with(g, t, dofs).extremes(rank_rel_tol);
-    }
-    let rows = selected_rows(dofs);
-    let mut gram = g.select(&rows, k);
-    let ev = extreme_eigenvalues(&mut gram, k);
-    extremes_from(g, t, &rows, k, ev, rank_rel_tol)
-}
-
-/// [`commanded_extremes_with`] for two axis selections of one configuration (the static
-/// analysis' all six rows and its commanded ones), each equal to its own call bit for bit: the
-/// two Gram blocks' Laguerre iterations share one loop ([`extreme_eigenvalues_pair`]).
-pub fn commanded_extremes_pair_with(
-    g: &ScaledGram,
-    t: &Matrix6xX<f64>,
-    dofs: [CommandedDofs; 2],
-    rank_rel_tol: f64,
-) -> [SigmaExtremes; 2] {
-    let ks = dofs.map(CommandedDofs::len);
-    if !ks
-        .iter()
-        .all(|&k| extremes_route_applies(g, k, rank_rel_tol))
-    {
-        return dofs.map(|d| commanded_extremes_with(g, t, d, rank_rel_tol));
-    }
-    let rows = dofs.map(selected_rows);
-    let (mut ga, mut gb) = (g.select(&rows[0], ks[0]), g.select(&rows[1], ks[1]));
-    let ev = extreme_eigenvalues_pair(&mut ga, ks[0], &mut gb, ks[1]);
-    std::array::from_fn(|i| extremes_from(g, t, &rows[i], ks[i], ev[i], rank_rel_tol))
-}
-
-/// Whether [`commanded_extremes_with`]'s Gram route may score `k` commanded rows of `g`: not
-/// for invalid input, nothing commanded, or a rank tolerance the route cannot certify.
-fn extremes_route_applies(g: &ScaledGram, k: usize, rank_rel_tol: f64) -> bool {
-    g.valid && k > 0 && rank_rel_tol * rank_rel_tol < EXTREMES_MIN_RATIO
-}
-
-/// The [`SigmaExtremes`] of the rows `rows[..k]` whose Gram block has the extreme eigenvalues
-/// `(lo, hi)`: the QR + Jacobi route below [`EXTREMES_MIN_RATIO`].
-fn extremes_from(
+/// The squared singular values of `S·T_L` (the rows `rows[..k]` of the `T` whose Gram matrix
+/// is `g`) by the route that keeps small ones accurate: the triangular factor of `(S T_L)ᵀ`
+/// (Givens QR, one thruster column at a time), then one-sided Jacobi on it.
+pub(super) fn triangle_sigma_sq(
     g: &ScaledGram,
     t: &Matrix6xX<f64>,
     rows: &[usize; 6],
     k: usize,
-    (lo, hi): (f64, f64),
-    rank_rel_tol: f64,
-) -> SigmaExtremes {
-    if lo < EXTREMES_MIN_RATIO * hi {
-        return from_squares(&triangle_sigma_sq(g, t, rows, k), k).extremes(rank_rel_tol);
-    }
-    let (sigma_min, sigma_max) = (lo.max(0.0).sqrt(), hi.max(0.0).sqrt());
-    SigmaExtremes {
-        k,
-        sigma_min,
-        sigma_max,
-        condition_number: condition(sigma_max, sigma_min),
-        rank: k,
-    }
-}
-
-/// The squared singular values of `S·T_L` (the rows `rows[..k]` of the `T` whose Gram matrix
-/// is `g`) by the route that keeps small ones accurate: the triangular factor of `(S T_L)ᵀ`
-/// (Givens QR, one thruster column at a time), then one-sided Jacobi on it.
-fn triangle_sigma_sq(g: &ScaledGram, t: &Matrix6xX<f64>, rows: &[usize; 6], k: usize) -> [f64; 6] {
+) -> [f64; 6] {
     let mut r = [[0.0; 6]; 6];
     for col in t.column_iter() {
         let x = select_scaled(col.as_slice(), rows, k, g.char_length);
@@ -594,7 +532,7 @@ fn full_gram(t: &Matrix6xX<f64>, l: f64) -> [[f64; 6]; 6] {
 }
 
 /// The row indices of `dofs`, in order, in the first `dofs.len()` entries.
-fn selected_rows(dofs: CommandedDofs) -> [usize; 6] {
+pub(super) fn selected_rows(dofs: CommandedDofs) -> [usize; 6] {
     let mut rows = [0; 6];
     let mut k = 0;
     for (i, on) in dofs.mask().iter().enumerate() {

@@ -140,9 +140,36 @@ pub(crate) fn extreme_eigenvalues_pair(
     if ka <= 1 || kb <= 1 {
         return [extreme_eigenvalues(a, ka), extreme_eigenvalues(b, kb)];
     }
-    let [mut ta, mut tb] = Tridiagonal::of_pair(a, ka, b, kb);
+    let (mut ta, mut tb) = (Tridiagonal::of(a, ka), Tridiagonal::of(b, kb));
     let [ra, rb] = laguerre_extremes([&ta, &tb]);
     [ta.settle(ra), tb.settle(rb)]
+}
+
+/// The smallest and largest eigenvalues of the symmetric positive semi-definite 6×6 block `a`
+/// (destroyed) and of its leading `kc×kc` principal block (`kc` 5 or 6), from one Householder
+/// reduction: [`householder_nested`] reduces the rows from the last one up, so the leading 5×5
+/// block of the tridiagonal form is similar to `a`'s leading 5×5 block (the first reflection
+/// acts on exactly that block, the others within it). Laguerre's iteration then runs on the
+/// two tridiagonal matrices in one loop as in [`extreme_eigenvalues_pair`]. The static
+/// analysis puts its commanded rows first, so all six rows and five commanded ones (the
+/// transport mode drops roll) cost one reduction instead of two; same accuracy as
+/// [`extreme_eigenvalues`] (about `ε‖a‖` absolute). A smaller block would be mixed with the
+/// rows after it by the first reflection.
+pub(crate) fn extreme_eigenvalues_nested(a: &mut [[f64; 6]; 6], kc: usize) -> [(f64, f64); 2] {
+    debug_assert!(kc == 5 || kc == 6, "nested block of {kc} rows");
+    let mut d = [0.0; 6];
+    let mut e = [0.0; 6];
+    householder_nested(a, &mut d, &mut e);
+    let mut tf = Tridiagonal::bounded(6, d, e);
+    if kc == 6 {
+        let [r] = laguerre_extremes([&tf]);
+        let x = tf.settle(r);
+        return [x, x];
+    }
+    e[kc - 1] = 0.0;
+    let mut tc = Tridiagonal::bounded(kc, d, e);
+    let [rf, rc] = laguerre_extremes([&tf, &tc]);
+    [tf.settle(rf), tc.settle(rc)]
 }
 
 /// The tridiagonal form of a Gram block and where Laguerre's iteration starts on it.
@@ -164,18 +191,6 @@ impl Tridiagonal {
         let mut e = [0.0; 6];
         householder_tridiagonal(a, k, &mut d, &mut e);
         Self::bounded(k, d, e)
-    }
-
-    /// [`Tridiagonal::of`] two blocks, the transport-mode pair (6 and 5 rows) and the all-six
-    /// pair by [`householder_pair`], equal to two calls bit for bit.
-    fn of_pair(a: &mut [[f64; 6]; 6], ka: usize, b: &mut [[f64; 6]; 6], kb: usize) -> [Self; 2] {
-        let (mut da, mut ea, mut db, mut eb) = ([0.0; 6], [0.0; 6], [0.0; 6], [0.0; 6]);
-        match (ka, kb) {
-            (6, 5) => householder_pair::<6, 5>(a, (&mut da, &mut ea), b, (&mut db, &mut eb)),
-            (6, 6) => householder_pair::<6, 6>(a, (&mut da, &mut ea), b, (&mut db, &mut eb)),
-            _ => return [Self::of(a, ka), Self::of(b, kb)],
-        }
-        [Self::bounded(ka, da, ea), Self::bounded(kb, db, eb)]
     }
 
     /// The tridiagonal `(d, e)` of `k` entries with the spectrum's bounds.
@@ -345,25 +360,69 @@ fn householder_k<const K: usize>(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mu
     householder_finish::<K>(a, d, e);
 }
 
-/// [`householder_k`] of two blocks (`KA×KA` of `a`, `KB×KB` of `b`), their reflections taken in
-/// turns so that the processor overlaps the two latency-bound chains (`sqrt`, division, the
-/// dot products); each block's operations are exactly those of its own call.
-fn householder_pair<const KA: usize, const KB: usize>(
-    a: &mut [[f64; 6]; 6],
-    ta: (&mut [f64; 6], &mut [f64; 6]),
-    b: &mut [[f64; 6]; 6],
-    tb: (&mut [f64; 6], &mut [f64; 6]),
-) {
-    for j in 0..KA.max(KB).saturating_sub(2) {
-        if j + 2 < KA {
-            householder_step::<KA>(a, j, ta.1);
+/// Householder reduction of the symmetric 6×6 `a` to tridiagonal form from the last row up
+/// (the order of Numerical Recipes' `tred2`): reflection `i` (`i = 5, 4, 3, 2`) acts on the
+/// indices `0..i` only and leaves row `i` with its entry at `i − 1`, so the leading 5×5 block
+/// of the result is similar to `a`'s (the first reflection is a similarity on it, the others
+/// act within it). Diagonal into `d`,
+/// subdiagonal (`e[i]` between rows `i` and `i + 1`) into `e`, `e[5] = 0`.
+fn householder_nested(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6]) {
+    // One copy per reflection, so that every loop bound is a constant (unrolled).
+    householder_step_up::<5>(a, e);
+    householder_step_up::<4>(a, e);
+    householder_step_up::<3>(a, e);
+    householder_step_up::<2>(a, e);
+    for i in 0..6 {
+        d[i] = a[i][i];
+    }
+    e[0] = a[1][0];
+    e[5] = 0.0;
+}
+
+/// Reflection `i = I` of [`householder_nested`]: `H = 1 − β v vᵀ` on the indices `0..i` maps
+/// row `i`'s entries there onto its last one, `e[i − 1]`, and the leading `i×i` block becomes
+/// `H A H` (same update as [`householder_step`], mirrored).
+#[inline(always)]
+fn householder_step_up<const I: usize>(a: &mut [[f64; 6]; 6], e: &mut [f64; 6]) {
+    let (i, l) = (I, I - 1);
+    let mut norm2 = 0.0;
+    for j in 0..i {
+        norm2 += a[i][j] * a[i][j];
+    }
+    if norm2 == 0.0 {
+        e[l] = 0.0;
+        return;
+    }
+    let norm = norm2.sqrt();
+    let alpha = if a[i][l] > 0.0 { -norm } else { norm };
+    let mut v = [0.0; 6];
+    v[..i].copy_from_slice(&a[i][..i]);
+    v[l] -= alpha;
+    let beta = 1.0 / (norm * (norm + a[i][l].abs()));
+    let mut p = [0.0; 6];
+    for r in 0..i {
+        let mut acc = 0.0;
+        for c in 0..i {
+            acc += a[r][c] * v[c];
         }
-        if j + 2 < KB {
-            householder_step::<KB>(b, j, tb.1);
+        p[r] = beta * acc;
+    }
+    let mut vp = 0.0;
+    for r in 0..i {
+        vp += v[r] * p[r];
+    }
+    let half = 0.5 * beta * vp;
+    for r in 0..i {
+        p[r] -= half * v[r];
+    }
+    for r in 0..i {
+        for c in r..i {
+            let x = a[r][c] - (v[r] * p[c] + p[r] * v[c]);
+            a[r][c] = x;
+            a[c][r] = x;
         }
     }
-    householder_finish::<KA>(a, ta.0, ta.1);
-    householder_finish::<KB>(b, tb.0, tb.1);
+    e[l] = alpha;
 }
 
 /// Reflection `j` of [`householder_k`]: zero column `j` below its subdiagonal, `e[j]` the
@@ -487,7 +546,22 @@ fn implicit_ql(d: &mut [f64; 6], e: &mut [f64; 6], k: usize) {
 /// without pivoting (pivots of magnitude below `ε²·trace` are raised to it, so a singular
 /// shifted matrix amplifies its null direction instead of dividing by zero), from a start with
 /// every component non-zero. Unit length, first `k` entries.
-pub(crate) fn shifted_inverse_iteration(mut a: [[f64; 6]; 6], k: usize, shift: f64) -> [f64; 6] {
+pub(crate) fn shifted_inverse_iteration(a: [[f64; 6]; 6], k: usize, shift: f64) -> [f64; 6] {
+    // One copy per size, so that every loop bound is a constant (unrolled, no bounds checks).
+    match k {
+        6 => inverse_iteration_k::<6>(a, shift),
+        5 => inverse_iteration_k::<5>(a, shift),
+        4 => inverse_iteration_k::<4>(a, shift),
+        3 => inverse_iteration_k::<3>(a, shift),
+        2 => inverse_iteration_k::<2>(a, shift),
+        1 => inverse_iteration_k::<1>(a, shift),
+        _ => std::array::from_fn(|i| 1.0 + 0.1 * i as f64),
+    }
+}
+
+/// [`shifted_inverse_iteration`] of the `K×K` block.
+fn inverse_iteration_k<const K: usize>(mut a: [[f64; 6]; 6], shift: f64) -> [f64; 6] {
+    let k = K;
     let trace: f64 = (0..k).map(|i| a[i][i].abs()).sum();
     let tiny = f64::EPSILON * f64::EPSILON * trace.max(f64::MIN_POSITIVE);
     for (i, row) in a.iter_mut().enumerate().take(k) {
@@ -536,83 +610,5 @@ pub(crate) fn shifted_inverse_iteration(mut a: [[f64; 6]; 6], k: usize, shift: f
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-
-    /// One side iterated alone: the loop `laguerre_extremes` interleaves.
-    fn one_side<const K: usize>(
-        d: &[f64; 6],
-        e2: &[f64; 6],
-        start: f64,
-        below: bool,
-    ) -> Option<f64> {
-        let tiny = 4.0 * f64::EPSILON * 10.0;
-        let mut x = start;
-        for _ in 0..40 {
-            let (mut p0, mut p1) = (1.0, d[0] - x);
-            let (mut dp0, mut dp1) = (0.0, -1.0);
-            let (mut ddp0, mut ddp1) = (0.0, 0.0);
-            for j in 1..K {
-                let (a, b) = (d[j] - x, e2[j - 1]);
-                let p2 = a * p1 - b * p0;
-                let dp2 = a * dp1 - b * dp0 - p1;
-                let ddp2 = a * ddp1 - b * ddp0 - 2.0 * dp1;
-                (p0, p1, dp0, dp1, ddp0, ddp1) = (p1, p2, dp1, dp2, ddp1, ddp2);
-            }
-            if let Some(r) = laguerre_update(&mut x, [p1, dp1, ddp1], K as f64, below, tiny) {
-                return r;
-            }
-        }
-        None
-    }
-
-    #[test]
-    fn interleaved_equals_one_side_at_a_time() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        for trial in 0..500 {
-            let d: [f64; 6] = std::array::from_fn(|_| rng.random::<f64>() * 4.0);
-            // Some trials with a (near-)zero coupling: repeated or decoupled roots.
-            let e2: [f64; 6] = std::array::from_fn(|_| {
-                if trial % 7 == 0 && rng.random::<f64>() < 0.5 {
-                    0.0
-                } else {
-                    rng.random::<f64>()
-                }
-            });
-            let (lo, hi) = (-3.0, 8.0);
-            let tri = |k| Tridiagonal {
-                k,
-                d,
-                e: [0.0; 6],
-                e2,
-                starts: [lo, hi],
-                scale: 10.0,
-            };
-            let (t6, t5, t3) = (tri(6), tri(5), tri(3));
-            let alone = |k| match k {
-                6 => [
-                    one_side::<6>(&d, &e2, lo, true),
-                    one_side::<6>(&d, &e2, hi, false),
-                ],
-                5 => [
-                    one_side::<5>(&d, &e2, lo, true),
-                    one_side::<5>(&d, &e2, hi, false),
-                ],
-                _ => [
-                    one_side::<3>(&d, &e2, lo, true),
-                    one_side::<3>(&d, &e2, hi, false),
-                ],
-            };
-            let bits = |r: [Option<f64>; 2]| r.map(|x| x.map(f64::to_bits));
-            let [r6] = laguerre_extremes([&t6]);
-            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
-            let [r6, r5] = laguerre_extremes([&t6, &t5]);
-            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
-            assert_eq!(bits(r5), bits(alone(5)), "trial {trial}");
-            let [r3, r6] = laguerre_extremes([&t3, &t6]);
-            assert_eq!(bits(r3), bits(alone(3)), "trial {trial}");
-            assert_eq!(bits(r6), bits(alone(6)), "trial {trial}");
-        }
-    }
-}
+#[path = "small_svd_tests.rs"]
+mod tests;

@@ -6,9 +6,10 @@ use nalgebra::Matrix6xX;
 use serde::Serialize;
 
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
+use crate::metrics::extremes::{commanded_extremes_pair_planned, PairPlan};
 use crate::metrics::singularity::{
-    commanded_extremes_pair_with, tcm_svd_metrics, weakest_direction_with, CommandedDofs,
-    ScaledGram, SingularityError, AXIS_NAMES,
+    tcm_svd_metrics, weakest_direction_with, CommandedDofs, ScaledGram, SingularityError,
+    AXIS_NAMES,
 };
 use crate::model::Vehicle;
 
@@ -61,7 +62,8 @@ pub(super) struct Eval<'a> {
     l: f64,
     tol: f64,
     threshold: f64,
-    commanded: CommandedDofs,
+    /// All six rows and the commanded ones, resolved once.
+    pair: PairPlan,
 }
 
 impl<'a> Eval<'a> {
@@ -73,7 +75,7 @@ impl<'a> Eval<'a> {
             l,
             tol,
             threshold,
-            commanded,
+            pair: PairPlan::new([CommandedDofs::ALL, commanded]),
         }
     }
 
@@ -91,8 +93,7 @@ impl<'a> Eval<'a> {
         forward_kinematics(self.v, &s.q, &mut s.ws);
         thruster_matrix(self.v, &s.ws, &mut s.t);
         let g = ScaledGram::new(&s.t, self.l);
-        let [full, cmd] =
-            commanded_extremes_pair_with(&g, &s.t, [CommandedDofs::ALL, self.commanded], self.tol);
+        let [full, cmd] = commanded_extremes_pair_planned(&g, &s.t, &self.pair, self.tol);
         let rank = full.rank;
         let flagged = rank < 6 || full.sigma_min < self.threshold;
         let lost_axis = (flagged && full.sigma_min.is_finite()).then(|| {
