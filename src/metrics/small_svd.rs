@@ -381,7 +381,7 @@ fn householder_nested(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6])
 
 /// Reflection `i = I` of [`householder_nested`]: `H = 1 − β v vᵀ` on the indices `0..i` maps
 /// row `i`'s entries there onto its last one, `e[i − 1]`, and the leading `i×i` block becomes
-/// `H A H` (same update as [`householder_step`], mirrored).
+/// `H A H` ([`reflect_block`]).
 #[inline(always)]
 fn householder_step_up<const I: usize>(a: &mut [[f64; 6]; 6], e: &mut [f64; 6]) {
     let (i, l) = (I, I - 1);
@@ -399,29 +399,7 @@ fn householder_step_up<const I: usize>(a: &mut [[f64; 6]; 6], e: &mut [f64; 6]) 
     v[..i].copy_from_slice(&a[i][..i]);
     v[l] -= alpha;
     let beta = 1.0 / (norm * (norm + a[i][l].abs()));
-    let mut p = [0.0; 6];
-    for r in 0..i {
-        let mut acc = 0.0;
-        for c in 0..i {
-            acc += a[r][c] * v[c];
-        }
-        p[r] = beta * acc;
-    }
-    let mut vp = 0.0;
-    for r in 0..i {
-        vp += v[r] * p[r];
-    }
-    let half = 0.5 * beta * vp;
-    for r in 0..i {
-        p[r] -= half * v[r];
-    }
-    for r in 0..i {
-        for c in r..i {
-            let x = a[r][c] - (v[r] * p[c] + p[r] * v[c]);
-            a[r][c] = x;
-            a[c][r] = x;
-        }
-    }
+    reflect_block(a, &v, beta, 0, i);
     e[l] = alpha;
 }
 
@@ -446,35 +424,40 @@ fn householder_step<const K: usize>(a: &mut [[f64; 6]; 6], j: usize, e: &mut [f6
     }
     v[lo] -= alpha;
     let beta = 1.0 / (norm * (norm + a[lo][j].abs()));
-    // A ← H A H on the trailing block: p = β A v, q = p − (β vᵀp / 2) v,
-    // A ← A − v qᵀ − q vᵀ.
+    reflect_block(a, &v, beta, lo, K);
+    e[j] = alpha;
+}
+
+/// `A ← H A H` on the block `lo..hi` of the symmetric `a` for `H = I − β v vᵀ` (`v` zero
+/// outside the block): `p = β A v`, `q = p − (β vᵀp / 2) v`, `A ← A − v qᵀ − q vᵀ`. The block
+/// stays exactly symmetric (the Gram matrices are built so, and entry (l, i) gets the same two
+/// products summed the other way round, which rounds the same): one triangle is updated and
+/// mirrored.
+#[inline(always)]
+fn reflect_block(a: &mut [[f64; 6]; 6], v: &[f64; 6], beta: f64, lo: usize, hi: usize) {
     let mut p = [0.0; 6];
-    for i in lo..K {
+    for i in lo..hi {
         let mut acc = 0.0;
-        for l in lo..K {
+        for l in lo..hi {
             acc += a[i][l] * v[l];
         }
         p[i] = beta * acc;
     }
     let mut vp = 0.0;
-    for i in lo..K {
+    for i in lo..hi {
         vp += v[i] * p[i];
     }
     let half = 0.5 * beta * vp;
-    for i in lo..K {
+    for i in lo..hi {
         p[i] -= half * v[i];
     }
-    // The block stays exactly symmetric (the Gram matrices are built so, and entry (l, i)
-    // gets the same two products summed the other way round, which rounds the same):
-    // update one triangle and mirror it.
-    for i in lo..K {
-        for l in i..K {
+    for i in lo..hi {
+        for l in i..hi {
             let x = a[i][l] - (v[i] * p[l] + p[i] * v[l]);
             a[i][l] = x;
             a[l][i] = x;
         }
     }
-    e[j] = alpha;
 }
 
 /// The diagonal and the last subdiagonal entry of [`householder_k`]'s reduced block.
