@@ -139,6 +139,44 @@ fn report_rebuilds_the_page_and_fails_loudly_when_it_cannot_write_it() {
     assert!(stderr(&o).contains("is not a directory"), "{}", stderr(&o));
 }
 
+#[test]
+fn a_rebuilt_report_shows_its_own_figures_not_an_earlier_reports() {
+    // A figure an earlier report wrote (a metric the study no longer has), recorded as the
+    // tool's own, and a figure of the user's, not recorded: the rebuilt report removes the
+    // first and draws neither; the user's file stays.
+    let dir = tempfile::tempdir().unwrap();
+    let out = sweep(dir.path());
+    let svg = |title: &str| {
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" height=\"10\">\
+             <text>{title}</text></svg>"
+        )
+    };
+    write(
+        &out.join("plots"),
+        "tornado_dropped_metric.svg",
+        &svg("stale figure"),
+    );
+    write(&out.join("plots"), "my_sketch.svg", &svg("user sketch"));
+    let record = out.join(".usm-study.files");
+    let mut owned = std::fs::read_to_string(&record).unwrap();
+    owned.push_str("plots/tornado_dropped_metric.svg\n");
+    std::fs::write(&record, owned).unwrap();
+    let o = run(&["report", arg(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("plots/tornado_dropped_metric.svg").exists());
+    assert!(out.join("plots/my_sketch.svg").exists());
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        !page.contains("stale figure"),
+        "the stale figure is on the page"
+    );
+    // The page shows every figure in plots/ (the user's too, as before): the sweep's own are
+    // all drawn again.
+    assert!(page.contains("user sketch"));
+    assert!(out.join("plots").read_dir().unwrap().count() > 2);
+}
+
 /// The `data-t` values of the snapshot groups of one view of a run drawing.
 fn snapshot_times(svg: &str, view: &str) -> Vec<f64> {
     let start = svg.find(&format!("id=\"view-{view}\"")).expect("view");

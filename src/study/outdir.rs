@@ -10,7 +10,9 @@
 //!   listed there (a directory written by an older version without the record: only the fixed
 //!   names of a sweep output, and only when its `manifest.json` says `usm-study` wrote it);
 //!   a user's own files are never removed, and files named like outputs that the tool did not
-//!   write are refused even with `--force`.
+//!   write are refused even with `--force`. A report removes the figures of the record under
+//!   `plots/` before it draws its own ([`remove_owned_plots`]), so none of an earlier version
+//!   of the study survives onto the review page.
 //! - [`claim`]: a directory holding another study's output is refused unless `--force`; one
 //!   holding finished cases of the same study is refused unless `--resume` (keep them) or
 //!   `--force` (start over). Temporary files of a killed run that held the lock
@@ -282,6 +284,34 @@ pub fn record_owned(dir: &Path, since: SystemTime, always: &[&str]) -> Result<()
     Ok(())
 }
 
+/// Remove the figures a report wrote into `dir/plots` before (`plots/NAME.svg` entries of the
+/// record, [`OWNED_FILE`]), so that the report about to be written leaves only its own: a
+/// figure an earlier version of the study drew (a metric since dropped) would otherwise stay
+/// beside the new ones and be shown on the review page. Only regular files named in the
+/// record go, and nothing when `plots` is not a real directory (a symbolic link is never
+/// followed); a user's own figures are not in the record. Their count.
+pub fn remove_owned_plots(dir: &Path) -> Result<usize, StudyError> {
+    let plots = dir.join("plots");
+    if !std::fs::symlink_metadata(&plots).is_ok_and(|m| m.is_dir()) {
+        return Ok(0);
+    }
+    let mut n = 0;
+    for f in read_owned(dir).unwrap_or_default() {
+        let Some(name) = f.strip_prefix("plots/") else {
+            continue;
+        };
+        if !name.ends_with(".svg") {
+            continue;
+        }
+        let p = plots.join(name);
+        if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file()) {
+            std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
+            n += 1;
+        }
+    }
+    Ok(n)
+}
+
 /// Remove the temporary files `.NAME.tmp-SUFFIX` of one dead run in `dir`; their count.
 fn remove_temporaries(dir: &Path, suffix: &str) -> Result<usize, StudyError> {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -309,6 +339,36 @@ mod tests {
             study: "h",
             resume: false,
         }
+    }
+
+    #[test]
+    fn a_report_removes_only_the_figures_the_record_names() {
+        let d = tempfile::tempdir().unwrap();
+        let p = &resolve(d.path()).unwrap();
+        let outside = tempfile::tempdir().unwrap();
+        let victim = outside.path().join("victim.svg");
+        std::fs::write(&victim, "<svg/>").unwrap();
+        std::fs::create_dir(p.join("plots")).unwrap();
+        for f in ["old_metric.svg", "axis_x.svg", "mine.svg"] {
+            std::fs::write(p.join("plots").join(f), "<svg/>").unwrap();
+        }
+        std::os::unix::fs::symlink(&victim, p.join("plots/link.svg")).unwrap();
+        std::fs::write(p.join(CASES_CSV), "x\n").unwrap();
+        let record = "cases.csv\nplots/old_metric.svg\nplots/axis_x.svg\nplots/link.svg\n\
+                      plots/../escape.svg\n";
+        std::fs::write(p.join(OWNED_FILE), record).unwrap();
+        assert_eq!(remove_owned_plots(p).unwrap(), 2);
+        assert!(!p.join("plots/old_metric.svg").exists() && !p.join("plots/axis_x.svg").exists());
+        // The user's figure, the table, the link and what it points to stay.
+        assert!(p.join("plots/mine.svg").exists() && p.join(CASES_CSV).exists());
+        assert!(std::fs::symlink_metadata(p.join("plots/link.svg")).is_ok() && victim.exists());
+        // A `plots` that is a link out of the directory is not touched at all.
+        let q = &resolve(&p.join("sub")).unwrap();
+        std::fs::write(outside.path().join("axis_y.svg"), "<svg/>").unwrap();
+        std::os::unix::fs::symlink(outside.path(), q.join("plots")).unwrap();
+        std::fs::write(q.join(OWNED_FILE), "plots/axis_y.svg\n").unwrap();
+        assert_eq!(remove_owned_plots(q).unwrap(), 0);
+        assert!(outside.path().join("axis_y.svg").exists());
     }
 
     #[test]

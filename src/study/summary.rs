@@ -71,6 +71,10 @@ impl Ctx<'_> {
 pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     let mut warnings = Vec::new();
     let plots = dir.join("plots");
+    // The figures of an earlier report go first: this one writes its own again.
+    if let Err(e) = super::outdir::remove_owned_plots(dir) {
+        warnings.push(e.to_string());
+    }
     if let Err(e) = std::fs::create_dir_all(&plots) {
         warnings.push(format!("{}: {e}", plots.display()));
         return warnings;
