@@ -216,6 +216,18 @@ fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
             "tune.param[1].name",
             "also a sweep axis",
         ),
+        (
+            text.replace("[tune]\n", "[tune]\nworlds = 4\n"),
+            "worlds = 4",
+            "tune.worlds",
+            "needs the study's [uncertainty]",
+        ),
+        (
+            text.replace("[tune]\n", "[tune]\nworlds = 0\n"),
+            "worlds = 0",
+            "tune.worlds",
+            "from 1 to 64",
+        ),
     ];
     for (i, (t, needle, key, message)) in bad.iter().enumerate() {
         let p = write(dir.path(), &format!("bad{i}.toml"), t);
@@ -239,6 +251,34 @@ fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
         assert!(e.contains(message), "case {i}: {e}");
         assert!(!out.exists(), "case {i}: nothing may run");
     }
+}
+
+/// `[tune] worlds = 2`: each case is tuned over two worlds of the study's `[uncertainty]`, then
+/// scored in the nominal world and its own worlds as before; rows identical for any `--jobs`.
+#[test]
+fn tuning_in_worlds_runs_and_gives_the_same_rows_for_any_jobs() {
+    let dir = tempfile::tempdir().unwrap();
+    let uncertainty = "
+[uncertainty]
+worlds = 2
+[[uncertainty.param]]
+name = \"hydro.drag_scale\"
+distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
+";
+    let text = format!("{BASE}{TUNE}{uncertainty}")
+        .replace("values = [3, 4]", "values = [4]")
+        .replace("[tune]\n", "[tune]\nworlds = 2\n");
+    let study = write(dir.path(), "worlds.toml", &text);
+    let (j1, j2) = (dir.path().join("j1"), dir.path().join("j2"));
+    sweep(&study, &j1, &["--jobs", "1"]);
+    sweep(&study, &j2, &["--jobs", "2"]);
+    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
+    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
+    let (head, rows) = table(&j1);
+    assert_eq!(rows.len(), 1);
+    let k = column(&head, &rows, "tuned.control.k_psi");
+    assert!(k[0] >= 0.15 && k[0] <= 1.35, "{k:?}");
+    assert_eq!(column(&head, &rows, "tune_feasible"), [1.0]);
 }
 
 #[test]

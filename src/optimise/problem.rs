@@ -476,8 +476,9 @@ fn parse_param(
     })
 }
 
-/// Each scenario of `variants` in each world of `u` (named `w<k>`, or `<variant>/w<k>`).
-fn in_worlds(
+/// Each scenario of `variants` in each world of `u` drawn from `seed` (named `w<k>`, or
+/// `<variant>/w<k>`).
+pub(super) fn in_worlds(
     variants: Vec<Variant>,
     u: &crate::study::schema::Uncertainty,
     seed: u64,

@@ -17,7 +17,7 @@
 
 use super::evaluate::CaseEvaluator;
 use super::history::Record;
-use super::problem::parse_spec;
+use super::problem::{in_worlds, parse_spec};
 use super::{minimise, Options, Problem, Spec};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
 use crate::input::document::Document;
@@ -26,7 +26,7 @@ use crate::sampling::{derive_seed, Sampler, Sampling};
 use crate::study::cases::Resolved;
 use crate::study::doe::Case;
 use crate::study::error::InputError;
-use crate::study::schema::{Study, Target};
+use crate::study::schema::{Study, Target, Uncertainty, WorldSampling};
 use crate::study::tune::{CaseTuner, TuneError, Tuned, TuningHook};
 use rayon::prelude::*;
 
@@ -48,6 +48,9 @@ pub struct Tuner {
     /// Independent tuning starts (`[tune] starts`, default 1): the case's own start, then
     /// Sobol points of the box, each with an equal share of the evaluation budget.
     starts: usize,
+    /// The tuning worlds (`[tune] worlds = N`): the study's `[uncertainty]` with `N` worlds
+    /// drawn apart from the scoring worlds; `None` to tune in the nominal world.
+    worlds: Option<Uncertainty>,
 }
 
 /// Most independent tuning starts.
@@ -56,14 +59,22 @@ pub const MAX_STARTS: usize = 16;
 /// Seed stream of the tuning starts' Sobol points (shared by every case).
 const STARTS_STREAM: u64 = 0x5354_4152_5453; // "STARTS"
 
+/// Most tuning worlds (`[tune] worlds`): each is a full run per evaluation.
+pub const MAX_TUNE_WORLDS: usize = 64;
+
+/// Seed stream of the tuning worlds (shared by every case: common random numbers), apart from
+/// the scoring worlds' stream so that a design is not tuned on the worlds it is scored in.
+const TUNE_WORLDS_STREAM: u64 = 0x5455_4e45_574c; // "TUNEWL"
+
 /// A parameter within this fraction of the unit box from a bound counts as on the bound.
 pub const BOUND_TOLERANCE: f64 = 1e-3;
 
 impl Tuner {
     /// The tuner of `study`'s `[tune]` section (`None` without one). Every check of a
     /// problem file applies (`docs/optimise.md`), and: no `[[tune.variant]]` (a case is
-    /// scored in its own scenario), no parameter that is also a sweep axis. Errors name the
-    /// file, the line and the key (`tune.param[1].upper`).
+    /// scored in its own scenario), no parameter that is also a sweep axis, `worlds` from 1 to
+    /// [`MAX_TUNE_WORLDS`] and only with the study's `[uncertainty]`. Errors name the file,
+    /// the line and the key (`tune.param[1].upper`).
     pub fn new(study: &Study) -> Result<Option<Tuner>, InputError> {
         let Some(t) = &study.tune else {
             return Ok(None);
@@ -86,6 +97,31 @@ impl Tuner {
             }
         }
         let mut t = t.clone();
+        let worlds = match t.remove("worlds") {
+            None => None,
+            Some(toml::Value::Integer(n)) if (1..=MAX_TUNE_WORLDS as i64).contains(&n) => {
+                let Some(u) = &study.uncertainty else {
+                    return Err(doc.err(
+                        "tune.worlds",
+                        "needs the study's [uncertainty] section to draw the tuning worlds from",
+                    ));
+                };
+                let mut u = u.clone();
+                u.worlds = n as usize;
+                // Saltelli's design serves the sensitivity indices of the scoring worlds; the
+                // tuning worlds are a plain Sobol sample of the same distributions.
+                if u.sampling == WorldSampling::Saltelli {
+                    u.sampling = WorldSampling::Points(Sampling::Sobol);
+                }
+                Some(u)
+            }
+            Some(v) => {
+                return Err(doc.err(
+                    "tune.worlds",
+                    format!("must be an integer from 1 to {MAX_TUNE_WORLDS}, got {v}"),
+                ))
+            }
+        };
         let starts = match t.remove("starts") {
             None => 1,
             Some(toml::Value::Integer(n)) if (1..=MAX_STARTS as i64).contains(&n) => n as usize,
@@ -118,6 +154,7 @@ impl Tuner {
             explicit_start,
             static_needed,
             starts,
+            worlds,
         }))
     }
 
@@ -138,6 +175,13 @@ impl Tuner {
                     p.start = x.clamp(p.lower, p.upper);
                 }
             }
+        }
+        if let Some(u) = &self.worlds {
+            // Every candidate in every tuning world: the objective combines the worlds
+            // (`[tune.objective] combine`, default the mean) and each constraint must hold in
+            // each of them, as in a problem file's `[uncertainty]`.
+            let variants = std::mem::take(&mut spec.variants);
+            spec.variants = in_worlds(variants, u, derive_seed(study.seed, TUNE_WORLDS_STREAM));
         }
         Problem { study: cs, spec }
     }
@@ -350,6 +394,39 @@ mod tests {
             assert_eq!(a.solver.max_evals, spec.solver.max_evals);
             assert_eq!(a.solver.method, spec.solver.method);
         }
+    }
+
+    /// `[tune] worlds = N` scores every candidate in N worlds of the study's `[uncertainty]`
+    /// (every uncertain key set in each), drawn from their own seed stream: not the scoring
+    /// worlds, the same for every case, none without the key.
+    #[test]
+    fn tuning_worlds_are_the_uncertain_keys_drawn_apart_from_the_scoring_worlds() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/thrusters.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let with = text.replacen("[tune]\n", "[tune]\nworlds = 3\n", 1);
+        assert_ne!(with, text);
+        let nominal = crate::study::parse::parse_study(&text, &path).unwrap();
+        let study = crate::study::parse::parse_study(&with, &path).unwrap();
+        let cases = crate::study::doe::expand(&study, None).unwrap();
+        let problem = |s: &crate::study::schema::Study, id: usize| {
+            let r = crate::study::cases::resolve_case(s, &cases[id]).unwrap();
+            Tuner::new(s).unwrap().unwrap().case_problem(s, &r)
+        };
+        assert_eq!(problem(&nominal, 0).spec.variants.len(), 1);
+        let p = problem(&study, 0);
+        let u = study.uncertainty.as_ref().unwrap();
+        let names: Vec<_> = p.spec.variants.iter().map(|v| v.name.as_str()).collect();
+        assert_eq!(names, ["w0", "w1", "w2"]);
+        let scoring = u.sample(study.seed);
+        for (v, w) in p.spec.variants.iter().zip(&scoring) {
+            let keys: Vec<_> = v.set.iter().map(|(k, _)| k.as_str()).collect();
+            let want: Vec<_> = u.params.iter().map(|q| q.name.as_str()).collect();
+            assert_eq!(keys, want);
+            let values: Vec<_> = v.set.iter().map(|(_, x)| x.clone()).collect();
+            assert_ne!(values, w.values, "a tuning world is a scoring world");
+        }
+        // Common random numbers: another case meets the same tuning worlds.
+        assert_eq!(problem(&study, 5).spec.variants, p.spec.variants);
     }
 
     #[test]
