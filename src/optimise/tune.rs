@@ -162,6 +162,12 @@ impl Tuner {
     /// and no axes; each parameter without `start` starts from the case's value. Public for
     /// the solver benchmark (`examples/solver_efficiency.rs`).
     pub fn case_problem(&self, study: &Study, r: &Resolved) -> Problem {
+        self.case_problem_in(study, r, true)
+    }
+
+    /// [`Tuner::case_problem`], in the tuning worlds (`[tune] worlds`) or, with `in_worlds_too`
+    /// false, in the nominal world alone (the scenario the tuned case is scored in).
+    fn case_problem_in(&self, study: &Study, r: &Resolved, in_worlds_too: bool) -> Problem {
         let mut cs = study.clone();
         cs.design = r.design.clone();
         cs.scenario_full = r.scenario.clone();
@@ -176,7 +182,7 @@ impl Tuner {
                 }
             }
         }
-        if let Some(u) = &self.worlds {
+        if let (Some(u), true) = (&self.worlds, in_worlds_too) {
             // Every candidate in every tuning world: the objective combines the worlds
             // (`[tune.objective] combine`, default the mean) and each constraint must hold in
             // each of them, as in a problem file's `[uncertainty]`.
@@ -267,7 +273,9 @@ impl CaseTuner for Tuner {
         r: &Resolved,
         x: &[f64],
     ) -> Result<Resolved, TuneError> {
-        let problem = self.case_problem(study, r);
+        // The case as scored: the nominal world (variant 0 of the tuning problem is its first
+        // tuning world when `[tune] worlds` is set).
+        let problem = self.case_problem_in(study, r, false);
         let mut s = CaseEvaluator::new(&problem)
             .for_case(case.id, Deadline::NONE)
             .resolve(x, 0)
@@ -427,6 +435,21 @@ mod tests {
         }
         // Common random numbers: another case meets the same tuning worlds.
         assert_eq!(problem(&study, 5).spec.variants, p.spec.variants);
+        // The tuned case is scored in the nominal world: resolved at a point, it equals the
+        // nominal-tuning study's case at that point (not tuning world w0).
+        use crate::study::tune::CaseTuner;
+        let x: Vec<f64> = p.spec.space.params.iter().map(|q| q.start).collect();
+        let at = |s: &crate::study::schema::Study| {
+            let r = crate::study::cases::resolve_case(s, &cases[5]).unwrap();
+            Tuner::new(s)
+                .unwrap()
+                .unwrap()
+                .at(s, &cases[5], &r, &x)
+                .unwrap()
+        };
+        let (tuned, plain) = (at(&study), at(&nominal));
+        assert_eq!(tuned.scenario, plain.scenario);
+        assert_eq!(tuned.design, plain.design);
     }
 
     #[test]
