@@ -249,8 +249,8 @@ impl CaseTuner for Tuner {
             }
         }
         let (best, _) = best.ok_or_else(|| TuneError::msg("no tuning start ran"))?;
-        let mut resolved = ev.resolve(&best.x, 0).map_err(TuneError::from_error)?;
-        resolved.hash = r.hash.clone();
+        // Scored as the case itself at the tuned point: in the nominal world ([`CaseTuner::at`]).
+        let resolved = self.at(study, case, r, &best.x)?;
         Ok(Tuned {
             resolved,
             x: best.x.clone(),
