@@ -104,6 +104,24 @@ fn sweep(study: &Path, out: &Path, extra: &[&str]) {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
+/// Sweep the one-case study `text` (written to `dir/name`) with `--jobs 1` into `dir/j1` and
+/// `--jobs 2` into `dir/j2`; the two `cases.csv` must be identical. `j1`, its header and rows.
+fn one_case_at_jobs_1_and_2(
+    dir: &Path,
+    name: &str,
+    text: &str,
+) -> (std::path::PathBuf, Vec<String>, Vec<Vec<String>>) {
+    let study = write(dir, name, text);
+    let (j1, j2) = (dir.join("j1"), dir.join("j2"));
+    sweep(&study, &j1, &["--jobs", "1"]);
+    sweep(&study, &j2, &["--jobs", "2"]);
+    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
+    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
+    let (head, rows) = table(&j1);
+    assert_eq!(rows.len(), 1);
+    (j1, head, rows)
+}
+
 #[test]
 fn tuned_sweep_rows_carry_tuned_values_and_do_not_depend_on_jobs_or_resume() {
     let dir = tempfile::tempdir().unwrap();
@@ -165,21 +183,14 @@ fn tuning_starts_side_by_side_give_the_one_thread_rows() {
         .replace("values = [3, 4]", "values = [4]")
         .replace("[tune]\n", "[tune]\nstarts = 3\n")
         .replace("max_evals = 6", "max_evals = 9");
-    let study = write(dir.path(), "starts.toml", &text);
-    let (j1, j2) = (dir.path().join("j1"), dir.path().join("j2"));
-    sweep(&study, &j1, &["--jobs", "1"]);
-    sweep(&study, &j2, &["--jobs", "2"]);
-    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
-    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
-    let (head, rows) = table(&j1);
-    assert_eq!(rows.len(), 1);
+    let (j1, head, rows) = one_case_at_jobs_1_and_2(dir.path(), "starts.toml", &text);
     // Three starts of three evaluations each; their spread is the tuning noise.
     let evals = column(&head, &rows, "tune_evaluations");
     assert!(evals[0] > 3.0 && evals[0] <= 9.0, "{evals:?}");
     let noise = column(&head, &rows, "tune_noise");
     assert!(noise[0].is_finite() && noise[0] >= 0.0, "{noise:?}");
     let summary = |d: &Path| std::fs::read_to_string(d.join("summary.md")).unwrap();
-    assert_eq!(summary(&j1), summary(&j2));
+    assert_eq!(summary(&j1), summary(&dir.path().join("j2")));
 }
 
 #[test]
@@ -268,14 +279,7 @@ distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
     let text = format!("{BASE}{TUNE}{uncertainty}")
         .replace("values = [3, 4]", "values = [4]")
         .replace("[tune]\n", "[tune]\nworlds = 2\n");
-    let study = write(dir.path(), "worlds.toml", &text);
-    let (j1, j2) = (dir.path().join("j1"), dir.path().join("j2"));
-    sweep(&study, &j1, &["--jobs", "1"]);
-    sweep(&study, &j2, &["--jobs", "2"]);
-    let a = std::fs::read_to_string(j1.join("cases.csv")).unwrap();
-    assert_eq!(a, std::fs::read_to_string(j2.join("cases.csv")).unwrap());
-    let (head, rows) = table(&j1);
-    assert_eq!(rows.len(), 1);
+    let (_, head, rows) = one_case_at_jobs_1_and_2(dir.path(), "worlds.toml", &text);
     let k = column(&head, &rows, "tuned.control.k_psi");
     assert!(k[0] >= 0.15 && k[0] <= 1.35, "{k:?}");
     assert_eq!(column(&head, &rows, "tune_feasible"), [1.0]);
