@@ -75,7 +75,7 @@ impl PairPlan {
     pub fn new(dofs: [CommandedDofs; 2]) -> Self {
         let ks = dofs.map(CommandedDofs::len);
         let rows = dofs.map(selected_rows);
-        let nested = match (0..2).rfind(|&i| ks[i] == 6) {
+        let nested = match (0..2).position(|i| ks[i] == 6) {
             Some(full) if ks[1 - full] >= 5 => {
                 let sel = 1 - full;
                 Some((sel, rows_first(&rows[sel], ks[sel])))

@@ -317,7 +317,7 @@ pub fn commanded_sigma(
 pub struct ScaledGram {
     gram: [[f64; 6]; 6],
     char_length: f64,
-    /// L finite and > 0 and every entry of `T` finite.
+    /// L finite and > 0 and every sum of squares finite (so every entry of `T`).
     pub(super) valid: bool,
 }
 

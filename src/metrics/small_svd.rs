@@ -384,23 +384,14 @@ fn householder_nested(a: &mut [[f64; 6]; 6], d: &mut [f64; 6], e: &mut [f64; 6])
 /// `H A H` ([`reflect_block`]).
 #[inline(always)]
 fn householder_step_up<const I: usize>(a: &mut [[f64; 6]; 6], e: &mut [f64; 6]) {
-    let (i, l) = (I, I - 1);
-    let mut norm2 = 0.0;
-    for j in 0..i {
-        norm2 += a[i][j] * a[i][j];
-    }
-    if norm2 == 0.0 {
-        e[l] = 0.0;
-        return;
-    }
-    let norm = norm2.sqrt();
-    let alpha = if a[i][l] > 0.0 { -norm } else { norm };
-    let mut v = [0.0; 6];
-    v[..i].copy_from_slice(&a[i][..i]);
-    v[l] -= alpha;
-    let beta = 1.0 / (norm * (norm + a[i][l].abs()));
-    reflect_block(a, &v, beta, 0, i);
-    e[l] = alpha;
+    let row = a[I];
+    e[I - 1] = match reflector(&row, 0, I, I - 1) {
+        Some((v, beta, alpha)) => {
+            reflect_block(a, &v, beta, 0, I);
+            alpha
+        }
+        None => 0.0,
+    };
 }
 
 /// Reflection `j` of [`householder_k`]: zero column `j` below its subdiagonal, `e[j]` the
@@ -408,24 +399,36 @@ fn householder_step_up<const I: usize>(a: &mut [[f64; 6]; 6], e: &mut [f64; 6]) 
 #[inline(always)]
 fn householder_step<const K: usize>(a: &mut [[f64; 6]; 6], j: usize, e: &mut [f64; 6]) {
     let lo = j + 1;
+    let column: [f64; 6] = std::array::from_fn(|i| a[i][j]);
+    e[j] = match reflector(&column, lo, K, lo) {
+        Some((v, beta, alpha)) => {
+            reflect_block(a, &v, beta, lo, K);
+            alpha
+        }
+        None => 0.0,
+    };
+}
+
+/// The Householder reflection of the entries `lo..hi` of `x` onto its entry `pivot`:
+/// `(v, β, α)` with `H = I − β v vᵀ`, `H x = α e_pivot` (`v = x − α e_pivot` unnormalised,
+/// zero outside `lo..hi`; `β = 2/(vᵀv) = 1/(‖x‖(‖x‖ + |x_pivot|))`, `α = −sgn(x_pivot)‖x‖`);
+/// `None` when those entries are all zero.
+#[inline(always)]
+fn reflector(x: &[f64; 6], lo: usize, hi: usize, pivot: usize) -> Option<([f64; 6], f64, f64)> {
     let mut norm2 = 0.0;
-    for i in lo..K {
-        norm2 += a[i][j] * a[i][j];
+    for xi in &x[lo..hi] {
+        norm2 += xi * xi;
     }
     if norm2 == 0.0 {
-        e[j] = 0.0;
-        return;
+        return None;
     }
     let norm = norm2.sqrt();
-    let alpha = if a[lo][j] > 0.0 { -norm } else { norm };
+    let alpha = if x[pivot] > 0.0 { -norm } else { norm };
     let mut v = [0.0; 6];
-    for i in lo..K {
-        v[i] = a[i][j];
-    }
-    v[lo] -= alpha;
-    let beta = 1.0 / (norm * (norm + a[lo][j].abs()));
-    reflect_block(a, &v, beta, lo, K);
-    e[j] = alpha;
+    v[lo..hi].copy_from_slice(&x[lo..hi]);
+    v[pivot] -= alpha;
+    let beta = 1.0 / (norm * (norm + x[pivot].abs()));
+    Some((v, beta, alpha))
 }
 
 /// `A ← H A H` on the block `lo..hi` of the symmetric `a` for `H = I − β v vᵀ` (`v` zero
