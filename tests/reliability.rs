@@ -843,3 +843,72 @@ fn optimise_holds_the_lock_and_refuses_a_sweeps_output() {
         stderr(&o)
     );
 }
+
+/// Issue 39 (high): `simulate` of a scenario with `[uncertainty]` wrote `uncertainty.json`
+/// through a planted link (a plain write), and a sweep wrote its `study.toml` copy the same
+/// way. Both now go through the one atomic writer: a link in the output folder is replaced by
+/// the tool's own file, never followed, and a dangling link creates nothing outside.
+#[test]
+fn planted_links_at_uncertainty_json_and_the_study_copy_are_replaced_not_followed() {
+    let d = tempfile::tempdir().unwrap();
+    let scenario = write(
+        d.path(),
+        "worlds_scenario.toml",
+        r#"[scenario]
+name = "w"
+mode = "transport"
+design = "usm-paper"
+duration = 5.0
+
+[path]
+segments = [ { from = [0.0, 0.0], to = [200.0, 0.0] } ]
+
+[uncertainty]
+worlds = 2
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.5, high = 1.5 }
+"#,
+    );
+    let notes = write(d.path(), "notes.txt", "mine\n");
+    let dangling = d.path().join("created_outside.json");
+    for (name, target) in [
+        ("uncertainty.json", &notes),
+        ("uncertainty.json", &dangling),
+    ] {
+        let out = d.path().join(format!(
+            "o_{}",
+            target.file_name().unwrap().to_str().unwrap()
+        ));
+        std::fs::create_dir_all(&out).unwrap();
+        std::os::unix::fs::symlink(target, out.join(name)).unwrap();
+        let o = run(&[
+            "simulate",
+            scenario.to_str().unwrap(),
+            "--no-plots",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let meta = std::fs::symlink_metadata(out.join(name)).unwrap();
+        assert!(meta.file_type().is_file(), "{name} is still a link");
+        assert!(read(&out.join(name)).starts_with(b"{"));
+    }
+    assert_eq!(read(&notes), b"mine\n");
+    assert!(!dangling.exists(), "a dangling link created a file outside");
+
+    // The sweep's copy of the study: a sweep refuses a link leading out of its output before
+    // anything runs (and, inside, writes `study.toml` through the same atomic writer).
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("sweep_out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::os::unix::fs::symlink(&notes, out.join("study.toml")).unwrap();
+    let o = sweep(&s, &out, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("symbolic link leading out of the output directory"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(read(&notes), b"mine\n");
+}

@@ -1,7 +1,7 @@
 //! Uncertain worlds in sweeps (issue 22): the verdict a summary opens with, and common random
 //! numbers.
 //!
-//! Small transport studies (3 links, a 45 s run, four worlds over the linear-damping scale and
+//! Small transport studies (3 links, a 45 s run, eight worlds over the linear-damping scale and
 //! a weak current) whose cases differ only in `metrics.efficiency`, which divides the thruster
 //! energy and nothing else: a known margin in energy per metre that is the same in every world.
 //! - a 10 % margin names the winner; a 0.1 % margin (inside the 1 % equivalence margin) is a
@@ -39,8 +39,11 @@ lambda = 0.1
 cross_track_bound = 1.0
 
 [uncertainty]
-worlds = 4
+worlds = 8
 sampling = "sobol"
+# Eight worlds, all successful, show a success probability ≥ 0.7 at 95 % (Wilson lower bound
+# 8/(8 + 1.645²) = 0.747) and let a sign test reach 95 % (8 of 8: p = 2⁻⁸).
+min_success_probability = 0.7
 
 [[uncertainty.param]]
 name = "hydro.linear_damping_scale"
@@ -117,6 +120,26 @@ fn a_ten_percent_margin_names_the_winner_and_a_tenth_of_a_percent_is_a_tie() {
     }
     let gap = column(&out, "validate.late_turn.gap");
     assert!(gap.iter().all(|g| g.is_finite()), "{gap:?}");
+    // The same 10 % margin over 4 worlds decides nothing at 95 % (issue 36 item 6): no design
+    // can be shown to succeed with probability ≥ 0.7 (4 of 4: lower bound 0.596), so the study
+    // is undecided and says how many worlds it needs (7), never a Winner.
+    let four = write(
+        dir.path(),
+        "wide4.toml",
+        &std::fs::read_to_string(&wide)
+            .unwrap()
+            .replace("worlds = 8", "worlds = 4"),
+    );
+    let out4 = dir.path().join("wide4");
+    ok(&sweep(&four, &out4, &["--jobs", "2"]));
+    let v = verdict(&out4);
+    assert!(v.starts_with("**Undecided: needs ≥ 7 worlds**"), "{v}");
+    assert!(column(&out4, "p_best").iter().all(|p| p.is_nan()));
+    let lower = column(&out4, "success_probability_lower");
+    assert!(lower.iter().all(|l| (l - 0.5965).abs() < 1e-3), "{lower:?}");
+    // With 4 worlds the sensitivity section is withheld, not printed as ±1.
+    let md = summary(&out4);
+    assert!(md.contains("Withheld: 4 worlds are too few"), "{md}");
 
     let narrow = study(
         dir.path(),
@@ -145,7 +168,7 @@ fn cases_differing_in_a_key_no_metric_reads_are_tied_never_a_winner() {
     assert!(v.starts_with("**Statistically tied: #0, #1"), "{v}");
     assert_eq!(column(&out, "p_best"), vec![0.5, 0.5]);
     let s = summary(&out);
-    assert!(s.contains("## Ranking over 4 uncertain worlds"), "{s}");
+    assert!(s.contains("## Ranking over 8 uncertain worlds"), "{s}");
     assert!(s.contains("## Sensitivity"), "{s}");
     assert!(s.contains("## Held-out validation"), "{s}");
 }
@@ -157,6 +180,14 @@ fn every_case_meets_the_same_worlds_for_any_jobs_shards_and_resume() {
         dir.path(),
         "s.toml",
         "[[axis]]\nname = \"design.links\"\nvalues = [3, 4]\n\n[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.6]\n",
+    );
+    // Four worlds are enough to check that every case meets the same ones.
+    let s = write(
+        dir.path(),
+        "s.toml",
+        &std::fs::read_to_string(&s)
+            .unwrap()
+            .replace("worlds = 8", "worlds = 4"),
     );
     let read = |out: &Path, f: &str| std::fs::read(out.join(f)).unwrap();
     let j1 = dir.path().join("j1");
@@ -224,7 +255,11 @@ fn bad_uncertainty_sections_exit_2_naming_the_key() {
             ),
             "kind",
         ),
-        (("worlds = 4", "worlds = 1"), "uncertainty.worlds"),
+        (("worlds = 8", "worlds = 1"), "uncertainty.worlds"),
+        (
+            ("min_success_probability = 0.7", "confidence = 1.0"),
+            "uncertainty.confidence",
+        ),
         (("low = 0.0, high = 0.02", "low = 0.0, mean = 0.02"), "mean"),
         (
             ("name = \"late_turn\"", "name = \"late turn\""),
@@ -245,7 +280,7 @@ fn a_saltelli_design_of_worlds_gives_sobol_indices_in_the_summary() {
     let dir = tempfile::tempdir().unwrap();
     let text = format!("{BASE}\n[[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.6]\n")
         .replace("sampling = \"sobol\"", "sampling = \"saltelli\"")
-        .replace("worlds = 4", "worlds = 3");
+        .replace("worlds = 8", "worlds = 3");
     let s = write(dir.path(), "saltelli.toml", &text);
     let out = dir.path().join("saltelli");
     ok(&sweep(&s, &out, &["--jobs", "2"]));

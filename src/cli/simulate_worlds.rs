@@ -106,9 +106,10 @@ pub fn run_worlds(w: &Worlds, out: &Path) -> anyhow::Result<()> {
         "status": row.status.as_str(),
         "reason": row.reason,
     });
-    std::fs::write(
-        out.join(UNCERTAINTY_JSON),
-        serde_json::to_string_pretty(&doc)? + "\n",
+    // The one writer (issue 39): atomic and link-safe, like every other output.
+    usm_study::report::atomic_write(
+        &out.join(UNCERTAINTY_JSON),
+        (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
     eprintln!(
         "[simulate] {} worlds: success probability {p:.3}; wrote {} and {}",

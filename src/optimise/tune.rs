@@ -18,6 +18,7 @@
 use super::evaluate::CaseEvaluator;
 use super::history::Record;
 use super::problem::{in_worlds, parse_spec};
+use super::search::Evaluator as _;
 use super::{minimise, Options, Problem, Spec};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
 use crate::input::document::Document;
@@ -51,7 +52,14 @@ pub struct Tuner {
     /// The tuning worlds (`[tune] worlds = N`): the study's `[uncertainty]` with `N` worlds
     /// drawn apart from the scoring worlds; `None` to tune in the nominal world.
     worlds: Option<Uncertainty>,
+    /// Independent tuning seeds (`[tune] seeds`, default 1): each seed tunes the case afresh
+    /// with its own tuning worlds, start points and solver seeds; the seeds' best points are
+    /// then compared in the pooled tuning worlds of all seeds (issue 36 item 5).
+    seeds: usize,
 }
+
+/// Most independent tuning seeds.
+pub const MAX_SEEDS: usize = 8;
 
 /// Most independent tuning starts.
 pub const MAX_STARTS: usize = 16;
@@ -132,6 +140,16 @@ impl Tuner {
                 ))
             }
         };
+        let seeds = match t.remove("seeds") {
+            None => 1,
+            Some(toml::Value::Integer(n)) if (1..=MAX_SEEDS as i64).contains(&n) => n as usize,
+            Some(v) => {
+                return Err(doc.err(
+                    "tune.seeds",
+                    format!("must be an integer from 1 to {MAX_SEEDS}, got {v}"),
+                ))
+            }
+        };
         let spec = parse_spec(&doc, &t, "tune", study)?;
         if spec.solver.max_evals / starts < 2 {
             return Err(doc.err(
@@ -155,6 +173,7 @@ impl Tuner {
             static_needed,
             starts,
             worlds,
+            seeds,
         }))
     }
 
@@ -168,6 +187,17 @@ impl Tuner {
     /// [`Tuner::case_problem`], in the tuning worlds (`[tune] worlds`) or, with `in_worlds_too`
     /// false, in the nominal world alone (the scenario the tuned case is scored in).
     fn case_problem_in(&self, study: &Study, r: &Resolved, in_worlds_too: bool) -> Problem {
+        let worlds = if in_worlds_too {
+            WorldsOf::Seed(0)
+        } else {
+            WorldsOf::Nominal
+        };
+        self.case_problem_with(study, r, worlds)
+    }
+
+    /// [`Tuner::case_problem`] in the worlds `which` names: none (nominal), one tuning seed's,
+    /// or every seed's pooled.
+    fn case_problem_with(&self, study: &Study, r: &Resolved, which: WorldsOf) -> Problem {
         let mut cs = study.clone();
         cs.design = r.design.clone();
         cs.scenario_full = r.scenario.clone();
@@ -182,29 +212,47 @@ impl Tuner {
                 }
             }
         }
-        if let (Some(u), true) = (&self.worlds, in_worlds_too) {
+        if let Some(u) = &self.worlds {
             // Every candidate in every tuning world: the objective combines the worlds
             // (`[tune.objective] combine`, default the mean) and each constraint must hold in
             // each of them, as in a problem file's `[uncertainty]`.
-            let variants = std::mem::take(&mut spec.variants);
-            spec.variants = in_worlds(variants, u, derive_seed(study.seed, TUNE_WORLDS_STREAM));
+            let seeds: Vec<usize> = match which {
+                WorldsOf::Nominal => Vec::new(),
+                WorldsOf::Seed(k) => vec![k],
+                WorldsOf::Pooled => (0..self.seeds).collect(),
+            };
+            if !seeds.is_empty() {
+                let variants = std::mem::take(&mut spec.variants);
+                for k in seeds {
+                    let mut v = in_worlds(variants.clone(), u, tune_worlds_seed(study.seed, k));
+                    if matches!(which, WorldsOf::Pooled) {
+                        for x in &mut v {
+                            x.name = format!("s{k}/{}", x.name);
+                        }
+                    }
+                    spec.variants.extend(v);
+                }
+            }
         }
         Problem { study: cs, spec }
     }
-}
 
-impl CaseTuner for Tuner {
-    /// Tune case `case` (resolved as `r`) within `deadline`: the case at the best point.
-    fn tune(
+    /// One tuning seed's search of case `case`: the seed's tuning worlds, its starts side by
+    /// side. Seed 0 is the tuning of a study without `seeds` exactly.
+    fn tune_seed(
         &self,
         study: &Study,
         case: &Case,
         r: &Resolved,
         deadline: Deadline,
-    ) -> Result<Tuned, TuneError> {
-        let problem = self.case_problem(study, r);
+        k: usize,
+    ) -> Result<SeedResult, TuneError> {
+        let problem = self.case_problem_with(study, r, WorldsOf::Seed(k));
         let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
         let mut spec = problem.spec.clone();
+        if k > 0 {
+            spec.solver.seed = derive_seed(spec.solver.seed, SEEDS_STREAM ^ k as u64);
+        }
         let quiet = |_: &Record| {};
         let opts = Options {
             jobs: 1,
@@ -213,18 +261,26 @@ impl CaseTuner for Tuner {
             on_record: &quiet,
         };
         let d = spec.space.dim();
-        let sobol = Sampler::new(
-            Sampling::Sobol,
-            self.starts.max(2),
-            d,
-            derive_seed(study.seed, STARTS_STREAM),
-        )
-        .map_err(TuneError::from_error)?;
+        let starts_seed = if k == 0 {
+            derive_seed(study.seed, STARTS_STREAM)
+        } else {
+            derive_seed(derive_seed(study.seed, STARTS_STREAM), k as u64)
+        };
+        let sobol = Sampler::new(Sampling::Sobol, self.starts.max(2), d, starts_seed)
+            .map_err(TuneError::from_error)?;
         spec.solver.max_evals = self.spec.solver.max_evals / self.starts;
         // The starts' points depend only on the Sobol stream, so the starts are independent
         // runs: side by side (a case tuned last, or alone, keeps every thread busy), their
         // outcomes combined in start order so nothing depends on the thread count.
-        let specs = start_specs(&spec, self.starts, &sobol);
+        let specs = if k == 0 {
+            start_specs(&spec, self.starts, &sobol)
+        } else {
+            // A later seed starts every start from the Sobol stream (its start 0 too), so it
+            // does not retrace seed 0's first start from the case's own values.
+            let mut v = start_specs(&spec, self.starts + 1, &sobol);
+            v.remove(0);
+            v
+        };
         let outs: Vec<_> = specs
             .par_iter()
             .with_max_len(1)
@@ -249,19 +305,170 @@ impl CaseTuner for Tuner {
             }
         }
         let (best, _) = best.ok_or_else(|| TuneError::msg("no tuning start ran"))?;
+        Ok(SeedResult {
+            best,
+            noise: relative_spread(&bests),
+            curve,
+            evaluations,
+        })
+    }
+}
+
+/// Which tuning worlds a tuning problem runs in.
+#[derive(Clone, Copy, Debug)]
+enum WorldsOf {
+    /// The nominal world alone (how a tuned case is scored).
+    Nominal,
+    /// Tuning seed `k`'s worlds.
+    Seed(usize),
+    /// Every seed's worlds together (the seeds' best points compared).
+    Pooled,
+}
+
+/// What one tuning seed found.
+struct SeedResult {
+    best: Record,
+    /// Spread of the starts' bests within the seed.
+    noise: f64,
+    curve: Vec<f64>,
+    evaluations: usize,
+}
+
+/// Seed stream of tuning seed `k`'s solver seeds (seed 0 keeps the study's).
+const SEEDS_STREAM: u64 = 0x5345_4544_5353; // "SEEDSS"
+
+/// The seed of tuning seed `k`'s worlds: seed 0 the tuning-worlds stream itself (a one-seed
+/// tuning is unchanged), seed `k > 0` a stream derived from it.
+fn tune_worlds_seed(study_seed: u64, k: usize) -> u64 {
+    let base = derive_seed(study_seed, TUNE_WORLDS_STREAM);
+    if k == 0 {
+        base
+    } else {
+        derive_seed(base, k as u64)
+    }
+}
+
+impl CaseTuner for Tuner {
+    /// Tune case `case` (resolved as `r`) within `deadline`: the case at the best point.
+    ///
+    /// With `[tune] seeds = S > 1`, each seed tunes afresh ([`Tuner::tune_seed`]); the seeds'
+    /// best points are then run in the pooled tuning worlds of every seed (the nominal world
+    /// without `[tune] worlds`), and the case takes the point that is feasible there (or
+    /// least infeasible) with the lowest objective. `tune_noise` is then the relative spread
+    /// of the seeds' pooled objectives and `tune_success_spread` the spread of the fraction
+    /// of pooled worlds in which each seed's point meets every constraint: the seeds'
+    /// disagreement on what the verdict uses.
+    fn tune(
+        &self,
+        study: &Study,
+        case: &Case,
+        r: &Resolved,
+        deadline: Deadline,
+    ) -> Result<Tuned, TuneError> {
+        let runs: Vec<Result<SeedResult, TuneError>> = (0..self.seeds)
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|k| self.tune_seed(study, case, r, deadline, k))
+            .collect();
+        let mut seeds = Vec::with_capacity(runs.len());
+        for run in runs {
+            seeds.push(run?);
+        }
+        let mut evaluations: usize = seeds.iter().map(|s| s.evaluations).sum();
+        let mut curve = Vec::new();
+        for s in &seeds {
+            // Each seed's curve carries the earlier seeds' best on (as starts do).
+            let carried = curve.last().copied().unwrap_or(f64::NAN);
+            curve.extend(
+                s.curve
+                    .iter()
+                    .map(|&c| match (c.is_nan(), carried.is_nan()) {
+                        (true, _) => carried,
+                        (false, true) => c,
+                        (false, false) => c.min(carried),
+                    }),
+            );
+        }
+        let (pick, feasible, noise, success_spread) = if seeds.len() == 1 {
+            let s = &seeds[0];
+            (0, s.best.score.feasible, s.noise, f64::NAN)
+        } else {
+            let pooled = self.case_problem_with(study, r, WorldsOf::Pooled);
+            let ev = CaseEvaluator::new(&pooled).for_case(case.id, deadline);
+            let evals: Vec<_> = seeds
+                .par_iter()
+                .with_max_len(1)
+                .map(|s| ev.evaluate(&s.best.x))
+                .collect();
+            evaluations += evals.len();
+            let scorer = super::score::Scorer::new(
+                &pooled.spec.objective,
+                &pooled.spec.constraints,
+                ev.metrics(),
+                &evals[0].metrics,
+            );
+            let scored: Vec<(super::score::Score, f64, f64)> = evals
+                .iter()
+                .map(|e| {
+                    let mut score = scorer.score(&e.metrics);
+                    if e.failure.is_some() {
+                        score.feasible = false;
+                        score.violation = score.violation.max(1.0);
+                    }
+                    let raw = raw_metrics_objective(&scorer, &e.metrics);
+                    let met = e
+                        .metrics
+                        .iter()
+                        .filter(|m| {
+                            (0..scorer.constraints.len())
+                                .all(|k| scorer.constraint_violation(k, m) == 0.0)
+                        })
+                        .count();
+                    (score, raw, met as f64 / e.metrics.len().max(1) as f64)
+                })
+                .collect();
+            let mut pick = 0;
+            for i in 1..scored.len() {
+                let (a, b) = (&scored[i], &scored[pick]);
+                let better = match (a.0.feasible, b.0.feasible) {
+                    (true, true) => a.1 < b.1,
+                    _ => a.0.better_than(&b.0),
+                };
+                if better {
+                    pick = i;
+                }
+            }
+            let costs: Vec<f64> = scored.iter().map(|s| s.1).collect();
+            let shares: Vec<f64> = scored.iter().map(|s| s.2).collect();
+            let (lo, hi) = shares
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(*x), b.max(*x))
+                });
+            (
+                pick,
+                scored[pick].0.feasible,
+                relative_spread(&costs),
+                hi - lo,
+            )
+        };
+        let best = &seeds[pick].best;
+        let best_x = best.x.clone();
         // Scored as the case itself at the tuned point: in the nominal world ([`CaseTuner::at`]).
-        let resolved = self.at(study, case, r, &best.x)?;
+        let resolved = self.at(study, case, r, &best_x)?;
+        let bound_hits = best
+            .u
+            .iter()
+            .filter(|u| **u <= BOUND_TOLERANCE || **u >= 1.0 - BOUND_TOLERANCE)
+            .count();
         Ok(Tuned {
             resolved,
-            x: best.x.clone(),
+            x: best_x,
             evaluations,
-            feasible: best.score.feasible,
-            noise: relative_spread(&bests),
-            bound_hits: best
-                .u
-                .iter()
-                .filter(|u| **u <= BOUND_TOLERANCE || **u >= 1.0 - BOUND_TOLERANCE)
-                .count(),
+            feasible,
+            noise,
+            success_spread,
+            bound_hits,
             curve,
         })
     }
@@ -321,7 +528,17 @@ fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
     }
 }
 
-/// Relative spread `(max − min) / |min|` of the finite values (NaN with fewer than two).
+/// The unnormalised objective of one evaluation's metrics (as [`raw_objective`]).
+fn raw_metrics_objective(scorer: &super::score::Scorer, metrics: &[Vec<f64>]) -> f64 {
+    scorer
+        .objective
+        .terms
+        .iter()
+        .zip(&scorer.term_columns)
+        .map(|(t, &c)| t.weight * super::score::mean_of(metrics, c))
+        .sum()
+}
+
 /// The unnormalised objective of `r`: `Σ w_i · m_i` with each term's metric averaged over the
 /// scenarios. The starts of a tuning normalise by their own start points, so their scores are
 /// not comparable; this is.
@@ -335,6 +552,7 @@ fn raw_objective(scorer: &super::score::Scorer, r: &Record) -> f64 {
         .sum()
 }
 
+/// Relative spread `(max − min) / |min|` of the finite values (NaN with fewer than two).
 fn relative_spread(xs: &[f64]) -> f64 {
     let f: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
     if f.len() < 2 {

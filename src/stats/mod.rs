@@ -8,11 +8,13 @@
 //! - [`sobol`]: Saltelli designs ([`SaltelliDesign`]) and first-order / total Sobol indices
 //!   with percentile-bootstrap intervals ([`sobol_indices`]);
 //! - [`srrc`](mod@srrc): standardised (rank) regression coefficients ([`srrc()`], [`src()`]);
+//! - [`confidence`]: Wilson lower bounds, the exact sign test and Holm's correction;
 //! - [`ranking`]: paired ranking of cases over common worlds ([`rank_stats`]) and the
 //!   winner-or-tie verdict ([`verdict`]).
 //!
 //! The formulas and their sources are `docs/statistics.md`.
 
+pub mod confidence;
 pub mod describe;
 pub mod normal;
 pub mod ranking;

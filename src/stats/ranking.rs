@@ -6,6 +6,7 @@
 //! world. A case whose objective is not finite in a world counts as failed there. Rows longer
 //! than the shortest one are read up to its length.
 
+use super::confidence::{holm, holm_adjusted, sign_test_p};
 use super::describe::quantile_sorted;
 
 /// How a case ranks among all cases over the worlds.
@@ -94,8 +95,9 @@ pub fn rank_stats(obj: &[Vec<f64>], ok: &[Vec<bool>]) -> Vec<RankStats> {
 /// The rule of [`verdict`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VerdictSettings {
-    /// Fraction of paired worlds in which the leader must beat a case to be called better
-    /// than it (default 0.95).
+    /// Confidence level `1 − α` of the verdict's tests (default 0.95): a winner is named only
+    /// when the one-sided sign tests against every other eligible case reject "not better" at
+    /// family-wise level `α` after Holm's correction.
     pub confidence: f64,
     /// Relative margin below which a difference in one world is a tie (default 0.01).
     pub equivalence: f64,
@@ -117,8 +119,8 @@ impl Default for VerdictSettings {
 /// A [`VerdictSettings`] field out of its range.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum VerdictSettingsError {
-    /// `confidence` must lie in (0, 1].
-    #[error("confidence must be in (0, 1], got {0}")]
+    /// `confidence` must lie in (0, 1).
+    #[error("confidence must be in (0, 1), got {0}")]
     Confidence(f64),
     /// `equivalence` must be finite and ≥ 0.
     #[error("equivalence must be a finite relative margin ≥ 0, got {0}")]
@@ -131,7 +133,7 @@ pub enum VerdictSettingsError {
 impl VerdictSettings {
     /// Checks every field's range (callers locate the error in their file).
     pub fn validate(&self) -> Result<(), VerdictSettingsError> {
-        if !(self.confidence > 0.0 && self.confidence <= 1.0) {
+        if !(self.confidence > 0.0 && self.confidence < 1.0) {
             return Err(VerdictSettingsError::Confidence(self.confidence));
         }
         if !(self.equivalence.is_finite() && self.equivalence >= 0.0) {
@@ -150,17 +152,29 @@ pub struct Contender {
     /// The case's index.
     pub case: usize,
     /// Fraction of all worlds in which the leader succeeds and beats this case (the case fails,
-    /// or the leader is better by more than the relative margin δ).
+    /// or the leader is better by more than the relative margin δ): `wins / W`.
     pub p_beats: f64,
     /// Median over the worlds where both succeed of `(obj_c − obj_L) / |obj_L|` (NaN when
     /// there is no such world).
     pub margin: f64,
+    /// Worlds the leader wins ([`Contender::p_beats`] × W).
+    pub wins: usize,
+    /// The one-sided sign test's p-value of the wins ([`super::confidence::sign_test_p`]).
+    pub p_value: f64,
+    /// The Holm-adjusted p-value over the leader's comparisons
+    /// ([`super::confidence::holm_adjusted`]).
+    pub p_adjusted: f64,
+    /// For a case the leader does not beat with confidence but leads (more wins than half the
+    /// worlds and a median margin beyond δ): the fewest worlds in which the same share of wins
+    /// would reach the confidence (`None`: a tie, or more than 65 536 worlds).
+    pub needs_worlds: Option<usize>,
 }
 
 /// The answer of [`verdict`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum Verdict {
-    /// The leader beats every other eligible case in at least `confidence` of the worlds.
+    /// The leader beats every other eligible case with the stated confidence (Holm-corrected
+    /// one-sided sign tests of the paired margin).
     Winner {
         /// The winning case.
         leader: usize,
@@ -171,8 +185,11 @@ pub enum Verdict {
         p_beats: f64,
         /// The leader's margin over the runner-up (NaN when alone).
         margin: f64,
+        /// The largest Holm-adjusted p-value over the comparisons (0 when alone).
+        p_value: f64,
     },
-    /// Some eligible cases are not beaten with the required confidence.
+    /// Some eligible cases are not beaten with the required confidence and the data do not
+    /// lean to the leader against at least one of them (a tie).
     Tied {
         /// The case with the lowest mean objective.
         leader: usize,
@@ -180,8 +197,30 @@ pub enum Verdict {
         /// margin (NaN margins last, then by index).
         tied: Vec<Contender>,
     },
+    /// The leader leads every case it does not beat with confidence, but there are too few
+    /// worlds to reach the confidence: more worlds could decide.
+    Undecided {
+        /// The case with the lowest mean objective.
+        leader: usize,
+        /// The cases not yet beaten with confidence (each with its `needs_worlds`).
+        open: Vec<Contender>,
+        /// The most worlds any open comparison needs.
+        needs_worlds: usize,
+    },
     /// No case is eligible.
     NoneEligible,
+}
+
+impl Verdict {
+    /// The leader (winner, first of a tie, or undecided leader), if any case is eligible.
+    pub fn leader(&self) -> Option<usize> {
+        match self {
+            Verdict::Winner { leader, .. }
+            | Verdict::Tied { leader, .. }
+            | Verdict::Undecided { leader, .. } => Some(*leader),
+            Verdict::NoneEligible => None,
+        }
+    }
 }
 
 /// Mean objective of case `c` over the worlds where it succeeds (NaN when it never does).
@@ -197,7 +236,8 @@ fn mean_success(obj: &[Vec<f64>], ok: &[Vec<bool>], c: usize, nw: usize) -> f64 
     }
 }
 
-/// Compares leader `l` with case `c` (see [`Contender`]), δ the relative tie margin.
+/// Compares leader `l` with case `c` (see [`Contender`]), δ the relative tie margin; the
+/// p-values are filled in by the caller.
 fn contend(
     obj: &[Vec<f64>],
     ok: &[Vec<bool>],
@@ -234,7 +274,29 @@ fn contend(
             beats as f64 / nw as f64
         },
         margin: quantile_sorted(&rel, 0.5),
+        wins: beats,
+        p_value: sign_test_p(beats, nw),
+        p_adjusted: f64::NAN,
+        needs_worlds: None,
     }
+}
+
+/// The fewest worlds `n > nw` in which the share of wins `wins/nw` reaches a sign-test p-value
+/// of at most `level` (`None` when the share is at most ½ or `n` would pass 65 536).
+fn worlds_to_reach(wins: usize, nw: usize, level: f64) -> Option<usize> {
+    if nw == 0 || 2 * wins <= nw {
+        return None;
+    }
+    let share = wins as f64 / nw as f64;
+    let mut n = nw.max(1);
+    while n <= 1 << 16 {
+        let k = (share * n as f64).floor() as usize;
+        if sign_test_p(k, n) <= level {
+            return Some(n);
+        }
+        n += 1.max(n / 64);
+    }
+    None
 }
 
 /// Orders contenders by increasing margin, NaN margins last, then by case index.
@@ -246,18 +308,23 @@ fn by_margin(a: &Contender, b: &Contender) -> std::cmp::Ordering {
         .then(a.case.cmp(&b.case))
 }
 
-/// Names a winner only when the data support it.
+/// Names a winner only when the data support it with the stated confidence
+/// (`docs/statistics.md`, "The verdict").
 ///
 /// The leader is the eligible case (`eligible[c]`; missing entries count as not eligible) with
 /// the lowest mean objective over the worlds where it succeeds (cases that never succeed come
-/// last; ties go to the lower index). For every other eligible case c, `p_beats` is the
-/// fraction of worlds in which the leader succeeds and either c fails or
-/// `obj_L < obj_c − δ·|obj_L|`, with `δ = max(equivalence, noise)`; `margin` is the median
-/// relative difference where both succeed ([`Contender`]). The leader is a
-/// [`Verdict::Winner`] iff its `p_beats` against every other eligible case is at least
-/// `confidence`; the runner-up is then the case with the smallest margin. A single eligible
-/// case is a winner over itself: `runner_up = leader`, `p_beats = 1`, `margin = NaN`.
-/// Otherwise the verdict is [`Verdict::Tied`] with the cases not beaten.
+/// last; ties go to the lower index). For every other eligible case c, the leader *wins* a
+/// world when it succeeds there and either c fails or `obj_L < obj_c − δ·|obj_L|`, with
+/// `δ = max(equivalence, noise)`; `p_beats = wins/W` and `margin` is the median relative
+/// difference where both succeed ([`Contender`]). Each comparison is a one-sided exact sign test
+/// of H₀ "the leader wins at most half of the worlds" (`p = P(Binomial(W, ½) ≥ wins)`), and
+/// the comparisons are corrected together by Holm's procedure at `α = 1 − confidence`. The
+/// leader is a [`Verdict::Winner`] iff every comparison is rejected; the runner-up is then the
+/// case with the smallest margin. A single eligible case is a winner over itself:
+/// `runner_up = leader`, `p_beats = 1`, `margin = NaN`. Otherwise the cases not beaten are
+/// either *open* — the leader wins more than half of the worlds against them and the median
+/// margin exceeds δ, so more worlds (`needs_worlds`) could decide — or *tied*. All open →
+/// [`Verdict::Undecided`]; any tied → [`Verdict::Tied`].
 pub fn verdict(
     obj: &[Vec<f64>],
     ok: &[Vec<bool>],
@@ -279,29 +346,64 @@ pub fn verdict(
         return Verdict::NoneEligible;
     };
     let delta = s.equivalence.max(s.noise);
+    let alpha = 1.0 - s.confidence;
     let mut others: Vec<Contender> = candidates
         .iter()
         .filter(|&&(c, _)| c != leader)
         .map(|&(c, _)| contend(obj, ok, leader, c, nw, delta))
         .collect();
+    let p: Vec<f64> = others.iter().map(|c| c.p_value).collect();
+    let rejected = holm(&p, alpha);
+    for (c, a) in others.iter_mut().zip(holm_adjusted(&p)) {
+        c.p_adjusted = a;
+    }
+    // The open comparisons must reach, each, at least the last Holm threshold α/m_open.
+    let m_open = rejected.iter().filter(|r| !**r).count().max(1);
+    for (c, r) in others.iter_mut().zip(&rejected) {
+        if !*r && c.margin > delta {
+            c.needs_worlds = worlds_to_reach(c.wins, nw, alpha / m_open as f64);
+        }
+    }
     others.sort_by(by_margin);
-    if others.iter().all(|c| c.p_beats >= s.confidence) {
+    if rejected.iter().all(|r| *r) {
+        let p_value = others.iter().map(|c| c.p_adjusted).fold(0.0f64, f64::max);
         return match others.first() {
             Some(r) => Verdict::Winner {
                 leader,
                 runner_up: r.case,
                 p_beats: r.p_beats,
                 margin: r.margin,
+                p_value,
             },
             None => Verdict::Winner {
                 leader,
                 runner_up: leader,
                 p_beats: 1.0,
                 margin: f64::NAN,
+                p_value: 0.0,
             },
         };
     }
-    others.retain(|c| c.p_beats < s.confidence);
+    let beaten: Vec<usize> = candidates
+        .iter()
+        .filter(|&&(c, _)| c != leader)
+        .zip(&rejected)
+        .filter(|(_, r)| **r)
+        .map(|(&(c, _), _)| c)
+        .collect();
+    others.retain(|c| !beaten.contains(&c.case));
+    if others.iter().all(|c| c.needs_worlds.is_some()) {
+        let needs_worlds = others
+            .iter()
+            .filter_map(|c| c.needs_worlds)
+            .max()
+            .unwrap_or(nw);
+        return Verdict::Undecided {
+            leader,
+            open: others,
+            needs_worlds,
+        };
+    }
     Verdict::Tied {
         leader,
         tied: others,

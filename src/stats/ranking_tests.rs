@@ -24,17 +24,13 @@ fn identical_cases_are_tied_with_half_the_wins_each() {
         (1.0, 1.0, 1.0)
     );
     let v = verdict(&obj, &ok, &[true, true], &VerdictSettings::default());
-    assert_eq!(
-        v,
-        Verdict::Tied {
-            leader: 0,
-            tied: vec![Contender {
-                case: 1,
-                p_beats: 0.0,
-                margin: 0.0
-            }]
-        }
-    );
+    let Verdict::Tied { leader: 0, tied } = v else {
+        panic!("expected a tie, got {v:?}");
+    };
+    assert_eq!(tied.len(), 1);
+    let c: Contender = tied[0];
+    assert_eq!((c.case, c.p_beats, c.margin, c.wins), (1, 0.0, 0.0, 0));
+    assert_eq!((c.p_value, c.needs_worlds), (1.0, None));
 }
 
 #[test]
@@ -56,12 +52,15 @@ fn a_ten_percent_paired_margin_names_the_winner() {
         runner_up,
         p_beats,
         margin,
+        p_value,
     } = verdict(&obj, &ok, &[true; 3], &VerdictSettings::default())
     else {
         panic!("expected a winner");
     };
     assert_eq!((leader, runner_up, p_beats), (0, 1, 1.0));
     assert!((margin - 0.10).abs() < 0.03, "{margin}");
+    // Both comparisons won in 24 of 24 worlds: Holm-adjusted p = 2 · 2⁻²⁴.
+    assert!((p_value - 2.0 * 2f64.powi(-24)).abs() < 1e-15, "{p_value}");
     let r = rank_stats(&obj, &ok);
     assert_eq!(r[0].p_best, 1.0);
     assert_eq!(
@@ -135,6 +134,7 @@ fn failures_are_beaten_and_never_lead() {
             runner_up: 1,
             p_beats,
             margin,
+            ..
         } => assert_eq!((p_beats, margin), (1.0, 0.2)),
         v => panic!("expected a winner, got {v:?}"),
     }
@@ -143,13 +143,19 @@ fn failures_are_beaten_and_never_lead() {
     assert_eq!((r[2].rank_p05, r[2].rank_p95), (2.0, 3.0));
     assert_eq!(r[2].p_best, 0.0);
     assert_eq!((r[1].rank_p05, r[1].rank_p95), (2.0, 2.0));
-    // A leader failing in a world does not beat anyone there.
+    // A leader failing in a world does not beat anyone there; 3 wins of 4 at a 100 % margin
+    // lean to the leader but cannot reach 95 % (p = 5/16): undecided, not tied.
     let mut ok3 = all_ok(2, 4);
     ok3[0][0] = false;
     let obj3 = vec![vec![1.0; 4], vec![2.0; 4]];
     match verdict(&obj3, &ok3, &[true, true], &s) {
-        Verdict::Tied { leader: 0, tied } => assert_eq!(tied[0].p_beats, 0.75),
-        v => panic!("expected a tie, got {v:?}"),
+        Verdict::Undecided {
+            leader: 0, open, ..
+        } => {
+            assert_eq!(open[0].p_beats, 0.75);
+            assert_eq!(open[0].p_value, 5.0 / 16.0);
+        }
+        v => panic!("expected undecided, got {v:?}"),
     }
 }
 
@@ -165,19 +171,97 @@ fn eligibility_decides_who_is_compared() {
             runner_up: 1,
             p_beats,
             margin,
+            ..
         } => assert!(p_beats == 1.0 && margin.is_nan()),
         v => panic!("expected a lone winner, got {v:?}"),
     }
     assert_eq!(verdict(&obj, &ok, &[false; 3], &s), Verdict::NoneEligible);
     assert_eq!(verdict(&obj, &ok, &[], &s), Verdict::NoneEligible);
-    assert!(matches!(
-        verdict(&obj, &ok, &[true, true, false], &s),
+    // Two worlds cannot show anything at 95 %: 2 of 2 has p = 0.25; five would do.
+    match verdict(&obj, &ok, &[true, true, false], &s) {
+        Verdict::Undecided {
+            leader: 0,
+            open,
+            needs_worlds: 5,
+        } => assert_eq!(open[0].case, 1),
+        v => panic!("expected undecided needing 5 worlds, got {v:?}"),
+    }
+}
+
+/// Issue 36 item 6, "must show": one design beats another by ≈ 10 % in every world. At 4
+/// worlds the sign test cannot reach 95 % (4 of 4: p = 0.0625), so the verdict is undecided and
+/// says how many worlds it needs; at 32 worlds it is a Winner (p = 2⁻³²).
+#[test]
+fn ten_percent_in_every_world_is_undecided_at_4_worlds_and_a_winner_at_32() {
+    let obj_at = |worlds: usize| -> Vec<Vec<f64>> {
+        [1.0, 1.10]
+            .iter()
+            .map(|k| (0..worlds).map(|w| 60.0 * k * wobble(w, 0.3)).collect())
+            .collect()
+    };
+    let s = VerdictSettings::default();
+    match verdict(&obj_at(4), &all_ok(2, 4), &[true, true], &s) {
+        Verdict::Undecided {
+            leader: 0,
+            open,
+            needs_worlds,
+        } => {
+            assert_eq!((open[0].wins, open[0].p_value), (4, 0.0625));
+            assert_eq!(needs_worlds, 5);
+        }
+        v => panic!("expected undecided at 4 worlds, got {v:?}"),
+    }
+    match verdict(&obj_at(32), &all_ok(2, 32), &[true, true], &s) {
         Verdict::Winner {
             leader: 0,
             runner_up: 1,
+            p_value,
             ..
-        }
+        } => assert_eq!(p_value, 2f64.powi(-32)),
+        v => panic!("expected a winner at 32 worlds, got {v:?}"),
+    }
+    // One failed world of 16 does not turn a 2.3× gap into a tie (15 of 16: p = 17/65536).
+    let mut obj = vec![vec![60.0; 16], vec![140.0; 16]];
+    obj[0][3] = 61.0;
+    let mut ok = all_ok(2, 16);
+    ok[0][5] = false;
+    assert!(matches!(
+        verdict(&obj, &ok, &[true, true], &s),
+        Verdict::Winner { leader: 0, .. }
     ));
+}
+
+/// Holm across competitors: the leader beats an easy rival in every world and a close one in
+/// 12 of 16 worlds (p = 0.0384). Alone, 0.0384 ≤ 0.05 wins; Holm tests the smaller p first at
+/// 0.05/2 (2⁻¹⁶, rejected), then 0.0384 at 0.05: rejected too, so the leader wins. With 11 of
+/// 16 (p = 0.105) the close rival stays open.
+#[test]
+fn holm_corrects_across_the_competitors() {
+    let w = 16;
+    let leader = vec![100.0; w];
+    let easy = vec![200.0; w];
+    let close_with = |wins: usize| -> Vec<f64> {
+        (0..w)
+            .map(|i| if i < wins { 110.0 } else { 100.0 })
+            .collect()
+    };
+    let s = VerdictSettings::default();
+    let obj = vec![leader.clone(), easy.clone(), close_with(12)];
+    assert!(matches!(
+        verdict(&obj, &all_ok(3, w), &[true; 3], &s),
+        Verdict::Winner { leader: 0, .. }
+    ));
+    let obj = vec![leader, easy, close_with(11)];
+    match verdict(&obj, &all_ok(3, w), &[true; 3], &s) {
+        // The median of 11 × 0.10 and 5 × 0 is 0.10 > δ and 11 > 8 wins: it leads without
+        // reaching 95 %, so it is open (undecided), not tied.
+        Verdict::Undecided {
+            leader: 0, open, ..
+        } => {
+            assert_eq!((open.len(), open[0].case, open[0].wins), (1, 2, 11));
+        }
+        v => panic!("expected the close rival left open, got {v:?}"),
+    }
 }
 
 #[test]
@@ -285,13 +369,19 @@ proptest! {
         let eligible: Vec<bool> = (0..cases).map(|c| c % 2 == 0 || ok[c][0]).collect();
         let s = VerdictSettings::default();
         match verdict(&obj, &ok, &eligible, &s) {
-            Verdict::Winner { leader, runner_up, p_beats, .. } => {
+            Verdict::Winner { leader, runner_up, p_beats, p_value, .. } => {
                 prop_assert!(eligible[leader] && eligible[runner_up]);
-                prop_assert!(p_beats >= s.confidence);
+                prop_assert!(p_beats > 0.5 && p_value <= 1.0 - s.confidence);
             }
             Verdict::Tied { leader, tied } => {
                 prop_assert!(eligible[leader] && !tied.is_empty());
-                prop_assert!(tied.iter().all(|c| c.case != leader && c.p_beats < s.confidence));
+                prop_assert!(tied.iter().all(|c| c.case != leader));
+                prop_assert!(tied.iter().any(|c| c.needs_worlds.is_none()));
+            }
+            Verdict::Undecided { leader, open, needs_worlds } => {
+                prop_assert!(eligible[leader] && !open.is_empty());
+                prop_assert!(open.iter().all(|c| c.needs_worlds.is_some() && c.case != leader));
+                prop_assert!(needs_worlds > worlds);
             }
             Verdict::NoneEligible => prop_assert!(eligible.iter().all(|e| !e)),
         }

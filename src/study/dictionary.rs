@@ -104,7 +104,8 @@ const TUNING: &[ColumnDoc] = &[
     c("tuned.<param>", "as the key", "f64", "the tuned value of each `[[tune.param]]` (e.g. `tuned.control.k_psi`), at which the case is scored"),
     c("tune_evaluations", "–", "i64", "fresh closed-loop runs the tuning used"),
     c("tune_feasible", "0/1", "bool", "1 when the tuned point met every `[[tune.constraint]]`"),
-    c("tune_noise", "–", "f64", "relative spread (max − min)/min of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start"),
+    c("tune_noise", "–", "f64", "relative spread (max − min)/min of the tuned objective: with `[tune] seeds` ≥ 2, of each seed's best point run in the pooled tuning worlds of every seed; else of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start and one seed"),
+    c("tune_success_spread", "–", "f64", "with `[tune] seeds` ≥ 2: spread (max − min) over the seeds of the fraction of the pooled tuning worlds in which each seed's best point meets every `[[tune.constraint]]`"),
     c("tune_bound_hits", "–", "i64", "tuned parameters within 0.1 % of a bound of their box"),
 ];
 
@@ -211,6 +212,7 @@ const WORLDS: &[ColumnDoc] = &[
     c("<m>_mean, <m>_std, <m>_p05, <m>_p95", "as <m>", "f64", "mean, sample standard deviation and 5 %/95 % quantiles of tracked metric <m> over the sampled worlds (the plain <m> is the nominal world)"),
     c("<m>_worst", "as <m>", "f64", "the worst value of <m> over the worlds, by its direction (largest for costs, smallest for σ_min and outcomes, largest |x| for signed metrics)"),
     c("success_probability", "–", "f64", "fraction of the worlds in which the run met every `[success]` criterion"),
+    c("success_probability_lower", "–", "f64", "one-sided Wilson lower confidence bound of success_probability at the study's confidence (docs/statistics.md): a case is ranked when it reaches min_success_probability; NaN when the case did not run in worlds"),
     c("p_best", "–", "f64", "fraction of the paired worlds in which the case is best on the objective among the ranked cases (ties share); NaN when not ranked"),
     c("rank_p05, rank_p50, rank_p95", "–", "f64", "5 %, 50 % and 95 % quantiles of the case's rank (1 = best) over the worlds among the ranked cases"),
     c("validate.<v>.<objective>", "as the objective", "f64", "the objective in held-out variant <v> at the tuned values"),

@@ -176,7 +176,8 @@ pub fn run_sweep(
             return Ok(done);
         }
     }
-    std::fs::write(out.join(STUDY_COPY), &study.text).map_err(|e| StudyError::io(&out, e))?;
+    // Atomic and link-safe (issue 39): a planted link is replaced, never followed.
+    crate::report::atomic_write(&out.join(STUDY_COPY), study.text.as_bytes())?;
     let schema = raw_schema(study);
     if opts.resume {
         notes.extend(journal::repair(&partial, &schema)?);

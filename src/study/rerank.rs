@@ -14,7 +14,9 @@ use std::path::Path;
 use super::error::{Notes, StudyError};
 use super::manifest::{write_manifest, Manifest};
 use super::records::{Extreme, CASES_CSV, CASES_PARQUET};
-use super::robust::{add_rank_columns, write_case_files, P_BEST, RANK_COLUMNS, WORLDS_CSV};
+use super::robust::{
+    add_rank_columns, write_case_files, P_BEST, RANK_COLUMNS, SUCCESS_LOWER, WORLDS_CSV,
+};
 use super::selection::Selection;
 use crate::input::keypath::did_you_mean;
 use crate::report::{read_csv, Table};
@@ -85,9 +87,11 @@ pub fn apply(
             // The new objective first, the other metrics in their order.
             info.metrics[..=k].rotate_right(1);
             let worlds = read_csv(&dir.join(WORLDS_CSV))?;
-            table
-                .columns
-                .retain(|c| c.name != P_BEST && !RANK_COLUMNS.contains(&c.name.as_str()));
+            table.columns.retain(|c| {
+                c.name != P_BEST
+                    && c.name != SUCCESS_LOWER
+                    && !RANK_COLUMNS.contains(&c.name.as_str())
+            });
             add_rank_columns(table, &worlds, info);
             let axes: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
             write_case_files(table, dir, &axes)?;

@@ -25,12 +25,16 @@ use crate::evaluate::disqualified;
 use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
+use crate::stats::confidence::{wilson_lower, wilson_worlds_needed};
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
 
 /// The per-world table of a study output (long format: one row per case and world).
 pub const WORLDS_CSV: &str = "worlds.csv";
 /// Column of the ranking: fraction of worlds in which the case is best.
 pub const P_BEST: &str = "p_best";
+/// The one-sided Wilson lower bound of `success_probability` at the study's confidence, the
+/// figure eligibility is judged by (docs/statistics.md, "Eligibility").
+pub const SUCCESS_LOWER: &str = "success_probability_lower";
 /// Rank columns (5 %, 50 %, 95 % quantiles over the worlds).
 pub const RANK_COLUMNS: [&str; 3] = ["rank_p05", "rank_p50", "rank_p95"];
 /// The best-so-far tuning curves of a tuned study (long format: case, evaluation, best).
@@ -275,8 +279,14 @@ pub struct Paired {
     pub ok: Vec<Vec<bool>>,
     /// Whether case `c` ran (`ok` or `unsuccessful`): it met its worlds.
     pub ran: Vec<bool>,
-    /// Whether case `c` is ranked: it ran and reaches the success requirement.
+    /// Whether case `c` is ranked: it ran and the Wilson lower bound of its success
+    /// probability reaches the requirement.
     pub eligible: Vec<bool>,
+    /// Worlds in which case `c` succeeded with a finite objective.
+    pub successes: Vec<usize>,
+    /// The one-sided Wilson lower bound of case `c`'s success probability at the study's
+    /// confidence ([`wilson_lower`]).
+    pub lower: Vec<f64>,
 }
 
 /// The paired data of `table`'s cases from `worlds` (see [`Paired`]).
@@ -284,7 +294,8 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
     let objective = info.objective();
     let ids = table.i64(CASE_ID).ok()?;
     let status = table.str(STATUS).ok()?;
-    let p = table.f64(SUCCESS_PROBABILITY).ok()?;
+    // Present in every robust table (the point estimate beside the bound below).
+    table.f64(SUCCESS_PROBABILITY).ok()?;
     let row_of: BTreeMap<i64, usize> = ids.iter().enumerate().map(|(r, id)| (*id, r)).collect();
     let n_worlds = worlds
         .i64("world")
@@ -322,14 +333,33 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
             ) && !reason.is_some_and(|x| disqualified(&x[r]))
         })
         .collect();
+    // Eligibility by confidence, not by the proportion (issue 36 item 6): the one-sided Wilson
+    // lower bound of the success probability at the study's confidence must reach the
+    // requirement (docs/statistics.md, "Eligibility").
+    let successes: Vec<usize> = ok
+        .iter()
+        .zip(&obj)
+        .map(|(o, v)| {
+            o.iter()
+                .zip(v)
+                .filter(|(s, x)| **s && x.is_finite())
+                .count()
+        })
+        .collect();
+    let lower: Vec<f64> = successes
+        .iter()
+        .map(|&k| wilson_lower(k, n_worlds, info.confidence))
+        .collect();
     let eligible = (0..ids.len())
-        .map(|r| ran[r] && p[r] >= info.min_success_probability)
+        .map(|r| ran[r] && lower[r] >= info.min_success_probability)
         .collect();
     Some(Paired {
         obj,
         ok,
         ran,
         eligible,
+        successes,
+        lower,
     })
 }
 
@@ -352,15 +382,28 @@ pub fn add_rank_columns(table: &mut Table, worlds: &Table, info: &RobustInfo) {
             col[c] = x;
         }
     }
+    // The Wilson lower bound beside the point estimate, for every case that ran.
+    cols.insert(
+        0,
+        (0..n)
+            .map(|r| if pd.ran[r] { pd.lower[r] } else { f64::NAN })
+            .collect(),
+    );
     let at = table
         .columns
         .iter()
         .position(|c| c.name == STATUS)
         .unwrap_or(table.columns.len());
-    for (name, v) in [P_BEST, RANK_COLUMNS[0], RANK_COLUMNS[1], RANK_COLUMNS[2]]
-        .into_iter()
-        .zip(cols)
-        .rev()
+    for (name, v) in [
+        SUCCESS_LOWER,
+        P_BEST,
+        RANK_COLUMNS[0],
+        RANK_COLUMNS[1],
+        RANK_COLUMNS[2],
+    ]
+    .into_iter()
+    .zip(cols)
+    .rev()
     {
         table.columns.insert(
             at,
@@ -384,6 +427,32 @@ pub struct StudyVerdict {
     pub below_requirement: usize,
     /// Cases ranked.
     pub ranked: usize,
+    /// Cases that ran whose success proportion meets the requirement but whose lower bound
+    /// does not yet (too few worlds), each with the worlds it would need at the same
+    /// proportion (`None`: not reachable).
+    pub pending: Vec<(usize, Option<usize>)>,
+}
+
+/// The fewest worlds in which a success proportion `share` gives a Wilson lower bound at the
+/// study's confidence that reaches its requirement (`None` beyond 65 536 worlds or when the
+/// share itself is below the requirement).
+fn worlds_for_share(share: f64, info: &RobustInfo) -> Option<usize> {
+    let need = info.min_success_probability;
+    if share >= 1.0 {
+        return wilson_worlds_needed(need, info.confidence);
+    }
+    if share <= need {
+        return None;
+    }
+    let mut n = 1usize;
+    while n <= 1 << 16 {
+        let k = (share * n as f64).floor() as usize;
+        if wilson_lower(k, n, info.confidence) >= need {
+            return Some(n);
+        }
+        n += 1.max(n / 64);
+    }
+    None
 }
 
 /// The paired verdict of `table` (rows) with `worlds` under `info`'s rule, the tuning noise
@@ -415,12 +484,26 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
     let below_requirement = (0..pd.eligible.len())
         .filter(|&r| pd.ran[r] && !pd.eligible[r])
         .count();
+    let n_worlds = pd.obj.first().map_or(0, Vec::len);
+    let pending = (0..pd.eligible.len())
+        .filter(|&r| {
+            pd.ran[r]
+                && !pd.eligible[r]
+                && n_worlds > 0
+                && pd.successes[r] as f64 >= info.min_success_probability * n_worlds as f64
+        })
+        .map(|r| {
+            let share = pd.successes[r] as f64 / n_worlds as f64;
+            (r, worlds_for_share(share, info))
+        })
+        .collect();
     Some(StudyVerdict {
         verdict: verdict(&pd.obj, &pd.ok, &pd.eligible, &settings),
         noise,
         noise_measured,
         below_requirement,
         ranked: pd.eligible.iter().filter(|e| **e).count(),
+        pending,
     })
 }
 

@@ -247,6 +247,9 @@ pub const TUNE_FEASIBLE: &str = "tune_feasible";
 /// Column of a tuned study's rows: relative spread of the tuned objective across the
 /// independent tuning starts (`[tune] starts`), the tuning noise.
 pub const TUNE_NOISE: &str = "tune_noise";
+/// Column of a study tuned with `[tune] seeds` ≥ 2: the spread over the seeds of the fraction
+/// of pooled tuning worlds in which each seed's best point meets every constraint.
+pub const TUNE_SUCCESS_SPREAD: &str = "tune_success_spread";
 /// Column of a tuned study's rows: tuned parameters on a bound of their box.
 pub const TUNE_BOUND_HITS: &str = "tune_bound_hits";
 /// Prefix of a row's best-so-far tuning curve (`tune_curve.<k>`), moved to `tuning.csv`.
@@ -257,8 +260,8 @@ pub const TUNED_PREFIX: &str = "tuned.";
 impl Study {
     /// The columns per-case tuning adds to every row: `tuned.<param>` for each
     /// `[[tune.param]]` in file order, then [`TUNE_EVALUATIONS`], [`TUNE_FEASIBLE`],
-    /// [`TUNE_NOISE`] and [`TUNE_BOUND_HITS`]
-    /// (none without `[tune]`).
+    /// [`TUNE_NOISE`], [`TUNE_SUCCESS_SPREAD`] (only with `[tune] seeds` ≥ 2) and
+    /// [`TUNE_BOUND_HITS`] (none without `[tune]`).
     pub fn tune_columns(&self) -> Vec<String> {
         let Some(t) = &self.tune else {
             return Vec::new();
@@ -273,6 +276,13 @@ impl Study {
         cols.push(TUNE_EVALUATIONS.into());
         cols.push(TUNE_FEASIBLE.into());
         cols.push(TUNE_NOISE.into());
+        if t.get("seeds")
+            .and_then(toml::Value::as_integer)
+            .unwrap_or(1)
+            > 1
+        {
+            cols.push(TUNE_SUCCESS_SPREAD.into());
+        }
         cols.push(TUNE_BOUND_HITS.into());
         cols
     }

@@ -12,7 +12,9 @@ use std::path::Path;
 
 use super::manifest::Manifest;
 use super::records::CASE_ID;
-use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
+use super::robust::{
+    study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, SUCCESS_LOWER, WORLDS_CSV,
+};
 use super::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
 use super::selection::cell_text;
 use super::verdict_box::{verdict_box, BoxInput};
@@ -92,10 +94,7 @@ impl<'a> Robust<'a> {
 
     /// The leader of the verdict (winner or first of the tie), if any design is ranked.
     fn leader(&self) -> Option<usize> {
-        match &self.verdict.verdict {
-            Verdict::Winner { leader, .. } | Verdict::Tied { leader, .. } => Some(*leader),
-            Verdict::NoneEligible => None,
-        }
+        self.verdict.verdict.leader()
     }
 
     fn pct(x: f64) -> String {
@@ -125,30 +124,33 @@ impl<'a> Robust<'a> {
         };
         match &v.verdict {
             Verdict::Winner {
-                leader,
-                runner_up,
-                p_beats,
-                margin,
+                leader, runner_up, ..
             } if leader == runner_up => format!(
-                "**Winner: {}** — the only design ranked (success probability ≥ {}) over {n} \
-                 worlds by `{o}`.",
+                "**Winner: {}** — the only design ranked (success probability ≥ {} at {:.0} % \
+                 confidence, Wilson lower bound) over {n} worlds by `{o}`.{}",
                 self.label(*leader),
-                self.info.min_success_probability
+                self.info.min_success_probability,
+                100.0 * self.info.confidence,
+                self.pending_text()
             ),
             Verdict::Winner {
                 leader,
                 runner_up,
                 p_beats,
                 margin,
+                p_value,
             } => format!(
-                "**Winner: {}** by `{o}` — beats every other ranked design in ≥ {:.0} % of {n} \
-                 paired worlds; runner-up {}: beaten in {:.0} % of the worlds, median margin {} \
-                 ({noise}).",
+                "**Winner: {}** by `{o}` — beats every other ranked design at {:.0} % confidence \
+                 (one-sided sign tests of the paired margin over {n} worlds, Holm-corrected; \
+                 largest adjusted p = {}); runner-up {}: beaten in {:.0} % of the worlds, median \
+                 margin {} ({noise}).{}",
                 self.label(*leader),
                 100.0 * self.info.confidence,
+                fmt_p(*p_value),
                 self.label(*runner_up),
                 100.0 * p_beats,
-                Self::pct(*margin)
+                Self::pct(*margin),
+                self.pending_text()
             ),
             Verdict::Tied { leader, tied } => {
                 let list: Vec<String> = std::iter::once(format!("#{}", self.ids[*leader]))
@@ -163,30 +165,129 @@ impl<'a> Robust<'a> {
                     .take(5)
                     .map(|c| {
                         format!(
-                            "#{} {} (beaten in {:.0} % of worlds)",
+                            "#{} {} (beaten in {:.0} % of worlds, p = {})",
                             self.ids[c.case],
                             Self::pct(c.margin),
-                            100.0 * c.p_beats
+                            100.0 * c.p_beats,
+                            fmt_p(c.p_adjusted)
                         )
                     })
                     .collect();
                 format!(
-                    "**Statistically tied: {}{}** by `{o}` over {n} paired worlds — no design \
-                     beats all others in ≥ {:.0} % of the worlds. Leader {}; median margins \
-                     behind it: {} ({noise}).",
+                    "**Statistically tied: {}{}** by `{o}` over {n} paired worlds — the leader \
+                     does not beat these at {:.0} % confidence and the worlds do not lean its \
+                     way (a tie: more worlds would not separate them). Leader {}; median \
+                     margins behind it: {} ({noise}).{}",
                     list.join(", "),
                     if tied.len() > TOP { ", …" } else { "" },
                     100.0 * self.info.confidence,
                     self.label(*leader),
-                    margins.join("; ")
+                    margins.join("; "),
+                    self.pending_text()
+                )
+            }
+            Verdict::Undecided {
+                leader,
+                open,
+                needs_worlds,
+            } => {
+                let margins: Vec<String> = open
+                    .iter()
+                    .take(5)
+                    .map(|c| {
+                        format!(
+                            "#{} {} (beaten in {} of {n} worlds, p = {})",
+                            self.ids[c.case],
+                            Self::pct(c.margin),
+                            c.wins,
+                            fmt_p(c.p_adjusted)
+                        )
+                    })
+                    .collect();
+                format!(
+                    "**Undecided: needs ≥ {needs_worlds} worlds** — the leader {} by `{o}` leads \
+                     every ranked design, but {n} worlds cannot show it at {:.0} % confidence \
+                     against {}: {} ({noise}).{}",
+                    self.label(*leader),
+                    100.0 * self.info.confidence,
+                    if open.len() == 1 {
+                        "one of them".to_string()
+                    } else {
+                        format!("{} of them", open.len())
+                    },
+                    margins.join("; "),
+                    self.pending_text()
+                )
+            }
+            Verdict::NoneEligible if !v.pending.is_empty() => {
+                let need = v.pending.iter().filter_map(|p| p.1).min();
+                format!(
+                    "**Undecided: {}** — no design is shown to succeed with probability ≥ {} at \
+                     {:.0} % confidence over {n} worlds (one-sided Wilson lower bound); {} \
+                     succeeded often enough to qualify with more worlds: {}.",
+                    need.map_or("needs more worlds".to_string(), |w| format!(
+                        "needs ≥ {w} worlds"
+                    )),
+                    self.info.min_success_probability,
+                    100.0 * self.info.confidence,
+                    v.pending.len(),
+                    self.pending_list()
                 )
             }
             Verdict::NoneEligible => format!(
                 "**No winner: no design reaches the required success probability {}** over {n} \
-                 worlds.",
-                self.info.min_success_probability
+                 worlds (one-sided Wilson lower bound at {:.0} % confidence).",
+                self.info.min_success_probability,
+                100.0 * self.info.confidence
             ),
         }
+    }
+
+    /// The designs that succeeded often enough in their worlds but cannot yet be shown to
+    /// meet the requirement, with their lower bounds.
+    fn pending_list(&self) -> String {
+        let lower = self.col(SUCCESS_LOWER);
+        let sp = self.col(SUCCESS_PROBABILITY);
+        let items: Vec<String> = self
+            .verdict
+            .pending
+            .iter()
+            .take(TOP)
+            .map(|(r, _)| {
+                format!(
+                    "{} (success {:.2}, lower bound {:.2})",
+                    self.label(*r),
+                    sp[*r],
+                    lower[*r]
+                )
+            })
+            .collect();
+        let more = self.verdict.pending.len().saturating_sub(TOP);
+        if more > 0 {
+            format!("{}, and {more} more", items.join("; "))
+        } else {
+            items.join("; ")
+        }
+    }
+
+    /// A sentence on pending designs after a verdict (empty without any).
+    fn pending_text(&self) -> String {
+        let p = &self.verdict.pending;
+        if p.is_empty() {
+            return String::new();
+        }
+        let need = p.iter().filter_map(|x| x.1).max();
+        format!(
+            " Not ranked for too few worlds ({} design{} whose success proportion meets the \
+             requirement but not its {:.0} % lower bound{}): {}.",
+            p.len(),
+            if p.len() == 1 { "" } else { "s" },
+            100.0 * self.info.confidence,
+            need.map_or(String::new(), |w| format!(
+                "; ≥ {w} worlds would qualify them"
+            )),
+            self.pending_list()
+        )
     }
 
     /// The verdict line and the box under it ([`super::verdict_box`]): the leader's caveats
@@ -426,6 +527,7 @@ impl<'a> Robust<'a> {
         let top_margin = match &self.verdict.verdict {
             Verdict::Winner { margin, .. } => *margin,
             Verdict::Tied { tied, .. } => tied.first().map_or(f64::NAN, |c| c.margin),
+            Verdict::Undecided { open, .. } => open.first().map_or(f64::NAN, |c| c.margin),
             Verdict::NoneEligible => f64::NAN,
         };
         let _ = writeln!(
@@ -622,6 +724,19 @@ impl<'a> Robust<'a> {
             md,
             "## Sensitivity: which uncertain parameters drive each metric\n"
         );
+        if self.info.sampling != "saltelli" && self.info.worlds < MIN_SENSITIVITY_WORLDS {
+            // With a handful of worlds a rank correlation is ±1 by chance and its bootstrap
+            // interval collapses onto it (issue 36 item 6): withheld, with the reason.
+            let _ = writeln!(
+                md,
+                "Withheld: {} worlds are too few for a rank correlation to mean anything (with \
+                 n worlds Spearman's ρ takes only n(n²−1)/6 + 1 values and a bootstrap over n \
+                 worlds repeats them; the exact two-sided 5 % critical value is 0.648 at n = \
+                 10). Run ≥ {MIN_SENSITIVITY_WORLDS} worlds for this section.\n",
+                self.info.worlds
+            );
+            return;
+        }
         for m in &self.info.metrics {
             let Some((mut rows, method)) = self.sensitivity(m) else {
                 continue;
@@ -694,5 +809,20 @@ impl<'a> Robust<'a> {
 fn write_plot(dir: &Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
     if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
         warnings.push(format!("{name}: {e}"));
+    }
+}
+
+/// The fewest worlds for which the sensitivity section prints rank correlations or
+/// regression coefficients (fewer: withheld with the reason).
+pub const MIN_SENSITIVITY_WORLDS: usize = 10;
+
+/// A p-value for the verdict line: `< 1e-4` below it, else three significant digits.
+fn fmt_p(p: f64) -> String {
+    if !p.is_finite() {
+        "–".into()
+    } else if p < 1e-4 {
+        "< 1e-4".into()
+    } else {
+        format!("{p:.3}")
     }
 }

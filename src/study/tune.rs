@@ -14,7 +14,7 @@ use super::doe::Case;
 use super::error::{InputError, StudyError};
 use super::schema::{
     Study, TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_CURVE_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE,
-    TUNE_NOISE,
+    TUNE_NOISE, TUNE_SUCCESS_SPREAD,
 };
 use crate::evaluate::{Deadline, Metrics};
 
@@ -61,6 +61,10 @@ pub struct Tuned {
     /// Relative spread of the best feasible objective across independent tuning starts
     /// (`[tune] starts`; NaN with one start or fewer than two feasible): the tuning noise.
     pub noise: f64,
+    /// With `[tune] seeds` ≥ 2: the spread (max − min) over the seeds of the fraction of the
+    /// pooled tuning worlds in which each seed's best point meets every constraint; NaN with
+    /// one seed.
+    pub success_spread: f64,
     /// Tuned parameters on a bound of their box (within 0.1 % of its width).
     pub bound_hits: usize,
     /// Best feasible tuning objective after each fresh evaluation (relative to the start
@@ -77,6 +81,9 @@ impl Tuned {
         metrics.set(TUNE_EVALUATIONS, self.evaluations as f64);
         metrics.set(TUNE_FEASIBLE, f64::from(u8::from(self.feasible)));
         metrics.set(TUNE_NOISE, self.noise);
+        if !self.success_spread.is_nan() {
+            metrics.set(TUNE_SUCCESS_SPREAD, self.success_spread);
+        }
         metrics.set(TUNE_BOUND_HITS, self.bound_hits as f64);
         for (k, x) in self.curve.iter().enumerate() {
             metrics.push(format!("{TUNE_CURVE_PREFIX}{k}"), *x);

@@ -155,7 +155,17 @@ pub fn parse_uncertainty(
             "uncertainty.min_success_probability",
             0.9,
         )?,
-        confidence: probability(f.confidence, "uncertainty.confidence", 0.95)?,
+        confidence: match probability(f.confidence, "uncertainty.confidence", 0.95)? {
+            // A confidence level 1 − α of the verdict's tests (docs/statistics.md): α = 0 or 1
+            // would make every or no comparison significant.
+            c if c > 0.0 && c < 1.0 => c,
+            c => {
+                return Err(doc.err(
+                    "uncertainty.confidence",
+                    format!("must be within (0, 1) (a confidence level 1 − α), got {c}"),
+                ))
+            }
+        },
         equivalence: probability(f.equivalence, "uncertainty.equivalence", 0.01)?,
     }))
 }
