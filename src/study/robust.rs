@@ -428,9 +428,22 @@ pub struct StudyVerdict {
     /// Cases ranked.
     pub ranked: usize,
     /// Cases that ran whose success proportion meets the requirement but whose lower bound
-    /// does not yet (too few worlds), each with the worlds it would need at the same
-    /// proportion (`None`: not reachable).
-    pub pending: Vec<(usize, Option<usize>)>,
+    /// does not yet (too few worlds).
+    pub pending: Vec<Pending>,
+}
+
+/// A case not ranked only for too few worlds: its success proportion meets the requirement,
+/// its Wilson lower bound does not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pending {
+    /// The case's row.
+    pub row: usize,
+    /// Worlds it would need at the same proportion (`None`: not reachable).
+    pub worlds_needed: Option<usize>,
+    /// Its success proportion over the worlds.
+    pub share: f64,
+    /// Its Wilson lower bound.
+    pub lower: f64,
 }
 
 /// The fewest worlds in which a success proportion `share` gives a Wilson lower bound at the
@@ -494,7 +507,12 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
         })
         .map(|r| {
             let share = pd.successes[r] as f64 / n_worlds as f64;
-            (r, worlds_for_share(share, info))
+            Pending {
+                row: r,
+                worlds_needed: worlds_for_share(share, info),
+                share,
+                lower: pd.lower[r],
+            }
         })
         .collect();
     Some(StudyVerdict {

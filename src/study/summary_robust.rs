@@ -12,9 +12,7 @@ use std::path::Path;
 
 use super::manifest::Manifest;
 use super::records::CASE_ID;
-use super::robust::{
-    study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, SUCCESS_LOWER, WORLDS_CSV,
-};
+use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
 use super::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
 use super::selection::cell_text;
 use super::verdict_box::{verdict_box, BoxInput};
@@ -220,7 +218,7 @@ impl<'a> Robust<'a> {
                 )
             }
             Verdict::NoneEligible if !v.pending.is_empty() => {
-                let need = v.pending.iter().filter_map(|p| p.1).min();
+                let need = v.pending.iter().filter_map(|p| p.worlds_needed).min();
                 format!(
                     "**Undecided: {}** — no design is shown to succeed with probability ≥ {} at \
                      {:.0} % confidence over {n} worlds (one-sided Wilson lower bound); {} \
@@ -246,19 +244,17 @@ impl<'a> Robust<'a> {
     /// The designs that succeeded often enough in their worlds but cannot yet be shown to
     /// meet the requirement, with their lower bounds.
     fn pending_list(&self) -> String {
-        let lower = self.col(SUCCESS_LOWER);
-        let sp = self.col(SUCCESS_PROBABILITY);
         let items: Vec<String> = self
             .verdict
             .pending
             .iter()
             .take(TOP)
-            .map(|(r, _)| {
+            .map(|p| {
                 format!(
                     "{} (success {:.2}, lower bound {:.2})",
-                    self.label(*r),
-                    sp[*r],
-                    lower[*r]
+                    self.label(p.row),
+                    p.share,
+                    p.lower
                 )
             })
             .collect();
@@ -276,7 +272,7 @@ impl<'a> Robust<'a> {
         if p.is_empty() {
             return String::new();
         }
-        let need = p.iter().filter_map(|x| x.1).max();
+        let need = p.iter().filter_map(|x| x.worlds_needed).max();
         format!(
             " Not ranked for too few worlds ({} design{} whose success proportion meets the \
              requirement but not its {:.0} % lower bound{}): {}.",
@@ -457,7 +453,7 @@ impl<'a> Robust<'a> {
                 highlight: Some(r) == leader,
             })
             .collect();
-        if !rank_rows.is_empty() {
+        if !rank_rows.is_empty() && self.verdict.ranked > 0 {
             let title = format!(
                 "Rank of each design by {o} over {} worlds (5–95 %)",
                 self.info.worlds
