@@ -101,6 +101,9 @@ fn a_bad_faults_section_is_a_located_error() {
         ("at = 30.0\nkind = \"melted\"", "faults.kind"),
         ("at = 30.0\nsingle = false", "faults.single"),
         ("at = 30.0\nkind = \"derated\"", "faults.value"),
+        // Issue 39: a fault after the run's end (170 s) never strikes.
+        ("at = 170.0", "faults.at"),
+        ("at = 500.0", "not within the run"),
     ] {
         let text = STUDY.replace(
             "single = true\nat = 30.0\nkind = \"dead\"\ninformed = true",

@@ -322,6 +322,24 @@ distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
     // Seed 1 has its own full budget (6) and each seed's best runs once more, pooled.
     assert!(e2 > e1 && e2 <= 2.0 * 6.0 + 2.0, "{e1} {e2}");
     assert_eq!(column(&head2, &rows2, "tune_feasible"), [1.0]);
+    // A tuned key that the worlds or a validation variant also set is refused (issue 39): the
+    // world's value would replace the tuned one in every run.
+    for (extra, key) in [
+        (
+            "[[uncertainty.param]]\nname = \"control.k_psi\"\ndistribution = { kind = \"uniform\", low = 0.2, high = 0.4 }\n",
+            "uncertain parameter `control.k_psi`",
+        ),
+        (
+            "[[validate]]\nname = \"v\"\nset = { \"control.k_6p\" = 0.1 }\n",
+            "validation variant `v`",
+        ),
+    ] {
+        let p = write(dir.path(), "both.toml", &format!("{one}{extra}"));
+        let o = run(&["sweep", arg(&p), "--dry-run"]);
+        assert_eq!(o.status.code(), Some(2), "{extra}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("tune.param[") && e.contains(key), "{e}");
+    }
     // Bad values are refused with the key.
     for bad in ["seeds = 0", "seeds = 9", "seeds = \"two\""] {
         let p = write(

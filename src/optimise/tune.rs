@@ -151,6 +151,7 @@ impl Tuner {
             }
         };
         let spec = parse_spec(&doc, &t, "tune", study)?;
+        check_two_roads(&spec, study, &doc)?;
         if spec.solver.max_evals / starts < 2 {
             return Err(doc.err(
                 "tune.starts",
@@ -312,6 +313,46 @@ impl Tuner {
             evaluations,
         })
     }
+}
+
+/// A tuned key that the study's worlds or validation variants also set (issue 39): the world's
+/// or variant's value would replace the tuned one in every run there, so the worlds would score
+/// values other than those the table names (and with `[tune] worlds` every candidate would run
+/// at the world's value: a flat tuning). Refused, naming both keys.
+fn check_two_roads(spec: &Spec, study: &Study, doc: &Document) -> Result<(), InputError> {
+    use crate::study::axes::overlaps;
+    for (i, p) in spec.space.params.iter().enumerate() {
+        let at = format!("tune.param[{i}].name");
+        if let Some(u) = study
+            .uncertainty
+            .iter()
+            .flat_map(|u| &u.params)
+            .find(|u| overlaps(&u.target, &p.target))
+        {
+            return Err(doc.err(
+                &at,
+                format!(
+                    "`{}` is also the uncertain parameter `{}`: every world would replace the \
+                     tuned value, so the worlds would score values the table does not name; \
+                     tune it or vary it, not both",
+                    p.name, u.name
+                ),
+            ));
+        }
+        for v in &study.validate {
+            if let Some((key, _, _)) = v.set.iter().find(|(_, t, _)| overlaps(t, &p.target)) {
+                return Err(doc.err(
+                    &at,
+                    format!(
+                        "`{}` is also set by the validation variant `{}` (`{key}`): the variant \
+                         would replace the tuned value; tune it or validate it, not both",
+                        p.name, v.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Which tuning worlds a tuning problem runs in.

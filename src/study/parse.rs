@@ -224,6 +224,40 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
     study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
     study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
     study.faults = parse_faults(file.faults.as_ref(), study.mode.is_dynamic(), doc)?;
+    if let Some(f) = &study.faults {
+        // A fault that strikes after the run ends never strikes: every design would read
+        // "survives every single fault" (issue 39). Checked against the longest duration any
+        // case runs (an axis over `scenario.duration` included).
+        let base = study
+            .scenario_full
+            .get("scenario")
+            .and_then(|t| t.get("duration"))
+            .and_then(|d| d.as_float().or_else(|| d.as_integer().map(|i| i as f64)));
+        let longest = study
+            .axes
+            .iter()
+            .filter(|a| a.name == "scenario.duration")
+            .flat_map(|a| match &a.spec {
+                super::schema::AxisSpec::Values(v) => v
+                    .iter()
+                    .filter_map(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+                    .collect::<Vec<_>>(),
+                super::schema::AxisSpec::Range { start, stop, .. } => vec![start.max(*stop)],
+                super::schema::AxisSpec::Distribution(_) => vec![f64::INFINITY],
+            })
+            .chain(base)
+            .fold(f64::NAN, f64::max);
+        if longest.is_finite() && f.at >= longest {
+            return Err(doc.err(
+                "faults.at",
+                format!(
+                    "{} s is not within the run ({} s): the fault would never strike and every \
+                     design would read as surviving it",
+                    f.at, longest
+                ),
+            ));
+        }
+    }
     if let Some(f) = &file.faults {
         (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
     }
