@@ -912,3 +912,42 @@ distribution = { kind = "uniform", low = 0.5, high = 1.5 }
     );
     assert_eq!(read(&notes), b"mine\n");
 }
+
+/// Issue 39 item 4: a journal written by a build with other sources is not resumed silently.
+/// The study hash includes the build identity (a hash of the sources, `build.rs`), and the
+/// journal's record beside it (`cases.partial.study`) holds the hash of the study and build that
+/// wrote it; a record from another build (here: another hash planted in the record, as another
+/// build would have written) makes `--resume` start afresh and say why. The same build resumes.
+#[test]
+fn a_journal_of_another_build_is_not_resumed_silently() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "quick.toml", QUICK);
+    let out = d.path().join("o");
+    let o = sweep(&s, &out, &["--max-cases", "2", "--jobs", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let record = out.join("cases.partial.study");
+    let ours = String::from_utf8(read(&record)).unwrap();
+    assert_eq!(ours.len(), 64, "{ours}");
+    std::fs::write(&record, "0".repeat(64)).unwrap();
+    let o = sweep(&s, &out, &["--resume"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("another build of usm-study") && e.contains("not resumed"),
+        "{e}"
+    );
+    assert!(e.contains("resumed 0 cases, ran 4"), "{e}");
+    assert_eq!(read(&record), ours.as_bytes());
+    // The manifest names the build.
+    let m: serde_json::Value = serde_json::from_slice(&read(&out.join("manifest.json"))).unwrap();
+    assert_eq!(m["build_id"].as_str().map(str::len), Some(32), "{m}");
+    // This build's own journal resumes as before.
+    let o = sweep(&s, &out, &["--force", "--max-cases", "2", "--jobs", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = sweep(&s, &out, &["--resume"]);
+    assert!(
+        stderr(&o).contains("resumed 2 cases, ran 2"),
+        "{}",
+        stderr(&o)
+    );
+}

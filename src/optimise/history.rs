@@ -39,8 +39,10 @@ pub enum JournalError {
     },
     /// The journal belongs to another problem.
     #[error(
-        "{}: the journal is of another problem (hash {found}, this problem {expected}); \
-         run without --resume to start afresh",
+        "{}: the journal is of another problem or another build of usm-study (hash {found}, \
+         this problem with this build {expected}; the hash includes the build's source \
+         identity, so old results are never mixed with a changed model); run without \
+         --resume to start afresh",
         path.display()
     )]
     OtherProblem {

@@ -47,7 +47,8 @@ use super::manifest::{
 };
 use super::outdir;
 use super::records::{
-    axis_text, compact, raw_schema, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE, STUDY_COPY,
+    axis_text, compact, raw_schema, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE,
+    PARTIAL_STUDY_FILE, STUDY_COPY,
 };
 use super::robust::{write_tables, RobustInfo};
 use super::runner::TIMEOUT;
@@ -179,10 +180,13 @@ pub fn run_sweep(
     // Atomic and link-safe (issue 39): a planted link is replaced, never followed.
     crate::report::atomic_write(&out.join(STUDY_COPY), study.text.as_bytes())?;
     let schema = raw_schema(study);
-    if opts.resume {
+    // A journal is resumed only by the study (and build) that wrote it (issue 39 item 4).
+    let resume = opts.resume && journal_of_this_study(&out, &partial, study, &mut notes);
+    if resume {
         notes.extend(journal::repair(&partial, &schema)?);
     }
-    let (mut appender, done) = open_partial(&partial, &schema, opts.resume)?;
+    let (mut appender, done) = open_partial(&partial, &schema, resume)?;
+    crate::report::atomic_write(&out.join(PARTIAL_STUDY_FILE), study.hash.as_bytes())?;
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     } else {
@@ -292,6 +296,42 @@ impl SweepOutcome {
         self.unsuccessful = c.unsuccessful;
         self.failed = c.failed;
         self.skipped = c.skipped;
+    }
+}
+
+/// Whether the journal in `out` was written by this study and build: its record
+/// ([`PARTIAL_STUDY_FILE`]) holds this study's hash, which includes the build identity. A
+/// journal of another study text or another build is not resumed (a model fix would otherwise
+/// mix with old results): a note says so and the cases run afresh. A journal without a record
+/// (written before the record existed) is resumed with a note saying it could not be checked.
+fn journal_of_this_study(
+    out: &Path,
+    partial: &Path,
+    study: &Study,
+    notes: &mut super::error::Notes,
+) -> bool {
+    if !partial.is_file() {
+        return true;
+    }
+    match std::fs::read_to_string(out.join(PARTIAL_STUDY_FILE)) {
+        Ok(h) if h.trim() == study.hash => true,
+        Ok(_) => {
+            notes.push(format!(
+                "{} was written by another study text or another build of usm-study (build {} \
+                 now): not resumed; every case runs afresh",
+                partial.display(),
+                &super::hash::BUILD_ID[..12]
+            ));
+            false
+        }
+        Err(_) => {
+            notes.push(format!(
+                "{} has no record of the study and build that wrote it ({PARTIAL_STUDY_FILE}, \
+                 written since issue 39): resumed without that check",
+                partial.display()
+            ));
+            true
+        }
     }
 }
 
@@ -492,6 +532,7 @@ fn sweep_manifest(
     Manifest {
         tool: "usm-study".into(),
         tool_version: env!("CARGO_PKG_VERSION").into(),
+        build_id: Some(super::hash::BUILD_ID.into()),
         git_commit: git_commit(),
         study_name: study.name.clone(),
         description: study.description.clone(),

@@ -53,12 +53,20 @@ fn sha_hex(parts: &[&[u8]]) -> String {
     hex(&h.finalize()[..16])
 }
 
-/// SHA-256 (hex, full length) of the study text, the canonical base design and the tool
-/// version.
+/// The identity of this build: a hash of the crate's sources, `Cargo.toml` and `Cargo.lock`
+/// computed by `build.rs` (issue 39 item 4). Two builds from different sources have different
+/// identities, so a study's hash ([`study_hash`]) — and with it a resumed sweep's or
+/// optimisation's journal — changes with any change of the code that could change results.
+pub const BUILD_ID: &str = env!("USM_BUILD_ID");
+
+/// SHA-256 (hex, full length) of the study text, the canonical base design, the tool version
+/// and the build identity ([`BUILD_ID`]).
 pub fn study_hash(text: &str, design: &toml::Table) -> String {
     let mut h = Sha256::new();
     h.update(b"usm-study study v1\0");
     h.update(env!("CARGO_PKG_VERSION").as_bytes());
+    h.update([0]);
+    h.update(BUILD_ID.as_bytes());
     h.update([0]);
     h.update(text.as_bytes());
     h.update([0]);

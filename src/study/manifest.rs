@@ -76,6 +76,10 @@ pub struct Manifest {
     pub tool: String,
     /// Tool version.
     pub tool_version: String,
+    /// The build's identity ([`super::hash::BUILD_ID`], a hash of the sources): part of the
+    /// study hash, so another build's journal is not resumed. Absent in older manifests.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build_id: Option<String>,
     /// `git rev-parse HEAD` of the working directory, when available.
     pub git_commit: Option<String>,
     /// Study name.

@@ -25,7 +25,7 @@ use std::time::SystemTime;
 
 use super::error::{Notes, StudyError};
 use super::manifest::MANIFEST_FILE;
-use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, STUDY_COPY};
+use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, PARTIAL_STUDY_FILE, STUDY_COPY};
 
 pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE, RELEASED_FILE};
 
@@ -33,10 +33,11 @@ pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE, RELEASE
 pub const OWNED_FILE: &str = ".usm-study.files";
 
 /// Files of a sweep output (besides `plots/`).
-pub const SWEEP_FILES: [&str; 9] = [
+pub const SWEEP_FILES: [&str; 10] = [
     CASES_CSV,
     CASES_PARQUET,
     PARTIAL_FILE,
+    PARTIAL_STUDY_FILE,
     MANIFEST_FILE,
     STUDY_COPY,
     "summary.md",

@@ -59,6 +59,9 @@ impl StatusCounts {
 
 /// The raw rows, appended as cases finish, compacted at the end.
 pub const PARTIAL_FILE: &str = "cases.partial.csv";
+/// Beside the journal: the hash of the study that wrote it (which includes the build identity,
+/// [`super::hash::BUILD_ID`]). `--resume` reuses the journal only when it matches.
+pub const PARTIAL_STUDY_FILE: &str = "cases.partial.study";
 /// The final table as CSV.
 pub const CASES_CSV: &str = "cases.csv";
 /// The final table as Parquet.
