@@ -124,6 +124,17 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         let _ = writeln!(o, "cg = {}", farr(b.cg.as_slice()));
         let _ = writeln!(o, "cb = {}", farr(b.cb.as_slice()));
         let _ = writeln!(o, "volume = {}  # displaced [m³]", fnum(b.volume));
+        let d = b.cb - b.cg;
+        let _ = writeln!(
+            o,
+            "# hydrostatics: CB − CG = [{:.6}, {:.6}, {:.6}] m (metacentric height {:.6} m), \
+             wet weight {:.6} N (positive sinks)",
+            d.x,
+            d.y,
+            d.z,
+            d.z,
+            (b.mass - v.fluid.rho * b.volume) * v.fluid.g
+        );
         let _ = writeln!(
             o,
             "inertia = {}  # about the CG [kg·m²]",
