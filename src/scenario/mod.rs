@@ -33,6 +33,7 @@ pub mod config;
 mod controller;
 mod error;
 pub mod fault;
+mod nominal;
 pub(crate) mod recorder;
 pub mod run;
 mod setup;
