@@ -401,15 +401,13 @@ impl GeneratorSpec {
         } else {
             self.thrust_limit
         };
-        let thrusters = self.rule_thrusters(&lengths, limit);
-        let last = lengths[n - 1];
         let v = Vehicle {
             name: name.to_string(),
             bodies,
             joints,
-            thrusters,
+            thrusters: self.rule_thrusters(&lengths, limit),
             base: Se3::identity(),
-            end_effector: Se3::from_translation(Vec3::new(last, 0.0, 0.0)),
+            end_effector: Se3::from_translation(Vec3::new(lengths[n - 1], 0.0, 0.0)),
             fluid,
         };
         v.validate()?;
