@@ -59,6 +59,7 @@ pub fn run(a: &InspectArgs) -> anyhow::Result<ExitCode> {
             write_kinematics(&mut o, &report.kinematics);
             write_authority(&mut o, &report.kinematics);
             write_dynamics(&mut o, &report);
+            write_hydrostatics(&mut o, &report);
             print!("{o}");
         }
     }
@@ -274,4 +275,42 @@ fn write_dynamics(o: &mut String, report: &InspectReport) {
     let _ = writeln!(o, "  kinetic energy: {} J", fmt_num(d.kinetic_energy));
     let _ = writeln!(o, "  bias h: [{}]", num_list(&d.bias));
     let _ = writeln!(o, "  acceleration: [{}]", num_list(&d.acceleration));
+}
+
+/// Wet weight, centres, metacentric height, restoring moments and trim (docs/model.md §4).
+fn write_hydrostatics(o: &mut String, report: &InspectReport) {
+    let h = &report.hydrostatics;
+    let (g, b) = (h.centre_of_gravity, h.centre_of_buoyancy);
+    let trim = |x: Option<f64>| x.map_or("none (C = G: neutral)".into(), |d| format!("{d:.3}°"));
+    let _ = writeln!(
+        o,
+        "\nhydrostatics (chain rigid at this state, base level; moments about the CG)"
+    );
+    let _ = writeln!(
+        o,
+        "  weight {} N, buoyancy {} N, wet weight {} N (positive sinks)",
+        fmt_num(h.weight),
+        fmt_num(h.buoyancy),
+        fmt_num(h.wet_weight)
+    );
+    let _ = writeln!(
+        o,
+        "  CG [{}] m, CB [{}] m (base frame); metacentric height GM {} m",
+        num_list(&g),
+        num_list(&b),
+        fmt_num(h.metacentric_height)
+    );
+    let _ = writeln!(
+        o,
+        "  restoring moment per radian: roll {} N·m/rad, pitch {} N·m/rad; at level [{}] N·m",
+        fmt_num(h.roll_restoring_moment),
+        fmt_num(h.pitch_restoring_moment),
+        num_list(&h.level_moment)
+    );
+    let _ = writeln!(
+        o,
+        "  trim: roll {}, pitch {}",
+        trim(h.trim_roll_deg),
+        trim(h.trim_pitch_deg)
+    );
 }

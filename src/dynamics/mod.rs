@@ -30,7 +30,9 @@
 //! - `integrator`: the fixed-step RK4 step and the adaptive Dormand–Prince 5(4) span
 //!   integrator with error control ([`Integrator`] chooses), and the folding of the joint
 //!   work's quadrature states at the sign changes of the joint power;
-//! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`.
+//! - [`inspect`]: the JSON-ready [`DynamicsReport`] of `usm-study inspect`;
+//! - [`hydrostatics`]: wet weight, centres, metacentric height, restoring moments per radian
+//!   and trim of a design at one configuration (`inspect`, `design draw`).
 //!
 //! Nothing in a time step allocates: every buffer lives in the workspace or the simulator.
 
@@ -39,6 +41,7 @@ pub mod algorithms;
 pub(crate) mod cholesky;
 pub mod config;
 pub mod hydro;
+pub mod hydrostatics;
 pub mod inspect;
 mod integrator;
 pub mod manoeuvring;

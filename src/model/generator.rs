@@ -181,7 +181,27 @@ pub struct GeneratorSpec {
     pub cd_axial: f64,
     /// Cross-flow drag coefficient of every body.
     pub cd_cross: f64,
+    /// Metacentric height `GM` [m] of every body: its centre of buoyancy this far above its
+    /// centre of gravity (body z). The centre of gravity stays on the body's axis at its
+    /// geometric centre (as in `usm-paper`); the centre of buoyancy is raised by `GM`
+    /// (buoyancy foam fitted above the axis). Not the other way round: a CG below the axis
+    /// couples sway and roll in `M_11`, which transport's base control (USM-33) then commands
+    /// as a roll moment that a straight body without roll authority cannot produce (measured
+    /// on ends/4: a capsize within 1 s in still water). `|GM|` < the radius; negative is
+    /// top-heavy. Default [`DEFAULT_METACENTRIC_HEIGHT`].
+    pub metacentric_height: f64,
+    /// Trim rule: the design's wet weight `W − B` [N] (positive sinks), spread over the
+    /// bodies in proportion to their masses, `V_i = (m_i/ρ)(1 − wet_weight/(g Σ m))`, so
+    /// that every body is trimmed alike and the vehicle stays level (no trim moment). Default
+    /// 0: neutral, the paper's "wet mass 0" (USM Table II).
+    pub wet_weight: f64,
 }
+
+/// Default [`GeneratorSpec::metacentric_height`] [m]: the REMUS 100's centre of gravity 2 cm
+/// below its centre of buoyancy (Fossen's MSS toolbox `remus100.m`, `r_bg = [0 0 0.02]`, after
+/// Prestero 2001, z_G = 1.96 cm), a torpedo AUV of 0.19 m diameter against the USM's 0.17 m.
+/// The USM paper states no value (inferred for the USM, docs/assumptions.md).
+pub const DEFAULT_METACENTRIC_HEIGHT: f64 = 0.02;
 
 impl Default for GeneratorSpec {
     fn default() -> Self {
@@ -201,6 +221,8 @@ impl Default for GeneratorSpec {
             cd_axial_ends: 0.8,
             cd_axial: 0.1,
             cd_cross: 1.0,
+            metacentric_height: DEFAULT_METACENTRIC_HEIGHT,
+            wet_weight: 0.0,
         }
     }
 }
@@ -222,6 +244,55 @@ pub fn link_body(k: usize) -> usize {
 }
 
 impl GeneratorSpec {
+    /// The factor on every body's neutral volume `m_i/ρ` of the trim rule
+    /// ([`Self::wet_weight`]) for a design of `dry_mass` [kg] under gravity `g` [m/s²]:
+    /// `1 − wet_weight/(g · dry_mass)`; exactly 1 for a neutral design.
+    pub fn volume_factor(&self, dry_mass: f64, g: f64) -> f64 {
+        if self.wet_weight == 0.0 {
+            1.0
+        } else {
+            1.0 - self.wet_weight / (g * dry_mass)
+        }
+    }
+
+    /// Apply the hydrostatic rules to freshly built neutral bodies: CB raised by `GM` above
+    /// the CG (the geometric centre), volumes scaled by [`Self::volume_factor`].
+    fn apply_hydrostatics(&self, bodies: &mut [super::Body], g: f64) -> Result<(), ModelError> {
+        let r_min = bodies
+            .iter()
+            .map(|b| b.radius)
+            .fold(f64::INFINITY, f64::min);
+        let gm = self.metacentric_height;
+        if !gm.is_finite() || gm.abs() >= r_min {
+            return Err(ModelError::new(
+                "generator.metacentric_height",
+                format!(
+                    "must be finite with |GM| < the radius {r_min} m (the CB inside the body), got {gm}"
+                ),
+            ));
+        }
+        let dry_mass: f64 = bodies.iter().map(|b| b.mass).sum();
+        let w = self.wet_weight;
+        if !w.is_finite() || w >= g * dry_mass || (w != 0.0 && g <= 0.0) {
+            return Err(ModelError::new(
+                "generator.wet_weight",
+                format!(
+                    "must be finite and below the dry weight {} N (a positive displaced \
+                     volume), got {w}",
+                    g * dry_mass
+                ),
+            ));
+        }
+        let factor = self.volume_factor(dry_mass, g);
+        for b in bodies.iter_mut() {
+            b.cb.z += gm;
+            if factor != 1.0 {
+                b.volume *= factor;
+            }
+        }
+        Ok(())
+    }
+
     /// Build the vehicle (validated).
     pub fn build(&self, name: &str) -> Result<Vehicle, ModelError> {
         let n = self.links;
@@ -323,21 +394,20 @@ impl GeneratorSpec {
                 self.joint_limit,
             ));
         }
+        self.apply_hydrostatics(&mut bodies, fluid.g)?;
         let dry_mass: f64 = bodies.iter().map(|b| b.mass).sum();
         let limit = if self.thrust_per_kg > 0.0 {
             self.thrust_per_kg * dry_mass
         } else {
             self.thrust_limit
         };
-        let thrusters = self.rule_thrusters(&lengths, limit);
-        let last = lengths[n - 1];
         let v = Vehicle {
             name: name.to_string(),
             bodies,
             joints,
-            thrusters,
+            thrusters: self.rule_thrusters(&lengths, limit),
             base: Se3::identity(),
-            end_effector: Se3::from_translation(Vec3::new(last, 0.0, 0.0)),
+            end_effector: Se3::from_translation(Vec3::new(lengths[n - 1], 0.0, 0.0)),
             fluid,
         };
         v.validate()?;
@@ -430,8 +500,11 @@ mod tests {
     fn paper_profile_and_rule_at_five_links_is_usm_paper() {
         // USM Table II: the generated 5-link paper design has the preset's bodies (masses,
         // lengths, inertias) and thrusters (bodies, positions, directions, limits).
+        // The preset keeps CB = CG (its inference from "wet mass 0"); with the metacentric
+        // height set to 0 the generator gives the same centres, bit for bit.
         let spec = GeneratorSpec {
             body_profile: BodyProfile::Paper,
+            metacentric_height: 0.0,
             ..Default::default()
         };
         let g = spec.build("g").unwrap();
@@ -440,6 +513,7 @@ mod tests {
         for (a, b) in g.bodies.iter().zip(&p.bodies) {
             assert_eq!((a.mass, a.length, a.volume), (b.mass, b.length, b.volume));
             assert_eq!(a.inertia, b.inertia);
+            assert_eq!((a.cg, a.cb), (b.cg, b.cb));
         }
         assert!((g.total_mass() - 81.3).abs() < 1e-9);
         assert_eq!(g.thrusters.len(), p.thrusters.len());
@@ -542,5 +616,42 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.build("g").unwrap_err().key, "generator.thrust_per_kg");
+    }
+
+    #[test]
+    fn hydrostatic_rules_raise_the_cb_and_trim_by_mass() {
+        // Default: every body's CB 2 cm above its CG (the geometric centre, on the axis).
+        let v = GeneratorSpec::default().build("g").unwrap();
+        for b in &v.bodies {
+            assert_eq!(b.cg, b.centre());
+            assert!((b.cb.z - b.cg.z - DEFAULT_METACENTRIC_HEIGHT).abs() < 1e-15);
+            assert!((b.volume * 1026.0 - b.mass).abs() < 1e-12 * b.mass);
+        }
+        // A wet weight of 5 N spread by mass: each body sinks by its share, no trim moment.
+        let spec = GeneratorSpec {
+            wet_weight: 5.0,
+            ..Default::default()
+        };
+        let v = spec.build("g").unwrap();
+        let total = v.total_mass();
+        for b in &v.bodies {
+            let wet = b.mass * 9.81 - 1026.0 * b.volume * 9.81;
+            assert!((wet - 5.0 * b.mass / total).abs() < 1e-9, "{}", b.name);
+        }
+        for (gm, key) in [
+            (0.1, "generator.metacentric_height"),
+            (f64::NAN, "generator.metacentric_height"),
+        ] {
+            let bad = GeneratorSpec {
+                metacentric_height: gm,
+                ..Default::default()
+            };
+            assert_eq!(bad.build("g").unwrap_err().key, key);
+        }
+        let bad = GeneratorSpec {
+            wet_weight: 1e6,
+            ..Default::default()
+        };
+        assert_eq!(bad.build("g").unwrap_err().key, "generator.wet_weight");
     }
 }

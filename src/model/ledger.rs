@@ -155,10 +155,48 @@ pub const LEDGER: &[Assumption] = &[
     Assumption {
         key: "hydro.buoyancy_offset",
         name: "buoyancy",
-        value: "neutral: displaced volume m/ρ per body, CG = CB at the volumetric centre",
+        value: "neutral: displaced volume m/ρ per body (generated designs: `generator.wet_weight` = 0)",
         source: Source::Paper("USM paper Table II (wet mass 0) and section VI-A"),
         range: Some((-0.02, 0.02)),
-        note: "displaced volume × (1 + offset): a vehicle trimmed to within ±2 % of neutral",
+        note: "displaced volume × (1 + offset): a vehicle trimmed to within ±2 % of neutral \
+               (±16 N on the 81.3 kg paper design)",
+    },
+    Assumption {
+        key: "hydro.cb_offset_z",
+        name: "metacentric height GM (CB above CG, every body)",
+        value: "usm-paper: 0 (CB = CG at the volumetric centre); generated designs: 0.02 m \
+                (`generator.metacentric_height`, the CB raised above the CG on the axis)",
+        source: Source::Inferred(
+            "the USM paper states none (CB = CG read from \"wet mass 0\"); the generator takes the \
+             REMUS 100's CG 2 cm below its CB (Fossen's MSS remus100.m r_bg = [0 0 0.02] m, after \
+             Prestero 2001: 1.96 cm), a 0.19 m torpedo AUV against the USM's 0.17 m",
+        ),
+        range: Some((-0.01, 0.01)),
+        note: "every body's CB moved along its z by the offset: ballast placement known to about \
+               half the REMUS value; GM 1–3 cm on generated designs, ±1 cm (top- to bottom-heavy) \
+               on usm-paper; |offset| ≤ the body radius",
+    },
+    Assumption {
+        key: "hydro.cb_offset_x",
+        name: "longitudinal CB − CG offset (trim, every body)",
+        value: "0: CB straight above CG in every body, the vehicle level (no trim moment)",
+        source: Source::Inferred("a design is ballasted to trim level; the paper states nothing"),
+        range: Some((-0.002, 0.002)),
+        note: "every body's CB moved along its x: a pitch moment B·offset at level (±1.6 N·m on the \
+               paper design), a trim pitch of up to asin(0.002/0.02) ≈ 5.7° at GM 2 cm: trimmed \
+               to a few degrees",
+    },
+    Assumption {
+        key: "hydro.controller_nominal",
+        name: "the controller's model of the plant",
+        value: "false: the base control's M_11 and n (USM-33/35) are the plant's own",
+        source: Source::Inferred(
+            "the paper's controller cancels its model's terms; which model it has is not stated",
+        ),
+        range: None,
+        note: "true keeps M_11 and n at the nominal design (no world scales or CB shifts, still \
+               water, payload neutral) while the plant takes the world: proposed for studies \
+               with worlds",
     },
     Assumption {
         key: "thrusters.limit_scale",
@@ -307,6 +345,25 @@ pub const LEDGER: &[Assumption] = &[
         note: "any direction",
     },
     Assumption {
+        key: "physics.current_vertical",
+        name: "vertical current (inertial +z, up)",
+        value: "0 m/s",
+        source: Source::Inferred("the paper's simulations state no current"),
+        range: Some((-0.02, 0.02)),
+        note: "open-ocean upwelling is of 10⁻⁴ m/s, but internal waves and flow around subsea \
+               structures reach cm/s: ±2 cm/s, a tenth of the horizontal range; |w| ≤ 1 m/s is \
+               refused beyond",
+    },
+    Assumption {
+        key: "mission.payload_wet_weight",
+        name: "payload wet weight m_p g − ρ V_p g",
+        value: "0 N (a payload is neutral unless `payload_volume` says otherwise)",
+        source: Source::Inferred("the paper carries no payload"),
+        range: Some((-2.0, 2.0)),
+        note: "a payload trimmed to within ±0.2 kg of neutral; only with a `mission.payload_mass` \
+               of at least W/g (a wet weight above the payload's weight is refused)",
+    },
+    Assumption {
         key: "initial.position[1]",
         name: "transport start: lateral offset",
         value: "−3 m (3 m to the right of the first segment)",
@@ -347,6 +404,19 @@ pub const LEDGER: &[Assumption] = &[
         ),
         range: None,
         note: "design-side (`generator.*` keys of a design or study)",
+    },
+    Assumption {
+        key: "",
+        name: "generator: hydrostatic rules",
+        value: "every body's CG at its geometric centre (on the axis) and its CB `metacentric_height` \
+                (0.02 m) above; `wet_weight` (0 N) spread over the bodies by mass, so the vehicle stays level",
+        source: Source::Inferred(
+            "GM from the REMUS 100 (see the metacentric-height row); neutral and level as the paper's \
+             \"wet mass 0\"",
+        ),
+        range: None,
+        note: "design-side (`generator.metacentric_height`, `generator.wet_weight`); worlds vary \
+               them through `hydro.cb_offset_z`, `hydro.cb_offset_x` and `hydro.buoyancy_offset`",
     },
     Assumption {
         key: "",

@@ -32,6 +32,14 @@ pub struct ModelScales {
     /// Lift at every body's trailing face, not only at the chain's free faces
     /// (`Hydro::Cylinder` `lift_every_body`). Nominal false.
     pub lift_every_body: bool,
+    /// Shift [m] of every body's centre of buoyancy along its own z axis: a metacentric-height
+    /// error (positive raises the CB, more righting moment). Not a factor: nominal 0;
+    /// |shift| ≤ the body's radius (the CB of the displaced volume stays inside the body).
+    pub cb_offset_z: f64,
+    /// Shift [m] of every body's centre of buoyancy along its own x axis (towards the head):
+    /// a longitudinal trim error, the pitch moment `ρ V g · shift` per body at level. Nominal
+    /// 0; |shift| ≤ half the body's length.
+    pub cb_offset_x: f64,
 }
 
 impl Default for ModelScales {
@@ -45,6 +53,8 @@ impl Default for ModelScales {
             thrust_limit: 1.0,
             lift_slope: 0.0,
             lift_every_body: false,
+            cb_offset_z: 0.0,
+            cb_offset_x: 0.0,
         }
     }
 }
@@ -83,6 +93,14 @@ impl ModelScales {
                 format!("must be finite and > 0, got {}", self.thrust_limit),
             ));
         }
+        for (k, v) in [
+            (keys.cb_offset_z, self.cb_offset_z),
+            (keys.cb_offset_x, self.cb_offset_x),
+        ] {
+            if !v.is_finite() {
+                return Err(ModelError::new(k, format!("must be finite, got {v}")));
+            }
+        }
         if !self.buoyancy_offset.is_finite() || self.buoyancy_offset <= -1.0 {
             return Err(ModelError::new(
                 keys.buoyancy_offset,
@@ -110,6 +128,10 @@ pub struct ScaleKeys {
     pub thrust_limit: &'static str,
     /// Name of [`ModelScales::lift_slope`].
     pub lift_slope: &'static str,
+    /// Name of [`ModelScales::cb_offset_z`].
+    pub cb_offset_z: &'static str,
+    /// Name of [`ModelScales::cb_offset_x`].
+    pub cb_offset_x: &'static str,
 }
 
 impl Vehicle {
@@ -123,6 +145,7 @@ impl Vehicle {
             if s.buoyancy_offset != 0.0 {
                 b.volume *= 1.0 + s.buoyancy_offset;
             }
+            shift_cb(b, s, keys)?;
             if s.hydro_nominal() {
                 continue;
             }
@@ -175,6 +198,30 @@ impl Vehicle {
         }
         Ok(())
     }
+}
+
+/// Shift `b`'s centre of buoyancy by the world's offsets, each within the body (the error
+/// names the key and the body).
+fn shift_cb(b: &mut super::Body, s: &ModelScales, keys: &ScaleKeys) -> Result<(), ModelError> {
+    for (key, shift, bound, axis) in [
+        (keys.cb_offset_z, s.cb_offset_z, b.radius, 2),
+        (keys.cb_offset_x, s.cb_offset_x, 0.5 * b.length, 0),
+    ] {
+        if shift == 0.0 {
+            continue;
+        }
+        if shift.abs() > bound {
+            return Err(ModelError::new(
+                key,
+                format!(
+                    "moves body {}'s centre of buoyancy out of the body: |{shift}| m > {bound} m",
+                    b.name
+                ),
+            ));
+        }
+        b.cb[axis] += shift;
+    }
+    Ok(())
 }
 
 impl Vehicle {
@@ -235,6 +282,8 @@ mod tests {
         buoyancy_offset: "bo",
         thrust_limit: "tl",
         lift_slope: "ls",
+        cb_offset_z: "cbz",
+        cb_offset_x: "cbx",
     };
 
     #[test]
@@ -258,6 +307,8 @@ mod tests {
             thrust_limit: 0.8,
             lift_slope: 2.0,
             lift_every_body: true,
+            cb_offset_z: 0.01,
+            cb_offset_x: -0.02,
         };
         v.apply_scales(&s, &KEYS).unwrap();
         for (b, b0) in v.bodies.iter().zip(&v0.bodies) {
@@ -287,6 +338,8 @@ mod tests {
             let (ma, ma0) = (b.added_mass(1026.0), b0.added_mass(1026.0));
             assert!((ma - 1.5 * ma0).abs().max() <= 1e-12 * ma0.abs().max());
             assert_eq!(b.volume, b0.volume * 1.01);
+            assert_eq!(b.cb, b0.cb + Vec3::new(-0.02, 0.0, 0.01));
+            assert_eq!(b.cg, b0.cg);
         }
         for (t, t0) in v.thrusters.iter().zip(&v0.thrusters) {
             assert_eq!(t.u_max, 0.8 * t0.u_max);
@@ -313,6 +366,19 @@ mod tests {
             ..ModelScales::default()
         };
         assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "ls");
+        // A centre of buoyancy moved out of the body (radius 0.085 m) is refused by its key.
+        let s = ModelScales {
+            cb_offset_z: 0.1,
+            ..ModelScales::default()
+        };
+        let e = v.apply_scales(&s, &KEYS).unwrap_err();
+        assert_eq!(e.key, "cbz");
+        assert!(e.message.contains("out of the body"), "{}", e.message);
+        let s = ModelScales {
+            cb_offset_x: f64::INFINITY,
+            ..ModelScales::default()
+        };
+        assert_eq!(v.apply_scales(&s, &KEYS).unwrap_err().key, "cbx");
     }
     #[test]
     fn a_payload_adds_its_mass_moment_and_volume_at_the_end_effector() {

@@ -5,10 +5,13 @@
 use std::path::Path;
 
 use super::error::PipelineError;
+use crate::dynamics::hydrostatics::hydrostatics;
 use crate::kinematics::{forward_kinematics, thruster_matrix_owned, KinWorkspace};
 use crate::metrics::singularity::{tcm_metrics, TcmMetrics, AXIS_NAMES, DEFAULT_RANK_REL_TOL};
 use crate::model::Vehicle;
-use crate::report::drawing::{nice_length, render_svg, Arrow, Cylinder, JointAxis, Scene, Triad};
+use crate::report::drawing::{
+    nice_length, render_svg, Arrow, Cylinder, JointAxis, Marker, Scene, Triad,
+};
 use crate::report::{atomic_write, fmt_short};
 use crate::state::VehicleState;
 
@@ -118,7 +121,36 @@ pub fn vehicle_scene(v: &Vehicle, s: &VehicleState) -> Scene {
             "arrow length ∝ thrust limit: {} m per N",
             fmt_short(m_per_n)
         ),
+        markers: Vec::new(),
     }
+}
+
+/// The whole vehicle's centres of gravity and buoyancy at `s` as markers (inertial frame),
+/// and the caption line of its hydrostatics (docs/model.md §4 "Restoring forces").
+pub fn hydrostatic_markers(v: &Vehicle, s: &VehicleState) -> (Vec<Marker>, String) {
+    let h = hydrostatics(v, &s.q);
+    let g_ib = s.base.to_se3();
+    let at = |c: [f64; 3]| g_ib.act_point(&crate::spatial::Vec3::from(c));
+    let markers = vec![
+        Marker {
+            name: "CG".into(),
+            position: at(h.centre_of_gravity),
+            filled: true,
+        },
+        Marker {
+            name: "CB".into(),
+            position: at(h.centre_of_buoyancy),
+            filled: false,
+        },
+    ];
+    let line = format!(
+        "hydrostatics: wet weight {} N; CB {} m above CG (GM); restoring {} N·m/rad in roll \
+         and pitch about the CG",
+        fmt_short(h.wet_weight),
+        fmt_short(h.metacentric_height),
+        fmt_short(h.roll_restoring_moment)
+    );
+    (markers, line)
 }
 
 /// The weakest of the six base DOFs under the thrust limits: the axis whose attainable wrench
@@ -257,6 +289,9 @@ pub fn draw_design(
     let m = state_metrics(v, s)?;
     let mut scene = scene;
     scene.caption = caption(v, state_label, m.as_ref());
+    let (markers, line) = hydrostatic_markers(v, s);
+    scene.markers = markers;
+    scene.caption.push(line);
     Ok(render_svg(&scene))
 }
 

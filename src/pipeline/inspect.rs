@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use super::error::PipelineError;
 use crate::allocation::AttainableAuthority;
+use crate::dynamics::hydrostatics::{hydrostatics, Hydrostatics};
 use crate::dynamics::{inspect_dynamics, DynOptions, DynamicsReport, SimState};
 use crate::kinematics::{ee_jacobian, forward_kinematics, thruster_matrix_owned, KinWorkspace};
 use crate::metrics::singularity::{tcm_metrics, tcm_svd_metrics, LostDirection, TcmMetrics};
@@ -90,19 +91,27 @@ pub struct InspectReport {
     pub kinematics: KinematicsReport,
     /// Mass matrix, bias, acceleration and energy (docs/model.md §4).
     pub dynamics: DynamicsReport,
+    /// Wet weight, centres, metacentric height, restoring moments and trim at the state's
+    /// joint angles (docs/model.md §4 "Restoring forces"); a property of the design, given
+    /// also with `rigid`.
+    pub hydrostatics: Hydrostatics,
     /// Whether the bodies were taken in vacuum (no added mass, drag, restoring forces or
     /// current).
     pub rigid: bool,
 }
 
 impl InspectReport {
-    /// The report as one JSON object: the kinematic keys, then the dynamic keys, then `rigid`.
+    /// The report as one JSON object: the kinematic keys, then the dynamic keys, then `rigid`
+    /// and `hydrostatics` (an object: `wet_weight` N, `roll_restoring_moment` and
+    /// `pitch_restoring_moment` N·m/rad, `metacentric_height` m, trim angles, per body).
     pub fn to_json(&self) -> Result<serde_json::Value, PipelineError> {
         let mut obj = serde_json::to_value(&self.kinematics)?;
         let dv = serde_json::to_value(&self.dynamics)?;
+        let hv = serde_json::to_value(&self.hydrostatics)?;
         if let (Some(o), serde_json::Value::Object(dm)) = (obj.as_object_mut(), dv) {
             o.extend(dm);
             o.insert("rigid".into(), serde_json::Value::Bool(self.rigid));
+            o.insert("hydrostatics".into(), hv);
         }
         Ok(obj)
     }
@@ -178,6 +187,7 @@ pub fn inspect(
     Ok(InspectReport {
         kinematics,
         dynamics,
+        hydrostatics: hydrostatics(v, &s.q),
         rigid,
     })
 }

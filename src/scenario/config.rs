@@ -346,7 +346,24 @@ impl ScenarioFile {
             ModeGains::Transport(g) => g.validate(),
             ModeGains::Work(g) => g.validate(v.n_joints()),
         }
-        .map_err(file_key_error)
+        .map_err(file_key_error)?;
+        self.world_vehicle(v).map(|_| ())
+    }
+
+    /// The plant this file's world makes of the design `v`: the file's 3-D current, the
+    /// `[hydro]` scale factors and centre-of-buoyancy shifts, the thrust derating and the
+    /// mission payload (docs/model.md §4, §6). Errors name the key (a CB shifted out of a
+    /// body, a payload wet weight above its weight).
+    pub fn world_vehicle(&self, v: &Vehicle) -> Result<Vehicle, KeyError> {
+        let mut w = v.clone();
+        w.fluid.current = crate::spatial::Vec3::from(self.physics.total_current());
+        let key = |e: crate::model::ModelError| KeyError::new(e.key, e.message);
+        let scales = self.hydro.scales(self.thrusters.limit_scale);
+        w.apply_scales(&scales, &SCALE_KEYS).map_err(key)?;
+        let volume = self.mission.payload_volume_in(w.fluid.rho, w.fluid.g)?;
+        w.add_payload(self.mission.payload_mass, volume)
+            .map_err(key)?;
+        Ok(w)
     }
 
     /// Base control gains: the file's, or the mode's default
@@ -475,6 +492,7 @@ impl ScenarioFile {
         finite("initial.position", &self.initial.position)?;
         finite("initial.yaw_deg", &[self.initial.yaw_deg])?;
         finite("initial.joint_angles_deg", &self.initial.joint_angles_deg)?;
+        self.physics.validate_current()?;
         finite("physics.current", &self.physics.total_current())?;
         let scales = self.hydro.scales(self.thrusters.limit_scale);
         scales

@@ -33,6 +33,9 @@ pub mod config;
 mod controller;
 mod error;
 pub mod fault;
+mod nominal;
+#[cfg(test)]
+mod nominal_tests;
 pub(crate) mod recorder;
 pub mod run;
 mod setup;

@@ -139,8 +139,11 @@ impl ClosedLoop<'_> {
     fn period(&mut self, k: usize, rec: &mut Recorder) -> Result<(), Failure> {
         let t = k as f64 * self.file.scenario.control_dt;
         let measured = timed!(rec.timing.control_s, self.measure(t))?;
-        let terms = timed!(rec.timing.dynamics_s, self.sim.base_control_terms())
+        let mut terms = timed!(rec.timing.dynamics_s, self.sim.base_control_terms())
             .map_err(|e| (t, e.to_string()))?;
+        if let Some(nominal) = self.nominal.as_mut() {
+            terms = timed!(rec.timing.dynamics_s, nominal.terms(self.sim.state()));
+        }
         timed!(rec.timing.control_s, self.control(t, &measured, &terms));
         timed!(
             rec.timing.allocation_s,

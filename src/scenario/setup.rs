@@ -3,14 +3,14 @@
 //! every buffer the loop needs once, so that no time step allocates.
 
 use super::channels::check_log_size;
-use super::config::{ScenarioFile, SCALE_KEYS};
+use super::config::ScenarioFile;
 use super::controller::{Command, ModeController};
 use super::error::ScenarioError;
 use super::fault::Fault;
+use super::nominal::NominalModel;
 use crate::allocation::{Allocation, Allocator};
 use crate::control::dynamic::DynamicController;
 use crate::dynamics::{SimState, Simulator};
-use crate::input::located::KeyError;
 use crate::kinematics::KinWorkspace;
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};
@@ -45,6 +45,9 @@ pub(crate) struct ClosedLoop<'f> {
     pub n_control: usize,
     /// The file's thruster fault, if any (`scenario::fault`).
     pub fault: Option<Fault>,
+    /// The controller's own model when the world keeps it nominal (`hydro.controller_nominal`,
+    /// `scenario::nominal`); `None`: the controller cancels the plant's terms.
+    pub nominal: Option<NominalModel>,
 }
 
 /// The initial state of the file on `v`: position, yaw and (optionally) joint angles.
@@ -97,18 +100,8 @@ impl<'f> ClosedLoop<'f> {
         file.validate()?;
         let s = &file.scenario;
         check_log_size(file, v)?;
-        let mut vehicle = v.clone();
-        vehicle.fluid.current = Vec3::from(file.physics.total_current());
-        vehicle
-            .apply_scales(&file.hydro.scales(file.thrusters.limit_scale), &SCALE_KEYS)
-            .map_err(|e| ScenarioError::Key(KeyError::new(e.key, e.message)))?;
-        let mission = &file.mission;
-        let payload_volume = mission
-            .payload_volume
-            .unwrap_or(mission.payload_mass / vehicle.fluid.rho);
-        vehicle
-            .add_payload(mission.payload_mass, payload_volume)
-            .map_err(|e| ScenarioError::Key(KeyError::new(e.key, e.message)))?;
+        let nominal = NominalModel::of(v, file)?;
+        let vehicle = file.world_vehicle(v).map_err(ScenarioError::Key)?;
         let v = &vehicle;
         let n_thrusters = v.n_thrusters();
         if n_thrusters == 0 {
@@ -148,6 +141,7 @@ impl<'f> ClosedLoop<'f> {
             cmd,
             fault,
             vehicle,
+            nominal,
         })
     }
 }

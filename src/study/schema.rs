@@ -290,7 +290,7 @@ impl Study {
 
 /// Keys of the design generator table (design-file schema); `design.<key>` is an alias of
 /// `design.generator.<key>` when the base design uses the generator.
-pub const GENERATOR_KEYS: [&str; 15] = [
+pub const GENERATOR_KEYS: [&str; 17] = [
     "links",
     "link_length",
     "link_mass",
@@ -306,6 +306,8 @@ pub const GENERATOR_KEYS: [&str; 15] = [
     "cd_axial_ends",
     "cd_axial",
     "cd_cross",
+    "metacentric_height",
+    "wet_weight",
 ];
 
 /// Whether `key` is a scenario-side top-level table (including `static`).

@@ -250,6 +250,8 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
         cd_axial_ends: g.cd_axial_ends.unwrap_or(d.cd_axial_ends),
         cd_axial: g.cd_axial.unwrap_or(d.cd_axial),
         cd_cross: g.cd_cross.unwrap_or(d.cd_cross),
+        metacentric_height: g.metacentric_height.unwrap_or(d.metacentric_height),
+        wet_weight: g.wet_weight.unwrap_or(d.wet_weight),
     };
     for (key, values) in [
         ("link_length", &spec.link_length),
@@ -283,8 +285,12 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
     if file.fluid.is_some() {
         v.fluid = fluid(file);
         if v.fluid.rho > 0.0 {
+            let factor = spec.volume_factor(v.total_mass(), v.fluid.g);
             for b in &mut v.bodies {
                 b.volume = b.mass / v.fluid.rho;
+                if factor != 1.0 {
+                    b.volume *= factor;
+                }
             }
         }
     }

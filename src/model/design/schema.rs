@@ -108,6 +108,8 @@ pub(super) struct GeneratorFile {
     pub(super) cd_axial_ends: Option<f64>,
     pub(super) cd_axial: Option<f64>,
     pub(super) cd_cross: Option<f64>,
+    pub(super) metacentric_height: Option<f64>,
+    pub(super) wet_weight: Option<f64>,
 }
 
 /// A thruster's body: by name or by 0-based index.

@@ -124,6 +124,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         let _ = writeln!(o, "cg = {}", farr(b.cg.as_slice()));
         let _ = writeln!(o, "cb = {}", farr(b.cb.as_slice()));
         let _ = writeln!(o, "volume = {}  # displaced [m³]", fnum(b.volume));
+        hydrostatics_comment(&mut o, v, b);
         let _ = writeln!(
             o,
             "inertia = {}  # about the CG [kg·m²]",
@@ -200,6 +201,23 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         }
     }
     o
+}
+
+/// The comment line of body `b`'s hydrostatics (docs/model.md §4 "Restoring forces"): `CB −
+/// CG`, the metacentric height and the wet weight in `v`'s fluid; the file's keys `cg`, `cb`
+/// and `volume` carry the values.
+fn hydrostatics_comment(o: &mut String, v: &Vehicle, b: &crate::model::Body) {
+    let d = b.cb - b.cg;
+    let _ = writeln!(
+        o,
+        "# hydrostatics: CB − CG = [{:.6}, {:.6}, {:.6}] m (metacentric height {:.6} m), \
+         wet weight {:.6} N (positive sinks)",
+        d.x,
+        d.y,
+        d.z,
+        d.z,
+        (b.mass - v.fluid.rho * b.volume) * v.fluid.g
+    );
 }
 
 /// Whether every body of `v` has its own name (thrusters then name their body).

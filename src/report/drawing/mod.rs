@@ -27,5 +27,5 @@ pub mod svg;
 pub mod views;
 
 pub use page::{layout, nice_length, render_svg, Layout, ACCENT};
-pub use scene::{Arrow, Cylinder, JointAxis, Scene, Triad};
+pub use scene::{Arrow, Cylinder, JointAxis, Marker, Scene, Triad};
 pub use views::{Bounds, View, ViewTransform};

@@ -56,6 +56,9 @@ fn content_bounds(scene: &Scene, view: View) -> Bounds {
         b.extend(view.project(&a.start));
         b.extend(view.project(&(a.start + a.direction * a.length)));
     }
+    for m in &scene.markers {
+        b.extend(view.project(&m.position));
+    }
     for t in &scene.triads {
         b.extend(view.project(&t.pose.p));
         for k in 0..3 {

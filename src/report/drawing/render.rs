@@ -134,6 +134,7 @@ pub(super) fn view(
     joints(s, scene, view, t);
     let pending = arrows(s, labels, scene, view, t);
     triads(s, labels, scene, view, t);
+    markers(s, labels, scene, view, t);
     for (names, anchor, pref) in group_labels(pending) {
         let id = format!("{}-label-{}", view.id(), file_stem_safe(&names[0]));
         labels.place(s, &label_text(&names), anchor, pref, &id);
@@ -302,5 +303,21 @@ fn triads(s: &mut Svg, labels: &mut Labeller, scene: &Scene, view: View, t: &Vie
         s.close("g");
         let id = format!("{}-frame-{}", view.id(), file_stem_safe(&tr.name));
         labels.place(s, &tr.name, o, [-1.0, 1.0], &id);
+    }
+}
+
+/// Labelled points: a filled dot or a ring, the name beside it.
+fn markers(s: &mut Svg, labels: &mut Labeller, scene: &Scene, view: View, t: &ViewTransform) {
+    for m in &scene.markers {
+        let c = t.to_svg(view.project(&m.position));
+        s.open("g", &[("data-marker", m.name.as_str().into())]);
+        if m.filled {
+            circle(s, "jdot", c, 3.0);
+        } else {
+            circle(s, "jring", c, 4.5);
+        }
+        s.close("g");
+        let id = format!("{}-marker-{}", view.id(), file_stem_safe(&m.name));
+        labels.place(s, &m.name, c, [1.0, 1.0], &id);
     }
 }

@@ -566,6 +566,7 @@ mod tests {
                     arrows: Vec::new(),
                     triads: Vec::new(),
                     arrow_legend: String::new(),
+                    markers: Vec::new(),
                 },
             }
         };

@@ -55,6 +55,17 @@ pub struct Triad {
     pub size: f64,
 }
 
+/// A labelled point: the whole vehicle's centre of gravity (`filled`) or of buoyancy.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Marker {
+    /// Label next to the point (written as `data-marker`).
+    pub name: String,
+    /// The point, inertial frame [m].
+    pub position: Vec3,
+    /// Drawn as a filled dot (else as a ring).
+    pub filled: bool,
+}
+
 /// Everything a drawing shows, in the inertial frame (z up).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -70,4 +81,6 @@ pub struct Scene {
     pub triads: Vec<Triad>,
     /// Legend text explaining the arrow lengths (e.g. `length ∝ limit: 0.01 m per N`).
     pub arrow_legend: String,
+    /// Labelled points (the centres of gravity and buoyancy of `design draw`).
+    pub markers: Vec<Marker>,
 }

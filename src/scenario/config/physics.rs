@@ -64,14 +64,32 @@ impl Default for ThrusterSpec {
 }
 
 impl PhysicsSpec {
+    /// The current's world keys within their ranges: `current_vertical` finite with
+    /// |w| ≤ 1 m/s (ocean vertical currents are of mm/s to cm/s; the bound refuses a unit
+    /// slip, e.g. cm/s written as m/s).
+    pub fn validate_current(&self) -> Result<(), crate::input::located::KeyError> {
+        let w = self.current_vertical;
+        if !w.is_finite() || w.abs() > 1.0 {
+            return Err(crate::input::located::KeyError::new(
+                "physics.current_vertical",
+                format!("must be finite with |w| <= 1 m/s, got {w}"),
+            ));
+        }
+        Ok(())
+    }
+
     /// The current in the inertial frame [m/s]: `current` plus the horizontal current of
-    /// `current_speed` towards `current_direction`.
+    /// `current_speed` towards `current_direction`, plus `current_vertical` along inertial +z
+    /// (up).
     pub fn total_current(&self) -> [f64; 3] {
         let mut c = self.current;
         if self.current_speed != 0.0 {
             let a = self.current_direction.to_radians();
             c[0] += self.current_speed * a.cos();
             c[1] += self.current_speed * a.sin();
+        }
+        if self.current_vertical != 0.0 {
+            c[2] += self.current_vertical;
         }
         c
     }
@@ -99,6 +117,19 @@ pub struct HydroScaleSpec {
     /// Apply that lift at every body's trailing face (each body its own blunt base), not only
     /// at the chain's free faces: an upper bound on the lift (default false).
     pub lift_every_body: bool,
+    /// Shift [m] of every body's centre of buoyancy along its own z axis (up when level):
+    /// a metacentric-height error (`ModelScales::cb_offset_z`; |shift| ≤ the body's radius).
+    pub cb_offset_z: f64,
+    /// Shift [m] of every body's centre of buoyancy along its own x axis (towards the head):
+    /// a longitudinal trim error, a pitch moment `B·shift` at level (|shift| ≤ half the
+    /// body's length).
+    pub cb_offset_x: f64,
+    /// Keep the controller's model at the nominal design while the plant takes this world:
+    /// the base control's `M_11` and `n` (USM-33/35) come from the design without the scale
+    /// factors and centre-of-buoyancy shifts above, in still water, the mission payload
+    /// neutrally buoyant (`scenario::nominal`). Default false: the controller cancels the
+    /// plant's own terms.
+    pub controller_nominal: bool,
 }
 
 impl Default for HydroScaleSpec {
@@ -111,6 +142,9 @@ impl Default for HydroScaleSpec {
             buoyancy_offset: 0.0,
             lift_slope: 0.0,
             lift_every_body: false,
+            cb_offset_z: 0.0,
+            cb_offset_x: 0.0,
+            controller_nominal: false,
         }
     }
 }
@@ -124,6 +158,8 @@ pub const SCALE_KEYS: crate::model::world::ScaleKeys = crate::model::world::Scal
     buoyancy_offset: "hydro.buoyancy_offset",
     thrust_limit: "thrusters.limit_scale",
     lift_slope: "hydro.lift_slope",
+    cb_offset_z: "hydro.cb_offset_z",
+    cb_offset_x: "hydro.cb_offset_x",
 };
 
 impl HydroScaleSpec {
@@ -138,6 +174,8 @@ impl HydroScaleSpec {
             thrust_limit: limit_scale,
             lift_slope: self.lift_slope,
             lift_every_body: self.lift_every_body,
+            cb_offset_z: self.cb_offset_z,
+            cb_offset_x: self.cb_offset_x,
         }
     }
 }
@@ -164,6 +202,9 @@ pub struct PhysicsSpec {
     pub current_speed: f64,
     /// Direction [deg] of that current: the angle from inertial +x towards +y.
     pub current_direction: f64,
+    /// Vertical current [m/s] added to `current` along inertial +z (up; an uncertain world's
+    /// key: upwelling > 0, downwelling < 0; |w| ≤ 1 m/s).
+    pub current_vertical: f64,
     /// Time integrator: `"dopri5"` (adaptive Dormand–Prince 5(4), the default) or `"rk4"`
     /// (fixed steps of `scenario.dt`); see [`Integrator`].
     pub integrator: String,
@@ -182,6 +223,7 @@ impl Default for PhysicsSpec {
             current: [0.0; 3],
             current_speed: 0.0,
             current_direction: 0.0,
+            current_vertical: 0.0,
             integrator: "dopri5".into(),
             rtol: DOPRI5_DEFAULT.0,
             atol: DOPRI5_DEFAULT.1,

@@ -41,6 +41,8 @@ fn arb_spec() -> impl Strategy<Value = GeneratorSpec> {
                 cd_axial_ends: ce,
                 cd_axial: ca,
                 cd_cross: cc,
+                metacentric_height: crate::model::generator::DEFAULT_METACENTRIC_HEIGHT,
+                wet_weight: 0.0,
             },
         )
 }
