@@ -170,6 +170,35 @@ pub struct TransportGains {
     pub integral_limit: Option<f64>,
     /// Time constant [s] of the filtered difference in the PD surge law.
     pub derivative_time_constant: f64,
+    /// Whether the depth and attitude autopilot adds its terms ([`TransportController::autopilot`],
+    /// docs/model.md §5 "Autopilot"): depth hold with integral action and roll/pitch
+    /// stabilisation towards level. Default false: the paper's laws alone (USM-38…41 and
+    /// USM-34's velocity feedback on the other axes), bit for bit.
+    pub autopilot: bool,
+    /// Autopilot depth gain `k_zp` [1/s²]: inertial vertical acceleration per metre of depth
+    /// error. Default 0.25 (**inferred**: with the heave velocity feedback `K_p,heave = 1/s`
+    /// and `k_zi` the depth loop `s³ + s² + k_zp s + k_zi` has roots −0.70 and −0.15 ± 0.08i).
+    pub k_depth_p: f64,
+    /// Autopilot depth integral gain `k_zi` [1/s³] on `∫(z − z_r) dt`. Default 0.02
+    /// (**inferred**, see `k_depth_p`).
+    pub k_depth_i: f64,
+    /// Anti-windup bound on `|∫(z − z_r) dt|` [m·s] (clamped). Default 10 m·s: `k_zi` × 10 =
+    /// 0.2 m/s², about twice what a 2 % buoyancy error of the paper design needs
+    /// (0.02 g m / (m + heave added mass) ≈ 0.1 m/s²).
+    pub depth_integral_limit: f64,
+    /// Autopilot roll gain `k_φp` [1/s²] on the base's roll from level. Default 0.25
+    /// (**inferred**: with `k_φd = 1/s`, a critically damped 0.5 rad/s loop). Applied only in
+    /// the control periods when the design can command roll
+    /// ([`TransportMeasurement::roll_authority`]).
+    pub k_roll_p: f64,
+    /// Autopilot roll rate gain `k_φd` [1/s] on the base roll rate `p`. Default 1.
+    pub k_roll_d: f64,
+    /// Autopilot pitch gain `k_θp` [1/s²] on the base's pitch from level. Default 0.25
+    /// (**inferred**: with the existing `K_p,pitch = 1/s` of USM-34, critically damped).
+    pub k_pitch_p: f64,
+    /// Autopilot pitch rate gain `k_θd` [1/s] on the base pitch rate `q`, added to USM-34's
+    /// `K_p,pitch`. Default 0.
+    pub k_pitch_d: f64,
 }
 
 impl TransportGains {
@@ -190,6 +219,14 @@ impl TransportGains {
             joint_sign: -1.0,
             integral_limit: None,
             derivative_time_constant: 0.5,
+            autopilot: false,
+            k_depth_p: 0.25,
+            k_depth_i: 0.02,
+            depth_integral_limit: 10.0,
+            k_roll_p: 0.25,
+            k_roll_d: 1.0,
+            k_pitch_p: 0.25,
+            k_pitch_d: 0.0,
         }
     }
 
@@ -233,6 +270,13 @@ impl TransportGains {
                 "transport.derivative_time_constant",
                 self.derivative_time_constant,
             ),
+            ("transport.k_depth_p", self.k_depth_p),
+            ("transport.k_depth_i", self.k_depth_i),
+            ("transport.depth_integral_limit", self.depth_integral_limit),
+            ("transport.k_roll_p", self.k_roll_p),
+            ("transport.k_roll_d", self.k_roll_d),
+            ("transport.k_pitch_p", self.k_pitch_p),
+            ("transport.k_pitch_d", self.k_pitch_d),
         ] {
             check_nonneg(k, v)?;
         }
@@ -276,6 +320,14 @@ struct TransportGainsSpec {
     joint_sign: Option<f64>,
     integral_limit: Option<f64>,
     derivative_time_constant: Option<f64>,
+    autopilot: Option<bool>,
+    k_depth_p: Option<f64>,
+    k_depth_i: Option<f64>,
+    depth_integral_limit: Option<f64>,
+    k_roll_p: Option<f64>,
+    k_roll_d: Option<f64>,
+    k_pitch_p: Option<f64>,
+    k_pitch_d: Option<f64>,
 }
 
 impl TryFrom<TransportGainsSpec> for TransportGains {
@@ -299,7 +351,15 @@ impl TryFrom<TransportGainsSpec> for TransportGains {
             yaw_rate_source,
             yaw_rate_reference,
             joint_sign,
-            derivative_time_constant
+            derivative_time_constant,
+            autopilot,
+            k_depth_p,
+            k_depth_i,
+            depth_integral_limit,
+            k_roll_p,
+            k_roll_d,
+            k_pitch_p,
+            k_pitch_d
         );
         if s.integral_limit.is_some() {
             g.integral_limit = s.integral_limit;
@@ -360,6 +420,18 @@ pub struct TransportMeasurement {
     pub ee_position: Vec3,
     /// End-effector velocity in `I` [m/s].
     pub ee_velocity: Vec3,
+    /// Base origin depth `z_b` (inertial z, up) [m] (the autopilot's depth hold).
+    pub base_z: f64,
+    /// The inertial up direction in `F_b`, `g = R_Ibᵀ e_z` (`(0, 0, 1)` when level; the
+    /// autopilot's tilt error).
+    pub base_up: Vec3,
+    /// Base angular velocity `ω_b` in `F_b` [rad/s].
+    pub base_rates: Vec3,
+    /// Whether the design can command a roll moment in this configuration: σ_min of all six
+    /// rows of the scaled `T(q)` at or above `[metrics] threshold` (docs/model.md §6). Set by
+    /// the closed loop only when the autopilot is on (false otherwise, and by
+    /// [`measure_transport`]); without it the autopilot leaves roll to the hydrostatics.
+    pub roll_authority: bool,
 }
 
 /// Compute [`TransportMeasurement`] from the state: base pose, a workspace after
@@ -388,6 +460,10 @@ pub fn measure_transport(
         surge_base: v_b[0],
         ee_position: g_ie.p,
         ee_velocity: g_ie.r * lin(&v_e),
+        base_z: g_ib.p.z,
+        base_up: g_ib.r.transpose() * Vec3::z(),
+        base_rates: ang(v_b),
+        roll_authority: false,
     }
 }
 
@@ -402,6 +478,8 @@ pub struct TransportOutput {
     pub heading_error: f64,
     /// Surge error `u − u_c` [m/s].
     pub surge_error: f64,
+    /// Whether the autopilot commanded roll in this step.
+    pub roll_commanded: bool,
 }
 
 /// The transport-mode controller: LOS guidance, USM-38 joint references, USM-40/41 base
@@ -420,6 +498,8 @@ pub struct TransportController {
     offset: Vec<f64>,
     q_sec: Vec<f64>,
     step: Vec<f64>,
+    depth_ref: Option<f64>,
+    depth_integral: f64,
 }
 
 impl TransportController {
@@ -440,6 +520,8 @@ impl TransportController {
             offset: vec![0.0; v.n_joints()],
             q_sec: vec![0.0; v.n_joints()],
             step: vec![0.0; v.n_joints()],
+            depth_ref: None,
+            depth_integral: 0.0,
         })
     }
 
@@ -530,6 +612,67 @@ impl TransportController {
         self.guidance.reset();
         self.q_ref.fill(0.0);
         self.offset.fill(0.0);
+        self.depth_ref = None;
+        self.depth_integral = 0.0;
+    }
+
+    /// The autopilot's depth reference `z_r` [m] (the base depth at its first step; `None`
+    /// before it, or without the autopilot).
+    pub fn depth_reference(&self) -> Option<f64> {
+        self.depth_ref
+    }
+
+    /// The autopilot's depth integral `∫(z_b − z_r) dt` [m·s].
+    pub fn depth_integral(&self) -> f64 {
+        self.depth_integral
+    }
+
+    /// The autopilot's base acceleration (docs/model.md §5 "Autopilot"), added to USM-40/41's
+    /// `a^b` when [`TransportGains::autopilot`] is set; advances the depth integral over `dt`
+    /// [s]. In `F_b` [m/s², rad/s²]:
+    ///
+    /// - **depth hold**: the inertial vertical acceleration
+    ///   `a_z = −k_zp (z_b − z_r) − k_zi ∫(z_b − z_r) dt`, with `z_r` the base depth at the first
+    ///   step (transport paths are horizontal, at the depth the vehicle starts) and the integral
+    ///   clamped to `±depth_integral_limit` (anti-windup), expressed in the base frame,
+    ///   `R_Ibᵀ (0, 0, a_z)`; USM-34's heave velocity feedback `−K_p,heave v_b,z` stays the
+    ///   damping;
+    /// - **attitude**: the tilt error `e = ∠(g, e_z) · (g × e_z)/|g × e_z|` (`g = R_Ibᵀ e_z`, the
+    ///   inertial up seen from the base: the rotation, in `F_b`, from level to the base's
+    ///   attitude; `(φ, θ, 0)` to first order, exact angle up to 180°), and
+    ///   `a_4 = −k_φp e_x − k_φd p` (roll, only when `meas.roll_authority`),
+    ///   `a_5 = −k_θp e_y − k_θd q` (pitch, always: transport commands pitch).
+    ///
+    /// Returns the acceleration and whether roll was commanded. Allocation-free.
+    pub fn autopilot(&mut self, meas: &TransportMeasurement, dt: f64) -> (Vec6, bool) {
+        let g = &self.gains;
+        let z_r = *self.depth_ref.get_or_insert(meas.base_z);
+        let e_z = meas.base_z - z_r;
+        if dt.is_finite() && dt > 0.0 && e_z.is_finite() {
+            let l = g.depth_integral_limit;
+            self.depth_integral = (self.depth_integral + e_z * dt).clamp(-l, l);
+        }
+        let a_z = -g.k_depth_p * e_z - g.k_depth_i * self.depth_integral;
+        let lin_b = meas.base_up * a_z;
+        let axis = meas.base_up.cross(&Vec3::z());
+        let s = axis.norm();
+        let angle = s.atan2(meas.base_up.dot(&Vec3::z()));
+        let tilt = if s > 0.0 {
+            axis * (angle / s)
+        } else {
+            Vec3::zeros()
+        };
+        let roll = meas.roll_authority;
+        let a_roll = if roll {
+            -g.k_roll_p * tilt.x - g.k_roll_d * meas.base_rates.x
+        } else {
+            0.0
+        };
+        let a_pitch = -g.k_pitch_p * tilt.y - g.k_pitch_d * meas.base_rates.y;
+        (
+            Vec6::new(lin_b.x, lin_b.y, lin_b.z, a_roll, a_pitch, 0.0),
+            roll,
+        )
     }
 
     /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
@@ -605,11 +748,19 @@ impl TransportController {
             YawRateSource::BaseYawRate => meas.base_yaw_rate,
         };
         let a6 = self.yaw_acceleration(meas.psi, psi_dot, los.psi_r, los.psi_r_dot);
+        let mut a_b = Vec6::new(a1, 0.0, 0.0, 0.0, 0.0, a6);
+        let mut roll_commanded = false;
+        if self.gains.autopilot {
+            let (a, roll) = self.autopilot(meas, dt);
+            a_b += a;
+            roll_commanded = roll;
+        }
         TransportOutput {
             los,
-            a_b: Vec6::new(a1, 0.0, 0.0, 0.0, 0.0, a6),
+            a_b,
             heading_error: wrap_angle(meas.psi - los.psi_r),
             surge_error: u - self.gains.u0,
+            roll_commanded,
         }
     }
 }
