@@ -89,7 +89,10 @@ fn the_leader_capsizes_under_a_tiny_vertical_current_and_a_dead_thruster_and_fai
         assert_eq!(metric(r, "success"), 0.0, "{what}");
         assert_eq!(missed(r), Some("max_roll_deg"), "{what}: {:?}", r.missed);
         let detail = &r.missed.as_ref().unwrap().detail;
-        assert!(detail.starts_with("max_abs_roll_deg = "), "{what}: {detail}");
+        assert!(
+            detail.starts_with("max_abs_roll_deg = "),
+            "{what}: {detail}"
+        );
         assert!(metric(r, "success_margin") < -1.0, "{what}");
     }
 }

@@ -322,11 +322,18 @@ mod tests {
         let id = |m: &[(String, f64)]| judge(&s, &none, Mode::Transport, m).map(|x| x.criterion);
         // On its back, saturated and off the path: the roll is named, not the saturation or
         // the cross-track error it caused.
-        let mut capsized = with(transport(-1.3, &[30.0, f64::NAN]), "max_abs_roll_deg", 178.6);
+        let mut capsized = with(
+            transport(-1.3, &[30.0, f64::NAN]),
+            "max_abs_roll_deg",
+            178.6,
+        );
         capsized[2].1 = 0.4;
         let m = judge(&s, &none, Mode::Transport, &capsized).unwrap();
         assert_eq!(m.criterion, Criterion::MaxRoll);
-        assert_eq!(m.to_string(), "max_roll_deg: max_abs_roll_deg = 178.6000° > 30°");
+        assert_eq!(
+            m.to_string(),
+            "max_roll_deg: max_abs_roll_deg = 178.6000° > 30°"
+        );
         let ok = transport(0.05, &[30.0]);
         assert_eq!(id(&ok), None);
         assert_eq!(
@@ -348,14 +355,23 @@ mod tests {
             max_vertical_error: 0.0,
             ..SuccessSpec::default()
         };
-        let rolled = with(with(ok.clone(), "max_abs_roll_deg", 90.0), "max_vertical_error", 3.0);
+        let rolled = with(
+            with(ok.clone(), "max_abs_roll_deg", 90.0),
+            "max_vertical_error",
+            3.0,
+        );
         assert_eq!(judge(&off, &none, Mode::Transport, &rolled), None);
         // A run that stopped early still names `no_failure` first.
         let mut stopped = capsized.clone();
         stopped[0].1 = 0.0;
         assert_eq!(id(&stopped), Some(Criterion::NoFailure));
         // The margin sees the attitude: 20° of 30° leaves a third.
-        let margin = success_margin(&s, &none, Mode::Transport, &with(ok, "max_abs_roll_deg", 20.0));
+        let margin = success_margin(
+            &s,
+            &none,
+            Mode::Transport,
+            &with(ok, "max_abs_roll_deg", 20.0),
+        );
         assert!((margin - 1.0 / 3.0).abs() < 1e-12, "{margin}");
         // Work mode is not judged on them (the base's attitude is free to the task there).
         let mut w = metrics(&COMMON);
