@@ -170,34 +170,25 @@ pub struct TransportGains {
     pub integral_limit: Option<f64>,
     /// Time constant [s] of the filtered difference in the PD surge law.
     pub derivative_time_constant: f64,
-    /// Whether the depth and attitude autopilot adds its terms ([`TransportController::autopilot`],
-    /// docs/model.md §5 "Autopilot"): depth hold with integral action and roll/pitch
-    /// stabilisation towards level. Default false: the paper's laws alone (USM-38…41 and
-    /// USM-34's velocity feedback on the other axes), bit for bit.
+    /// Whether the depth and attitude autopilot adds its terms (docs/model.md §5 "Autopilot",
+    /// `TransportController::autopilot`). Default false: the paper's laws alone, bit for bit.
     pub autopilot: bool,
-    /// Autopilot depth gain `k_zp` [1/s²]: inertial vertical acceleration per metre of depth
-    /// error. Default 0.25 (**inferred**: with the heave velocity feedback `K_p,heave = 1/s`
-    /// and `k_zi` the depth loop `s³ + s² + k_zp s + k_zi` has roots −0.70 and −0.15 ± 0.08i).
+    /// Depth gain `k_zp` [1/s²] (default 0.25, **inferred**: with `K_p,heave = 1/s` and `k_zi`
+    /// the loop `s³ + s² + k_zp s + k_zi` has roots −0.70, −0.15 ± 0.08i).
     pub k_depth_p: f64,
-    /// Autopilot depth integral gain `k_zi` [1/s³] on `∫(z − z_r) dt`. Default 0.02
-    /// (**inferred**, see `k_depth_p`).
+    /// Depth integral gain `k_zi` [1/s³] on `∫(z − z_r) dt` (default 0.02, **inferred**).
     pub k_depth_i: f64,
-    /// Anti-windup bound on `|∫(z − z_r) dt|` [m·s] (clamped). Default 10 m·s: `k_zi` × 10 =
-    /// 0.2 m/s², about twice what a 2 % buoyancy error of the paper design needs
-    /// (0.02 g m / (m + heave added mass) ≈ 0.1 m/s²).
+    /// Anti-windup bound on `|∫(z − z_r) dt|` [m·s] (default 10: `k_zi` × 10 = 0.2 m/s², about
+    /// twice what a 2 % buoyancy error of the paper design needs).
     pub depth_integral_limit: f64,
-    /// Autopilot roll gain `k_φp` [1/s²] on the base's roll from level. Default 0.25
-    /// (**inferred**: with `k_φd = 1/s`, a critically damped 0.5 rad/s loop). Applied only in
-    /// the control periods when the design can command roll
-    /// ([`TransportMeasurement::roll_authority`]).
+    /// Roll gain `k_φp` [1/s²] (default 0.25, **inferred**), applied only when the design can
+    /// command roll ([`TransportMeasurement::roll_authority`]).
     pub k_roll_p: f64,
-    /// Autopilot roll rate gain `k_φd` [1/s] on the base roll rate `p`. Default 1.
+    /// Roll rate gain `k_φd` [1/s] (default 1: with `k_φp`, critically damped at 0.5 rad/s).
     pub k_roll_d: f64,
-    /// Autopilot pitch gain `k_θp` [1/s²] on the base's pitch from level. Default 0.25
-    /// (**inferred**: with the existing `K_p,pitch = 1/s` of USM-34, critically damped).
+    /// Pitch gain `k_θp` [1/s²] (default 0.25, **inferred**; USM-34's `K_p,pitch` damps).
     pub k_pitch_p: f64,
-    /// Autopilot pitch rate gain `k_θd` [1/s] on the base pitch rate `q`, added to USM-34's
-    /// `K_p,pitch`. Default 0.
+    /// Pitch rate gain `k_θd` [1/s], added to USM-34's `K_p,pitch` (default 0).
     pub k_pitch_d: f64,
 }
 
@@ -351,16 +342,10 @@ impl TryFrom<TransportGainsSpec> for TransportGains {
             yaw_rate_source,
             yaw_rate_reference,
             joint_sign,
-            derivative_time_constant,
-            autopilot,
-            k_depth_p,
-            k_depth_i,
-            depth_integral_limit,
-            k_roll_p,
-            k_roll_d,
-            k_pitch_p,
-            k_pitch_d
+            derivative_time_constant
         );
+        set!(autopilot, k_depth_p, k_depth_i, depth_integral_limit);
+        set!(k_roll_p, k_roll_d, k_pitch_p, k_pitch_d);
         if s.integral_limit.is_some() {
             g.integral_limit = s.integral_limit;
         }
@@ -420,17 +405,14 @@ pub struct TransportMeasurement {
     pub ee_position: Vec3,
     /// End-effector velocity in `I` [m/s].
     pub ee_velocity: Vec3,
-    /// Base origin depth `z_b` (inertial z, up) [m] (the autopilot's depth hold).
+    /// Base origin depth `z_b` (inertial z, up) [m].
     pub base_z: f64,
-    /// The inertial up direction in `F_b`, `g = R_Ibᵀ e_z` (`(0, 0, 1)` when level; the
-    /// autopilot's tilt error).
+    /// The inertial up direction in `F_b`, `R_Ibᵀ e_z` ((0, 0, 1) when level).
     pub base_up: Vec3,
     /// Base angular velocity `ω_b` in `F_b` [rad/s].
     pub base_rates: Vec3,
-    /// Whether the design can command a roll moment in this configuration: σ_min of all six
-    /// rows of the scaled `T(q)` at or above `[metrics] threshold` (docs/model.md §6). Set by
-    /// the closed loop only when the autopilot is on (false otherwise, and by
-    /// [`measure_transport`]); without it the autopilot leaves roll to the hydrostatics.
+    /// Whether T(q) can command roll now (σ_min of all six scaled rows ≥ `[metrics]
+    /// threshold`; set by the closed loop with the autopilot on, else false).
     pub roll_authority: bool,
 }
 
@@ -616,65 +598,6 @@ impl TransportController {
         self.depth_integral = 0.0;
     }
 
-    /// The autopilot's depth reference `z_r` [m] (the base depth at its first step; `None`
-    /// before it, or without the autopilot).
-    pub fn depth_reference(&self) -> Option<f64> {
-        self.depth_ref
-    }
-
-    /// The autopilot's depth integral `∫(z_b − z_r) dt` [m·s].
-    pub fn depth_integral(&self) -> f64 {
-        self.depth_integral
-    }
-
-    /// The autopilot's base acceleration (docs/model.md §5 "Autopilot"), added to USM-40/41's
-    /// `a^b` when [`TransportGains::autopilot`] is set; advances the depth integral over `dt`
-    /// [s]. In `F_b` [m/s², rad/s²]:
-    ///
-    /// - **depth hold**: the inertial vertical acceleration
-    ///   `a_z = −k_zp (z_b − z_r) − k_zi ∫(z_b − z_r) dt`, with `z_r` the base depth at the first
-    ///   step (transport paths are horizontal, at the depth the vehicle starts) and the integral
-    ///   clamped to `±depth_integral_limit` (anti-windup), expressed in the base frame,
-    ///   `R_Ibᵀ (0, 0, a_z)`; USM-34's heave velocity feedback `−K_p,heave v_b,z` stays the
-    ///   damping;
-    /// - **attitude**: the tilt error `e = ∠(g, e_z) · (g × e_z)/|g × e_z|` (`g = R_Ibᵀ e_z`, the
-    ///   inertial up seen from the base: the rotation, in `F_b`, from level to the base's
-    ///   attitude; `(φ, θ, 0)` to first order, exact angle up to 180°), and
-    ///   `a_4 = −k_φp e_x − k_φd p` (roll, only when `meas.roll_authority`),
-    ///   `a_5 = −k_θp e_y − k_θd q` (pitch, always: transport commands pitch).
-    ///
-    /// Returns the acceleration and whether roll was commanded. Allocation-free.
-    pub fn autopilot(&mut self, meas: &TransportMeasurement, dt: f64) -> (Vec6, bool) {
-        let g = &self.gains;
-        let z_r = *self.depth_ref.get_or_insert(meas.base_z);
-        let e_z = meas.base_z - z_r;
-        if dt.is_finite() && dt > 0.0 && e_z.is_finite() {
-            let l = g.depth_integral_limit;
-            self.depth_integral = (self.depth_integral + e_z * dt).clamp(-l, l);
-        }
-        let a_z = -g.k_depth_p * e_z - g.k_depth_i * self.depth_integral;
-        let lin_b = meas.base_up * a_z;
-        let axis = meas.base_up.cross(&Vec3::z());
-        let s = axis.norm();
-        let angle = s.atan2(meas.base_up.dot(&Vec3::z()));
-        let tilt = if s > 0.0 {
-            axis * (angle / s)
-        } else {
-            Vec3::zeros()
-        };
-        let roll = meas.roll_authority;
-        let a_roll = if roll {
-            -g.k_roll_p * tilt.x - g.k_roll_d * meas.base_rates.x
-        } else {
-            0.0
-        };
-        let a_pitch = -g.k_pitch_p * tilt.y - g.k_pitch_d * meas.base_rates.y;
-        (
-            Vec6::new(lin_b.x, lin_b.y, lin_b.z, a_roll, a_pitch, 0.0),
-            roll,
-        )
-    }
-
     /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
     /// joint limits. `psi`, `psi_r` [rad]; `out` of length n (extra entries untouched).
     pub fn joint_references(&self, psi: f64, psi_r: f64, out: &mut [f64]) {
@@ -764,6 +687,10 @@ impl TransportController {
         }
     }
 }
+
+/// The depth and attitude autopilot (`impl TransportController`, docs/model.md §5).
+#[path = "transport_autopilot.rs"]
+mod autopilot;
 
 #[cfg(test)]
 #[path = "transport_tests.rs"]
