@@ -170,6 +170,26 @@ pub struct TransportGains {
     pub integral_limit: Option<f64>,
     /// Time constant [s] of the filtered difference in the PD surge law.
     pub derivative_time_constant: f64,
+    /// Whether the depth and attitude autopilot adds its terms (docs/model.md §5 "Autopilot",
+    /// `TransportController::autopilot`). Default false: the paper's laws alone, bit for bit.
+    pub autopilot: bool,
+    /// Depth gain `k_zp` [1/s²] (default 0.25, **inferred**: with `K_p,heave = 1/s` and `k_zi`
+    /// the loop `s³ + s² + k_zp s + k_zi` has roots −0.70, −0.15 ± 0.08i).
+    pub k_depth_p: f64,
+    /// Depth integral gain `k_zi` [1/s³] on `∫(z − z_r) dt` (default 0.02, **inferred**).
+    pub k_depth_i: f64,
+    /// Anti-windup bound on `|∫(z − z_r) dt|` [m·s] (default 10: `k_zi` × 10 = 0.2 m/s², about
+    /// twice what a 2 % buoyancy error of the paper design needs).
+    pub depth_integral_limit: f64,
+    /// Roll gain `k_φp` [1/s²] (default 0.25, **inferred**), applied only when the design can
+    /// command roll ([`TransportMeasurement::roll_authority`]).
+    pub k_roll_p: f64,
+    /// Roll rate gain `k_φd` [1/s] (default 1: with `k_φp`, critically damped at 0.5 rad/s).
+    pub k_roll_d: f64,
+    /// Pitch gain `k_θp` [1/s²] (default 0.25, **inferred**; USM-34's `K_p,pitch` damps).
+    pub k_pitch_p: f64,
+    /// Pitch rate gain `k_θd` [1/s], added to USM-34's `K_p,pitch` (default 0).
+    pub k_pitch_d: f64,
 }
 
 impl TransportGains {
@@ -190,6 +210,14 @@ impl TransportGains {
             joint_sign: -1.0,
             integral_limit: None,
             derivative_time_constant: 0.5,
+            autopilot: false,
+            k_depth_p: 0.25,
+            k_depth_i: 0.02,
+            depth_integral_limit: 10.0,
+            k_roll_p: 0.25,
+            k_roll_d: 1.0,
+            k_pitch_p: 0.25,
+            k_pitch_d: 0.0,
         }
     }
 
@@ -233,6 +261,13 @@ impl TransportGains {
                 "transport.derivative_time_constant",
                 self.derivative_time_constant,
             ),
+            ("transport.k_depth_p", self.k_depth_p),
+            ("transport.k_depth_i", self.k_depth_i),
+            ("transport.depth_integral_limit", self.depth_integral_limit),
+            ("transport.k_roll_p", self.k_roll_p),
+            ("transport.k_roll_d", self.k_roll_d),
+            ("transport.k_pitch_p", self.k_pitch_p),
+            ("transport.k_pitch_d", self.k_pitch_d),
         ] {
             check_nonneg(k, v)?;
         }
@@ -276,6 +311,14 @@ struct TransportGainsSpec {
     joint_sign: Option<f64>,
     integral_limit: Option<f64>,
     derivative_time_constant: Option<f64>,
+    autopilot: Option<bool>,
+    k_depth_p: Option<f64>,
+    k_depth_i: Option<f64>,
+    depth_integral_limit: Option<f64>,
+    k_roll_p: Option<f64>,
+    k_roll_d: Option<f64>,
+    k_pitch_p: Option<f64>,
+    k_pitch_d: Option<f64>,
 }
 
 impl TryFrom<TransportGainsSpec> for TransportGains {
@@ -301,6 +344,8 @@ impl TryFrom<TransportGainsSpec> for TransportGains {
             joint_sign,
             derivative_time_constant
         );
+        set!(autopilot, k_depth_p, k_depth_i, depth_integral_limit);
+        set!(k_roll_p, k_roll_d, k_pitch_p, k_pitch_d);
         if s.integral_limit.is_some() {
             g.integral_limit = s.integral_limit;
         }
@@ -360,6 +405,15 @@ pub struct TransportMeasurement {
     pub ee_position: Vec3,
     /// End-effector velocity in `I` [m/s].
     pub ee_velocity: Vec3,
+    /// Base origin depth `z_b` (inertial z, up) [m].
+    pub base_z: f64,
+    /// The inertial up direction in `F_b`, `R_Ibᵀ e_z` ((0, 0, 1) when level).
+    pub base_up: Vec3,
+    /// Base angular velocity `ω_b` in `F_b` [rad/s].
+    pub base_rates: Vec3,
+    /// Whether T(q) can command roll now (σ_min of all six scaled rows ≥ `[metrics]
+    /// threshold`; set by the closed loop with the autopilot on, else false).
+    pub roll_authority: bool,
 }
 
 /// Compute [`TransportMeasurement`] from the state: base pose, a workspace after
@@ -388,6 +442,10 @@ pub fn measure_transport(
         surge_base: v_b[0],
         ee_position: g_ie.p,
         ee_velocity: g_ie.r * lin(&v_e),
+        base_z: g_ib.p.z,
+        base_up: g_ib.r.transpose() * Vec3::z(),
+        base_rates: ang(v_b),
+        roll_authority: false,
     }
 }
 
@@ -402,6 +460,8 @@ pub struct TransportOutput {
     pub heading_error: f64,
     /// Surge error `u − u_c` [m/s].
     pub surge_error: f64,
+    /// Whether the autopilot commanded roll in this step.
+    pub roll_commanded: bool,
 }
 
 /// The transport-mode controller: LOS guidance, USM-38 joint references, USM-40/41 base
@@ -420,6 +480,8 @@ pub struct TransportController {
     offset: Vec<f64>,
     q_sec: Vec<f64>,
     step: Vec<f64>,
+    depth_ref: Option<f64>,
+    depth_integral: f64,
 }
 
 impl TransportController {
@@ -440,6 +502,8 @@ impl TransportController {
             offset: vec![0.0; v.n_joints()],
             q_sec: vec![0.0; v.n_joints()],
             step: vec![0.0; v.n_joints()],
+            depth_ref: None,
+            depth_integral: 0.0,
         })
     }
 
@@ -530,6 +594,8 @@ impl TransportController {
         self.guidance.reset();
         self.q_ref.fill(0.0);
         self.offset.fill(0.0);
+        self.depth_ref = None;
+        self.depth_integral = 0.0;
     }
 
     /// USM-38: `out[i] = s_q k_ψ wrap(ψ − ψ_r)` for yaw joints, 0 otherwise, clamped to the
@@ -605,14 +671,26 @@ impl TransportController {
             YawRateSource::BaseYawRate => meas.base_yaw_rate,
         };
         let a6 = self.yaw_acceleration(meas.psi, psi_dot, los.psi_r, los.psi_r_dot);
+        let mut a_b = Vec6::new(a1, 0.0, 0.0, 0.0, 0.0, a6);
+        let mut roll_commanded = false;
+        if self.gains.autopilot {
+            let (a, roll) = self.autopilot(meas, dt);
+            a_b += a;
+            roll_commanded = roll;
+        }
         TransportOutput {
             los,
-            a_b: Vec6::new(a1, 0.0, 0.0, 0.0, 0.0, a6),
+            a_b,
             heading_error: wrap_angle(meas.psi - los.psi_r),
             surge_error: u - self.gains.u0,
+            roll_commanded,
         }
     }
 }
+
+/// The depth and attitude autopilot (`impl TransportController`, docs/model.md §5).
+#[path = "transport_autopilot.rs"]
+mod autopilot;
 
 #[cfg(test)]
 #[path = "transport_tests.rs"]

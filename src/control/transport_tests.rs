@@ -269,3 +269,134 @@ fn closed_loop_transport_derived_sign_beats_paper_sign() {
         assert!(by_sign[0] < 2.0, "{by_sign:?}");
     }
 }
+
+/// A level measurement on the path's line at depth `z` with the base's up direction
+/// `up` (in `F_b`) and body rates `rates`.
+fn attitude_meas(z: f64, up: Vec3, rates: Vec3, roll_authority: bool) -> TransportMeasurement {
+    TransportMeasurement {
+        ee_position: Vec3::new(5.0, 0.0, z),
+        ee_velocity: Vec3::new(0.5, 0.0, 0.0),
+        surge_base: 0.5,
+        surge_ee: 0.5,
+        base_z: z,
+        base_up: up,
+        base_rates: rates,
+        roll_authority,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn the_autopilot_is_off_by_default_and_the_paper_laws_are_unchanged() {
+    let v = usm_paper();
+    for g in [TransportGains::method1(), TransportGains::method2()] {
+        assert!(!g.autopilot);
+        let mut off = TransportController::new(&v, g.clone(), &path()).unwrap();
+        // Rolled 30°, pitched, 2 m below the start: the paper's laws command none of it.
+        let up = Vec3::new(-0.2, 0.5, 0.84).normalize();
+        off.step(
+            0.0,
+            &attitude_meas(0.0, Vec3::z(), Vec3::zeros(), true),
+            0.05,
+        );
+        let out = off.step(
+            0.05,
+            &attitude_meas(-2.0, up, Vec3::new(0.3, 0.1, 0.0), true),
+            0.05,
+        );
+        assert_eq!(&out.a_b.as_slice()[1..5], &[0.0; 4]);
+        assert!(!out.roll_commanded);
+        assert_eq!(off.depth_integral(), 0.0);
+    }
+}
+
+#[test]
+fn the_autopilot_holds_depth_with_a_bounded_integral_and_levels_the_base() {
+    let v = usm_paper();
+    let g = TransportGains {
+        autopilot: true,
+        ..TransportGains::method2()
+    };
+    let (kzp, kzi, lim) = (g.k_depth_p, g.k_depth_i, g.depth_integral_limit);
+    let mut ctl = TransportController::new(&v, g.clone(), &path()).unwrap();
+    // The first step fixes the depth reference (−1.5 m, where the vehicle starts).
+    let out = ctl.step(
+        0.0,
+        &attitude_meas(-1.5, Vec3::z(), Vec3::zeros(), false),
+        0.1,
+    );
+    assert_eq!(ctl.depth_reference(), Some(-1.5));
+    assert_eq!(&out.a_b.as_slice()[1..5], &[0.0; 4]);
+    // 0.4 m too deep, level: a_z = −k_zp e − k_zi ∫e along the base z (= inertial z).
+    let out = ctl.step(
+        0.1,
+        &attitude_meas(-1.9, Vec3::z(), Vec3::zeros(), false),
+        0.1,
+    );
+    let e = -0.4;
+    let expect = -kzp * e - kzi * (e * 0.1);
+    assert!((ctl.depth_integral() - e * 0.1).abs() < 1e-15);
+    assert!((out.a_b[2] - expect).abs() < 1e-15, "{}", out.a_b[2]);
+    assert!(expect > 0.0, "pushes up");
+    // Anti-windup: the integral stops at its bound.
+    for k in 0..2000 {
+        ctl.step(
+            0.2 + k as f64 * 0.1,
+            &attitude_meas(-1.9, Vec3::z(), Vec3::zeros(), false),
+            0.1,
+        );
+    }
+    assert_eq!(ctl.depth_integral(), -lim);
+    // Rolled by φ about the base x axis: up = (0, sin φ, cos φ); the roll law acts only with
+    // authority, the pitch law always. The error is the exact angle (2.5 rad, not sin 2.5).
+    ctl.reset();
+    for (phi, p, auth) in [(0.1, 0.02, true), (2.5, -0.1, true), (0.1, 0.02, false)] {
+        let up = Vec3::new(0.0, f64::sin(phi), f64::cos(phi));
+        let meas = attitude_meas(0.0, up, Vec3::new(p, 0.0, 0.0), auth);
+        let out = ctl.step(0.0, &meas, 0.1);
+        let want = if auth {
+            -g.k_roll_p * phi - g.k_roll_d * p
+        } else {
+            0.0
+        };
+        assert!(
+            (out.a_b[3] - want).abs() < 1e-12,
+            "φ {phi}: {} vs {want}",
+            out.a_b[3]
+        );
+        assert_eq!(out.roll_commanded, auth);
+        assert!(out.a_b[4].abs() < 1e-12);
+    }
+    // Pitched by θ about the base y axis: up = (−sin θ, 0, cos θ).
+    let th = 0.2;
+    let up = Vec3::new(-f64::sin(th), 0.0, f64::cos(th));
+    let out = ctl.step(
+        0.0,
+        &attitude_meas(0.0, up, Vec3::new(0.0, 0.05, 0.0), false),
+        0.1,
+    );
+    assert!((out.a_b[4] - (-g.k_pitch_p * th - g.k_pitch_d * 0.05)).abs() < 1e-12);
+    // The tilt error is that of the base's actual attitude: a base rolled by φ (ZYX, any
+    // heading) measured through `measure_transport` gives up = R_Ibᵀ e_z = (0, sin φ, cos φ).
+    let mut ws = KinWorkspace::new(&v);
+    forward_kinematics(&v, &[0.0; 8], &mut ws);
+    let base = BasePose {
+        orientation: UnitQuaternion::from_euler_angles(0.3, 0.0, 1.1),
+        position: Vec3::new(1.0, 2.0, -3.0),
+    };
+    let m = measure_transport(&base, &ws, &Vec6::zeros(), &[0.0; 8]);
+    assert!((m.base_up - Vec3::new(0.0, 0.3f64.sin(), 0.3f64.cos())).norm() < 1e-12);
+    assert_eq!(m.base_z, -3.0);
+}
+
+#[test]
+fn autopilot_keys_parse_and_are_checked() {
+    let g: TransportGains =
+        toml::from_str("autopilot = true\nk_depth_p = 0.5\nk_roll_d = 2.0").unwrap();
+    assert!(g.autopilot);
+    assert_eq!((g.k_depth_p, g.k_roll_d, g.k_depth_i), (0.5, 2.0, 0.02));
+    let e = toml::from_str::<TransportGains>("k_depth_i = -1.0").unwrap_err();
+    assert!(e.to_string().contains("transport.k_depth_i"), "{e}");
+    let s = toml::to_string(&g).unwrap();
+    assert_eq!(toml::from_str::<TransportGains>(&s).unwrap(), g);
+}

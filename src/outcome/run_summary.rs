@@ -9,7 +9,7 @@ use crate::metrics::trajectory::{
     integrate, segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
 };
 use crate::scenario::channels::{Channel, Pose, Trajectory};
-use crate::scenario::config::{MetricsSpec, Mode, ScenarioFile};
+use crate::scenario::config::{MetricsSpec, Mode, ModeGains, ScenarioFile};
 use crate::scenario::recorder::AllocationCounts;
 use crate::scenario::success::Missed;
 use crate::spatial::wrap_angle;
@@ -55,7 +55,7 @@ pub const COMMON_METRICS: [&str; 27] = [
 pub const SEGMENT_METRICS: [&str; 3] = ["convergence_time", "overshoot", "cross_track_rms"];
 
 /// Transport metrics over the whole run (after the per-segment ones).
-pub const TRANSPORT_METRICS: [&str; 12] = [
+pub const TRANSPORT_METRICS: [&str; 16] = [
     "segments_reached",
     "converged",
     "convergence_time",
@@ -68,6 +68,10 @@ pub const TRANSPORT_METRICS: [&str; 12] = [
     "total_energy_per_metre",
     "cross_track_iae",
     "mission_cost",
+    "max_abs_roll_deg",
+    "max_abs_pitch_deg",
+    "max_vertical_error",
+    "roll_commanded_fraction",
 ];
 
 /// Work-mode regulation metrics (then [`ROLL_METRICS`]).
@@ -312,7 +316,8 @@ fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
 /// metre (`total_energy_per_metre` [J/m], thrusters and joint drives) and the integrated
 /// absolute cross-track error `cross_track_iae` [m·s] over the whole run; the mission's
 /// score `mission_cost = total_energy_per_metre + w · cross_track_iae` [J/m] (`w` =
-/// `[mission] tracking_weight`, J/m per m·s).
+/// `[mission] tracking_weight`, J/m per m·s); the attitude and depth of the run
+/// ([`attitude_metrics`]).
 fn transport_metrics(
     out: &mut Metrics,
     file: &ScenarioFile,
@@ -383,7 +388,60 @@ fn transport_metrics(
         iae,
         total_per_metre + file.mission.tracking_weight * iae,
     ];
-    add_all(out, &TRANSPORT_METRICS, values);
+    let [roll, pitch, vertical] = attitude_metrics(traj);
+    let mut all = [0.0; 16];
+    all[..12].copy_from_slice(&values);
+    all[12..].copy_from_slice(&[roll, pitch, vertical, roll_commanded_fraction(file, traj)]);
+    add_all(out, &TRANSPORT_METRICS, all);
+}
+
+/// `roll_commanded_fraction`: the fraction of the logged control periods in which the
+/// transport autopilot commanded roll (docs/model.md §5 "Autopilot": σ_min of all six rows
+/// of the scaled T(q), the logged `sigma_min`, at or above `[metrics] threshold`); 0 without
+/// the autopilot (`control.autopilot = false`, the paper's laws), NaN without a log.
+fn roll_commanded_fraction(file: &ScenarioFile, traj: &Trajectory) -> f64 {
+    let on = matches!(file.mode_gains(), Ok(ModeGains::Transport(g)) if g.autopilot);
+    let sigma = channel(traj, Channel::SigmaMin);
+    if sigma.is_empty() {
+        return f64::NAN;
+    }
+    if !on {
+        return 0.0;
+    }
+    let threshold = file.metrics.threshold;
+    sigma.iter().filter(|s| **s >= threshold).count() as f64 / sigma.len() as f64
+}
+
+/// Transport attitude and depth over the whole logged run (the `[success]` bounds
+/// `max_roll_deg`, `max_pitch_deg`, `max_vertical_error` judge them):
+/// - `max_abs_roll_deg`, `max_abs_pitch_deg` [deg]: the largest |roll| and |pitch| of the base
+///   frame (its ZYX Euler angles in `I`, roll wrapped into (−180°, 180°]) — the deviation from
+///   transport's level reference (a horizontal path, every pitch-joint reference 0);
+/// - `max_vertical_error` [m]: the largest `|z − z(0)|` of the base origin and of the end
+///   effector (the "front" of the cross-track error): the depth deviation from the path, which
+///   lies at the depth the vehicle starts at.
+///
+/// NaN when the run logged no sample.
+fn attitude_metrics(traj: &Trajectory) -> [f64; 3] {
+    let peak = |c: Channel| {
+        let x = channel(traj, c);
+        if x.is_empty() {
+            return f64::NAN;
+        }
+        x.iter().fold(0.0f64, |m, a| m.max(wrap_angle(*a).abs()))
+    };
+    let depth = |c: Channel| {
+        let z = channel(traj, c);
+        match z.first() {
+            None => f64::NAN,
+            Some(z0) => z.iter().fold(0.0f64, |m, z| m.max((z - z0).abs())),
+        }
+    };
+    [
+        peak(Channel::BasePose(Pose::Roll)).to_degrees(),
+        peak(Channel::BasePose(Pose::Pitch)).to_degrees(),
+        depth(Channel::BasePose(Pose::Z)).max(depth(Channel::EePose(Pose::Z))),
+    ]
 }
 
 /// Work: final errors and settling times of the end-effector, the base's drift, the

@@ -6,9 +6,10 @@ use crate::scenario::success::{Criterion, Missed, SuccessSpec};
 
 /// Judge a run of `mode` by its summary `metrics` (see [`super::run_summary`]) against
 /// `spec` and the `mission`'s requirements: `None` when it met every criterion, else the
-/// first one missed (the mission's reach first, its deadline after the transport criteria). `metrics` must
-/// hold `completed`, `peak_thrust`, `saturation_fraction` and the mode's metrics; a
-/// missing or NaN value misses its criterion.
+/// first one missed (the mission's reach first, its deadline after the transport criteria;
+/// in transport the attitude and depth bounds right after `no_failure`, see
+/// [`judge_attitude`]). `metrics` must hold `completed`, `peak_thrust`, `saturation_fraction`
+/// and the mode's metrics; a missing or NaN value misses its criterion.
 pub fn judge(
     spec: &SuccessSpec,
     mission: &MissionSpec,
@@ -39,6 +40,11 @@ pub fn judge(
     }
     // The metric `name` against its upper `limit` (NaN misses).
     let check = |c, name, limit, unit| exceeds(c, name, get(name), limit, unit);
+    if mode == Mode::Transport {
+        if let Some(m) = judge_attitude(spec, &get) {
+            return Some(m);
+        }
+    }
     if spec.max_peak_thrust > 0.0 {
         let m = check(
             Criterion::MaxPeakThrust,
@@ -92,6 +98,38 @@ fn exceeds(criterion: Criterion, label: &str, x: f64, limit: f64, unit: &str) ->
     })
 }
 
+/// The transport attitude and depth bounds, each judged when its bound is positive: the base's
+/// largest |roll| (`max_abs_roll_deg` against `max_roll_deg`), its largest |pitch|
+/// (`max_abs_pitch_deg` against `max_pitch_deg`), then the largest depth deviation from the
+/// path (`max_vertical_error` against `max_vertical_error`). They come before the thrust and
+/// path criteria because a capsize causes their misses (a vehicle on its back saturates its
+/// thrusters and leaves the path): the verdict names the axis that failed.
+fn judge_attitude(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
+    [
+        (
+            Criterion::MaxRoll,
+            "max_abs_roll_deg",
+            spec.max_roll_deg,
+            "°",
+        ),
+        (
+            Criterion::MaxPitch,
+            "max_abs_pitch_deg",
+            spec.max_pitch_deg,
+            "°",
+        ),
+        (
+            Criterion::MaxVerticalError,
+            "max_vertical_error",
+            spec.max_vertical_error,
+            " m",
+        ),
+    ]
+    .into_iter()
+    .filter(|(_, _, bound, _)| *bound > 0.0)
+    .find_map(|(c, name, bound, unit)| exceeds(c, name, get(name), bound, unit))
+}
+
 /// The transport criteria: the final cross-track bound, then each reached segment's
 /// convergence window in the order the segments became active.
 fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
@@ -134,7 +172,8 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
 
 /// The run's signed, normalised distance to its `[success]` and `[mission]` bounds (metric
 /// `success_margin`): the smallest over the criteria that apply of `(bound − value) / bound`
-/// (`|final_cross_track|`, each reached segment's convergence time, the saturation fraction,
+/// (`|final_cross_track|`, each reached segment's convergence time, the judged attitude and
+/// depth bounds of transport, the saturation fraction,
 /// the peak thrust when bounded, the work pose errors, the reach requirement as
 /// `(reach − required) / required`). Positive: every bound met with at least that relative room;
 /// negative: the worst miss relative to its bound ("missed by 1 cm of 0.1 m" is −0.1); −1 for a
@@ -180,6 +219,15 @@ pub fn success_margin(
     }
     match mode {
         Mode::Transport => {
+            for (name, bound) in [
+                ("max_abs_roll_deg", spec.max_roll_deg),
+                ("max_abs_pitch_deg", spec.max_pitch_deg),
+                ("max_vertical_error", spec.max_vertical_error),
+            ] {
+                if bound > 0.0 {
+                    m = m.min(room(get(name), bound));
+                }
+            }
             m = m.min(room(get("final_cross_track").abs(), spec.cross_track_bound));
             let reached = get("segments_reached");
             let n = if reached.is_finite() && reached > 0.0 {
@@ -230,7 +278,7 @@ fn judge_deadline(deadline: f64, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
 
 #[cfg(test)]
 mod tests {
-    use crate::outcome::success::judge;
+    use crate::outcome::success::{judge, success_margin};
     use crate::scenario::config::{MissionSpec, Mode};
     use crate::scenario::success::{Criterion, SuccessSpec};
 
@@ -254,8 +302,85 @@ mod tests {
         m.extend(metrics(&[
             ("segments_reached", seg.len() as f64),
             ("final_cross_track", final_ct),
+            ("max_abs_roll_deg", 0.5),
+            ("max_abs_pitch_deg", 1.0),
+            ("max_vertical_error", 0.02),
         ]));
         m
+    }
+
+    /// `m` with metric `k` set to `x`.
+    fn with(mut m: Vec<(String, f64)>, k: &str, x: f64) -> Vec<(String, f64)> {
+        m.iter_mut().find(|(n, _)| n == k).unwrap().1 = x;
+        m
+    }
+
+    #[test]
+    fn a_capsize_is_named_by_its_axis_before_its_symptoms() {
+        let s = SuccessSpec::default();
+        let none = MissionSpec::default();
+        let id = |m: &[(String, f64)]| judge(&s, &none, Mode::Transport, m).map(|x| x.criterion);
+        // On its back, saturated and off the path: the roll is named, not the saturation or
+        // the cross-track error it caused.
+        let mut capsized = with(
+            transport(-1.3, &[30.0, f64::NAN]),
+            "max_abs_roll_deg",
+            178.6,
+        );
+        capsized[2].1 = 0.4;
+        let m = judge(&s, &none, Mode::Transport, &capsized).unwrap();
+        assert_eq!(m.criterion, Criterion::MaxRoll);
+        assert_eq!(
+            m.to_string(),
+            "max_roll_deg: max_abs_roll_deg = 178.6000° > 30°"
+        );
+        let ok = transport(0.05, &[30.0]);
+        assert_eq!(id(&ok), None);
+        assert_eq!(
+            id(&with(ok.clone(), "max_abs_pitch_deg", 31.0)),
+            Some(Criterion::MaxPitch)
+        );
+        assert_eq!(
+            id(&with(ok.clone(), "max_vertical_error", 5.2)),
+            Some(Criterion::MaxVerticalError)
+        );
+        // A missing or NaN metric misses its bound; a bound of 0 is not judged.
+        assert_eq!(
+            id(&with(ok.clone(), "max_abs_roll_deg", f64::NAN)),
+            Some(Criterion::MaxRoll)
+        );
+        let off = SuccessSpec {
+            max_roll_deg: 0.0,
+            max_pitch_deg: 0.0,
+            max_vertical_error: 0.0,
+            ..SuccessSpec::default()
+        };
+        let rolled = with(
+            with(ok.clone(), "max_abs_roll_deg", 90.0),
+            "max_vertical_error",
+            3.0,
+        );
+        assert_eq!(judge(&off, &none, Mode::Transport, &rolled), None);
+        // A run that stopped early still names `no_failure` first.
+        let mut stopped = capsized.clone();
+        stopped[0].1 = 0.0;
+        assert_eq!(id(&stopped), Some(Criterion::NoFailure));
+        // The margin sees the attitude: 20° of 30° leaves a third.
+        let margin = success_margin(
+            &s,
+            &none,
+            Mode::Transport,
+            &with(ok, "max_abs_roll_deg", 20.0),
+        );
+        assert!((margin - 1.0 / 3.0).abs() < 1e-12, "{margin}");
+        // Work mode is not judged on them (the base's attitude is free to the task there).
+        let mut w = metrics(&COMMON);
+        w.extend(metrics(&[
+            ("final_position_error", 0.01),
+            ("final_orientation_error_deg", 0.1),
+            ("max_abs_roll_deg", 90.0),
+        ]));
+        assert_eq!(judge(&s, &none, Mode::Work, &w), None);
     }
 
     #[test]
@@ -361,7 +486,6 @@ mod tests {
 
     #[test]
     fn the_success_margin_says_by_how_much_a_bound_was_met_or_missed() {
-        use crate::outcome::success::success_margin;
         let s = SuccessSpec::default();
         let none = MissionSpec::default();
         let margin = |m: &[(String, f64)]| success_margin(&s, &none, Mode::Transport, m);

@@ -83,6 +83,9 @@ pub(crate) struct Measurement<'a> {
     pub m11: &'a Matrix6<f64>,
     /// Bias wrench n of USM-33, base frame.
     pub nvec: &'a Vec6,
+    /// Whether T(q) can command a roll moment now (transport autopilot only; see
+    /// [`ModeController::wants_roll_authority`]).
+    pub roll_authority: bool,
 }
 
 /// The commands of one control period, held until the next (zero-order hold).
@@ -195,6 +198,12 @@ impl ModeController {
         })
     }
 
+    /// Whether the mode's law uses [`Measurement::roll_authority`]: transport with the
+    /// autopilot on (`control.autopilot`), so that the loop computes σ_min of T(q) only then.
+    pub fn wants_roll_authority(&self) -> bool {
+        matches!(self, ModeController::Transport { law, .. } if law.gains().autopilot)
+    }
+
     /// One control period at time `t` [s] of length `dt` [s]: the mode's law, then the base's
     /// dynamic control; writes `cmd` and the logged signals.
     pub fn step(
@@ -207,7 +216,8 @@ impl ModeController {
     ) {
         match self {
             ModeController::Transport { law, path, signals } => {
-                let tm = measure_transport(meas.base, meas.ws, meas.v_b, meas.qd);
+                let mut tm = measure_transport(meas.base, meas.ws, meas.v_b, meas.qd);
+                tm.roll_authority = meas.roll_authority;
                 let out = law.step(t, &tm, dt);
                 cmd.q_ref.copy_from_slice(law.q_ref());
                 cmd.qd_ref.fill(0.0);

@@ -83,10 +83,14 @@ method = "qp"
 [success]
 # A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
 # ends within 0.1 m of the path, and each segment converges (|e_y| < metrics.band and staying)
-# within 60 s of becoming active.
+# within 60 s of becoming active; stays upright and at the path's depth over the whole run (base
+# |roll| and |pitch| within 30 deg, base and head within 1 m of the depth they started at).
 max_saturation_fraction = 0.05
 cross_track_bound = 0.1
 convergence_window = 60.0
+max_roll_deg = 30.0
+max_pitch_deg = 30.0
+max_vertical_error = 1.0
 "#;
 
 /// The joint servos of `transport-method1-torque-limited`: torque-level PD servos whose

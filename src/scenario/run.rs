@@ -17,6 +17,7 @@ use super::recorder::{timed, AllocationCounts, Recorder, Timing};
 use super::setup::ClosedLoop;
 use crate::dynamics::ActuatorCommand;
 use crate::kinematics::{forward_kinematics, thruster_matrix, BasePose};
+use crate::metrics::singularity::{commanded_sigma_with, CommandedDofs, ScaledGram};
 use crate::metrics::trajectory::EnergyMetrics;
 use crate::model::Vehicle;
 use crate::spatial::Vec6;
@@ -75,9 +76,17 @@ impl ClosedLoop<'_> {
         Ok(Measured { base, v_b })
     }
 
-    /// Control: the mode's law and the base's dynamic control (USM-33) from the measurement
-    /// and the base-control terms (M11, n); then T(q) for the allocator.
+    /// Control: T(q) for the allocator (and, with the transport autopilot, whether it can
+    /// command roll: σ_min of all six rows of the scaled T(q) at or above `[metrics]
+    /// threshold`, docs/model.md §5 "Autopilot"), then the mode's law and the base's dynamic
+    /// control (USM-33) from the measurement and the base-control terms (M11, n).
     fn control(&mut self, t: f64, measured: &Measured, terms: &(Matrix6<f64>, Vec6)) {
+        thruster_matrix(&self.vehicle, &self.ws, &mut self.t_mat);
+        let roll_authority = self.mode.wants_roll_authority() && {
+            let g = ScaledGram::new(&self.t_mat, self.file.char_length(&self.vehicle));
+            let s = commanded_sigma_with(&g, &self.t_mat, CommandedDofs::ALL).sigma_min;
+            s >= self.file.metrics.threshold
+        };
         let meas = Measurement {
             base: &measured.base,
             v_b: &measured.v_b,
@@ -85,11 +94,11 @@ impl ClosedLoop<'_> {
             qd: &self.qd_meas,
             m11: &terms.0,
             nvec: &terms.1,
+            roll_authority,
         };
         let dt = self.file.scenario.control_dt;
         self.mode
             .step(t, dt, &meas, &mut self.base_ctl, &mut self.cmd);
-        thruster_matrix(&self.vehicle, &self.ws, &mut self.t_mat);
     }
 
     /// Allocate: thrusts for τ_c (USM-36/37). With a `[fault]` that has struck, the informed

@@ -10,13 +10,19 @@
 //! # transport
 //! cross_track_bound = 0.1        # m, |cross-track error| at the end of the run
 //! convergence_window = 60.0      # s after a segment becomes active
+//! max_roll_deg = 30.0            # deg, |base roll| over the whole run (0 = not judged)
+//! max_pitch_deg = 30.0           # deg, |base pitch| over the whole run (0 = not judged)
+//! max_vertical_error = 1.0       # m, |depth deviation| of base or head from the path (0 = not judged)
 //! # work
 //! position_tolerance = 0.02      # m, final end-effector position error
 //! orientation_tolerance_deg = 2.0 # deg, final pointing error (roll excluded)
 //! ```
 //!
-//! Criteria are checked in the order of [`Criterion::ALL`]; a verdict names the first one
-//! missed by its id, which is the `[success]` key that bounds it (`no_failure` has none).
+//! Criteria are checked in the order of [`Criterion::ALL`], except that the mission's reach
+//! comes first and the transport attitude and depth bounds come right after `no_failure` (a
+//! capsize saturates the thrusters and leaves the path: the verdict names the cause, the roll,
+//! not its symptoms); a verdict names the first one missed by its id, which is the `[success]`
+//! key that bounds it (`no_failure` has none).
 //! Studies rank and compare only successful runs (`study::summary`).
 
 use std::fmt;
@@ -49,6 +55,23 @@ pub struct SuccessSpec {
     /// Work: final end-effector pointing error, roll excluded (metric
     /// `final_orientation_error_deg`) [deg]. Default 2°.
     pub orientation_tolerance_deg: f64,
+    /// Transport: the largest |roll| of the base frame from level (the transport reference:
+    /// the path is horizontal and every joint reference keeps the body level) over the whole
+    /// run, ZYX roll wrapped into (−180°, 180°] (metric `max_abs_roll_deg`) [deg]. Judged over
+    /// the whole run, not after convergence: the start is level, so a nominal transient does
+    /// not roll, and a capsize at any time ends the mission. 0 = not judged. Default 30°
+    /// (**inferred**: a capsize detector, not a ride-quality bound; a study may tighten it).
+    pub max_roll_deg: f64,
+    /// Transport: the largest |pitch| of the base frame from level over the whole run (metric
+    /// `max_abs_pitch_deg`) [deg]. 0 = not judged. Default 30° (**inferred**, as the roll).
+    pub max_pitch_deg: f64,
+    /// Transport: the largest vertical deviation from the path over the whole run, of the base
+    /// origin or the end effector (the "front" the cross-track error is measured at), from
+    /// the depth each started at (transport paths are horizontal, at the depth the vehicle
+    /// starts; metric `max_vertical_error`) [m]. The 3-D complement of
+    /// [`SuccessSpec::cross_track_bound`]. 0 = not judged. Default 1 m (**inferred**: ten
+    /// times the cross-track bound).
+    pub max_vertical_error: f64,
 }
 
 impl Default for SuccessSpec {
@@ -60,6 +83,9 @@ impl Default for SuccessSpec {
             convergence_window: 60.0,
             position_tolerance: 0.02,
             orientation_tolerance_deg: 2.0,
+            max_roll_deg: 30.0,
+            max_pitch_deg: 30.0,
+            max_vertical_error: 1.0,
         }
     }
 }
@@ -82,6 +108,21 @@ impl SuccessSpec {
             if !v.is_finite() || v <= 0.0 {
                 return bad(k, "a finite number > 0", v);
             }
+        }
+        for (k, v) in [
+            ("max_roll_deg", self.max_roll_deg),
+            ("max_pitch_deg", self.max_pitch_deg),
+        ] {
+            if !(0.0..=180.0).contains(&v) {
+                return bad(k, "in [0, 180] (0 = not judged)", v);
+            }
+        }
+        if !self.max_vertical_error.is_finite() || self.max_vertical_error < 0.0 {
+            return bad(
+                "max_vertical_error",
+                "finite and >= 0 (0 = not judged)",
+                self.max_vertical_error,
+            );
         }
         if !self.max_peak_thrust.is_finite() || self.max_peak_thrust < 0.0 {
             return bad(
@@ -123,14 +164,22 @@ pub enum Criterion {
     MissionReach,
     /// `[mission] deadline` (transport): every reached segment converged this soon.
     MissionDeadline,
+    /// [`SuccessSpec::max_roll_deg`] (transport): the base rolled too far (a capsize).
+    MaxRoll,
+    /// [`SuccessSpec::max_pitch_deg`] (transport).
+    MaxPitch,
+    /// [`SuccessSpec::max_vertical_error`] (transport): left the path's depth.
+    MaxVerticalError,
 }
 
 impl Criterion {
     /// Every criterion. A run is judged in this order, except that the mission's design
     /// requirement [`Criterion::MissionReach`] comes first (a design that cannot reach fails
-    /// the mission whatever its run did); new criteria are appended, so an index into this
-    /// list stays valid across versions.
-    pub const ALL: [Criterion; 9] = [
+    /// the mission whatever its run did) and the attitude and depth bounds
+    /// ([`Criterion::MaxRoll`], [`Criterion::MaxPitch`], [`Criterion::MaxVerticalError`]) right
+    /// after [`Criterion::NoFailure`]; new criteria are appended, so an index into this list
+    /// stays valid across versions.
+    pub const ALL: [Criterion; 12] = [
         Criterion::NoFailure,
         Criterion::MaxPeakThrust,
         Criterion::MaxSaturationFraction,
@@ -140,6 +189,9 @@ impl Criterion {
         Criterion::OrientationTolerance,
         Criterion::MissionReach,
         Criterion::MissionDeadline,
+        Criterion::MaxRoll,
+        Criterion::MaxPitch,
+        Criterion::MaxVerticalError,
     ];
 
     /// The machine-readable id.
@@ -154,6 +206,9 @@ impl Criterion {
             Criterion::OrientationTolerance => "orientation_tolerance_deg",
             Criterion::MissionReach => "mission.reach",
             Criterion::MissionDeadline => "mission.deadline",
+            Criterion::MaxRoll => "max_roll_deg",
+            Criterion::MaxPitch => "max_pitch_deg",
+            Criterion::MaxVerticalError => "max_vertical_error",
         }
     }
 

@@ -153,6 +153,10 @@ const RUN_TRANSPORT: &[ColumnDoc] = &[
     c("total_energy_per_metre", "J/m", "f64", "total_energy / path_progress: thrusters and joint drives per metre of path"),
     c("mission_cost", "J/m", "f64", "total_energy_per_metre + `[mission] tracking_weight` × cross_track_iae: the default objective of transport studies"),
     c("cross_track_iae", "m·s", "f64", "∫|cross-track error| dt over the whole run: the tracking term of a transport mission (arriving late on the path is not free)"),
+    c("max_abs_roll_deg", "deg", "f64", "largest |roll| of the base frame from level over the whole run (ZYX roll, wrapped; 180 = on its back): judged by `[success] max_roll_deg`"),
+    c("max_abs_pitch_deg", "deg", "f64", "largest |pitch| of the base frame from level over the whole run: judged by `[success] max_pitch_deg`"),
+    c("max_vertical_error", "m", "f64", "largest depth deviation from the path over the whole run, of the base origin or the end effector, from the depth each started at: judged by `[success] max_vertical_error`"),
+    c("roll_commanded_fraction", "–", "f64", "fraction of the logged control periods in which the transport autopilot commanded roll (T(q) could: σ_min of all six rows ≥ `[metrics] threshold`); 0 without the autopilot (`control.autopilot = false`): roll then relies on the hydrostatics"),
 ];
 
 const RUN_WORK: &[ColumnDoc] = &[
