@@ -9,7 +9,7 @@
 //! - [`riccati`]: the equality-constrained LQ subproblem (terminal equality through a
 //!   parametric multiplier);
 //! - [`qp`]: the box-bounded QP (Mehrotra interior point over the Riccati solve);
-//! - [`sqp`]: the SQP with the ℓ1 merit line search, KKT residuals, status and log;
+//! - [`sqp`]: the SQP with the filter line search, KKT residuals, status and log;
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
 
 pub mod chain;

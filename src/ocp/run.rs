@@ -141,7 +141,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     }
     atomic_write(&dir.join("trajectory.csv"), csv.as_bytes())?;
     let mut it = String::from(
-        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,penalty\n",
+        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size\n",
     );
     for r in &sol.log {
         let cells = [
@@ -152,7 +152,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
             format_f64(r.complementarity),
             format_f64(r.step),
             r.qp_iterations.to_string(),
-            format_f64(r.penalty),
+            r.filter_size.to_string(),
         ];
         it.push_str(&cells.join(","));
         it.push('\n');
@@ -182,7 +182,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         "knots": spec.knots,
         "dt": run.dt,
         "hydrodynamics": spec.hydrodynamics,
-        "method": "multiple shooting, Gauss-Newton SQP, Riccati interior-point QP, l1-merit line search",
+        "method": "multiple shooting, Gauss-Newton SQP, Riccati interior-point QP, filter line search",
         "derivatives": "central differences (eps 1e-6, tangent coordinates)",
         "optimum": "a local optimum from the rest trajectory (single start)",
     });

@@ -12,8 +12,13 @@
 //! tangent coordinates), takes the Gauss–Newton Hessian `2Q`, `2R`, `2Q_N` (exact for the
 //! objective's least-squares terms; the curvature of the dynamics and of `⊖` is left out)
 //! and solves the QP of [`super::qp`] (Riccati-based interior point, bounds strictly
-//! feasible). The step is accepted by an Armijo backtracking line search on the ℓ1 merit
-//! `φ = J + ρ (Σ‖d_k‖₁ + ‖c‖₁)` with `ρ ≥ 2 max(‖λ‖∞, ‖ν‖∞)` (increased monotonically).
+//! feasible). The step is accepted by a backtracking filter line search (Wächter & Biegler
+//! 2006) on the pair (θ, J), `θ = Σ‖d_k‖₁ + ‖c‖₁`: a trial point must not be dominated by
+//! the filter and must decrease θ or J by the margin γ = 1e-5·θ; when θ is small
+//! (≤ 1e-4·max(1, θ_start)) and the step is a descent direction of J with
+//! `α(−∇J·Δ)^2.3 > θ^1.1`, Armijo on J is required instead (and the filter is not grown).
+//! No feasibility restoration: no acceptable step down to α = 1e-10 ends the solve as
+//! `Stalled`.
 //!
 //! KKT residuals at an iterate, with the QP's multipliers (λ, ν, z):
 //! primal `max(‖d_k‖∞, ‖c‖∞)`; stationarity `max ‖∇_u L‖∞, ‖∇_x L‖∞` with
@@ -27,6 +32,9 @@ use super::riccati::{LqError, LqStage, LqTerminal};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use std::time::Instant;
+
+/// Margin of the filter's acceptance tests (γ_θ = γ_φ).
+const GAMMA: f64 = 1e-5;
 
 /// The problem data besides the model.
 #[derive(Clone, Debug)]
@@ -103,8 +111,8 @@ pub struct IterLog {
     pub step: f64,
     /// Interior-point iterations of this QP.
     pub qp_iterations: usize,
-    /// Merit penalty ρ.
-    pub penalty: f64,
+    /// Entries added to the filter so far.
+    pub filter_size: usize,
 }
 
 /// Wall-clock time by phase [s].
@@ -224,7 +232,9 @@ pub fn solve<M: OcpModel>(
     };
     xs[0].copy_from_slice(&prob.x0);
     debug_assert_eq!(xs[0].len(), nq);
-    let mut penalty: f64 = 1.0;
+    let mut filter: Vec<(f64, f64)> = Vec::new();
+    let mut filter_pushes = 0;
+    let mut theta_first: Option<f64> = None;
     let mut z_warm: Option<(Vec<DVector<f64>>, Vec<DVector<f64>>)> = None;
     let mut it = 0;
     loop {
@@ -306,7 +316,7 @@ pub fn solve<M: OcpModel>(
             complementarity: comp,
             step: 0.0,
             qp_iterations: qp.iterations,
-            penalty,
+            filter_size: filter_pushes,
         };
         if kkt.iter().all(|r| *r <= set.tolerance) {
             log.push(row);
@@ -338,15 +348,15 @@ pub fn solve<M: OcpModel>(
                 timing,
             );
         }
-        // Merit line search.
-        let lmax = qp.lam.iter().map(|l| l.amax()).fold(qp.nu.amax(), f64::max);
-        penalty = penalty.max(2.0 * lmax);
-        let mut slope = -penalty * ev.infeas1;
+        // Filter line search (Wächter & Biegler 2006, without restoration).
+        let mut slope = 0.0;
         for k in 0..n {
             slope += ev.stages[k].r_vec.dot(&qp.du[k]) + ev.stages[k].q_vec.dot(&qp.dx[k]);
         }
         slope += ev.term.q_vec.dot(&qp.dx[n]);
-        let phi0 = ev.objective + penalty * ev.infeas1;
+        let (theta0, j0) = (ev.infeas1, ev.objective);
+        let scale = *theta_first.get_or_insert(theta0.max(1.0));
+        let (theta_min, theta_max) = (1e-4 * scale, 1e4 * scale);
         let tl = Instant::now();
         let mut alpha = 1.0;
         let mut accepted = None;
@@ -364,8 +374,22 @@ pub fn solve<M: OcpModel>(
                 }
             }
             if let Ok(e) = evaluate(model, prob, &xt, &ut, false) {
-                let phi = e.objective + penalty * e.infeas1;
-                if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope.min(0.0) {
+                let (theta, j) = (e.infeas1, e.objective);
+                let in_filter = theta <= theta_max
+                    && filter
+                        .iter()
+                        .all(|&(tf, jf): &(f64, f64)| theta < tf || j < jf);
+                let switching = slope < 0.0 && alpha * (-slope).powf(2.3) > theta0.powf(1.1);
+                let ok = if switching && theta0 <= theta_min {
+                    in_filter && j <= j0 + 1e-4 * alpha * slope
+                } else {
+                    in_filter && (theta <= (1.0 - GAMMA) * theta0 || j <= j0 - GAMMA * theta0)
+                };
+                if ok {
+                    if !(switching && j <= j0 + 1e-4 * alpha * slope) {
+                        filter.push(((1.0 - GAMMA) * theta0, j0 - GAMMA * theta0));
+                        filter_pushes += 1;
+                    }
                     accepted = Some(alpha);
                     break;
                 }
@@ -375,7 +399,7 @@ pub fn solve<M: OcpModel>(
         timing.line_search += tl.elapsed().as_secs_f64();
         let Some(alpha) = accepted else {
             log.push(row);
-            let msg = "line search found no decrease of the merit function".to_string();
+            let msg = "the filter line search found no acceptable step".to_string();
             return finish(
                 xs,
                 us,
