@@ -21,6 +21,8 @@
 //!
 //! Derivatives: the trait's central differences (ε = 1e-6 in tangent coordinates) — not yet
 //! analytic nor automatic (docs/ocp.md §5).
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use super::model::{ModelError, OcpModel};
 use crate::dynamics::{forward_dynamics, DynOptions, DynWorkspace};

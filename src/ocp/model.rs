@@ -6,6 +6,8 @@
 //! `∂f/∂x e_i ≈ (f(x ⊕ εe_i, u) ⊖ f(x ⊕ −εe_i, u)) ⊖-relative to f(x, u) / 2ε` with ε = 1e-6
 //! (truncation O(ε²), rounding O(1e-16/ε)); an implementation may override them with
 //! analytic ones.
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use nalgebra::{DMatrix, DVector};
 

@@ -23,6 +23,8 @@
 //! tolerance = 1e-6           # KKT tolerance
 //! max_iterations = 200
 //! ```
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use crate::input::document::{read_text, Document};
 use crate::input::located::{InputError, Location};

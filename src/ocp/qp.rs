@@ -12,6 +12,8 @@
 //! the terminal residual `C δx_N + c`. The iterate starts at `δu = 0`, which must be strictly
 //! inside the bounds, and every step is shortened to stay strictly inside (fraction to the
 //! boundary 0.995): no returned control ever violates a bound.
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use super::riccati::{solve_lq, LqError, LqStage, LqTerminal};
 use nalgebra::DVector;
@@ -58,6 +60,7 @@ pub struct QpSolution {
 
 /// Solve the bounded subproblem: `stages`/`term` as in [`solve_lq`], `lo`/`hi` one vector per
 /// stage (nu each, `lo < 0 < hi` entrywise), `z0` optional warm-start multipliers.
+#[allow(clippy::type_complexity)]
 pub fn solve_box_qp(
     stages: &[LqStage],
     term: &LqTerminal,
@@ -96,24 +99,7 @@ pub fn solve_box_qp(
     }
     let mut lam = vec![DVector::zeros(nx); n + 1];
     let mut nuv = DVector::zeros(term.c_vec.len());
-    let init_z = |s: f64, warm: Option<f64>| -> f64 {
-        if !s.is_finite() {
-            return 0.0;
-        }
-        warm.filter(|z| *z > 0.0)
-            .unwrap_or(1.0 / s)
-            .clamp(1e-8, 1e8)
-    };
-    let mut z_lo = vec![DVector::zeros(nu); n];
-    let mut z_hi = vec![DVector::zeros(nu); n];
-    for k in 0..n {
-        for i in 0..nu {
-            let wl = z0.map(|(l, _)| l[k][i]);
-            let wh = z0.map(|(_, h)| h[k][i]);
-            z_lo[k][i] = init_z(-lo[k][i], wl);
-            z_hi[k][i] = init_z(hi[k][i], wh);
-        }
-    }
+    let (mut z_lo, mut z_hi) = initial_multipliers(lo, hi, z0);
     let mut work: Vec<LqStage> = stages.to_vec();
     for w in work.iter_mut() {
         w.d.fill(0.0);
@@ -122,24 +108,7 @@ pub fn solve_box_qp(
     let mut iterations = 0;
     let mut converged = false;
     for _ in 0..set.max_iterations {
-        // Slacks, complementarity.
-        let mut mu = 0.0;
-        let mut comp_max: f64 = 0.0;
-        for k in 0..n {
-            for i in 0..nu {
-                if lo[k][i].is_finite() {
-                    let sz = (du[k][i] - lo[k][i]) * z_lo[k][i];
-                    mu += sz;
-                    comp_max = comp_max.max(sz);
-                }
-                if hi[k][i].is_finite() {
-                    let sz = (hi[k][i] - du[k][i]) * z_hi[k][i];
-                    mu += sz;
-                    comp_max = comp_max.max(sz);
-                }
-            }
-        }
-        mu /= nb as f64;
+        let (mu, comp_max) = complementarity(lo, hi, &du, &z_lo, &z_hi, None);
         let res = residuals(stages, term, &dx, &du, &lam, &nuv, &z_lo, &z_hi);
         if iterations > 0
             && comp_max <= set.tolerance
@@ -150,41 +119,14 @@ pub fn solve_box_qp(
             break;
         }
         iterations += 1;
-        // Barrier Hessian and the fixed parts of the step problem.
-        for (k, (w, s)) in work.iter_mut().zip(stages).enumerate() {
-            w.r_mat.copy_from(&s.r_mat);
-            for i in 0..nu {
-                let mut sig = 0.0;
-                if lo[k][i].is_finite() {
-                    sig += z_lo[k][i] / (du[k][i] - lo[k][i]);
-                }
-                if hi[k][i].is_finite() {
-                    sig += z_hi[k][i] / (hi[k][i] - du[k][i]);
-                }
-                w.r_mat[(i, i)] += sig;
-            }
-            w.q_vec = &s.q_mat * &dx[k] + &s.q_vec;
-        }
+        barrier_hessian(&mut work, stages, lo, hi, &du, &dx, &z_lo, &z_hi);
         wterm.q_vec = &term.q_mat * &dx[n] + &term.q_vec;
         wterm.c_vec = &term.c_mat * &dx[n] + &term.c_vec;
         // Predictor (τ = 0), then corrector (τ = σμ − Δs_aff∘Δz_aff).
         let zero = |_: usize, _: usize, _: bool| 0.0;
         let aff = newton(&mut work, stages, &wterm, lo, hi, &du, &z_lo, &z_hi, &zero)?;
         let a_aff = step_length(lo, hi, &du, &z_lo, &z_hi, &aff, 1.0);
-        let mut mu_aff = 0.0;
-        for k in 0..n {
-            for i in 0..nu {
-                if lo[k][i].is_finite() {
-                    mu_aff += (du[k][i] + a_aff * aff.du[k][i] - lo[k][i])
-                        * (z_lo[k][i] + a_aff * aff.dz_lo[k][i]);
-                }
-                if hi[k][i].is_finite() {
-                    mu_aff += (hi[k][i] - du[k][i] - a_aff * aff.du[k][i])
-                        * (z_hi[k][i] + a_aff * aff.dz_hi[k][i]);
-                }
-            }
-        }
-        mu_aff /= nb as f64;
+        let (mu_aff, _) = complementarity(lo, hi, &du, &z_lo, &z_hi, Some((a_aff, &aff)));
         let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
         let target = |k: usize, i: usize, upper: bool| {
             if upper {
@@ -218,6 +160,100 @@ pub fn solve_box_qp(
         iterations,
         converged,
     })
+}
+
+/// Starting bound multipliers: the warm start where positive, else `1/s`, in [1e-8, 1e8]
+/// (0 where unbounded).
+#[allow(clippy::type_complexity)]
+fn initial_multipliers(
+    lo: &[DVector<f64>],
+    hi: &[DVector<f64>],
+    z0: Option<(&[DVector<f64>], &[DVector<f64>])>,
+) -> (Vec<DVector<f64>>, Vec<DVector<f64>>) {
+    let init_z = |s: f64, warm: Option<f64>| -> f64 {
+        if !s.is_finite() {
+            return 0.0;
+        }
+        warm.filter(|z| *z > 0.0)
+            .unwrap_or(1.0 / s)
+            .clamp(1e-8, 1e8)
+    };
+    let nu = lo.first().map_or(0, |v| v.len());
+    let mut z_lo = vec![DVector::zeros(nu); lo.len()];
+    let mut z_hi = vec![DVector::zeros(nu); lo.len()];
+    for k in 0..lo.len() {
+        for i in 0..nu {
+            let wl = z0.map(|(l, _)| l[k][i]);
+            let wh = z0.map(|(_, h)| h[k][i]);
+            z_lo[k][i] = init_z(-lo[k][i], wl);
+            z_hi[k][i] = init_z(hi[k][i], wh);
+        }
+    }
+    (z_lo, z_hi)
+}
+
+/// (mean, max) of the complementarity products `s∘z` over the finite bounds, at the
+/// iterate or, with `Some((α, d))`, at the iterate moved by α along `d`.
+fn complementarity(
+    lo: &[DVector<f64>],
+    hi: &[DVector<f64>],
+    du: &[DVector<f64>],
+    z_lo: &[DVector<f64>],
+    z_hi: &[DVector<f64>],
+    step: Option<(f64, &Direction)>,
+) -> (f64, f64) {
+    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    for k in 0..du.len() {
+        for i in 0..du[k].len() {
+            let (a, ddu, dzl, dzh) = match step {
+                Some((a, d)) => (a, d.du[k][i], d.dz_lo[k][i], d.dz_hi[k][i]),
+                None => (0.0, 0.0, 0.0, 0.0),
+            };
+            let u = du[k][i] + a * ddu;
+            if lo[k][i].is_finite() {
+                let sz = (u - lo[k][i]) * (z_lo[k][i] + a * dzl);
+                sum += sz;
+                max = max.max(sz);
+                count += 1;
+            }
+            if hi[k][i].is_finite() {
+                let sz = (hi[k][i] - u) * (z_hi[k][i] + a * dzh);
+                sum += sz;
+                max = max.max(sz);
+                count += 1;
+            }
+        }
+    }
+    (sum / count.max(1) as f64, max)
+}
+
+/// The step problem's Hessian `R + diag(z_lo/s_lo + z_hi/s_hi)` and state gradient
+/// `Q δx + q` at the iterate.
+#[allow(clippy::too_many_arguments)]
+fn barrier_hessian(
+    work: &mut [LqStage],
+    stages: &[LqStage],
+    lo: &[DVector<f64>],
+    hi: &[DVector<f64>],
+    du: &[DVector<f64>],
+    dx: &[DVector<f64>],
+    z_lo: &[DVector<f64>],
+    z_hi: &[DVector<f64>],
+) {
+    for (k, (w, s)) in work.iter_mut().zip(stages).enumerate() {
+        w.r_mat.copy_from(&s.r_mat);
+        for i in 0..du[k].len() {
+            let mut sig = 0.0;
+            if lo[k][i].is_finite() {
+                sig += z_lo[k][i] / (du[k][i] - lo[k][i]);
+            }
+            if hi[k][i].is_finite() {
+                sig += z_hi[k][i] / (hi[k][i] - du[k][i]);
+            }
+            w.r_mat[(i, i)] += sig;
+        }
+        w.q_vec = &s.q_mat * &dx[k] + &s.q_vec;
+    }
 }
 
 /// A Newton direction of the interior point.

@@ -16,6 +16,8 @@
 //! constraint is not reachable by the linearised dynamics: [`LqError::Unreachable`]). The
 //! costates are `λ_k = P_k δx_k + p_k + Γ_k ν` (multipliers of the dynamics rows, with the
 //! Lagrangian `… + λ_{k+1}ᵀ(A δx + B δu + d − δx_{k+1})`). Cost O(N (nx + nc)³).
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use nalgebra::{DMatrix, DVector};
 

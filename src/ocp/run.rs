@@ -2,6 +2,8 @@
 //! model and the effort objective from a [`ProblemSpec`] and runs the SQP; [`write_outputs`]
 //! writes `trajectory.csv` (the time-series column names of `simulate` where they apply),
 //! `iterations.csv` (the iteration log) and `summary.json`.
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use super::chain::ChainModel;
 use super::model::OcpModel;

@@ -25,9 +25,11 @@
 //! `∇_u L = 2R u_k + B_kᵀλ_{k+1} − z_lo + z_hi`, `∇_x L = 2Q e_k + A_kᵀλ_{k+1} − λ_k`,
 //! `∇_{x_N} L = 2Q_N e_N + Cᵀν − λ_N`; complementarity `max (u − u_lo)∘z_lo, (u_hi − u)∘z_hi`.
 //! Converged when all three are at most the tolerance (default 1e-6).
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use super::model::{ModelError, OcpModel};
-use super::qp::{residuals, solve_box_qp, QpSettings};
+use super::qp::{residuals, solve_box_qp, QpSettings, QpSolution};
 use super::riccati::{LqError, LqStage, LqTerminal};
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -111,7 +113,7 @@ pub struct IterLog {
     pub step: f64,
     /// Interior-point iterations of this QP.
     pub qp_iterations: usize,
-    /// Entries added to the filter so far.
+    /// Entries in the filter.
     pub filter_size: usize,
 }
 
@@ -174,101 +176,116 @@ pub fn solve<M: OcpModel>(
     set: &SqpSettings,
 ) -> OcpSolution {
     let t0 = Instant::now();
-    let (n, nu, nq) = (prob.knots, model.nu(), model.nq());
-    let mut timing = Timing::default();
+    let (n, nu) = (prob.knots, model.nu());
     let mut us = us.unwrap_or_else(|| vec![vec![0.0; nu]; n]);
     for u in us.iter_mut() {
         for i in 0..nu {
             u[i] = strictly_inside(u[i], prob.u_lo[i], prob.u_hi[i]);
         }
     }
-    let mut log = Vec::new();
-    let finish = |xs: Vec<Vec<f64>>,
-                  us: Vec<Vec<f64>>,
-                  status,
-                  message: String,
-                  e: Option<&Eval>,
-                  kkt,
-                  log,
-                  it,
-                  timing: Timing| {
-        let mut timing = timing;
-        timing.total = t0.elapsed().as_secs_f64();
-        OcpSolution {
-            xs,
-            us,
+    let mut st = SolveState {
+        xs: xs.unwrap_or_default(),
+        us,
+        log: Vec::new(),
+        timing: Timing::default(),
+        iterations: 0,
+    };
+    let end = iterate(model, prob, set, &mut st);
+    st.timing.total = t0.elapsed().as_secs_f64();
+    let e = end.eval.as_ref();
+    OcpSolution {
+        xs: st.xs,
+        us: st.us,
+        status: end.status,
+        message: end.message,
+        objective: e.map_or(f64::NAN, |e| e.objective),
+        kkt: end.kkt,
+        terminal_violation: e.map_or(f64::NAN, |e| e.term.c_vec.amax()),
+        iterations: st.iterations,
+        log: st.log,
+        timing: st.timing,
+    }
+}
+
+/// The iterate and the bookkeeping of a solve.
+struct SolveState {
+    xs: Vec<Vec<f64>>,
+    us: Vec<Vec<f64>>,
+    log: Vec<IterLog>,
+    timing: Timing,
+    iterations: usize,
+}
+
+/// How the iteration ended.
+struct End {
+    status: Status,
+    message: String,
+    eval: Option<Eval>,
+    kkt: [f64; 3],
+}
+
+impl End {
+    fn new(status: Status, message: String, eval: Option<Eval>, kkt: [f64; 3]) -> Self {
+        Self {
             status,
             message,
-            objective: e.map_or(f64::NAN, |e| e.objective),
+            eval,
             kkt,
-            terminal_violation: e.map_or(f64::NAN, |e| e.term.c_vec.amax()),
-            iterations: it,
-            log,
-            timing,
         }
-    };
-    let mut xs = match xs {
-        Some(x) => x,
-        None => {
-            let mut x = vec![prob.x0.clone(); n + 1];
-            for k in 0..n {
-                let (a, b) = x.split_at_mut(k + 1);
-                if let Err(e) = model.step(&a[k], &us[k], &mut b[0]) {
-                    return finish(
-                        x,
-                        us,
-                        Status::Diverged,
-                        e.0,
-                        None,
-                        [f64::NAN; 3],
-                        log,
-                        0,
-                        timing,
-                    );
-                }
+    }
+}
+
+/// Multipliers of the lower and upper control bounds, per stage.
+type BoundMultipliers = (Vec<DVector<f64>>, Vec<DVector<f64>>);
+
+/// The filter of the line search and its scale.
+#[derive(Default)]
+struct Filter {
+    entries: Vec<(f64, f64)>,
+    theta_first: Option<f64>,
+}
+
+/// The SQP iteration on `st` (states rolled out first when empty).
+fn iterate<M: OcpModel>(
+    model: &mut M,
+    prob: &OcpProblem,
+    set: &SqpSettings,
+    st: &mut SolveState,
+) -> End {
+    let (n, nu) = (prob.knots, model.nu());
+    if st.xs.is_empty() {
+        let mut x = vec![prob.x0.clone(); n + 1];
+        for k in 0..n {
+            let (a, b) = x.split_at_mut(k + 1);
+            if let Err(e) = model.step(&a[k], &st.us[k], &mut b[0]) {
+                st.xs = x;
+                return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]);
             }
-            x
         }
-    };
-    xs[0].copy_from_slice(&prob.x0);
-    debug_assert_eq!(xs[0].len(), nq);
-    let mut filter: Vec<(f64, f64)> = Vec::new();
-    let mut filter_pushes = 0;
-    let mut theta_first: Option<f64> = None;
-    let mut z_warm: Option<(Vec<DVector<f64>>, Vec<DVector<f64>>)> = None;
-    let mut it = 0;
+        st.xs = x;
+    }
+    st.xs[0].copy_from_slice(&prob.x0);
+    let mut filter = Filter::default();
+    let mut z_warm: Option<BoundMultipliers> = None;
     loop {
+        let it = st.iterations;
         let ts = Instant::now();
-        let ev = match evaluate(model, prob, &xs, &us, true) {
+        let ev = match evaluate(model, prob, &st.xs, &st.us, true) {
             Ok(e) => e,
-            Err(e) => {
-                return finish(
-                    xs,
-                    us,
-                    Status::Diverged,
-                    e.0,
-                    None,
-                    [f64::NAN; 3],
-                    log,
-                    it,
-                    timing,
-                )
-            }
+            Err(e) => return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]),
         };
-        timing.derivatives += ts.elapsed().as_secs_f64();
-        // Bounds of the step.
-        let lo: Vec<DVector<f64>> = us
-            .iter()
-            .map(|u| DVector::from_iterator(nu, (0..nu).map(|i| prob.u_lo[i] - u[i])))
-            .collect();
-        let hi: Vec<DVector<f64>> = us
-            .iter()
-            .map(|u| DVector::from_iterator(nu, (0..nu).map(|i| prob.u_hi[i] - u[i])))
-            .collect();
+        st.timing.derivatives += ts.elapsed().as_secs_f64();
+        let bound = |b: &[f64]| -> Vec<DVector<f64>> {
+            let us = &st.us;
+            us.iter()
+                .map(|u| DVector::from_iterator(nu, (0..nu).map(|i| b[i] - u[i])))
+                .collect()
+        };
+        let (lo, hi) = (bound(&prob.u_lo), bound(&prob.u_hi));
         let tq = Instant::now();
         let warm = z_warm.as_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
         let qp = solve_box_qp(&ev.stages, &ev.term, &lo, &hi, warm, &set.qp);
-        timing.qp += tq.elapsed().as_secs_f64();
+        st.timing.qp += tq.elapsed().as_secs_f64();
         let qp = match qp {
             Ok(q) => q,
             Err(e) => {
@@ -277,148 +294,137 @@ pub fn solve<M: OcpModel>(
                     LqError::NotConvex(_) => Status::Diverged,
                 };
                 let kkt = [ev.infeas_max, f64::NAN, f64::NAN];
-                return finish(
-                    xs,
-                    us,
-                    status,
-                    e.to_string(),
-                    Some(&ev),
-                    kkt,
-                    log,
-                    it,
-                    timing,
-                );
+                return End::new(status, e.to_string(), Some(ev), kkt);
             }
         };
-        // KKT residuals at the current iterate with the QP's multipliers.
-        let zx = vec![DVector::zeros(model.nx()); n + 1];
-        let zu = vec![DVector::zeros(nu); n];
-        let (stat, _) = residuals(
-            &ev.stages, &ev.term, &zx, &zu, &qp.lam, &qp.nu, &qp.z_lo, &qp.z_hi,
-        );
-        let mut comp: f64 = 0.0;
-        for k in 0..n {
-            for i in 0..nu {
-                if prob.u_lo[i].is_finite() {
-                    comp = comp.max((us[k][i] - prob.u_lo[i]) * qp.z_lo[k][i]);
-                }
-                if prob.u_hi[i].is_finite() {
-                    comp = comp.max((prob.u_hi[i] - us[k][i]) * qp.z_hi[k][i]);
-                }
-            }
-        }
-        let kkt = [ev.infeas_max, stat, comp];
+        let kkt = kkt_residuals(prob, &ev, &qp, &st.us, model.nx());
         let mut row = IterLog {
             iteration: it,
             objective: ev.objective,
             primal: ev.infeas_max,
-            stationarity: stat,
-            complementarity: comp,
+            stationarity: kkt[1],
+            complementarity: kkt[2],
             step: 0.0,
             qp_iterations: qp.iterations,
-            filter_size: filter_pushes,
+            filter_size: filter.entries.len(),
         };
         if kkt.iter().all(|r| *r <= set.tolerance) {
-            log.push(row);
+            st.log.push(row);
             let msg = format!("KKT residuals at most {:e}", set.tolerance);
-            return finish(
-                xs,
-                us,
-                Status::Converged,
-                msg,
-                Some(&ev),
-                kkt,
-                log,
-                it,
-                timing,
-            );
+            return End::new(Status::Converged, msg, Some(ev), kkt);
         }
         if it >= set.max_iterations {
-            log.push(row);
+            st.log.push(row);
             let msg = format!("{} iterations", set.max_iterations);
-            return finish(
-                xs,
-                us,
-                Status::MaxIterations,
-                msg,
-                Some(&ev),
-                kkt,
-                log,
-                it,
-                timing,
-            );
+            return End::new(Status::MaxIterations, msg, Some(ev), kkt);
         }
-        // Filter line search (Wächter & Biegler 2006, without restoration).
-        let mut slope = 0.0;
-        for k in 0..n {
-            slope += ev.stages[k].r_vec.dot(&qp.du[k]) + ev.stages[k].q_vec.dot(&qp.dx[k]);
-        }
-        slope += ev.term.q_vec.dot(&qp.dx[n]);
-        let (theta0, j0) = (ev.infeas1, ev.objective);
-        let scale = *theta_first.get_or_insert(theta0.max(1.0));
-        let (theta_min, theta_max) = (1e-4 * scale, 1e4 * scale);
         let tl = Instant::now();
-        let mut alpha = 1.0;
-        let mut accepted = None;
-        let (mut xt, mut ut) = (xs.clone(), us.clone());
-        while alpha >= 1e-10 {
-            for k in 0..=n {
-                if k > 0 {
-                    let dxk: Vec<f64> = qp.dx[k].iter().map(|v| alpha * v).collect();
-                    model.retract(&xs[k], &dxk, &mut xt[k]);
-                }
-                if k < n {
-                    for i in 0..nu {
-                        ut[k][i] = us[k][i] + alpha * qp.du[k][i];
-                    }
-                }
-            }
-            if let Ok(e) = evaluate(model, prob, &xt, &ut, false) {
-                let (theta, j) = (e.infeas1, e.objective);
-                let in_filter = theta <= theta_max
-                    && filter
-                        .iter()
-                        .all(|&(tf, jf): &(f64, f64)| theta < tf || j < jf);
-                let switching = slope < 0.0 && alpha * (-slope).powf(2.3) > theta0.powf(1.1);
-                let ok = if switching && theta0 <= theta_min {
-                    in_filter && j <= j0 + 1e-4 * alpha * slope
-                } else {
-                    in_filter && (theta <= (1.0 - GAMMA) * theta0 || j <= j0 - GAMMA * theta0)
-                };
-                if ok {
-                    if !(switching && j <= j0 + 1e-4 * alpha * slope) {
-                        filter.push(((1.0 - GAMMA) * theta0, j0 - GAMMA * theta0));
-                        filter_pushes += 1;
-                    }
-                    accepted = Some(alpha);
-                    break;
-                }
-            }
-            alpha *= 0.5;
-        }
-        timing.line_search += tl.elapsed().as_secs_f64();
-        let Some(alpha) = accepted else {
-            log.push(row);
+        let step = line_search(model, prob, st, &ev, &qp, &mut filter);
+        st.timing.line_search += tl.elapsed().as_secs_f64();
+        let Some((alpha, xt, ut)) = step else {
+            st.log.push(row);
             let msg = "the filter line search found no acceptable step".to_string();
-            return finish(
-                xs,
-                us,
-                Status::Stalled,
-                msg,
-                Some(&ev),
-                kkt,
-                log,
-                it,
-                timing,
-            );
+            return End::new(Status::Stalled, msg, Some(ev), kkt);
         };
         row.step = alpha;
-        log.push(row);
-        xs = xt;
-        us = ut;
+        st.log.push(row);
+        st.xs = xt;
+        st.us = ut;
         z_warm = Some((qp.z_lo, qp.z_hi));
-        it += 1;
+        st.iterations += 1;
     }
+}
+
+/// KKT residuals (primal, stationarity, complementarity) at the current iterate with the
+/// QP's multipliers.
+fn kkt_residuals(
+    prob: &OcpProblem,
+    ev: &Eval,
+    qp: &QpSolution,
+    us: &[Vec<f64>],
+    nx: usize,
+) -> [f64; 3] {
+    let n = prob.knots;
+    let nu = prob.u_lo.len();
+    let zx = vec![DVector::zeros(nx); n + 1];
+    let zu = vec![DVector::zeros(nu); n];
+    let (stat, _) = residuals(
+        &ev.stages, &ev.term, &zx, &zu, &qp.lam, &qp.nu, &qp.z_lo, &qp.z_hi,
+    );
+    let mut comp: f64 = 0.0;
+    for k in 0..n {
+        for i in 0..nu {
+            if prob.u_lo[i].is_finite() {
+                comp = comp.max((us[k][i] - prob.u_lo[i]) * qp.z_lo[k][i]);
+            }
+            if prob.u_hi[i].is_finite() {
+                comp = comp.max((prob.u_hi[i] - us[k][i]) * qp.z_hi[k][i]);
+            }
+        }
+    }
+    [ev.infeas_max, stat, comp]
+}
+
+/// Filter line search (Wächter & Biegler 2006, without restoration) along the QP step:
+/// the accepted step length and trial point, or `None` below α = 1e-10.
+#[allow(clippy::type_complexity)]
+fn line_search<M: OcpModel>(
+    model: &mut M,
+    prob: &OcpProblem,
+    st: &SolveState,
+    ev: &Eval,
+    qp: &QpSolution,
+    filter: &mut Filter,
+) -> Option<(f64, Vec<Vec<f64>>, Vec<Vec<f64>>)> {
+    let (n, nu) = (prob.knots, model.nu());
+    let mut slope = 0.0;
+    for k in 0..n {
+        slope += ev.stages[k].r_vec.dot(&qp.du[k]) + ev.stages[k].q_vec.dot(&qp.dx[k]);
+    }
+    slope += ev.term.q_vec.dot(&qp.dx[n]);
+    let (theta0, j0) = (ev.infeas1, ev.objective);
+    let scale = *filter.theta_first.get_or_insert(theta0.max(1.0));
+    let (theta_min, theta_max) = (1e-4 * scale, 1e4 * scale);
+    let mut alpha = 1.0;
+    let (mut xt, mut ut) = (st.xs.clone(), st.us.clone());
+    let mut dxk = vec![0.0; model.nx()];
+    while alpha >= 1e-10 {
+        for k in 0..=n {
+            if k > 0 {
+                for (d, v) in dxk.iter_mut().zip(qp.dx[k].iter()) {
+                    *d = alpha * v;
+                }
+                model.retract(&st.xs[k], &dxk, &mut xt[k]);
+            }
+            if k < n {
+                for i in 0..nu {
+                    ut[k][i] = st.us[k][i] + alpha * qp.du[k][i];
+                }
+            }
+        }
+        if let Ok(e) = evaluate(model, prob, &xt, &ut, false) {
+            let (theta, j) = (e.infeas1, e.objective);
+            let in_filter =
+                theta <= theta_max && filter.entries.iter().all(|&(tf, jf)| theta < tf || j < jf);
+            let armijo = j <= j0 + 1e-4 * alpha * slope;
+            let switching = slope < 0.0 && alpha * (-slope).powf(2.3) > theta0.powf(1.1);
+            let ok = if switching && theta0 <= theta_min {
+                in_filter && armijo
+            } else {
+                in_filter && (theta <= (1.0 - GAMMA) * theta0 || j <= j0 - GAMMA * theta0)
+            };
+            if ok {
+                if !(switching && armijo) {
+                    filter
+                        .entries
+                        .push(((1.0 - GAMMA) * theta0, j0 - GAMMA * theta0));
+                }
+                return Some((alpha, xt, ut));
+            }
+        }
+        alpha *= 0.5;
+    }
+    None
 }
 
 /// `v` moved strictly inside `[lo, hi]` (by 1e-3 of the width, or 1e-3 from a one-sided bound).

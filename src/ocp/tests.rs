@@ -1,6 +1,8 @@
 //! Tests of the OCP room: linear-quadratic problems with closed-form optima (the discrete
 //! Riccati recursion; the condensed KKT system solved densely; Clarabel on the condensed QP
 //! with active bounds), the Lie-group retraction, and the rigid chain.
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
 
 use super::chain::ChainModel;
 use super::model::{LinearModel, OcpModel};
