@@ -26,6 +26,7 @@ pub mod input;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod ocp;
 pub mod optimise;
 pub mod outcome;
 pub mod paper;

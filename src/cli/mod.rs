@@ -8,6 +8,7 @@ mod allocate;
 mod design;
 mod format;
 mod inspect;
+mod ocp;
 mod optimise;
 mod paper;
 mod progress;
@@ -55,6 +56,9 @@ enum Command {
     /// Optimise gains, layouts or references of a problem file with argmin (Nelder–Mead,
     /// particle swarm, L-BFGS), feasibility first.
     Optimise(optimise::OptimiseArgs),
+    /// Solve an optimal-control problem file (multiple shooting, Gauss–Newton SQP with a
+    /// Riccati interior-point QP) and write the trajectory and its summary.
+    Ocp(ocp::OcpArgs),
 }
 
 /// Threads per core `--jobs` may ask for: more only adds thread start-up and memory (results
@@ -97,5 +101,6 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Merge(a) => sweep::run_merge(a),
         Command::Report(a) => sweep::run_report(a),
         Command::Optimise(a) => optimise::run_optimise(a),
+        Command::Ocp(a) => ocp::run(a),
     }
 }

@@ -1,0 +1,213 @@
+//! The floating multibody chain as discrete dynamics (docs/ocp.md §2): symplectic Euler on
+//! the base pose's Lie group, base-wrench actuation.
+//!
+//! State representation (nq = 13 + 2n): `[p (3), Q (4: w, i, j, k), q (n), V_b (6), q̇ (n)]`
+//! — base position in the inertial frame [m], unit quaternion `R_Ib`, joint angles [rad],
+//! base twist `V_b = [v; ω]` in `F_b` [m/s, rad/s], joint rates [rad/s]. Tangent
+//! (nx = 12 + 2n): `[δp, δθ, δq, δV, δq̇]`, with the retraction `p ⊕ δp = p + R δp`,
+//! `R ⊕ δθ = R Exp(δθ)` (both in `F_b`, ℝ³ × SO(3)) and plain addition for the rest.
+//!
+//! Controls (nu = 6 + n): the base wrench `[f; m]` in `F_b` [N, N·m] about the base origin
+//! and the joint torques [N·m] — the generalised force `τ` of USM-19 directly (idealised
+//! actuation for comparison with rigid-body tools; thrusters are not modelled here yet).
+//!
+//! Step (symplectic Euler, as Crocoddyl's `IntegratedActionModelEuler` with Pinocchio's
+//! free-flyer `integrate`): `ζ̇ = M(q)⁻¹(τ − h(q, ζ))` (USM-19, [`forward_dynamics`], CRBA +
+//! Cholesky; hydrodynamics per [`DynOptions`]), `ζ⁺ = ζ + Δt ζ̇`, `g⁺ = g Exp_SE(3)(Δt V_b⁺)`,
+//! `q⁺ = q + Δt q̇⁺`.
+//!
+//! Terminal equality (nc = 9 + n): end-effector origin at `target` (inertial [m]), base
+//! twist and joint rates zero.
+//!
+//! Derivatives: the trait's central differences (ε = 1e-6 in tangent coordinates) — not yet
+//! analytic nor automatic (docs/ocp.md §5).
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
+
+use super::model::{ModelError, OcpModel};
+use crate::dynamics::{forward_dynamics, DynOptions, DynWorkspace};
+use crate::kinematics::{forward_kinematics, BasePose};
+use crate::model::Vehicle;
+use crate::spatial::{skew, Mat3, Vec3};
+use nalgebra::{Quaternion, UnitQuaternion};
+
+/// The chain's discrete dynamics and terminal constraint.
+#[derive(Clone, Debug)]
+pub struct ChainModel {
+    vehicle: Vehicle,
+    ws: DynWorkspace,
+    opts: DynOptions,
+    dt: f64,
+    target: Vec3,
+    tau: Vec<f64>,
+    zeta: Vec<f64>,
+}
+
+impl ChainModel {
+    /// The chain of `vehicle` with physics `opts`, step `dt` [s] and end-effector target
+    /// `target` (inertial frame [m]).
+    pub fn new(vehicle: Vehicle, opts: DynOptions, dt: f64, target: Vec3) -> Self {
+        let ws = DynWorkspace::new(&vehicle);
+        let nv = vehicle.n_dof();
+        Self {
+            vehicle,
+            ws,
+            opts,
+            dt,
+            target,
+            tau: vec![0.0; nv],
+            zeta: vec![0.0; nv],
+        }
+    }
+
+    /// The vehicle.
+    pub fn vehicle(&self) -> &Vehicle {
+        &self.vehicle
+    }
+
+    /// Number of joints n.
+    pub fn n_joints(&self) -> usize {
+        self.vehicle.n_joints()
+    }
+
+    /// The representation of a state: pose, joint angles, base twist, joint rates.
+    pub fn pack(pose: &BasePose, q: &[f64], twist: &[f64], qd: &[f64]) -> Vec<f64> {
+        let quat = pose.orientation.quaternion();
+        let mut x = Vec::with_capacity(13 + 2 * q.len());
+        x.extend_from_slice(pose.position.as_slice());
+        x.extend_from_slice(&[quat.w, quat.i, quat.j, quat.k]);
+        x.extend_from_slice(q);
+        x.extend_from_slice(twist);
+        x.extend_from_slice(qd);
+        x
+    }
+
+    /// The base pose of a state representation.
+    pub fn pose(x: &[f64]) -> BasePose {
+        BasePose {
+            position: Vec3::new(x[0], x[1], x[2]),
+            orientation: UnitQuaternion::new_normalize(Quaternion::new(x[3], x[4], x[5], x[6])),
+        }
+    }
+
+    /// End-effector origin in the inertial frame [m] at state `x`.
+    pub fn ee_position(&mut self, x: &[f64]) -> Vec3 {
+        let n = self.n_joints();
+        forward_kinematics(&self.vehicle, &x[7..7 + n], &mut self.ws.kin);
+        let pose = Self::pose(x);
+        pose.position + pose.orientation * self.ws.kin.g_be.p
+    }
+
+    /// End-effector pose in the inertial frame at state `x` (rotation, position).
+    pub fn ee_pose(&mut self, x: &[f64]) -> (Mat3, Vec3) {
+        let n = self.n_joints();
+        forward_kinematics(&self.vehicle, &x[7..7 + n], &mut self.ws.kin);
+        let pose = Self::pose(x);
+        let r = *pose.orientation.to_rotation_matrix().matrix();
+        (
+            r * self.ws.kin.g_be.r,
+            pose.position + r * self.ws.kin.g_be.p,
+        )
+    }
+}
+
+/// `Exp` of SO(3) and the left Jacobian `J(φ)` of SE(3)'s exponential:
+/// `Exp_SE(3)([v; φ]) = (Exp(φ), J(φ) v)`, `J = I + (1−cos θ)/θ² [φ]× + (θ−sin θ)/θ³ [φ]×²`
+/// (series below θ = 1e-4).
+fn se3_exp_parts(v: &Vec3, phi: &Vec3) -> (UnitQuaternion<f64>, Vec3) {
+    let th = phi.norm();
+    let k = skew(phi);
+    let (a, b) = if th < 1e-4 {
+        let t2 = th * th;
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        (
+            (1.0 - th.cos()) / (th * th),
+            (th - th.sin()) / (th * th * th),
+        )
+    };
+    let j = Mat3::identity() + k * a + k * k * b;
+    (UnitQuaternion::from_scaled_axis(*phi), j * v)
+}
+
+impl OcpModel for ChainModel {
+    fn nq(&self) -> usize {
+        13 + 2 * self.n_joints()
+    }
+    fn nx(&self) -> usize {
+        12 + 2 * self.n_joints()
+    }
+    fn nu(&self) -> usize {
+        6 + self.n_joints()
+    }
+    fn nc(&self) -> usize {
+        9 + self.n_joints()
+    }
+
+    fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let n = self.n_joints();
+        let pose = Self::pose(x);
+        let q = &x[7..7 + n];
+        self.zeta.copy_from_slice(&x[7 + n..13 + 2 * n]);
+        self.tau.copy_from_slice(u);
+        forward_dynamics(
+            &self.vehicle,
+            &mut self.ws,
+            &pose,
+            q,
+            &self.zeta,
+            &self.tau,
+            &self.opts,
+        )
+        .map_err(|e| ModelError(e.to_string()))?;
+        let dt = self.dt;
+        for (z, a) in self.zeta.iter_mut().zip(&self.ws.zeta_dot) {
+            *z += dt * a;
+        }
+        let v = Vec3::new(self.zeta[0], self.zeta[1], self.zeta[2]) * dt;
+        let w = Vec3::new(self.zeta[3], self.zeta[4], self.zeta[5]) * dt;
+        let (dr, dp) = se3_exp_parts(&v, &w);
+        let p = pose.position + pose.orientation * dp;
+        let r = pose.orientation * dr;
+        let quat = r.quaternion();
+        out[..3].copy_from_slice(p.as_slice());
+        out[3..7].copy_from_slice(&[quat.w, quat.i, quat.j, quat.k]);
+        for k in 0..n {
+            out[7 + k] = q[k] + dt * self.zeta[6 + k];
+        }
+        out[7 + n..13 + 2 * n].copy_from_slice(&self.zeta);
+        Ok(())
+    }
+
+    fn retract(&self, x: &[f64], dx: &[f64], out: &mut [f64]) {
+        let n = self.n_joints();
+        let pose = Self::pose(x);
+        let p = pose.position + pose.orientation * Vec3::new(dx[0], dx[1], dx[2]);
+        let r = pose.orientation * UnitQuaternion::from_scaled_axis(Vec3::new(dx[3], dx[4], dx[5]));
+        let quat = r.quaternion();
+        out[..3].copy_from_slice(p.as_slice());
+        out[3..7].copy_from_slice(&[quat.w, quat.i, quat.j, quat.k]);
+        for i in 0..6 + 2 * n {
+            out[7 + i] = x[7 + i] + dx[6 + i];
+        }
+    }
+
+    fn difference(&self, x0: &[f64], x1: &[f64], out: &mut [f64]) {
+        let n = self.n_joints();
+        let (a, b) = (Self::pose(x0), Self::pose(x1));
+        let dp = a.orientation.inverse() * (b.position - a.position);
+        let dr = (a.orientation.inverse() * b.orientation).scaled_axis();
+        out[..3].copy_from_slice(dp.as_slice());
+        out[3..6].copy_from_slice(dr.as_slice());
+        for i in 0..6 + 2 * n {
+            out[6 + i] = x1[7 + i] - x0[7 + i];
+        }
+    }
+
+    fn terminal(&mut self, x: &[f64], out: &mut [f64]) {
+        let n = self.n_joints();
+        let e = self.ee_position(x) - self.target;
+        out[..3].copy_from_slice(e.as_slice());
+        out[3..9 + n].copy_from_slice(&x[7 + n..13 + 2 * n]);
+    }
+}

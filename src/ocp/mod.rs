@@ -1,0 +1,30 @@
+//! Optimal control (issue 40, docs/ocp.md): direct multiple shooting of the multibody chain
+//! on the base pose's Lie group, solved by a Gauss–Newton SQP whose QP is a Riccati-based
+//! interior point.
+//!
+//! - [`model`]: the [`OcpModel`] trait (discrete dynamics with retraction, terminal equality,
+//!   central-difference Jacobians by default) and [`LinearModel`] (closed-form tests);
+//! - [`chain`]: [`ChainModel`], the floating chain under base-wrench actuation, symplectic
+//!   Euler on SE(3) over the project's multibody dynamics;
+//! - [`riccati`]: the equality-constrained LQ subproblem (terminal equality through a
+//!   parametric multiplier);
+//! - [`qp`]: the box-bounded QP (Mehrotra interior point over the Riccati solve);
+//! - [`sqp`]: the SQP with the filter line search, KKT residuals, status and log;
+//! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
+
+pub mod chain;
+pub mod model;
+pub mod problem;
+pub mod qp;
+pub mod riccati;
+pub mod run;
+pub mod sqp;
+
+#[cfg(test)]
+mod tests;
+
+pub use chain::ChainModel;
+pub use model::{LinearModel, ModelError, OcpModel};
+pub use problem::{load_problem, parse_problem, ProblemSpec};
+pub use run::{solve_spec, write_outputs, OcpRun};
+pub use sqp::{solve, IterLog, OcpProblem, OcpSolution, SqpSettings, Status, Timing};

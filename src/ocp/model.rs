@@ -1,0 +1,171 @@
+//! The discrete dynamics an optimal-control problem is posed on (docs/ocp.md §2):
+//! `x_{k+1} = f(x_k, u_k)` on a manifold, with a retraction `x ⊕ δ` and its inverse
+//! `x₁ ⊖ x₀` on the tangent space (size nx), and a terminal equality `c(x_N) = 0`.
+//!
+//! Derivatives default to central differences in tangent coordinates,
+//! `∂f/∂x e_i ≈ (f(x ⊕ εe_i, u) ⊖ f(x ⊕ −εe_i, u)) ⊖-relative to f(x, u) / 2ε` with ε = 1e-6
+//! (truncation O(ε²), rounding O(1e-16/ε)); an implementation may override them with
+//! analytic ones.
+// Stage and component loops read clearest with indices (k: knot, i: component).
+#![allow(clippy::needless_range_loop)]
+
+use nalgebra::{DMatrix, DVector};
+
+/// Error of a model evaluation (a singular mass matrix, a non-finite state): `what` failed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("dynamics failed: {0}")]
+pub struct ModelError(pub String);
+
+/// Step of the central differences in tangent coordinates.
+pub const FD_STEP: f64 = 1e-6;
+
+/// Discrete dynamics on a manifold, with a terminal equality (see the module documentation).
+pub trait OcpModel {
+    /// Size of the state's representation (e.g. 13 + 2n with a unit quaternion).
+    fn nq(&self) -> usize;
+    /// Size of the tangent space (the Newton variables of a state).
+    fn nx(&self) -> usize;
+    /// Number of controls.
+    fn nu(&self) -> usize;
+    /// Number of terminal equalities.
+    fn nc(&self) -> usize;
+    /// `out = f(x, u)` (representations, nq).
+    fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError>;
+    /// `out = x ⊕ dx` (dx in the tangent space at x).
+    fn retract(&self, x: &[f64], dx: &[f64], out: &mut [f64]);
+    /// `out = x1 ⊖ x0`, the tangent vector at x0 with `x0 ⊕ out = x1`.
+    fn difference(&self, x0: &[f64], x1: &[f64], out: &mut [f64]);
+    /// `out = c(x)` (nc).
+    fn terminal(&mut self, x: &[f64], out: &mut [f64]);
+
+    /// `A = ∂f/∂x` (nx×nx) and `B = ∂f/∂u` (nx×nu) at (x, u), tangent coordinates; central
+    /// differences unless overridden.
+    fn jacobians(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        a: &mut DMatrix<f64>,
+        b: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        let (nq, nx, nu) = (self.nq(), self.nx(), self.nu());
+        let mut f0 = vec![0.0; nq];
+        self.step(x, u, &mut f0)?;
+        let (mut xp, mut fp, mut fm) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq]);
+        let (mut dp, mut dm) = (vec![0.0; nx], vec![0.0; nx]);
+        let mut e = vec![0.0; nx];
+        for i in 0..nx {
+            e[i] = FD_STEP;
+            self.retract(x, &e, &mut xp);
+            self.step(&xp, u, &mut fp)?;
+            e[i] = -FD_STEP;
+            self.retract(x, &e, &mut xp);
+            self.step(&xp, u, &mut fm)?;
+            e[i] = 0.0;
+            self.difference(&f0, &fp, &mut dp);
+            self.difference(&f0, &fm, &mut dm);
+            for r in 0..nx {
+                a[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
+            }
+        }
+        let mut up = u.to_vec();
+        for i in 0..nu {
+            up[i] = u[i] + FD_STEP;
+            self.step(x, &up, &mut fp)?;
+            up[i] = u[i] - FD_STEP;
+            self.step(x, &up, &mut fm)?;
+            up[i] = u[i];
+            self.difference(&f0, &fp, &mut dp);
+            self.difference(&f0, &fm, &mut dm);
+            for r in 0..nx {
+                b[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
+            }
+        }
+        Ok(())
+    }
+
+    /// `C = ∂c/∂x` (nc×nx) at x, tangent coordinates; central differences unless overridden.
+    fn terminal_jacobian(&mut self, x: &[f64], c: &mut DMatrix<f64>) {
+        let (nq, nx, nc) = (self.nq(), self.nx(), self.nc());
+        let mut xp = vec![0.0; nq];
+        let (mut cp, mut cm) = (vec![0.0; nc], vec![0.0; nc]);
+        let mut e = vec![0.0; nx];
+        for i in 0..nx {
+            e[i] = FD_STEP;
+            self.retract(x, &e, &mut xp);
+            self.terminal(&xp, &mut cp);
+            e[i] = -FD_STEP;
+            self.retract(x, &e, &mut xp);
+            self.terminal(&xp, &mut cm);
+            e[i] = 0.0;
+            for r in 0..nc {
+                c[(r, i)] = (cp[r] - cm[r]) / (2.0 * FD_STEP);
+            }
+        }
+    }
+}
+
+/// A linear model `x_{k+1} = A x + B u + w` on ℝⁿ with the terminal equality `C x = c`
+/// (the closed-form test problems; exact analytic Jacobians).
+#[derive(Clone, Debug)]
+pub struct LinearModel {
+    /// `A` (nx×nx).
+    pub a: DMatrix<f64>,
+    /// `B` (nx×nu).
+    pub b: DMatrix<f64>,
+    /// Offset `w` (nx).
+    pub w: DVector<f64>,
+    /// `C` (nc×nx).
+    pub c: DMatrix<f64>,
+    /// Target `c` (nc).
+    pub target: DVector<f64>,
+}
+
+impl OcpModel for LinearModel {
+    fn nq(&self) -> usize {
+        self.a.nrows()
+    }
+    fn nx(&self) -> usize {
+        self.a.nrows()
+    }
+    fn nu(&self) -> usize {
+        self.b.ncols()
+    }
+    fn nc(&self) -> usize {
+        self.c.nrows()
+    }
+    fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        let y = &self.a * DVector::from_column_slice(x)
+            + &self.b * DVector::from_column_slice(u)
+            + &self.w;
+        out.copy_from_slice(y.as_slice());
+        Ok(())
+    }
+    fn retract(&self, x: &[f64], dx: &[f64], out: &mut [f64]) {
+        for ((o, a), b) in out.iter_mut().zip(x).zip(dx) {
+            *o = a + b;
+        }
+    }
+    fn difference(&self, x0: &[f64], x1: &[f64], out: &mut [f64]) {
+        for ((o, a), b) in out.iter_mut().zip(x0).zip(x1) {
+            *o = b - a;
+        }
+    }
+    fn terminal(&mut self, x: &[f64], out: &mut [f64]) {
+        let y = &self.c * DVector::from_column_slice(x) - &self.target;
+        out.copy_from_slice(y.as_slice());
+    }
+    fn jacobians(
+        &mut self,
+        _x: &[f64],
+        _u: &[f64],
+        a: &mut DMatrix<f64>,
+        b: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        a.copy_from(&self.a);
+        b.copy_from(&self.b);
+        Ok(())
+    }
+    fn terminal_jacobian(&mut self, _x: &[f64], c: &mut DMatrix<f64>) {
+        c.copy_from(&self.c);
+    }
+}
