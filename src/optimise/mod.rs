@@ -33,6 +33,7 @@ pub mod search;
 pub mod solver;
 pub mod space;
 pub mod tune;
+mod tune_seeds;
 
 pub use engine::{minimise, run, OptimiseError, Options, Outcome};
 pub use problem::{load_problem, parse_problem, Problem, Spec};

@@ -18,7 +18,9 @@
 use super::evaluate::CaseEvaluator;
 use super::history::Record;
 use super::problem::{in_worlds, parse_spec};
-use super::search::Evaluator as _;
+use super::tune_seeds::{
+    compare_in_pooled_worlds, relative_spread, tune_worlds_seed, SeedResult, WorldsOf, SEEDS_STREAM,
+};
 use super::{minimise, Options, Problem, Spec};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
 use crate::input::document::Document;
@@ -72,7 +74,7 @@ pub const MAX_TUNE_WORLDS: usize = 64;
 
 /// Seed stream of the tuning worlds (shared by every case: common random numbers), apart from
 /// the scoring worlds' stream so that a design is not tuned on the worlds it is scored in.
-const TUNE_WORLDS_STREAM: u64 = 0x5455_4e45_574c; // "TUNEWL"
+pub(super) const TUNE_WORLDS_STREAM: u64 = 0x5455_4e45_574c; // "TUNEWL"
 
 /// A parameter within this fraction of the unit box from a bound counts as on the bound.
 pub const BOUND_TOLERANCE: f64 = 1e-3;
@@ -355,40 +357,6 @@ fn check_two_roads(spec: &Spec, study: &Study, doc: &Document) -> Result<(), Inp
     Ok(())
 }
 
-/// Which tuning worlds a tuning problem runs in.
-#[derive(Clone, Copy, Debug)]
-enum WorldsOf {
-    /// The nominal world alone (how a tuned case is scored).
-    Nominal,
-    /// Tuning seed `k`'s worlds.
-    Seed(usize),
-    /// Every seed's worlds together (the seeds' best points compared).
-    Pooled,
-}
-
-/// What one tuning seed found.
-struct SeedResult {
-    best: Record,
-    /// Spread of the starts' bests within the seed.
-    noise: f64,
-    curve: Vec<f64>,
-    evaluations: usize,
-}
-
-/// Seed stream of tuning seed `k`'s solver seeds (seed 0 keeps the study's).
-const SEEDS_STREAM: u64 = 0x5345_4544_5353; // "SEEDSS"
-
-/// The seed of tuning seed `k`'s worlds: seed 0 the tuning-worlds stream itself (a one-seed
-/// tuning is unchanged), seed `k > 0` a stream derived from it.
-fn tune_worlds_seed(study_seed: u64, k: usize) -> u64 {
-    let base = derive_seed(study_seed, TUNE_WORLDS_STREAM);
-    if k == 0 {
-        base
-    } else {
-        derive_seed(base, k as u64)
-    }
-}
-
 impl CaseTuner for Tuner {
     /// Tune case `case` (resolved as `r`) within `deadline`: the case at the best point.
     ///
@@ -435,63 +403,9 @@ impl CaseTuner for Tuner {
             (0, s.best.score.feasible, s.noise, f64::NAN)
         } else {
             let pooled = self.case_problem_with(study, r, WorldsOf::Pooled);
-            let ev = CaseEvaluator::new(&pooled).for_case(case.id, deadline);
-            let evals: Vec<_> = seeds
-                .par_iter()
-                .with_max_len(1)
-                .map(|s| ev.evaluate(&s.best.x))
-                .collect();
-            evaluations += evals.len();
-            let scorer = super::score::Scorer::new(
-                &pooled.spec.objective,
-                &pooled.spec.constraints,
-                ev.metrics(),
-                &evals[0].metrics,
-            );
-            let scored: Vec<(super::score::Score, f64, f64)> = evals
-                .iter()
-                .map(|e| {
-                    let mut score = scorer.score(&e.metrics);
-                    if e.failure.is_some() {
-                        score.feasible = false;
-                        score.violation = score.violation.max(1.0);
-                    }
-                    let raw = raw_metrics_objective(&scorer, &e.metrics);
-                    let met = e
-                        .metrics
-                        .iter()
-                        .filter(|m| {
-                            (0..scorer.constraints.len())
-                                .all(|k| scorer.constraint_violation(k, m) == 0.0)
-                        })
-                        .count();
-                    (score, raw, met as f64 / e.metrics.len().max(1) as f64)
-                })
-                .collect();
-            let mut pick = 0;
-            for i in 1..scored.len() {
-                let (a, b) = (&scored[i], &scored[pick]);
-                let better = match (a.0.feasible, b.0.feasible) {
-                    (true, true) => a.1 < b.1,
-                    _ => a.0.better_than(&b.0),
-                };
-                if better {
-                    pick = i;
-                }
-            }
-            let costs: Vec<f64> = scored.iter().map(|s| s.1).collect();
-            let shares: Vec<f64> = scored.iter().map(|s| s.2).collect();
-            let (lo, hi) = shares
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                    (a.min(*x), b.max(*x))
-                });
-            (
-                pick,
-                scored[pick].0.feasible,
-                relative_spread(&costs),
-                hi - lo,
-            )
+            let p = compare_in_pooled_worlds(&pooled, case.id, deadline, &seeds);
+            evaluations += p.evaluations;
+            (p.pick, p.feasible, p.noise, p.success_spread)
         };
         let best = &seeds[pick].best;
         let best_x = best.x.clone();
@@ -569,17 +483,6 @@ fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
     }
 }
 
-/// The unnormalised objective of one evaluation's metrics (as [`raw_objective`]).
-fn raw_metrics_objective(scorer: &super::score::Scorer, metrics: &[Vec<f64>]) -> f64 {
-    scorer
-        .objective
-        .terms
-        .iter()
-        .zip(&scorer.term_columns)
-        .map(|(t, &c)| t.weight * super::score::mean_of(metrics, c))
-        .sum()
-}
-
 /// The unnormalised objective of `r`: `Σ w_i · m_i` with each term's metric averaged over the
 /// scenarios. The starts of a tuning normalise by their own start points, so their scores are
 /// not comparable; this is.
@@ -591,20 +494,6 @@ fn raw_objective(scorer: &super::score::Scorer, r: &Record) -> f64 {
         .zip(&scorer.term_columns)
         .map(|(t, &c)| t.weight * super::score::mean_of(&r.metrics, c))
         .sum()
-}
-
-/// Relative spread `(max − min) / |min|` of the finite values (NaN with fewer than two).
-fn relative_spread(xs: &[f64]) -> f64 {
-    let f: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
-    if f.len() < 2 {
-        return f64::NAN;
-    }
-    let (lo, hi) = f
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(*x), b.max(*x))
-        });
-    (hi - lo) / lo.abs()
 }
 
 /// The case's value of a parameter's key (a number), if it has one.
