@@ -72,10 +72,6 @@ const STARTS_STREAM: u64 = 0x5354_4152_5453; // "STARTS"
 /// Most tuning worlds (`[tune] worlds`): each is a full run per evaluation.
 pub const MAX_TUNE_WORLDS: usize = 64;
 
-/// Seed stream of the tuning worlds (shared by every case: common random numbers), apart from
-/// the scoring worlds' stream so that a design is not tuned on the worlds it is scored in.
-pub(super) const TUNE_WORLDS_STREAM: u64 = 0x5455_4e45_574c; // "TUNEWL"
-
 /// A parameter within this fraction of the unit box from a bound counts as on the bound.
 pub const BOUND_TOLERANCE: f64 = 1e-3;
 

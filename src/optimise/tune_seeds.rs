@@ -13,6 +13,10 @@ use crate::evaluate::Deadline;
 use crate::sampling::derive_seed;
 use rayon::prelude::*;
 
+/// Seed stream of the tuning worlds (shared by every case: common random numbers), apart from
+/// the scoring worlds' stream so that a design is not tuned on the worlds it is scored in.
+const TUNE_WORLDS_STREAM: u64 = 0x5455_4e45_574c; // "TUNEWL"
+
 /// Which tuning worlds a tuning problem runs in.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum WorldsOf {
@@ -42,7 +46,7 @@ pub(super) const SEEDS_STREAM: u64 = 0x5345_4544_5353; // "SEEDSS"
 /// The seed of tuning seed `k`'s worlds: seed 0 the tuning-worlds stream itself (a one-seed
 /// tuning is unchanged), seed `k > 0` a stream derived from it.
 pub(super) fn tune_worlds_seed(study_seed: u64, k: usize) -> u64 {
-    let base = derive_seed(study_seed, super::tune::TUNE_WORLDS_STREAM);
+    let base = derive_seed(study_seed, TUNE_WORLDS_STREAM);
     if k == 0 {
         base
     } else {
@@ -155,4 +159,3 @@ pub(super) fn relative_spread(xs: &[f64]) -> f64 {
         });
     (hi - lo) / lo.abs()
 }
-

@@ -177,16 +177,8 @@ pub fn run_sweep(
             return Ok(done);
         }
     }
-    // Atomic and link-safe (issue 39): a planted link is replaced, never followed.
-    crate::report::atomic_write(&out.join(STUDY_COPY), study.text.as_bytes())?;
     let schema = raw_schema(study);
-    // A journal is resumed only by the study (and build) that wrote it (issue 39 item 4).
-    let resume = opts.resume && journal_of_this_study(&out, &partial, study, &mut notes);
-    if resume {
-        notes.extend(journal::repair(&partial, &schema)?);
-    }
-    let (mut appender, done) = open_partial(&partial, &schema, resume)?;
-    crate::report::atomic_write(&out.join(PARTIAL_STUDY_FILE), study.hash.as_bytes())?;
+    let (mut appender, done) = open_journal(study, &out, &schema, opts.resume, &mut notes)?;
     let jobs = if opts.jobs == 0 {
         std::thread::available_parallelism().map_or(1, |n| n.get())
     } else {
@@ -297,6 +289,28 @@ impl SweepOutcome {
         self.failed = c.failed;
         self.skipped = c.skipped;
     }
+}
+
+/// The study's copy and its journal in `out`: the copy written (atomic and link-safe, issue
+/// 39), the journal resumed (`resume`) only when this study and build wrote it (issue 39 item 4)
+/// and repaired, else created; its record of the study written. The appender and the hashes of
+/// the cases it already holds.
+fn open_journal(
+    study: &Study,
+    out: &Path,
+    schema: &[(String, ColumnKind)],
+    resume: bool,
+    notes: &mut super::error::Notes,
+) -> Result<(CsvAppender, DoneHashes), StudyError> {
+    crate::report::atomic_write(&out.join(STUDY_COPY), study.text.as_bytes())?;
+    let partial = out.join(PARTIAL_FILE);
+    let resume = resume && journal_of_this_study(out, &partial, study, notes);
+    if resume {
+        notes.extend(journal::repair(&partial, schema)?);
+    }
+    let opened = open_partial(&partial, schema, resume)?;
+    crate::report::atomic_write(&out.join(PARTIAL_STUDY_FILE), study.hash.as_bytes())?;
+    Ok(opened)
 }
 
 /// Whether the journal in `out` was written by this study and build: its record

@@ -3,7 +3,7 @@
 //! designs pending more worlds (`docs/statistics.md`). A child of `summary_robust`.
 
 use super::{Robust, TOP};
-use crate::stats::ranking::Verdict;
+use crate::stats::ranking::{Contender, Verdict};
 
 impl Robust<'_> {
     /// The line the summary opens with.
@@ -53,73 +53,12 @@ impl Robust<'_> {
                 Self::pct(*margin),
                 self.pending_text()
             ),
-            Verdict::Tied { leader, tied } => {
-                let list: Vec<String> = std::iter::once(format!("#{}", self.ids[*leader]))
-                    .chain(
-                        tied.iter()
-                            .take(TOP)
-                            .map(|c| format!("#{}", self.ids[c.case])),
-                    )
-                    .collect();
-                let margins: Vec<String> = tied
-                    .iter()
-                    .take(5)
-                    .map(|c| {
-                        format!(
-                            "#{} {} (beaten in {:.0} % of worlds, p = {})",
-                            self.ids[c.case],
-                            Self::pct(c.margin),
-                            100.0 * c.p_beats,
-                            fmt_p(c.p_adjusted)
-                        )
-                    })
-                    .collect();
-                format!(
-                    "**Statistically tied: {}{}** by `{o}` over {n} paired worlds — the leader \
-                     does not beat these at {:.0} % confidence and the worlds do not lean its \
-                     way (a tie: more worlds would not separate them). Leader {}; median \
-                     margins behind it: {} ({noise}).{}",
-                    list.join(", "),
-                    if tied.len() > TOP { ", …" } else { "" },
-                    100.0 * self.info.confidence,
-                    self.label(*leader),
-                    margins.join("; "),
-                    self.pending_text()
-                )
-            }
+            Verdict::Tied { leader, tied } => self.tied_line(*leader, tied, &noise),
             Verdict::Undecided {
                 leader,
                 open,
                 needs_worlds,
-            } => {
-                let margins: Vec<String> = open
-                    .iter()
-                    .take(5)
-                    .map(|c| {
-                        format!(
-                            "#{} {} (beaten in {} of {n} worlds, p = {})",
-                            self.ids[c.case],
-                            Self::pct(c.margin),
-                            c.wins,
-                            fmt_p(c.p_adjusted)
-                        )
-                    })
-                    .collect();
-                format!(
-                    "**Undecided: needs ≥ {needs_worlds} worlds** — the leader {} by `{o}` leads \
-                     every ranked design, but {n} worlds cannot show it at {:.0} % confidence \
-                     against {}: {} ({noise}).{}",
-                    self.label(*leader),
-                    100.0 * self.info.confidence,
-                    if open.len() == 1 {
-                        "one of them".to_string()
-                    } else {
-                        format!("{} of them", open.len())
-                    },
-                    margins.join("; "),
-                    self.pending_text()
-                )
-            }
+            } => self.undecided_line(*leader, open, *needs_worlds, &noise),
             Verdict::NoneEligible if !v.pending.is_empty() => {
                 let need = v.pending.iter().filter_map(|p| p.worlds_needed).min();
                 format!(
@@ -142,6 +81,81 @@ impl Robust<'_> {
                 100.0 * self.info.confidence
             ),
         }
+    }
+
+    /// The verdict sentence of a tie: the leader and the cases it does not beat.
+    fn tied_line(&self, leader: usize, tied: &[Contender], noise: &str) -> String {
+        let (n, o) = (self.info.worlds, self.info.objective());
+        let list: Vec<String> = std::iter::once(format!("#{}", self.ids[leader]))
+            .chain(
+                tied.iter()
+                    .take(TOP)
+                    .map(|c| format!("#{}", self.ids[c.case])),
+            )
+            .collect();
+        let margins: Vec<String> = tied
+            .iter()
+            .take(5)
+            .map(|c| {
+                format!(
+                    "#{} {} (beaten in {:.0} % of worlds, p = {})",
+                    self.ids[c.case],
+                    Self::pct(c.margin),
+                    100.0 * c.p_beats,
+                    fmt_p(c.p_adjusted)
+                )
+            })
+            .collect();
+        format!(
+            "**Statistically tied: {}{}** by `{o}` over {n} paired worlds — the leader \
+             does not beat these at {:.0} % confidence and the worlds do not lean its \
+             way (a tie: more worlds would not separate them). Leader {}; median \
+             margins behind it: {} ({noise}).{}",
+            list.join(", "),
+            if tied.len() > TOP { ", …" } else { "" },
+            100.0 * self.info.confidence,
+            self.label(leader),
+            margins.join("; "),
+            self.pending_text()
+        )
+    }
+
+    /// The verdict sentence of an undecided study: the open comparisons and the worlds needed.
+    fn undecided_line(
+        &self,
+        leader: usize,
+        open: &[Contender],
+        needs_worlds: usize,
+        noise: &str,
+    ) -> String {
+        let (n, o) = (self.info.worlds, self.info.objective());
+        let margins: Vec<String> = open
+            .iter()
+            .take(5)
+            .map(|c| {
+                format!(
+                    "#{} {} (beaten in {} of {n} worlds, p = {})",
+                    self.ids[c.case],
+                    Self::pct(c.margin),
+                    c.wins,
+                    fmt_p(c.p_adjusted)
+                )
+            })
+            .collect();
+        format!(
+            "**Undecided: needs ≥ {needs_worlds} worlds** — the leader {} by `{o}` leads \
+             every ranked design, but {n} worlds cannot show it at {:.0} % confidence \
+             against {}: {} ({noise}).{}",
+            self.label(leader),
+            100.0 * self.info.confidence,
+            if open.len() == 1 {
+                "one of them".to_string()
+            } else {
+                format!("{} of them", open.len())
+            },
+            margins.join("; "),
+            self.pending_text()
+        )
     }
 
     /// The designs that succeeded often enough in their worlds but cannot yet be shown to
@@ -188,7 +202,6 @@ impl Robust<'_> {
             self.pending_list()
         )
     }
-
 }
 
 /// A p-value for the verdict line: `< 1e-4` below it, else three significant digits.
