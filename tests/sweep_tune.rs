@@ -264,11 +264,8 @@ fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
     }
 }
 
-/// `[tune] worlds = 2`: each case is tuned over two worlds of the study's `[uncertainty]`, then
-/// scored in the nominal world and its own worlds as before; rows identical for any `--jobs`.
-#[test]
-fn tuning_in_worlds_runs_and_gives_the_same_rows_for_any_jobs() {
-    let dir = tempfile::tempdir().unwrap();
+/// The one-design study tuned in two worlds of a drag-scale `[uncertainty]`.
+fn tuned_in_two_worlds() -> String {
     let uncertainty = "
 [uncertainty]
 worlds = 2
@@ -276,9 +273,17 @@ worlds = 2
 name = \"hydro.drag_scale\"
 distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
 ";
-    let text = format!("{BASE}{TUNE}{uncertainty}")
+    format!("{BASE}{TUNE}{uncertainty}")
         .replace("values = [3, 4]", "values = [4]")
-        .replace("[tune]\n", "[tune]\nworlds = 2\n");
+        .replace("[tune]\n", "[tune]\nworlds = 2\n")
+}
+
+/// `[tune] worlds = 2`: each case is tuned over two worlds of the study's `[uncertainty]`, then
+/// scored in the nominal world and its own worlds as before; rows identical for any `--jobs`.
+#[test]
+fn tuning_in_worlds_runs_and_gives_the_same_rows_for_any_jobs() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = tuned_in_two_worlds();
     let (_, head, rows) = one_case_at_jobs_1_and_2(dir.path(), "worlds.toml", &text);
     let k = column(&head, &rows, "tuned.control.k_psi");
     assert!(k[0] >= 0.15 && k[0] <= 1.35, "{k:?}");
@@ -294,16 +299,7 @@ distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
 #[test]
 fn two_tuning_seeds_compare_their_bests_in_the_pooled_worlds() {
     let dir = tempfile::tempdir().unwrap();
-    let uncertainty = "
-[uncertainty]
-worlds = 2
-[[uncertainty.param]]
-name = \"hydro.drag_scale\"
-distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }
-";
-    let one = format!("{BASE}{TUNE}{uncertainty}")
-        .replace("values = [3, 4]", "values = [4]")
-        .replace("[tune]\n", "[tune]\nworlds = 2\n");
+    let one = tuned_in_two_worlds();
     let two = one.replace("[tune]\n", "[tune]\nseeds = 2\n");
     for d in ["one", "two"] {
         std::fs::create_dir_all(dir.path().join(d)).unwrap();

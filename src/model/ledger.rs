@@ -388,6 +388,33 @@ pub const LEDGER: &[Assumption] = &[
         note: "`path.segments` of the scenario",
     },
     Assumption {
+        key: "success.max_roll_deg",
+        name: "transport success: attitude and depth bounds",
+        value: "|roll| and |pitch| of the base within 30° of level, base and head within 1 m of \
+                their starting depth, over the whole run (`max_pitch_deg`, `max_vertical_error` \
+                likewise)",
+        source: Source::Inferred(
+            "the paper states no attitude or depth requirement; a capsize detector, not a \
+             ride-quality bound (issue 36 item 3)",
+        ),
+        range: None,
+        note: "a run past either bound is unsuccessful and names the axis; 0 turns a bound off",
+    },
+    Assumption {
+        key: "control.autopilot",
+        name: "transport autopilot (depth hold, roll and pitch to level)",
+        value: "off; when on: k_depth_p 0.25, k_depth_i 0.02 (integral clamped at 10 m·s), \
+                k_roll_p 0.25, k_roll_d 1, k_pitch_p 0.25, k_pitch_d 0; roll only while T(q) \
+                can command it",
+        source: Source::Inferred(
+            "not in the paper (its laws are kept bit for bit with the autopilot off); gains \
+             chosen, reachable by a [tune]",
+        ),
+        range: None,
+        note: "docs/model.md §5; on a design that cannot command roll the hydrostatic restoring \
+               moment is all there is",
+    },
+    Assumption {
         key: "metrics.threshold",
         name: "singularity threshold of the commanded σ_min",
         value: "0.05 N/N",

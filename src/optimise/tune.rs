@@ -128,26 +128,8 @@ impl Tuner {
                 ))
             }
         };
-        let starts = match t.remove("starts") {
-            None => 1,
-            Some(toml::Value::Integer(n)) if (1..=MAX_STARTS as i64).contains(&n) => n as usize,
-            Some(v) => {
-                return Err(doc.err(
-                    "tune.starts",
-                    format!("must be an integer from 1 to {MAX_STARTS}, got {v}"),
-                ))
-            }
-        };
-        let seeds = match t.remove("seeds") {
-            None => 1,
-            Some(toml::Value::Integer(n)) if (1..=MAX_SEEDS as i64).contains(&n) => n as usize,
-            Some(v) => {
-                return Err(doc.err(
-                    "tune.seeds",
-                    format!("must be an integer from 1 to {MAX_SEEDS}, got {v}"),
-                ))
-            }
-        };
+        let starts = count(&mut t, "starts", MAX_STARTS, &doc)?;
+        let seeds = count(&mut t, "seeds", MAX_SEEDS, &doc)?;
         let spec = parse_spec(&doc, &t, "tune", study)?;
         check_two_roads(&spec, study, &doc)?;
         if spec.solver.max_evals / starts < 2 {
@@ -310,6 +292,18 @@ impl Tuner {
             curve,
             evaluations,
         })
+    }
+}
+
+/// `[tune] key`, a count from 1 to `max` (default 1), taken out of `t`; located error otherwise.
+fn count(t: &mut toml::Table, key: &str, max: usize, doc: &Document) -> Result<usize, InputError> {
+    match t.remove(key) {
+        None => Ok(1),
+        Some(toml::Value::Integer(n)) if (1..=max as i64).contains(&n) => Ok(n as usize),
+        Some(v) => Err(doc.err(
+            &format!("tune.{key}"),
+            format!("must be an integer from 1 to {max}, got {v}"),
+        )),
     }
 }
 

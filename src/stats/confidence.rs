@@ -98,6 +98,18 @@ pub fn sign_worlds_needed(alpha: f64) -> usize {
     (-alpha.log2()).ceil().max(1.0) as usize
 }
 
+/// The indices of `p` by increasing value, NaN last, ties by index.
+fn increasing(p: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..p.len()).collect();
+    order.sort_by(|&a, &b| {
+        p[a].is_nan()
+            .cmp(&p[b].is_nan())
+            .then(p[a].total_cmp(&p[b]))
+            .then(a.cmp(&b))
+    });
+    order
+}
+
 /// Holm's step-down procedure at family-wise level `alpha` (S. Holm 1979, "A simple
 /// sequentially rejective multiple test procedure", *Scand. J. Statist.* 6(2), 65–70): sort the
 /// `m` p-values increasingly, reject the `i`-th smallest (1-based) while
@@ -105,13 +117,7 @@ pub fn sign_worlds_needed(alpha: f64) -> usize {
 /// order), whether its hypothesis is rejected. NaN p-values are never rejected.
 pub fn holm(p: &[f64], alpha: f64) -> Vec<bool> {
     let m = p.len();
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_by(|&a, &b| {
-        p[a].is_nan()
-            .cmp(&p[b].is_nan())
-            .then(p[a].total_cmp(&p[b]))
-            .then(a.cmp(&b))
-    });
+    let order = increasing(p);
     let mut rejected = vec![false; m];
     for (i, &j) in order.iter().enumerate() {
         if p[j].is_nan() || p[j] > alpha / (m - i) as f64 {
@@ -126,13 +132,7 @@ pub fn holm(p: &[f64], alpha: f64) -> Vec<bool> {
 /// hypothesis is rejected by [`holm`] at level `alpha` iff its adjusted p-value is ≤ `alpha`.
 pub fn holm_adjusted(p: &[f64]) -> Vec<f64> {
     let m = p.len();
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_by(|&a, &b| {
-        p[a].is_nan()
-            .cmp(&p[b].is_nan())
-            .then(p[a].total_cmp(&p[b]))
-            .then(a.cmp(&b))
-    });
+    let order = increasing(p);
     let mut out = vec![f64::NAN; m];
     let mut running = 0.0f64;
     for (i, &j) in order.iter().enumerate() {
