@@ -134,6 +134,12 @@ fn a_ten_percent_margin_names_the_winner_and_a_tenth_of_a_percent_is_a_tie() {
     ok(&sweep(&four, &out4, &["--jobs", "2"]));
     let v = verdict(&out4);
     assert!(v.starts_with("**Undecided: needs ≥ 7 worlds**"), "{v}");
+    // The review page opens with that verdict too (it is a verdict, not a missing one).
+    let html = std::fs::read_to_string(out4.join("report.html")).unwrap();
+    assert!(
+        html.contains("<h2>Verdict") && html.contains("Undecided: needs"),
+        "report.html has no verdict section"
+    );
     assert!(column(&out4, "p_best").iter().all(|p| p.is_nan()));
     let lower = column(&out4, "success_probability_lower");
     assert!(lower.iter().all(|l| (l - 0.5965).abs() < 1e-3), "{lower:?}");

@@ -25,7 +25,12 @@ use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
 
 /// How the verdict line [`Robust::verdict_line`] writes opens.
-pub const VERDICT_OPENINGS: [&str; 3] = ["**Winner:", "**Statistically tied:", "**No winner"];
+pub const VERDICT_OPENINGS: [&str; 4] = [
+    "**Winner:",
+    "**Statistically tied:",
+    "**Undecided:",
+    "**No winner",
+];
 
 /// The verdict line of a `summary.md` text: its first paragraph after the title when it is one
 /// ([`VERDICT_OPENINGS`]); `None` for a study without uncertain worlds.
