@@ -19,7 +19,8 @@ use super::evaluate::CaseEvaluator;
 use super::history::Record;
 use super::problem::{in_worlds, parse_spec};
 use super::tune_seeds::{
-    compare_in_pooled_worlds, relative_spread, tune_worlds_seed, SeedResult, WorldsOf, SEEDS_STREAM,
+    compare_in_pooled_worlds, raw_metrics_objective, relative_spread, tune_worlds_seed, SeedResult,
+    WorldsOf, SEEDS_STREAM,
 };
 use super::{minimise, Options, Problem, Spec};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
@@ -477,13 +478,7 @@ fn best_so_far(records: &[Record], curve: &mut Vec<f64>) {
 /// scenarios. The starts of a tuning normalise by their own start points, so their scores are
 /// not comparable; this is.
 fn raw_objective(scorer: &super::score::Scorer, r: &Record) -> f64 {
-    scorer
-        .objective
-        .terms
-        .iter()
-        .zip(&scorer.term_columns)
-        .map(|(t, &c)| t.weight * super::score::mean_of(&r.metrics, c))
-        .sum()
+    raw_metrics_objective(scorer, &r.metrics)
 }
 
 /// The case's value of a parameter's key (a number), if it has one.

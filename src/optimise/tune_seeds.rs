@@ -135,8 +135,9 @@ pub(super) fn compare_in_pooled_worlds(
     }
 }
 
-/// The unnormalised objective of one evaluation's metrics (the objective's terms without the start point's normalisation).
-fn raw_metrics_objective(scorer: &Scorer, metrics: &[Vec<f64>]) -> f64 {
+/// The unnormalised objective `Σ w_i · m_i` of one evaluation's metrics (each term's metric
+/// averaged over the scenarios, without the start point's normalisation).
+pub(super) fn raw_metrics_objective(scorer: &Scorer, metrics: &[Vec<f64>]) -> f64 {
     scorer
         .objective
         .terms

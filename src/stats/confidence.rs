@@ -49,6 +49,26 @@ pub fn wilson_worlds_needed(required: f64, confidence: f64) -> Option<usize> {
     Some(n)
 }
 
+/// The fewest worlds `n ≥ from` at which the same share of favourable worlds, `⌊share·n⌋` of
+/// `n`, passes `passes(k, n)` (a lower bound reached, a p-value small enough): searched in steps
+/// of `max(1, n/64)` up to 65 536 worlds, `None` beyond. Serves both "how many worlds would
+/// qualify this design" and "how many worlds would decide this comparison".
+pub fn worlds_at_share(
+    share: f64,
+    from: usize,
+    passes: impl Fn(usize, usize) -> bool,
+) -> Option<usize> {
+    let mut n = from.max(1);
+    while n <= 1 << 16 {
+        let k = (share * n as f64).floor() as usize;
+        if passes(k, n) {
+            return Some(n);
+        }
+        n += 1.max(n / 64);
+    }
+    None
+}
+
 /// `ln C(n, i)` through `ln Γ` (libm's `lgamma`).
 fn ln_choose(n: usize, i: usize) -> f64 {
     let (n, i) = (n as f64, i as f64);

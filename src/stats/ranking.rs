@@ -6,7 +6,7 @@
 //! world. A case whose objective is not finite in a world counts as failed there. Rows longer
 //! than the shortest one are read up to its length.
 
-use super::confidence::{holm, holm_adjusted, sign_test_p};
+use super::confidence::{holm, holm_adjusted, sign_test_p, worlds_at_share};
 use super::describe::quantile_sorted;
 
 /// How a case ranks among all cases over the worlds.
@@ -288,15 +288,7 @@ fn worlds_to_reach(wins: usize, nw: usize, level: f64) -> Option<usize> {
         return None;
     }
     let share = wins as f64 / nw as f64;
-    let mut n = nw.max(1);
-    while n <= 1 << 16 {
-        let k = (share * n as f64).floor() as usize;
-        if sign_test_p(k, n) <= level {
-            return Some(n);
-        }
-        n += 1.max(n / 64);
-    }
-    None
+    worlds_at_share(share, nw, |k, n| sign_test_p(k, n) <= level)
 }
 
 /// Orders contenders by increasing margin, NaN margins last, then by case index.
@@ -364,11 +356,16 @@ pub fn verdict(
             c.needs_worlds = worlds_to_reach(c.wins, nw, alpha / m_open as f64);
         }
     }
-    others.sort_by(by_margin);
-    if rejected.iter().all(|r| *r) {
-        let p_value = others.iter().map(|c| c.p_adjusted).fold(0.0f64, f64::max);
-        return match others.first() {
-            Some(r) => Verdict::Winner {
+    // Each comparison with whether Holm rejected it, by increasing margin.
+    let mut judged: Vec<(Contender, bool)> = others.into_iter().zip(rejected).collect();
+    judged.sort_by(|a, b| by_margin(&a.0, &b.0));
+    if judged.iter().all(|(_, r)| *r) {
+        let p_value = judged
+            .iter()
+            .map(|(c, _)| c.p_adjusted)
+            .fold(0.0f64, f64::max);
+        return match judged.first() {
+            Some((r, _)) => Verdict::Winner {
                 leader,
                 runner_up: r.case,
                 p_beats: r.p_beats,
@@ -384,14 +381,11 @@ pub fn verdict(
             },
         };
     }
-    let beaten: Vec<usize> = candidates
-        .iter()
-        .filter(|&&(c, _)| c != leader)
-        .zip(&rejected)
-        .filter(|(_, r)| **r)
-        .map(|(&(c, _), _)| c)
+    let others: Vec<Contender> = judged
+        .into_iter()
+        .filter(|(_, beaten)| !beaten)
+        .map(|(c, _)| c)
         .collect();
-    others.retain(|c| !beaten.contains(&c.case));
     if others.iter().all(|c| c.needs_worlds.is_some()) {
         let needs_worlds = others
             .iter()

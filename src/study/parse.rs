@@ -228,20 +228,18 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         // A fault that strikes after the run ends never strikes: every design would read
         // "survives every single fault" (issue 39). Checked against the longest duration any
         // case runs (an axis over `scenario.duration` included).
+        let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
         let base = study
             .scenario_full
             .get("scenario")
             .and_then(|t| t.get("duration"))
-            .and_then(|d| d.as_float().or_else(|| d.as_integer().map(|i| i as f64)));
+            .and_then(number);
         let longest = study
             .axes
             .iter()
             .filter(|a| a.name == "scenario.duration")
             .flat_map(|a| match &a.spec {
-                super::schema::AxisSpec::Values(v) => v
-                    .iter()
-                    .filter_map(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
-                    .collect::<Vec<_>>(),
+                super::schema::AxisSpec::Values(v) => v.iter().filter_map(number).collect(),
                 super::schema::AxisSpec::Range { start, stop, .. } => vec![start.max(*stop)],
                 super::schema::AxisSpec::Distribution(_) => vec![f64::INFINITY],
             })

@@ -25,7 +25,7 @@ use crate::evaluate::disqualified;
 use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
-use crate::stats::confidence::{wilson_lower, wilson_worlds_needed};
+use crate::stats::confidence::{wilson_lower, wilson_worlds_needed, worlds_at_share};
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
 
 /// The per-world table of a study output (long format: one row per case and world).
@@ -457,15 +457,7 @@ fn worlds_for_share(share: f64, info: &RobustInfo) -> Option<usize> {
     if share <= need {
         return None;
     }
-    let mut n = 1usize;
-    while n <= 1 << 16 {
-        let k = (share * n as f64).floor() as usize;
-        if wilson_lower(k, n, info.confidence) >= need {
-            return Some(n);
-        }
-        n += 1.max(n / 64);
-    }
-    None
+    worlds_at_share(share, 1, |k, n| wilson_lower(k, n, info.confidence) >= need)
 }
 
 /// The paired verdict of `table` (rows) with `worlds` under `info`'s rule, the tuning noise
