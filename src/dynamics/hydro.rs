@@ -5,7 +5,7 @@
 //! body frame, with the moment about the body frame's origin.
 
 use super::manoeuvring::ManoeuvringKernel;
-use crate::model::{Body, Hydro};
+use crate::model::{Body, HullDrag, Hydro, Vehicle};
 use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 
 /// Strip-theory drag of a slender cylinder along its body x axis (docs/model.md §2), with the
@@ -35,6 +35,110 @@ pub struct CylinderDrag {
     pub free_rear: bool,
     /// The front face (`x = l`) is free: no body is joined in front of it (the chain's head).
     pub free_front: bool,
+    /// Hull skin friction `½ρ (1 + k) s_f 2πr l` [kg/m] (docs/model.md §2 "Hull drag"): the
+    /// axial force is `−k_friction C_F(Re) |u| u` with the ITTC-57 line [`ittc57`]; 0 = none.
+    pub k_friction: f64,
+    /// `L/ν` [s/m] of the whole chain: the Reynolds number is `Re = |u| L/ν`.
+    pub re_per_speed: f64,
+    /// Form drag `½ρ (C_nose A_front + C_base A_rear)` [kg/m] when moving head first
+    /// (`u > 0`: the front face leads), `A` the exposed areas of [`HullSite`].
+    pub k_form_ahead: f64,
+    /// Form drag `½ρ (C_nose A_rear + C_base A_front)` [kg/m] when moving tail first.
+    pub k_form_astern: f64,
+    /// Appendage drag `½ρ Σ C_D A` [kg/m] of the body's thrusters and rear joint gap.
+    pub k_appendage: f64,
+}
+
+/// Lowest Reynolds number at which [`ittc57`] is evaluated: below it the line's value at
+/// 10⁵ is kept (the line is a turbulent-flow fit, stated for Re ≳ 10⁵; `log₁₀ Re − 2` would
+/// vanish at Re = 100). At 10⁵ `C_F` = 0.0083.
+pub const ITTC57_RE_MIN: f64 = 1.0e5;
+
+/// The ITTC-57 model-ship correlation line `C_F = 0.075 / (log₁₀ Re − 2)²` (ITTC 1957;
+/// ITTC Recommended Procedure 7.5-02-02-02), with `Re` raised to [`ITTC57_RE_MIN`].
+#[inline]
+pub fn ittc57(re: f64) -> f64 {
+    let d = re.max(ITTC57_RE_MIN).log10() - 2.0;
+    0.075 / (d * d)
+}
+
+/// Hoerner's form factor of a streamlined body of revolution on its skin friction,
+/// `1 + 1.5 (d/L)^{3/2} + 7 (d/L)³` (S. F. Hoerner, *Fluid-Dynamic Drag*, 1965, ch. 6),
+/// for diameter `d` and length `l` [m].
+pub fn hoerner_form_factor(d: f64, l: f64) -> f64 {
+    let t = d / l;
+    1.0 + 1.5 * t.powf(1.5) + 7.0 * t.powi(3)
+}
+
+/// Where one body sits in the hull, read once from the chain when the dynamics are built
+/// (docs/model.md §2 "Hull drag"; nothing of it is recomputed per time step).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct HullSite {
+    /// No body is joined at the rear face (`x = 0`): the chain's tail.
+    pub free_rear: bool,
+    /// No body is joined at the front face (`x = l`): the chain's head.
+    pub free_front: bool,
+    /// Exposed area of the rear face [m²]: `πr²` when free, else the annulus
+    /// `π max(0, r² − r_prev²)` a larger body shows behind a smaller one (a diameter step).
+    pub rear_area: f64,
+    /// Exposed area of the front face [m²], likewise with the next body.
+    pub front_area: f64,
+    /// The hull's wetted length `L` [m]: the straight chain's length, all bodies.
+    pub hull_length: f64,
+    /// [`hoerner_form_factor`] of the chain (largest diameter over `L`).
+    pub form_factor: f64,
+    /// Thrusters on the body pushing along its axis (`|e_x · d| ≥ ½`): external pods.
+    pub pods: usize,
+    /// The body's other thrusters: tunnels through the hull.
+    pub tunnels: usize,
+    /// Joint gaps at the body's faces: one per joint at its rear face.
+    pub gaps: usize,
+}
+
+impl HullSite {
+    /// The site of every body of `v`, tail to head.
+    pub fn of_chain(v: &Vehicle) -> Vec<HullSite> {
+        let nb = v.bodies.len();
+        let hull_length = v.total_length();
+        let d_max = v.bodies.iter().map(|b| 2.0 * b.radius).fold(0.0, f64::max);
+        let form_factor = if hull_length > 0.0 {
+            hoerner_form_factor(d_max, hull_length)
+        } else {
+            1.0
+        };
+        let pi = std::f64::consts::PI;
+        (0..nb)
+            .map(|i| {
+                let r2 = v.bodies[i].radius.powi(2);
+                let exposed = |other: Option<usize>| match other {
+                    None => pi * r2,
+                    Some(j) => pi * (r2 - v.bodies[j].radius.powi(2)).max(0.0),
+                };
+                let (pods, tunnels) = v
+                    .thrusters
+                    .iter()
+                    .filter(|t| t.body == i)
+                    .fold((0, 0), |(p, t), th| {
+                        if th.direction.x.abs() >= 0.5 {
+                            (p + 1, t)
+                        } else {
+                            (p, t + 1)
+                        }
+                    });
+                HullSite {
+                    free_rear: i == 0,
+                    free_front: i + 1 == nb,
+                    rear_area: exposed(i.checked_sub(1)),
+                    front_area: exposed((i + 1 < nb).then_some(i + 1)),
+                    hull_length,
+                    form_factor,
+                    pods,
+                    tunnels,
+                    gaps: usize::from(i > 0),
+                }
+            })
+            .collect()
+    }
 }
 
 /// Cross-flow lift of a slender blunt-based cylinder (docs/model.md §2 "Lift"), `[N]`, for the
@@ -90,7 +194,50 @@ impl CylinderDrag {
             k_lift: 0.0,
             free_rear: false,
             free_front: false,
+            k_friction: 0.0,
+            re_per_speed: 0.0,
+            k_form_ahead: 0.0,
+            k_form_astern: 0.0,
+            k_appendage: 0.0,
         }
+    }
+
+    /// The same cylinder with its share of the hull's axial drag (docs/model.md §2 "Hull
+    /// drag") for constants `h` at `site`, in fluid of density `rho`: skin friction on its
+    /// side `2πr l` times the chain's form factor, nose and base drag on the exposed areas
+    /// of its faces, and the drag areas of its thrusters and joint gap.
+    pub fn with_hull(mut self, rho: f64, radius: f64, h: &HullDrag, site: &HullSite) -> Self {
+        let q = 0.5 * rho;
+        let side = 2.0 * std::f64::consts::PI * radius * self.length;
+        self.k_friction = q * h.friction_scale * site.form_factor * side;
+        self.re_per_speed = site.hull_length / h.viscosity;
+        let (nose, base) = (h.nose_cd * h.form_scale, h.base_cd * h.form_scale);
+        self.k_form_ahead = q * (nose * site.front_area + base * site.rear_area);
+        self.k_form_astern = q * (nose * site.rear_area + base * site.front_area);
+        self.k_appendage = q
+            * h.appendage_scale
+            * (site.pods as f64 * h.pod_drag_area
+                + site.tunnels as f64 * h.tunnel_drag_area
+                + site.gaps as f64 * h.gap_drag_area);
+        self
+    }
+
+    /// The quadratic axial coefficient `k(u)` [kg/m] of the axial force `−k(u) |u| u`: the
+    /// per-body `C_d,x` term, the appendages, the form drag of the leading and trailing faces
+    /// for the sign of `u`, and the skin friction at `Re = |u| L/ν` (docs/model.md §2).
+    #[inline]
+    pub fn axial_coefficient(&self, u: f64) -> f64 {
+        let form = if u > 0.0 {
+            self.k_form_ahead
+        } else {
+            self.k_form_astern
+        };
+        let friction = if self.k_friction == 0.0 {
+            0.0
+        } else {
+            self.k_friction * ittc57(u.abs() * self.re_per_speed)
+        };
+        self.k_axial + self.k_appendage + form + friction
     }
 
     /// The same cylinder with slender-body lift of slope `lift_slope` = `C_Lα` [1/rad] on
@@ -162,7 +309,7 @@ impl CylinderDrag {
             my -= s * dfz;
             mz += s * dfy;
         }
-        let fx = -self.k_axial * u.abs() * u;
+        let fx = -self.axial_coefficient(u) * u.abs() * u;
         // Linear damping on the twist at the centre c = (l/2, 0, 0): v_c = v + ω × c.
         let cx = 0.5 * self.length;
         let d = &self.linear;
@@ -212,10 +359,12 @@ pub enum DampingKernel {
 }
 
 impl DampingKernel {
-    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³]; `free_rear`
-    /// and `free_front` say whether its faces at `x = 0` and `x = l` are free (no body joined
-    /// there), where a cylinder's lift ([`CylinderDrag::lift`]) may act.
-    pub fn of(body: &Body, rho: f64, free_rear: bool, free_front: bool) -> Self {
+    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³] at `site` in
+    /// the chain ([`HullSite::of_chain`]): its free faces, where a cylinder's lift
+    /// ([`CylinderDrag::lift`]) may act, and what its hull drag
+    /// ([`CylinderDrag::with_hull`]) needs.
+    pub fn of(body: &Body, rho: f64, site: &HullSite) -> Self {
+        let (free_rear, free_front) = (site.free_rear, site.free_front);
         match &body.hydro {
             Hydro::Cylinder {
                 cd_x,
@@ -225,6 +374,7 @@ impl DampingKernel {
                 strips,
                 lift_slope,
                 lift_every_body,
+                hull,
                 ..
             } => {
                 let c = CylinderDrag::new(
@@ -237,6 +387,10 @@ impl DampingKernel {
                     *linear_damping,
                     *strips,
                 );
+                let c = match hull {
+                    Some(h) => c.with_hull(rho, body.radius, h, site),
+                    None => c,
+                };
                 DampingKernel::Cylinder(if *lift_slope == 0.0 {
                     c
                 } else {
@@ -285,6 +439,44 @@ impl DampingKernel {
             }
             DampingKernel::Manoeuvring(k) => k.wrench(v_r),
         }
+    }
+}
+
+/// The damping of a whole vehicle held rigid at its zero joint angles (the straight chain),
+/// for checks and reports (`results/drag/`, tests of docs/model.md §2 "Hull drag"): built
+/// once, like the dynamics' kernels; not used in the time step.
+#[derive(Clone, Debug)]
+pub struct RigidDamping {
+    kernels: Vec<DampingKernel>,
+    /// `g_bi` at `q = 0`: body `i`'s frame in the base frame `F_b`.
+    poses: Vec<crate::spatial::Se3>,
+}
+
+impl RigidDamping {
+    /// The kernels of `v` ([`HullSite::of_chain`], [`DampingKernel::of`]) and its straight
+    /// body poses.
+    pub fn new(v: &Vehicle) -> Self {
+        let ws = crate::kinematics::KinWorkspace::new(v);
+        Self {
+            kernels: v
+                .bodies
+                .iter()
+                .zip(HullSite::of_chain(v))
+                .map(|(b, site)| DampingKernel::of(b, v.fluid.rho, &site))
+                .collect(),
+            poses: ws.g_b,
+        }
+    }
+
+    /// The damping wrench on the vehicle [N, N·m], in `F_b` with the moment about its
+    /// origin, for the base twist `v_b` relative to the water (in `F_b`) of the rigid
+    /// straight vehicle: `Σ_i Ad_{g_bi}⁻ᵀ D_i(Ad_{g_bi}⁻¹ V_b)`.
+    pub fn wrench(&self, v_b: &Vec6) -> Vec6 {
+        self.kernels
+            .iter()
+            .zip(&self.poses)
+            .map(|(k, g)| g.wrench_to_parent(&k.wrench(&g.twist_to_child(v_b))))
+            .sum()
     }
 }
 
@@ -525,15 +717,20 @@ mod tests {
             _ => panic!("a cylinder"),
         };
         // No lift by default, whatever the faces.
-        assert_eq!(flags(&DampingKernel::of(&body, 1026.0, true, true)).0, 0.0);
+        let site = |rear: bool, front: bool| HullSite {
+            free_rear: rear,
+            free_front: front,
+            ..HullSite::default()
+        };
+        assert_eq!(flags(&DampingKernel::of(&body, 1026.0, &site(true, true))).0, 0.0);
         set(&mut body, 2.0, false);
-        let (k, rear, front) = flags(&DampingKernel::of(&body, 1026.0, true, false));
+        let (k, rear, front) = flags(&DampingKernel::of(&body, 1026.0, &site(true, false)));
         let expect = 0.5 * 1026.0 * 2.0 * std::f64::consts::PI * body.radius * body.radius;
         assert!((k - expect).abs() < 1e-12 * expect);
         assert_eq!((rear, front), (true, false));
-        assert!(!flags(&DampingKernel::of(&body, 1026.0, false, false)).1);
+        assert!(!flags(&DampingKernel::of(&body, 1026.0, &site(false, false))).1);
         set(&mut body, 2.0, true);
-        let (_, rear, front) = flags(&DampingKernel::of(&body, 1026.0, false, false));
+        let (_, rear, front) = flags(&DampingKernel::of(&body, 1026.0, &site(false, false)));
         assert_eq!((rear, front), (true, true));
     }
 
@@ -546,6 +743,85 @@ mod tests {
                 let w = c.lift(&v);
                 prop_assert!(v.dot(&w).abs() <= 1e-12 * (1.0 + w.norm() * v.norm()));
             }
+        }
+    }
+
+    #[test]
+    fn ittc57_line_values() {
+        // C_F = 0.075/(log10 Re − 2)²: 0.075/16 at Re = 1e6, 0.075/25 at 1e7; held below 1e5.
+        assert!((ittc57(1e6) - 0.075 / 16.0).abs() < 1e-15);
+        assert!((ittc57(1e7) - 0.075 / 25.0).abs() < 1e-15);
+        assert_eq!(ittc57(10.0), ittc57(ITTC57_RE_MIN));
+        assert_eq!(ittc57(0.0), ittc57(ITTC57_RE_MIN));
+        // Hoerner's form factor: 1 + 1.5·0.1^1.5 + 7·0.001 at d/L = 0.1.
+        let k = hoerner_form_factor(0.1, 1.0);
+        assert!((k - (1.0 + 1.5 * 0.1f64.powf(1.5) + 0.007)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn hull_sites_of_the_paper_design() {
+        let v = crate::model::presets::usm_paper();
+        let sites = HullSite::of_chain(&v);
+        let a = std::f64::consts::PI * 0.085 * 0.085;
+        // Only the tail's rear and the head's front are exposed (one radius throughout).
+        assert_eq!((sites[0].rear_area, sites[0].front_area), (a, 0.0));
+        assert_eq!((sites[8].rear_area, sites[8].front_area), (0.0, a));
+        assert!(sites[1..8]
+            .iter()
+            .all(|s| s.rear_area == 0.0 && s.front_area == 0.0));
+        // Thrusters: 2 on L1 (tunnels), 3 on L2 (2 pods, 1 tunnel), 2 on L3 (tunnels).
+        let count = |f: fn(&HullSite) -> usize| sites.iter().map(f).collect::<Vec<_>>();
+        assert_eq!(count(|s| s.pods), [0, 0, 0, 0, 2, 0, 0, 0, 0]);
+        assert_eq!(count(|s| s.tunnels), [0, 0, 2, 0, 1, 0, 2, 0, 0]);
+        assert_eq!(count(|s| s.gaps), [0, 1, 1, 1, 1, 1, 1, 1, 1]);
+        assert!(sites.iter().all(|s| s.hull_length == v.total_length()));
+        // A step in diameter exposes the annulus of the larger body.
+        let mut w = v.clone();
+        w.bodies[4].radius = 0.1;
+        let s = HullSite::of_chain(&w);
+        let ring = std::f64::consts::PI * (0.01 - 0.085 * 0.085);
+        assert!((s[4].rear_area - ring).abs() < 1e-15 && (s[4].front_area - ring).abs() < 1e-15);
+        assert_eq!((s[3].front_area, s[5].rear_area), (0.0, 0.0));
+    }
+
+    /// A paper-like head link with hull drag: free front face, one tunnel, one gap.
+    fn hull_head() -> CylinderDrag {
+        let site = HullSite {
+            free_front: true,
+            front_area: std::f64::consts::PI * 0.085 * 0.085,
+            hull_length: 3.3,
+            form_factor: 1.02,
+            tunnels: 1,
+            gaps: 1,
+            ..HullSite::default()
+        };
+        cyl().with_hull(1026.0, 0.085, &HullDrag::default(), &site)
+    }
+
+    #[test]
+    fn hull_axial_drag_is_its_written_out_sum() {
+        let c = hull_head();
+        let h = HullDrag::default();
+        let (q, a) = (0.5 * 1026.0, std::f64::consts::PI * 0.085 * 0.085);
+        let side = 2.0 * std::f64::consts::PI * 0.085 * 0.6;
+        let appendage = q * (h.tunnel_drag_area + h.gap_drag_area);
+        let friction = |u: f64| q * 1.02 * side * ittc57(u.abs() * 3.3 / h.viscosity);
+        let cd_x = q * 0.8 * a; // the per-body C_d,x of `cyl()` stays on top
+        // Head first: the free front face leads (nose); tail first: it trails (base).
+        for (u, form) in [(0.5, q * 0.8 * a), (-0.5, q * 0.1 * a)] {
+            let k = cd_x + appendage + form + friction(u);
+            let w = c.wrench(&Vec6::new(u, 0.0, 0.0, 0.0, 0.0, 0.0));
+            let expect = -k * u.abs() * u - 1.0 * u;
+            assert!((w[0] - expect).abs() < 1e-12 * expect.abs(), "{u}: {w}");
+            assert_eq!((w[1], w[2], w[3], w[4], w[5]), (0.0, 0.0, 0.0, 0.0, 0.0));
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn hull_drag_dissipates(v in proptest::array::uniform6(-2.0f64..2.0)) {
+            let v = Vec6::from_row_slice(&v);
+            prop_assert!(v.dot(&hull_head().wrench(&v)) <= 1e-12);
         }
     }
 

@@ -32,6 +32,15 @@ pub struct ModelScales {
     /// Lift at every body's trailing face, not only at the chain's free faces
     /// (`Hydro::Cylinder` `lift_every_body`). Nominal false.
     pub lift_every_body: bool,
+    /// Factor on the hull's skin friction (`HullDrag::friction_scale`; docs/model.md §2 "Hull
+    /// drag"), on top of `drag`. Nominal 1.
+    pub skin_friction: f64,
+    /// Factor on the hull's nose and base drag (`HullDrag::form_scale`), on top of `drag`.
+    /// Nominal 1.
+    pub form_drag: f64,
+    /// Factor on the hull's appendage allowance (`HullDrag::appendage_scale`: thrusters and
+    /// joint gaps), on top of `drag`. Nominal 1.
+    pub appendage: f64,
 }
 
 impl Default for ModelScales {
@@ -45,6 +54,9 @@ impl Default for ModelScales {
             thrust_limit: 1.0,
             lift_slope: 0.0,
             lift_every_body: false,
+            skin_friction: 1.0,
+            form_drag: 1.0,
+            appendage: 1.0,
         }
     }
 }
@@ -58,6 +70,9 @@ impl ModelScales {
             && self.added_mass == 1.0
             && self.lift_slope == 0.0
             && !self.lift_every_body
+            && self.skin_friction == 1.0
+            && self.form_drag == 1.0
+            && self.appendage == 1.0
     }
 
     /// Check the factors: finite, the damping, drag and added-mass factors ≥ 0, the thrust
@@ -69,6 +84,9 @@ impl ModelScales {
             (keys.drag, self.drag),
             (keys.added_mass, self.added_mass),
             (keys.lift_slope, self.lift_slope),
+            (keys.skin_friction, self.skin_friction),
+            (keys.form_drag, self.form_drag),
+            (keys.appendage, self.appendage),
         ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(ModelError::new(
@@ -110,6 +128,12 @@ pub struct ScaleKeys {
     pub thrust_limit: &'static str,
     /// Name of [`ModelScales::lift_slope`].
     pub lift_slope: &'static str,
+    /// Name of [`ModelScales::skin_friction`].
+    pub skin_friction: &'static str,
+    /// Name of [`ModelScales::form_drag`].
+    pub form_drag: &'static str,
+    /// Name of [`ModelScales::appendage`].
+    pub appendage: &'static str,
 }
 
 impl Vehicle {
@@ -135,8 +159,14 @@ impl Vehicle {
                     added_mass_scale,
                     lift_slope,
                     lift_every_body,
+                    hull,
                     ..
                 } => {
+                    if let Some(h) = hull {
+                        h.friction_scale *= s.drag * s.skin_friction;
+                        h.form_scale *= s.drag * s.form_drag;
+                        h.appendage_scale *= s.drag * s.appendage;
+                    }
                     for d in linear_damping.iter_mut() {
                         *d *= s.linear_damping;
                     }
@@ -235,6 +265,9 @@ mod tests {
         buoyancy_offset: "bo",
         thrust_limit: "tl",
         lift_slope: "ls",
+        skin_friction: "sf",
+        form_drag: "fd",
+        appendage: "ap",
     };
 
     #[test]
@@ -258,6 +291,9 @@ mod tests {
             thrust_limit: 0.8,
             lift_slope: 2.0,
             lift_every_body: true,
+            skin_friction: 1.5,
+            form_drag: 0.5,
+            appendage: 2.0,
         };
         v.apply_scales(&s, &KEYS).unwrap();
         for (b, b0) in v.bodies.iter().zip(&v0.bodies) {
@@ -267,6 +303,7 @@ mod tests {
                     linear_damping,
                     lift_slope,
                     lift_every_body,
+                    hull,
                     ..
                 },
                 Hydro::Cylinder {
@@ -282,6 +319,12 @@ mod tests {
             assert_eq!(linear_damping[3], 6.0 * ld0[3]);
             assert_eq!(linear_damping[4], 2.0 * ld0[4]);
             assert_eq!(*cd_x, 0.5 * cd_x0);
+            // The hull's factors: drag × their own.
+            let h = hull.expect("usm-paper bodies carry hull drag");
+            assert_eq!(
+                (h.friction_scale, h.form_scale, h.appendage_scale),
+                (0.75, 0.25, 1.0)
+            );
             assert_eq!(*lift_slope, 2.0, "set, not scaled");
             assert!(*lift_every_body);
             let (ma, ma0) = (b.added_mass(1026.0), b0.added_mass(1026.0));

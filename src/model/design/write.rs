@@ -142,6 +142,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 // A world property (scenario key `hydro.lift_slope`), not a design one.
                 lift_slope: _,
                 lift_every_body: _,
+                hull,
             } => {
                 let _ = writeln!(o, "kind = \"cylinder\"");
                 let _ = writeln!(o, "cd_x = {}", fnum(*cd_x));
@@ -156,6 +157,17 @@ pub fn design_to_toml(v: &Vehicle) -> String {
                 );
                 if *added_mass_scale != 1.0 {
                     let _ = writeln!(o, "added_mass_scale = {}", fnum(*added_mass_scale));
+                }
+                match hull {
+                    Some(h) => {
+                        let _ = writeln!(o, "hull = true  # hull drag, docs/model.md §2");
+                        for (k, v) in h.fields() {
+                            let _ = writeln!(o, "{k} = {}", fnum(v));
+                        }
+                    }
+                    None => {
+                        let _ = writeln!(o, "hull = false");
+                    }
                 }
             }
             Hydro::Coefficients {

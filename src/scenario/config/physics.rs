@@ -99,6 +99,14 @@ pub struct HydroScaleSpec {
     /// Apply that lift at every body's trailing face (each body its own blunt base), not only
     /// at the chain's free faces: an upper bound on the lift (default false).
     pub lift_every_body: bool,
+    /// Factor on the hull's skin friction (ITTC-57 line; docs/model.md §2 "Hull drag"), on
+    /// top of `drag_scale` (≥ 0).
+    pub skin_friction_scale: f64,
+    /// Factor on the hull's nose and base (form) drag, on top of `drag_scale` (≥ 0).
+    pub form_drag_scale: f64,
+    /// Factor on the hull's appendage allowance (thrusters, joint gaps), on top of
+    /// `drag_scale` (≥ 0).
+    pub appendage_scale: f64,
 }
 
 impl Default for HydroScaleSpec {
@@ -111,6 +119,9 @@ impl Default for HydroScaleSpec {
             buoyancy_offset: 0.0,
             lift_slope: 0.0,
             lift_every_body: false,
+            skin_friction_scale: 1.0,
+            form_drag_scale: 1.0,
+            appendage_scale: 1.0,
         }
     }
 }
@@ -124,6 +135,9 @@ pub const SCALE_KEYS: crate::model::world::ScaleKeys = crate::model::world::Scal
     buoyancy_offset: "hydro.buoyancy_offset",
     thrust_limit: "thrusters.limit_scale",
     lift_slope: "hydro.lift_slope",
+    skin_friction: "hydro.skin_friction_scale",
+    form_drag: "hydro.form_drag_scale",
+    appendage: "hydro.appendage_scale",
 };
 
 impl HydroScaleSpec {
@@ -138,6 +152,9 @@ impl HydroScaleSpec {
             thrust_limit: limit_scale,
             lift_slope: self.lift_slope,
             lift_every_body: self.lift_every_body,
+            skin_friction: self.skin_friction_scale,
+            form_drag: self.form_drag_scale,
+            appendage: self.appendage_scale,
         }
     }
 }
