@@ -44,7 +44,10 @@ fn usm_paper_cruise_drag_matches_the_hull_estimate() {
         "model {model} N, hand {hand} N"
     );
     // And the model is that formula, not merely near it (sums of a few terms: 1e-9).
-    assert!((model - hand).abs() < 1e-9 * hand, "model {model} N, hand {hand} N");
+    assert!(
+        (model - hand).abs() < 1e-9 * hand,
+        "model {model} N, hand {hand} N"
+    );
     // The per-body model charged 11.20 N here (issue 44); the hull drag about half.
     assert!(model < 0.6 * 11.20, "{model}");
 }

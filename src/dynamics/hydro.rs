@@ -114,17 +114,17 @@ impl HullSite {
                     None => pi * r2,
                     Some(j) => pi * (r2 - v.bodies[j].radius.powi(2)).max(0.0),
                 };
-                let (pods, tunnels) = v
-                    .thrusters
-                    .iter()
-                    .filter(|t| t.body == i)
-                    .fold((0, 0), |(p, t), th| {
-                        if th.direction.x.abs() >= 0.5 {
-                            (p + 1, t)
-                        } else {
-                            (p, t + 1)
-                        }
-                    });
+                let (pods, tunnels) =
+                    v.thrusters
+                        .iter()
+                        .filter(|t| t.body == i)
+                        .fold((0, 0), |(p, t), th| {
+                            if th.direction.x.abs() >= 0.5 {
+                                (p + 1, t)
+                            } else {
+                                (p, t + 1)
+                            }
+                        });
                 HullSite {
                     free_rear: i == 0,
                     free_front: i + 1 == nb,
@@ -722,7 +722,10 @@ mod tests {
             free_front: front,
             ..HullSite::default()
         };
-        assert_eq!(flags(&DampingKernel::of(&body, 1026.0, &site(true, true))).0, 0.0);
+        assert_eq!(
+            flags(&DampingKernel::of(&body, 1026.0, &site(true, true))).0,
+            0.0
+        );
         set(&mut body, 2.0, false);
         let (k, rear, front) = flags(&DampingKernel::of(&body, 1026.0, &site(true, false)));
         let expect = 0.5 * 1026.0 * 2.0 * std::f64::consts::PI * body.radius * body.radius;
@@ -807,7 +810,7 @@ mod tests {
         let appendage = q * (h.tunnel_drag_area + h.gap_drag_area);
         let friction = |u: f64| q * 1.02 * side * ittc57(u.abs() * 3.3 / h.viscosity);
         let cd_x = q * 0.8 * a; // the per-body C_d,x of `cyl()` stays on top
-        // Head first: the free front face leads (nose); tail first: it trails (base).
+                                // Head first: the free front face leads (nose); tail first: it trails (base).
         for (u, form) in [(0.5, q * 0.8 * a), (-0.5, q * 0.1 * a)] {
             let k = cd_x + appendage + form + friction(u);
             let w = c.wrench(&Vec6::new(u, 0.0, 0.0, 0.0, 0.0, 0.0));

@@ -289,8 +289,12 @@ impl GeneratorSpec {
         }
         // Per-body coefficients when either is given (USM Table II's values by default),
         // else the hull drag (docs/model.md §2 "Hull drag").
-        let per_body = (self.cd_axial_ends.is_some() || self.cd_axial.is_some())
-            .then(|| (self.cd_axial_ends.unwrap_or(0.8), self.cd_axial.unwrap_or(0.1)));
+        let per_body = (self.cd_axial_ends.is_some() || self.cd_axial.is_some()).then(|| {
+            (
+                self.cd_axial_ends.unwrap_or(0.8),
+                self.cd_axial.unwrap_or(0.1),
+            )
+        });
         let hydro = |length: f64, end: bool| match per_body {
             Some((ends, inner)) => Hydro::cylinder(if end { ends } else { inner }, self.cd_cross),
             None => Hydro::hull(length, self.cd_cross),

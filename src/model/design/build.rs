@@ -400,12 +400,7 @@ fn body(b: &BodySpec, i: usize, fluid: &Fluid, ctx: &Ctx) -> Result<Body, Design
 /// true` adds the hull drag on top; `linear_damping` given is per body, left out it is
 /// [`crate::model::LINEAR_DAMPING_PER_METRE`] × `length` with the hull and the former per-body default
 /// without.
-fn hydro(
-    h: Option<&HydroSpec>,
-    length: f64,
-    i: usize,
-    ctx: &Ctx,
-) -> Result<Hydro, DesignError> {
+fn hydro(h: Option<&HydroSpec>, length: f64, i: usize, ctx: &Ctx) -> Result<Hydro, DesignError> {
     let Some(h) = h else {
         return Ok(Hydro::hull(length, 1.0));
     };
