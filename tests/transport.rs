@@ -76,9 +76,11 @@ fn reproduced_both_methods_converge_turn_and_cruise_far_below_the_thrust_limit()
         assert!(cruise < 10.0, "{name}: cruise peak {cruise}");
         assert!(metric(r, "base_cross_track_rms") < 0.2, "{name}");
     }
-    // "Method 2 uses slightly more thruster effort": +1.5 % here (2369 vs 2333 N·s).
+    // "Method 2 uses slightly more thruster effort" is NOT reproduced under the hull drag
+    // (issue 44): Method 2 uses 3.6 % less (1373 vs 1424 N·s). Under the former per-body drag
+    // it used 1.5 % more (2369 vs 2333 N·s); the claim rests on a few per cent either way.
     let (e1, e2) = (metric(&r1, "effort_abs"), metric(&r2, "effort_abs"));
-    assert!(e2 > e1 && e2 < 1.05 * e1, "{e1} {e2}");
+    assert!(e2 < e1 && e2 > 0.9 * e1, "{e1} {e2}");
     // The presets run the default reading.
     let (d1, d2) = default_runs();
     assert_eq!(d1.get("effort_abs"), e1);
@@ -88,17 +90,18 @@ fn reproduced_both_methods_converge_turn_and_cruise_far_below_the_thrust_limit()
 #[test]
 fn adopted_reading_ordering_follows_the_yaw_gains_not_the_surge_source() {
     // Under the adopted reading (chosen because both methods converge under it) Method 1 is
-    // the faster: 24.6 / 26.4 s, overshoot 0.10 m, against Method 2's 71.7 / 71.4 s, 1.64 m.
+    // the faster: 26.2 / 28.9 s, no overshoot, against Method 2's 40.2 / 40.8 s, 0.93 m (hull
+    // drag, issue 44; the former per-body drag gave 24.6 / 26.4 against 71.7 / 71.4 s).
     // What makes the difference is the Table III yaw gains (k_6p = 0.13 vs 0.01): with the
-    // yaw gains and Δ swapped the ordering follows them (base surge with Method 1's: 24.6 s on
-    // segment 0; front surge with Method 2's: 68.8 s), and Method 1's k_6p alone makes
-    // Method 2 converge in 20.0 / 30.5 s, faster than Method 1 on segment 0. With k_6p = 0.01
-    // the base yaw loop (ω ≈ 0.06 rad/s) is far slower than the LOS loop (Δ/U = 4 s).
+    // yaw gains and Δ swapped the ordering follows them (base surge with Method 1's: 26.1 s on
+    // segment 0; front surge with Method 2's: 38.3 s), and Method 1's k_6p alone makes
+    // Method 2 converge faster than Method 1 on segment 0. With k_6p = 0.01 the base yaw loop
+    // is far slower than the LOS loop (Δ/U = 4 s).
     let (r1, r2) = default_runs();
     assert!(r1.converged() && r2.converged());
     let t = |r: &ReadingRun, k: &str| r.get(k);
-    assert_eq!(t(&r1, "seg0_convergence_time"), 24.6);
-    assert_eq!(t(&r2, "seg0_convergence_time"), 71.7);
+    assert!((t(&r1, "seg0_convergence_time") - 26.2).abs() < 1e-9);
+    assert!((t(&r2, "seg0_convergence_time") - 40.2).abs() < 1e-9);
     let r = TransportReading::DEFAULT;
     let base_fast =
         run_reading(r, TransportMethod::Method2, Some(TransportMethod::Method1)).unwrap();
@@ -109,7 +112,7 @@ fn adopted_reading_ordering_follows_the_yaw_gains_not_the_surge_source() {
         base_fast.get("seg0_convergence_time"),
         front_slow.get("seg0_convergence_time"),
     );
-    assert!(fast < 30.0 && slow > 60.0, "{fast} {slow}");
+    assert!(fast < 30.0 && slow > 35.0, "{fast} {slow}");
     // k_6p alone carries it.
     let k6p = run_reading_with(
         r,
@@ -119,8 +122,8 @@ fn adopted_reading_ordering_follows_the_yaw_gains_not_the_surge_source() {
     )
     .unwrap();
     assert!(k6p.converged());
-    assert_eq!(t(&k6p, "seg0_convergence_time"), 20.0);
-    assert!((t(&k6p, "seg1_convergence_time") - 30.5).abs() < 1e-9);
+    assert!((t(&k6p, "seg0_convergence_time") - 19.5).abs() < 1e-9);
+    assert!((t(&k6p, "seg1_convergence_time") - 15.4).abs() < 1e-9);
     assert!(t(&k6p, "seg0_convergence_time") < t(&r1, "seg0_convergence_time"));
 }
 
@@ -130,7 +133,7 @@ fn printed_reading_gives_the_papers_ranking_only_method2_converges() {
     // sway/heave/pitch are pure integrators and n cancels the bent body's steering force
     // (control::transport has the closed-loop analysis). Method 1 (k_6p = 0.13) is unstable
     // there: a bounded limit cycle with 40 N saturations (≈ 40 % of the time); Method 2
-    // (k_6p = 0.01) oscillates slowly and converges onto segment 1 (74.9 s after the turn).
+    // (k_6p = 0.01) oscillates slowly and converges onto segment 1 (72.8 s after the turn).
     // So the printed text supports the paper's ranking — Method 2 converges faster and with
     // less overshoot — but not its "both methods converge".
     let r1 = run_reading(TransportReading::PRINTED, TransportMethod::Method1, None).unwrap();
@@ -138,7 +141,7 @@ fn printed_reading_gives_the_papers_ranking_only_method2_converges() {
     assert!(!r1.failed && !r2.failed);
     assert!(!r1.converged() && !r2.converged());
     assert!(r1.get("seg0_convergence_time").is_nan() && r1.get("seg1_convergence_time").is_nan());
-    assert!((r2.get("seg1_convergence_time") - 74.9).abs() < 1e-9);
+    assert!((r2.get("seg1_convergence_time") - 72.8).abs() < 1e-9);
     assert!(r1.get("final_cross_track").abs() > 2.0 && r1.get("final_cross_track").abs() < 5.0);
     assert!(r2.get("final_cross_track").abs() < 0.1);
     assert!(r1.get("saturation_fraction") > 0.3);
@@ -156,27 +159,27 @@ fn printed_reading_gives_the_papers_ranking_only_method2_converges() {
 #[test]
 fn without_lift_the_runs_are_bit_identical_to_the_model_before_lift() {
     // `hydro.lift_slope = 0` (the default) must leave the model as it was: these are the
-    // adopted reading's and the printed reading's figures from results/paper/readings as
-    // committed before the lift term existed, to the last bit.
+    // adopted reading's and the printed reading's figures from results/paper/readings, to
+    // the last bit (re-pinned under the hull drag of issue 44; the lift term is unchanged).
     let lift_off = [("hydro", "lift_slope", toml::Value::Float(0.0))];
     let cases = [
         (
             TransportReading::DEFAULT,
             TransportMethod::Method1,
-            "2333.394416228177",
-            "5483.05301038629",
+            "1424.4017359017262",
+            "3077.17015495058",
         ),
         (
             TransportReading::DEFAULT,
             TransportMethod::Method2,
-            "2368.587681037731",
-            "5239.703614354733",
+            "1372.6289117115582",
+            "2711.4764663701694",
         ),
         (
             TransportReading::PRINTED,
             TransportMethod::Method2,
-            "3791.6108191557996",
-            "10230.917419223437",
+            "2902.051194986988",
+            "7744.64216155322",
         ),
     ];
     for (reading, method, effort, energy) in cases {
@@ -197,8 +200,10 @@ fn without_lift_the_runs_are_bit_identical_to_the_model_before_lift() {
 
 #[test]
 fn straight_vehicle_runs_straight_at_the_drag_balance_speed() {
-    // 2 × 5.6 N from the longitudinal thrusters, no joint motion: the axial drag
-    // Σ ½ρ C_d,x πr² u² + Σ d_x u = 26.8 u² + 9 u balances 11.2 N at u = 0.500 m/s.
+    // 2 × 2.69 N from the longitudinal thrusters, no joint motion: the hull drag
+    // (docs/model.md §2 "Hull drag": friction 1.01 N, nose and base 2.62 N, appendages 1.59 N,
+    // linear 0.17 N at 0.5 m/s) balances 5.38 N at u = 0.500 m/s (the former per-body drag:
+    // 11.2 N).
     let v = usm_paper();
     let mut sim = Simulator::new(&v, SimConfig::default()).unwrap();
     cruise(&mut sim, 6000);
@@ -222,14 +227,14 @@ fn straight_vehicle_runs_straight_at_the_drag_balance_speed() {
     disturb_yaw(&mut sim);
     cruise(&mut sim, 3000);
     let r = sim.state().base_twist[5];
-    assert!(r > 0.045 && r < 0.06, "yaw rate {r}");
+    assert!(r > 0.04 && r < 0.06, "yaw rate {r}");
 }
 
-/// `steps` × 0.01 s of the straight-running tests' command: 2 × 5.6 N from the longitudinal
+/// `steps` × 0.01 s of the straight-running tests' command: 2 × 2.69 N from the longitudinal
 /// thrusters, the joints held straight.
 fn cruise(sim: &mut Simulator, steps: usize) {
     let zero = [0.0; 8];
-    let thrust = [0.0, 0.0, 5.6, 5.6, 0.0, 0.0, 0.0];
+    let thrust = [0.0, 0.0, 2.69, 2.69, 0.0, 0.0, 0.0];
     let cmd = ActuatorCommand {
         thrust: &thrust,
         joint_ref: &zero,
@@ -253,9 +258,10 @@ fn disturb_yaw(sim: &mut Simulator) {
 fn lift_at_the_tail_slows_the_turn_onto_the_path_and_lift_at_every_body_narrows_the_gap() {
     // Adopted reading, Table III gains. Lift at the free trailing face (the tail, moving head
     // first) acts like a fin: the body becomes more directionally stable and resists the turns
-    // the bending and the yaw law command, so both methods converge later (Method 2: 71.7 s →
-    // 83.0 s on segment 0, segment 1 not within the 75 s left). The upper bound, lift at every
-    // body's trailing face, speeds Method 2 up (43.1 / 57.3 s) but Method 1 stays ahead.
+    // the bending and the yaw law command, so Method 2 converges later (40.2 / 40.8 s →
+    // 45.1 / 62.0 s; Method 1 26.2 / 28.7 s, unchanged on segment 0). The upper bound, lift at
+    // every body's trailing face, speeds both up (Method 2 36.5 / 36.2 s) but Method 1 stays
+    // ahead (22.1 / 18.6 s). (Hull drag, issue 44; the per-body drag gave 71.7 → 83.0 s.)
     let r = TransportReading::DEFAULT;
     let lift = |every: bool| {
         [
@@ -266,14 +272,14 @@ fn lift_at_the_tail_slows_the_turn_onto_the_path_and_lift_at_every_body_narrows_
     let m2 = run_reading_with(r, TransportMethod::Method2, None, &lift(false)).unwrap();
     let m1 = run_reading_with(r, TransportMethod::Method1, None, &lift(false)).unwrap();
     assert_eq!(m2.lift_slope, 2.0);
-    assert!((m2.get("seg0_convergence_time") - 83.0).abs() < 1e-9);
-    assert!(m2.get("seg1_convergence_time").is_nan());
-    assert!(m1.converged() && m1.get("seg0_convergence_time") > 24.6);
+    assert!((m2.get("seg0_convergence_time") - 45.1).abs() < 1e-9);
+    assert!((m2.get("seg1_convergence_time") - 62.0).abs() < 1e-9);
+    assert!(m1.converged() && m1.get("seg0_convergence_time") >= 26.2 - 1e-9);
     let e2 = run_reading_with(r, TransportMethod::Method2, None, &lift(true)).unwrap();
     let e1 = run_reading_with(r, TransportMethod::Method1, None, &lift(true)).unwrap();
     assert!(e1.converged() && e2.converged());
-    assert!((e2.get("seg0_convergence_time") - 43.1).abs() < 1e-9);
-    assert!((e2.get("seg1_convergence_time") - 57.3).abs() < 1e-9);
+    assert!((e2.get("seg0_convergence_time") - 36.5).abs() < 1e-9);
+    assert!((e2.get("seg1_convergence_time") - 36.2).abs() < 1e-9);
     for k in ["seg0_convergence_time", "seg1_convergence_time"] {
         assert!(e1.get(k) < e2.get(k), "{k}");
     }
@@ -314,8 +320,9 @@ fn lift_leaves_straight_running_alone_and_weakens_the_munk_instability() {
     // With lift at the free trailing face (the tail, moving head first), the net potential
     // load of slender-body theory sits at the nose instead of the Munk couple: half the
     // destabilising moment, and a side force that opposes the tail's sideslip. The bare body
-    // still turns (the nose load is ahead of the centre), but more slowly.
-    assert!(r0 > 0.045 && r0 < 0.06, "without lift {r0}");
+    // still turns (the nose load is ahead of the centre), but more slowly (under the hull drag
+    // 0.0007 rad/s against 0.049 after 30 s).
+    assert!(r0 > 0.04 && r0 < 0.06, "without lift {r0}");
     assert!(r2 > 0.0 && r2 < 0.8 * r0, "with lift {r2} (without {r0})");
 }
 

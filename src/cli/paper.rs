@@ -1,13 +1,15 @@
-//! `usm-study paper [usm|antonelli|readings|secondary] [--out DIR]`: regenerate a seed paper's
+//! `usm-study paper [usm|antonelli|readings|secondary|drag] [--out DIR]`: regenerate a seed paper's
 //! simulations — the USM paper (see [`usm_study::paper::usm`], the default), Antonelli &
 //! Chiaverini's case studies and Table I (see [`usm_study::paper::antonelli_outputs`]), the USM
 //! transport readings comparison (see [`usm_study::paper::readings`]), or the secondary
-//! objectives comparison (see [`usm_study::paper::secondary`]).
+//! objectives comparison (see [`usm_study::paper::secondary`]), or the hull drag against
+//! published vehicles (see [`usm_study::paper::published_drag`]).
 
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::paper::antonelli_outputs::run_antonelli;
+use usm_study::paper::published_drag::run_drag_comparison;
 use usm_study::paper::secondary::run_secondary_comparison;
 use usm_study::paper::transport_claims::run_readings_and_claims;
 use usm_study::paper::usm::run_paper;
@@ -26,6 +28,9 @@ pub enum PaperName {
     /// The USM paper's secondary objectives (manipulability, controllability) on and off, in
     /// work mode and transport: `secondary.csv` and `secondary.md`.
     Secondary,
+    /// The hull drag (docs/model.md §2) against published vehicles (NPS AUV II, REMUS 100):
+    /// `comparison.csv` and `comparison.md`.
+    Drag,
 }
 
 /// Arguments of `paper`.
@@ -36,7 +41,7 @@ pub struct PaperArgs {
     pub paper: PaperName,
     /// Output directory (default `results/paper` for `usm`, `results/antonelli` for
     /// `antonelli`, `results/paper/readings` for `readings`, `results/paper/secondary` for
-    /// `secondary`).
+    /// `secondary`, `results/drag` for `drag`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Also write each run's time series (CSV and Parquet; about 2 MB per run; `usm` only).
@@ -96,6 +101,23 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             None => eprintln!("[paper readings] no reading makes both methods converge"),
         }
         eprintln!("[paper readings] wrote {}", out.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    if a.paper == PaperName::Drag {
+        let out = a.out.clone().unwrap_or_else(|| "results/drag".into());
+        let rows = run_drag_comparison(&out)?;
+        for r in &rows {
+            eprintln!(
+                "[paper drag] {} {} at {}: published {:.2}, ours {:.2} ({:.2}x)",
+                r.vehicle,
+                r.coefficient,
+                r.at,
+                r.published,
+                r.ours,
+                r.ratio()
+            );
+        }
+        eprintln!("[paper drag] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }
     if a.paper == PaperName::Secondary {

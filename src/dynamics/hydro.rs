@@ -5,7 +5,7 @@
 //! body frame, with the moment about the body frame's origin.
 
 use super::manoeuvring::ManoeuvringKernel;
-use crate::model::{Body, Hydro};
+use crate::model::{Body, HullDrag, Hydro, Vehicle};
 use crate::spatial::{Mat3, Mat6, Vec3, Vec6};
 
 /// Strip-theory drag of a slender cylinder along its body x axis (docs/model.md §2), with the
@@ -35,6 +35,110 @@ pub struct CylinderDrag {
     pub free_rear: bool,
     /// The front face (`x = l`) is free: no body is joined in front of it (the chain's head).
     pub free_front: bool,
+    /// Hull skin friction `½ρ (1 + k) s_f 2πr l` [kg/m] (docs/model.md §2 "Hull drag"): the
+    /// axial force is `−k_friction C_F(Re) |u| u` with the ITTC-57 line [`ittc57`]; 0 = none.
+    pub k_friction: f64,
+    /// `L/ν` [s/m] of the whole chain: the Reynolds number is `Re = |u| L/ν`.
+    pub re_per_speed: f64,
+    /// Form drag `½ρ (C_nose A_front + C_base A_rear)` [kg/m] when moving head first
+    /// (`u > 0`: the front face leads), `A` the exposed areas of [`HullSite`].
+    pub k_form_ahead: f64,
+    /// Form drag `½ρ (C_nose A_rear + C_base A_front)` [kg/m] when moving tail first.
+    pub k_form_astern: f64,
+    /// Appendage drag `½ρ Σ C_D A` [kg/m] of the body's thrusters and rear joint gap.
+    pub k_appendage: f64,
+}
+
+/// Lowest Reynolds number at which [`ittc57`] is evaluated: below it the line's value at
+/// 10⁵ is kept (the line is a turbulent-flow fit, stated for Re ≳ 10⁵; `log₁₀ Re − 2` would
+/// vanish at Re = 100). At 10⁵ `C_F` = 0.0083.
+pub const ITTC57_RE_MIN: f64 = 1.0e5;
+
+/// The ITTC-57 model-ship correlation line `C_F = 0.075 / (log₁₀ Re − 2)²` (ITTC 1957;
+/// ITTC Recommended Procedure 7.5-02-02-02), with `Re` raised to [`ITTC57_RE_MIN`].
+#[inline]
+pub fn ittc57(re: f64) -> f64 {
+    let d = re.max(ITTC57_RE_MIN).log10() - 2.0;
+    0.075 / (d * d)
+}
+
+/// Hoerner's form factor of a streamlined body of revolution on its skin friction,
+/// `1 + 1.5 (d/L)^{3/2} + 7 (d/L)³` (S. F. Hoerner, *Fluid-Dynamic Drag*, 1965, ch. 6),
+/// for diameter `d` and length `l` [m].
+pub fn hoerner_form_factor(d: f64, l: f64) -> f64 {
+    let t = d / l;
+    1.0 + 1.5 * t.powf(1.5) + 7.0 * t.powi(3)
+}
+
+/// Where one body sits in the hull, read once from the chain when the dynamics are built
+/// (docs/model.md §2 "Hull drag"; nothing of it is recomputed per time step).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct HullSite {
+    /// No body is joined at the rear face (`x = 0`): the chain's tail.
+    pub free_rear: bool,
+    /// No body is joined at the front face (`x = l`): the chain's head.
+    pub free_front: bool,
+    /// Exposed area of the rear face [m²]: `πr²` when free, else the annulus
+    /// `π max(0, r² − r_prev²)` a larger body shows behind a smaller one (a diameter step).
+    pub rear_area: f64,
+    /// Exposed area of the front face [m²], likewise with the next body.
+    pub front_area: f64,
+    /// The hull's wetted length `L` [m]: the straight chain's length, all bodies.
+    pub hull_length: f64,
+    /// [`hoerner_form_factor`] of the chain (largest diameter over `L`).
+    pub form_factor: f64,
+    /// Thrusters on the body pushing along its axis (`|e_x · d| ≥ ½`): external pods.
+    pub pods: usize,
+    /// The body's other thrusters: tunnels through the hull.
+    pub tunnels: usize,
+    /// Joint gaps at the body's faces: one per joint at its rear face.
+    pub gaps: usize,
+}
+
+impl HullSite {
+    /// The site of every body of `v`, tail to head.
+    pub fn of_chain(v: &Vehicle) -> Vec<HullSite> {
+        let nb = v.bodies.len();
+        let hull_length = v.total_length();
+        let d_max = v.bodies.iter().map(|b| 2.0 * b.radius).fold(0.0, f64::max);
+        let form_factor = if hull_length > 0.0 {
+            hoerner_form_factor(d_max, hull_length)
+        } else {
+            1.0
+        };
+        let pi = std::f64::consts::PI;
+        (0..nb)
+            .map(|i| {
+                let r2 = v.bodies[i].radius.powi(2);
+                let exposed = |other: Option<usize>| match other {
+                    None => pi * r2,
+                    Some(j) => pi * (r2 - v.bodies[j].radius.powi(2)).max(0.0),
+                };
+                let (pods, tunnels) =
+                    v.thrusters
+                        .iter()
+                        .filter(|t| t.body == i)
+                        .fold((0, 0), |(p, t), th| {
+                            if th.direction.x.abs() >= 0.5 {
+                                (p + 1, t)
+                            } else {
+                                (p, t + 1)
+                            }
+                        });
+                HullSite {
+                    free_rear: i == 0,
+                    free_front: i + 1 == nb,
+                    rear_area: exposed(i.checked_sub(1)),
+                    front_area: exposed((i + 1 < nb).then_some(i + 1)),
+                    hull_length,
+                    form_factor,
+                    pods,
+                    tunnels,
+                    gaps: usize::from(i > 0),
+                }
+            })
+            .collect()
+    }
 }
 
 /// Cross-flow lift of a slender blunt-based cylinder (docs/model.md §2 "Lift"), `[N]`, for the
@@ -90,7 +194,50 @@ impl CylinderDrag {
             k_lift: 0.0,
             free_rear: false,
             free_front: false,
+            k_friction: 0.0,
+            re_per_speed: 0.0,
+            k_form_ahead: 0.0,
+            k_form_astern: 0.0,
+            k_appendage: 0.0,
         }
+    }
+
+    /// The same cylinder with its share of the hull's axial drag (docs/model.md §2 "Hull
+    /// drag") for constants `h` at `site`, in fluid of density `rho`: skin friction on its
+    /// side `2πr l` times the chain's form factor, nose and base drag on the exposed areas
+    /// of its faces, and the drag areas of its thrusters and joint gap.
+    pub fn with_hull(mut self, rho: f64, radius: f64, h: &HullDrag, site: &HullSite) -> Self {
+        let q = 0.5 * rho;
+        let side = 2.0 * std::f64::consts::PI * radius * self.length;
+        self.k_friction = q * h.friction_scale * site.form_factor * side;
+        self.re_per_speed = site.hull_length / h.viscosity;
+        let (nose, base) = (h.nose_cd * h.form_scale, h.base_cd * h.form_scale);
+        self.k_form_ahead = q * (nose * site.front_area + base * site.rear_area);
+        self.k_form_astern = q * (nose * site.rear_area + base * site.front_area);
+        self.k_appendage = q
+            * h.appendage_scale
+            * (site.pods as f64 * h.pod_drag_area
+                + site.tunnels as f64 * h.tunnel_drag_area
+                + site.gaps as f64 * h.gap_drag_area);
+        self
+    }
+
+    /// The quadratic axial coefficient `k(u)` [kg/m] of the axial force `−k(u) |u| u`: the
+    /// per-body `C_d,x` term, the appendages, the form drag of the leading and trailing faces
+    /// for the sign of `u`, and the skin friction at `Re = |u| L/ν` (docs/model.md §2).
+    #[inline]
+    pub fn axial_coefficient(&self, u: f64) -> f64 {
+        let form = if u > 0.0 {
+            self.k_form_ahead
+        } else {
+            self.k_form_astern
+        };
+        let friction = if self.k_friction == 0.0 {
+            0.0
+        } else {
+            self.k_friction * ittc57(u.abs() * self.re_per_speed)
+        };
+        self.k_axial + self.k_appendage + form + friction
     }
 
     /// The same cylinder with slender-body lift of slope `lift_slope` = `C_Lα` [1/rad] on
@@ -162,7 +309,7 @@ impl CylinderDrag {
             my -= s * dfz;
             mz += s * dfy;
         }
-        let fx = -self.k_axial * u.abs() * u;
+        let fx = -self.axial_coefficient(u) * u.abs() * u;
         // Linear damping on the twist at the centre c = (l/2, 0, 0): v_c = v + ω × c.
         let cx = 0.5 * self.length;
         let d = &self.linear;
@@ -212,10 +359,12 @@ pub enum DampingKernel {
 }
 
 impl DampingKernel {
-    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³]; `free_rear`
-    /// and `free_front` say whether its faces at `x = 0` and `x = l` are free (no body joined
-    /// there), where a cylinder's lift ([`CylinderDrag::lift`]) may act.
-    pub fn of(body: &Body, rho: f64, free_rear: bool, free_front: bool) -> Self {
+    /// Resolve the damping model of `body` in fluid of density `rho` [kg/m³] at `site` in
+    /// the chain ([`HullSite::of_chain`]): its free faces, where a cylinder's lift
+    /// ([`CylinderDrag::lift`]) may act, and what its hull drag
+    /// ([`CylinderDrag::with_hull`]) needs.
+    pub fn of(body: &Body, rho: f64, site: &HullSite) -> Self {
+        let (free_rear, free_front) = (site.free_rear, site.free_front);
         match &body.hydro {
             Hydro::Cylinder {
                 cd_x,
@@ -225,6 +374,7 @@ impl DampingKernel {
                 strips,
                 lift_slope,
                 lift_every_body,
+                hull,
                 ..
             } => {
                 let c = CylinderDrag::new(
@@ -237,6 +387,10 @@ impl DampingKernel {
                     *linear_damping,
                     *strips,
                 );
+                let c = match hull {
+                    Some(h) => c.with_hull(rho, body.radius, h, site),
+                    None => c,
+                };
                 DampingKernel::Cylinder(if *lift_slope == 0.0 {
                     c
                 } else {
@@ -288,6 +442,44 @@ impl DampingKernel {
     }
 }
 
+/// The damping of a whole vehicle held rigid at its zero joint angles (the straight chain),
+/// for checks and reports (`results/drag/`, tests of docs/model.md §2 "Hull drag"): built
+/// once, like the dynamics' kernels; not used in the time step.
+#[derive(Clone, Debug)]
+pub struct RigidDamping {
+    kernels: Vec<DampingKernel>,
+    /// `g_bi` at `q = 0`: body `i`'s frame in the base frame `F_b`.
+    poses: Vec<crate::spatial::Se3>,
+}
+
+impl RigidDamping {
+    /// The kernels of `v` ([`HullSite::of_chain`], [`DampingKernel::of`]) and its straight
+    /// body poses.
+    pub fn new(v: &Vehicle) -> Self {
+        let ws = crate::kinematics::KinWorkspace::new(v);
+        Self {
+            kernels: v
+                .bodies
+                .iter()
+                .zip(HullSite::of_chain(v))
+                .map(|(b, site)| DampingKernel::of(b, v.fluid.rho, &site))
+                .collect(),
+            poses: ws.g_b,
+        }
+    }
+
+    /// The damping wrench on the vehicle [N, N·m], in `F_b` with the moment about its
+    /// origin, for the base twist `v_b` relative to the water (in `F_b`) of the rigid
+    /// straight vehicle: `Σ_i Ad_{g_bi}⁻ᵀ D_i(Ad_{g_bi}⁻¹ V_b)`.
+    pub fn wrench(&self, v_b: &Vec6) -> Vec6 {
+        self.kernels
+            .iter()
+            .zip(&self.poses)
+            .map(|(k, g)| g.wrench_to_parent(&k.wrench(&g.twist_to_child(v_b))))
+            .sum()
+    }
+}
+
 /// Hydrostatic parameters of one body (docs/model.md §4 restoring forces).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Restoring {
@@ -336,234 +528,5 @@ impl Restoring {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::spatial::{ang, lin};
-    use proptest::prelude::*;
-
-    fn cyl() -> CylinderDrag {
-        CylinderDrag::new(
-            1026.0,
-            0.085,
-            0.6,
-            0.8,
-            1.0,
-            1.2,
-            [1.0, 2.0, 3.0, 0.05, 0.1, 0.2],
-            7,
-        )
-    }
-
-    /// Reference: the same integral written point by point in a different way (wrench of
-    /// each strip moved to the origin with the general formula `m = p × f`).
-    fn reference(c: &CylinderDrag, v: &Vec6) -> Vec6 {
-        let ds = c.length / c.strips as f64;
-        let mut w = Vec6::zeros();
-        for k in 0..c.strips {
-            let p = Vec3::new((k as f64 + 0.5) * ds, 0.0, 0.0);
-            let vp = lin(v) + ang(v).cross(&p);
-            let perp = Vec3::new(0.0, vp.y, vp.z);
-            let f = Vec3::new(
-                0.0,
-                -c.k_strip_y * perp.norm() * perp.y,
-                -c.k_strip_z * perp.norm() * perp.z,
-            );
-            let m = p.cross(&f);
-            w += Vec6::new(f.x, f.y, f.z, m.x, m.y, m.z);
-        }
-        w[0] -= c.k_axial * v[0].abs() * v[0];
-        let cc = Vec3::new(c.length / 2.0, 0.0, 0.0);
-        let vc = lin(v) + ang(v).cross(&cc);
-        let fl = -Vec3::new(c.linear[0] * vc.x, c.linear[1] * vc.y, c.linear[2] * vc.z);
-        let ml = -Vec3::new(c.linear[3] * v[3], c.linear[4] * v[4], c.linear[5] * v[5]);
-        let m = ml + cc.cross(&fl);
-        w + Vec6::new(fl.x, fl.y, fl.z, m.x, m.y, m.z)
-    }
-
-    #[test]
-    fn pure_translation_drag_closed_form() {
-        // A cylinder in pure cross-flow v_y: every strip sees the same v, so the total is
-        // exactly −½ρ C_d,y (2r) l v|v| − d_y v (docs/model.md §2), acting at the centre.
-        let c = cyl();
-        let v = 0.7;
-        let w = c.wrench(&Vec6::new(0.0, v, 0.0, 0.0, 0.0, 0.0));
-        let expect = -0.5 * 1026.0 * 1.0 * 2.0 * 0.085 * 0.6 * v * v - 2.0 * v;
-        // Sum of 7 equal terms: a few ulps of relative error.
-        assert!((w[1] - expect).abs() < 1e-12 * expect.abs());
-        // Moment about the origin = centre × force.
-        assert!((w[5] - 0.3 * w[1]).abs() < 1e-12 * expect.abs());
-        // Axial.
-        let w = c.wrench(&Vec6::new(-0.4, 0.0, 0.0, 0.0, 0.0, 0.0));
-        let expect = 0.5 * 1026.0 * 0.8 * std::f64::consts::PI * 0.085f64.powi(2) * 0.16 + 0.4;
-        assert!((w[0] - expect).abs() < 1e-12 * expect);
-    }
-
-    #[test]
-    fn pure_rotation_about_centre_has_no_net_strip_force() {
-        // Yaw about the geometric centre: v_y(s) = ω (s − l/2) is odd about the centre, so the
-        // strip forces cancel in pairs (midpoint rule is symmetric) and only a moment remains.
-        let c = cyl();
-        let w = 0.9;
-        let v = Vec6::new(0.0, -w * 0.3, 0.0, 0.0, 0.0, w);
-        let f = c.wrench(&v);
-        // Cancellation of O(10) N terms: 1e-12 absolute.
-        assert!(f[1].abs() < 1e-12, "{}", f[1]);
-        assert!(f[5] < 0.0, "the moment opposes the rotation");
-    }
-
-    proptest! {
-        #[test]
-        fn cylinder_matches_reference_and_dissipates(
-            v in proptest::array::uniform6(-2.0f64..2.0)
-        ) {
-            let c = cyl();
-            let v = Vec6::from_row_slice(&v);
-            let w = c.wrench(&v);
-            // Two evaluation orders of the same O(100) N sums: 1e-10 absolute.
-            prop_assert!((w - reference(&c, &v)).norm() < 1e-10);
-            // Drag and linear damping only remove energy: Vᵀ F ≤ 0.
-            prop_assert!(v.dot(&w) <= 1e-12);
-        }
-
-        #[test]
-        fn coefficient_damping_dissipates_for_diagonal_psd(
-            v in proptest::array::uniform6(-2.0f64..2.0)
-        ) {
-            let v = Vec6::from_row_slice(&v);
-            let dl = Mat6::from_diagonal(&Vec6::new(1.0, 2.0, 3.0, 0.1, 0.2, 0.3));
-            let dq = Mat6::from_diagonal(&Vec6::new(10.0, 20.0, 30.0, 1.0, 2.0, 3.0));
-            let w = coefficient_damping(&dl, &dq, &v);
-            prop_assert!(v.dot(&w) <= 0.0);
-            for i in 0..6 {
-                let e = -(dl[(i, i)] * v[i] + dq[(i, i)] * v[i].abs() * v[i]);
-                prop_assert!((w[i] - e).abs() < 1e-12);
-            }
-        }
-    }
-
-    /// The paper's link: ρ = 1026, r = 0.085 m, 0.6 m, with slender-body lift `C_Lα = 2` at
-    /// its free rear face.
-    fn lifting() -> CylinderDrag {
-        cyl().with_lift(1026.0, 0.085, 2.0, true, false)
-    }
-
-    #[test]
-    fn lift_is_perpendicular_to_the_flow_zero_at_zero_incidence_and_odd() {
-        let k = lifting().k_lift;
-        let (u, a) = (0.5, 0.1f64);
-        let v = Vec3::new(u * a.cos(), u * a.sin(), 0.0);
-        let f = slender_lift(k, &v);
-        // Hand value: ½ρ πr² U² C_Lα sin α cos α = ½·1026·π·0.085²·0.25·2·sin 0.1·cos 0.1.
-        let hand =
-            0.5 * 1026.0 * std::f64::consts::PI * 0.085f64.powi(2) * 0.25 * 2.0 * a.sin() * a.cos();
-        assert!((hand - 0.5783).abs() < 1e-4, "{hand}");
-        assert!((f.norm() - hand).abs() < 1e-14, "{} {hand}", f.norm());
-        // Perpendicular to the relative velocity (no work), in the plane of the axis and v,
-        // opposing the cross-flow component (a fin's lift).
-        assert!(f.dot(&v).abs() < 1e-15, "{}", f.dot(&v));
-        assert_eq!(f.z, 0.0);
-        assert!(f.y < 0.0 && f.x > 0.0);
-        // Odd in α: mirroring the incidence mirrors the force.
-        let g = slender_lift(k, &Vec3::new(v.x, -v.y, 0.0));
-        assert_eq!((g.x, g.y), (f.x, -f.y));
-        // Zero at α = 0 (pure axial flow), at α = 90° (pure cross-flow) and at rest.
-        assert_eq!(slender_lift(k, &Vec3::new(0.5, 0.0, 0.0)), Vec3::zeros());
-        assert_eq!(slender_lift(k, &Vec3::new(-0.5, 0.0, 0.0)), Vec3::zeros());
-        assert_eq!(slender_lift(k, &Vec3::new(0.0, 0.5, 0.2)), Vec3::zeros());
-        assert_eq!(slender_lift(k, &Vec3::zeros()), Vec3::zeros());
-        // Linear in α at small α: C_L = C_Lα α, i.e. ρ U² πr² α for C_Lα = 2.
-        let small = 1e-4f64;
-        let fs = slender_lift(k, &Vec3::new(u * small.cos(), u * small.sin(), 0.0));
-        let slope = 1026.0 * 0.25 * std::f64::consts::PI * 0.085f64.powi(2) * small;
-        assert!((fs.norm() - slope).abs() < 1e-8 * slope);
-    }
-
-    #[test]
-    fn lift_acts_at_the_free_trailing_face_only() {
-        let c = lifting();
-        let v = Vec6::new(0.5, 0.05, 0.0, 0.0, 0.0, 0.1);
-        // Moving head first (u > 0): the trailing face is the rear one (x = 0), free: the
-        // force is the lift of the rear face's velocity (v_y + ω_z·0) and makes no moment
-        // about the origin, which is that face.
-        let w = c.lift(&v);
-        let f = slender_lift(c.k_lift, &Vec3::new(0.5, 0.05, 0.0));
-        assert_eq!(Vec3::new(w[0], w[1], w[2]), f);
-        assert_eq!((w[3], w[4], w[5]), (0.0, 0.0, 0.0));
-        // The drag wrench with lift is the drag without it plus the lift.
-        assert_eq!(c.wrench(&v), cyl().wrench(&v) + w);
-        // Moving tail first: the trailing face is the front one, joined to the next body
-        // here: no lift. Free, it carries the lift of its own velocity and its moment.
-        let back = Vec6::new(-0.5, 0.05, 0.0, 0.0, 0.0, 0.1);
-        assert_eq!(c.lift(&back), Vec6::zeros());
-        let head = cyl().with_lift(1026.0, 0.085, 2.0, false, true);
-        let wb = head.lift(&back);
-        let fb = slender_lift(head.k_lift, &Vec3::new(-0.5, 0.05 + 0.1 * 0.6, 0.0));
-        assert_eq!(Vec3::new(wb[0], wb[1], wb[2]), fb);
-        assert!((wb[5] - 0.6 * fb.y).abs() < 1e-15);
-        // No lift where no face is free.
-        let inner = cyl().with_lift(1026.0, 0.085, 2.0, false, false);
-        assert_eq!(inner.lift(&v), Vec6::zeros());
-        assert_eq!(inner.lift(&back), Vec6::zeros());
-    }
-
-    #[test]
-    fn a_body_gets_lift_at_its_free_faces_or_at_every_face_when_asked() {
-        let mut body = crate::model::presets::usm_paper().bodies[4].clone();
-        let set = |b: &mut Body, slope: f64, every: bool| {
-            if let Hydro::Cylinder {
-                lift_slope,
-                lift_every_body,
-                ..
-            } = &mut b.hydro
-            {
-                *lift_slope = slope;
-                *lift_every_body = every;
-            }
-        };
-        let flags = |k: &DampingKernel| match k {
-            DampingKernel::Cylinder(c) => (c.k_lift, c.free_rear, c.free_front),
-            _ => panic!("a cylinder"),
-        };
-        // No lift by default, whatever the faces.
-        assert_eq!(flags(&DampingKernel::of(&body, 1026.0, true, true)).0, 0.0);
-        set(&mut body, 2.0, false);
-        let (k, rear, front) = flags(&DampingKernel::of(&body, 1026.0, true, false));
-        let expect = 0.5 * 1026.0 * 2.0 * std::f64::consts::PI * body.radius * body.radius;
-        assert!((k - expect).abs() < 1e-12 * expect);
-        assert_eq!((rear, front), (true, false));
-        assert!(!flags(&DampingKernel::of(&body, 1026.0, false, false)).1);
-        set(&mut body, 2.0, true);
-        let (_, rear, front) = flags(&DampingKernel::of(&body, 1026.0, false, false));
-        assert_eq!((rear, front), (true, true));
-    }
-
-    proptest! {
-        #[test]
-        fn lift_does_no_work(v in proptest::array::uniform6(-2.0f64..2.0)) {
-            // Vᵀ W_lift = f · (v + ω × p) = f · v_p = 0 for any twist, rotation included.
-            let v = Vec6::from_row_slice(&v);
-            for c in [lifting(), cyl().with_lift(1026.0, 0.085, 2.0, false, true)] {
-                let w = c.lift(&v);
-                prop_assert!(v.dot(&w).abs() <= 1e-12 * (1.0 + w.norm() * v.norm()));
-            }
-        }
-    }
-
-    #[test]
-    fn restoring_upright_and_tilted() {
-        let r = Restoring {
-            weight: 100.0,
-            buoyancy: 120.0,
-            cg: Vec3::new(0.3, 0.0, -0.05),
-            cb: Vec3::new(0.3, 0.0, 0.0),
-        };
-        // Level: net +20 N up; weight at x = 0.3 gives +30 N·m about y, buoyancy −36 N·m.
-        let w = r.wrench(&Mat3::identity());
-        assert!((w - Vec6::new(0.0, 0.0, 20.0, 0.0, 30.0 - 36.0, 0.0)).norm() < 1e-12);
-        // Rolled by 0.3 rad: the metacentric moment −(m g) z_g sin φ about x brings it back.
-        let rot = *nalgebra::Rotation3::from_euler_angles(0.3, 0.0, 0.0).matrix();
-        let w = r.wrench(&rot);
-        let expect_mx = -100.0 * 0.05 * 0.3f64.sin();
-        assert!((w[3] - expect_mx).abs() < 1e-12);
-    }
-}
+#[path = "hydro_tests.rs"]
+mod tests;

@@ -7,7 +7,7 @@
 //! `[v; ω]`, spatial acceleration and wrench `[f; m]`, all in body `i`'s own frame (moments
 //! about its origin). Generalised vectors are ordered `[base (6, in F_b); joints (n)]`.
 
-use super::hydro::{DampingKernel, Restoring};
+use super::hydro::{DampingKernel, HullSite, Restoring};
 use super::structure::is_axial;
 use crate::kinematics::KinWorkspace;
 use crate::model::Vehicle;
@@ -113,12 +113,13 @@ impl DynWorkspace {
             i_tot,
             axial,
             // A serial chain, tail to head: only the tail's rear face and the head's front
-            // face are free (where lift may act, `CylinderDrag::lift`).
+            // face are free (where lift may act, `CylinderDrag::lift`); the chain-level
+            // quantities of the hull drag are read here once (`HullSite`).
             damping: v
                 .bodies
                 .iter()
-                .enumerate()
-                .map(|(i, b)| DampingKernel::of(b, rho, i == 0, i + 1 == nb))
+                .zip(HullSite::of_chain(v))
+                .map(|(b, site)| DampingKernel::of(b, rho, &site))
                 .collect(),
             restoring: v
                 .bodies

@@ -175,10 +175,14 @@ pub struct GeneratorSpec {
     pub thrust_per_kg: f64,
     /// Lateral offset of the longitudinal thruster pair from the body axis [m].
     pub longitudinal_offset: f64,
-    /// Axial drag coefficient of the tail and head links.
-    pub cd_axial_ends: f64,
-    /// Axial drag coefficient of inner links and modules.
-    pub cd_axial: f64,
+    /// Per-body axial drag coefficient of the tail and head links (USM Table II: 0.8).
+    /// `None` with `cd_axial` `None` (the default): the hull drag of docs/model.md §2. Either
+    /// given: every body takes the per-body coefficient form of `Hydro::cylinder` (the other
+    /// one defaulting to Table II's value), with its per-body linear damping.
+    pub cd_axial_ends: Option<f64>,
+    /// Per-body axial drag coefficient of inner links and modules (USM Table II: 0.1); see
+    /// `cd_axial_ends`.
+    pub cd_axial: Option<f64>,
     /// Cross-flow drag coefficient of every body.
     pub cd_cross: f64,
     /// Metacentric height `GM` [m] of every body: its centre of buoyancy this far above its
@@ -218,8 +222,8 @@ impl Default for GeneratorSpec {
             thrust_limit: 40.0,
             thrust_per_kg: 0.0,
             longitudinal_offset: 0.10,
-            cd_axial_ends: 0.8,
-            cd_axial: 0.1,
+            cd_axial_ends: None,
+            cd_axial: None,
             cd_cross: 1.0,
             metacentric_height: DEFAULT_METACENTRIC_HEIGHT,
             wet_weight: 0.0,
@@ -293,6 +297,36 @@ impl GeneratorSpec {
         Ok(())
     }
 
+    /// The generator's numbers that must be finite and positive (or non-negative), with the
+    /// key that is wrong.
+    fn check_numbers(&self) -> Result<(), ModelError> {
+        for (key, v) in [
+            ("radius", self.radius),
+            ("module_length", self.module_length),
+            ("module_mass", self.module_mass),
+            ("joint_limit", self.joint_limit),
+        ] {
+            if !v.is_finite() || v <= 0.0 {
+                return Err(ModelError::new(
+                    format!("generator.{key}"),
+                    format!("must be a finite number > 0, got {v}"),
+                ));
+            }
+        }
+        for (key, v) in [
+            ("thrust_limit", self.thrust_limit),
+            ("thrust_per_kg", self.thrust_per_kg),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(ModelError::new(
+                    format!("generator.{key}"),
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Build the vehicle (validated).
     pub fn build(&self, name: &str) -> Result<Vehicle, ModelError> {
         let n = self.links;
@@ -330,30 +364,19 @@ impl GeneratorSpec {
         let fluid = Fluid::default();
         let rho = fluid.rho;
         let r = self.radius;
-        for (key, v) in [
-            ("radius", r),
-            ("module_length", self.module_length),
-            ("module_mass", self.module_mass),
-            ("joint_limit", self.joint_limit),
-        ] {
-            if !v.is_finite() || v <= 0.0 {
-                return Err(ModelError::new(
-                    format!("generator.{key}"),
-                    format!("must be a finite number > 0, got {v}"),
-                ));
-            }
-        }
-        for (key, v) in [
-            ("thrust_limit", self.thrust_limit),
-            ("thrust_per_kg", self.thrust_per_kg),
-        ] {
-            if !v.is_finite() || v < 0.0 {
-                return Err(ModelError::new(
-                    format!("generator.{key}"),
-                    format!("must be finite and >= 0, got {v}"),
-                ));
-            }
-        }
+        self.check_numbers()?;
+        // Per-body coefficients when either is given (USM Table II's values by default),
+        // else the hull drag (docs/model.md §2 "Hull drag").
+        let per_body = (self.cd_axial_ends.is_some() || self.cd_axial.is_some()).then(|| {
+            (
+                self.cd_axial_ends.unwrap_or(0.8),
+                self.cd_axial.unwrap_or(0.1),
+            )
+        });
+        let hydro = |length: f64, end: bool| match per_body {
+            Some((ends, inner)) => Hydro::cylinder(if end { ends } else { inner }, self.cd_cross),
+            None => Hydro::hull(length, self.cd_cross),
+        };
         let mut bodies = Vec::with_capacity(2 * n - 1);
         for k in 0..n {
             if k > 0 {
@@ -362,21 +385,16 @@ impl GeneratorSpec {
                     self.module_mass,
                     self.module_length,
                     r,
-                    Hydro::cylinder(self.cd_axial, self.cd_cross),
+                    hydro(self.module_length, false),
                     rho,
                 ));
             }
-            let cd_x = if k == 0 || k == n - 1 {
-                self.cd_axial_ends
-            } else {
-                self.cd_axial
-            };
             bodies.push(neutral_body(
                 &format!("L{k}"),
                 masses[k],
                 lengths[k],
                 r,
-                Hydro::cylinder(cd_x, self.cd_cross),
+                hydro(lengths[k], k == 0 || k == n - 1),
                 rho,
             ));
         }

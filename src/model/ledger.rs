@@ -76,27 +76,40 @@ pub const LEDGER: &[Assumption] = &[
     },
     Assumption {
         key: "hydro.linear_damping_scale",
-        name: "linear damping, translations",
-        value: "1 N·s/m per body on surge, sway and heave",
+        name: "linear damping, surge",
+        value: "0.1 N·s/m per metre of body (0.33 N·s/m on usm-paper)",
         source: Source::Inferred(
-            "the paper gives quadratic drag coefficients only; a small linear term keeps slow motion damped",
+            "the order of laminar (Blasius) skin friction 0.664ρ(νU/L)^½·2πr linearised at 0.1 m/s on the paper's hull (0.07 per m)",
         ),
         range: Some((0.0, 2.0)),
-        note: "about 40 % of the paper design's cruise drag (issue 22): from none to twice the \
-               assumption; the scale multiplies all six entries",
+        note: "3 % of the paper design's cruise drag at 0.5 m/s (was 1 N·s/m per body, 40 %, \
+               issue 22/44): from none to twice the assumption; the scale multiplies all six \
+               entries",
+    },
+    Assumption {
+        key: "hydro.linear_damping_scale",
+        name: "linear damping, sway and heave",
+        value: "2.7 N·s/m per metre of body",
+        source: Source::Inferred(
+            "the former 1 N·s/m per body of the paper's 9 bodies spread over its 3.3 m; no source: a regulariser of slow cross-flow",
+        ),
+        range: Some((0.0, 2.0)),
+        note: "the same scale as surge",
     },
     Assumption {
         key: "hydro.linear_damping_scale",
         name: "linear damping, rotations",
-        value: "0.05 N·m·s/rad per body about x, y and z",
-        source: Source::Inferred("so that no axis, roll included, is undamped"),
+        value: "0.136 N·m·s/rad per metre of body about x, y and z",
+        source: Source::Inferred(
+            "the former 0.05 N·m·s/rad per body of the paper's 9 bodies over its 3.3 m, so that no axis, roll included, is undamped",
+        ),
         range: Some((0.0, 2.0)),
         note: "the same scale as the translations",
     },
     Assumption {
         key: "hydro.roll_damping_scale",
         name: "roll damping",
-        value: "0.05 N·m·s/rad per body (the rotational linear damping about x)",
+        value: "0.136 N·m·s/rad per metre of body (the rotational linear damping about x)",
         source: Source::Inferred(
             "the cross-flow strips of a cylinder make no roll moment, so this is the only roll damping",
         ),
@@ -105,22 +118,59 @@ pub const LEDGER: &[Assumption] = &[
     },
     Assumption {
         key: "hydro.drag_scale",
-        name: "quadratic drag coefficients C_d,x / C_d,y = C_d,z",
-        value: "0.8 (end links) or 0.1 (inner bodies) axial; 1.0 cross-flow",
-        source: Source::Paper(USM_II),
+        name: "cross-flow drag coefficient C_d,y = C_d,z",
+        value: "1.0 on 2r per unit length",
+        source: Source::Paper(
+            "USM paper Table II; checked: a long cylinder's subcritical C_d 1.0–1.2 at the cross-flow Re 3e3–4e4 (Hoerner 1965 ch. 3) less end effects; REMUS 100 Y_v|v| (Prestero 2001) 1.05×",
+        ),
         range: Some((0.8, 1.2)),
-        note: "the paper chose typical values for blunt cylinders without experiments: ±20 %",
+        note: "the paper chose a typical value without experiments: ±20 %; the scale also \
+               multiplies every hull-drag term below and per-body C_d,x",
+    },
+    Assumption {
+        key: "hydro.skin_friction_scale",
+        name: "hull skin friction",
+        value: "ITTC-57 C_F = 0.075/(log₁₀Re − 2)² on 2πr l per body, Re = |u|L/ν of the whole chain (Re ≥ 1e5), × Hoerner's form factor 1 + 1.5(d/L)^1.5 + 7(d/L)³",
+        source: Source::Paper(
+            "ITTC 1957 friction line; Hoerner, Fluid-Dynamic Drag (1965) ch. 6; ν = 1.19e-6 m²/s seawater 15 °C (ITTC 7.5-02-01-03)",
+        ),
+        range: Some((0.8, 1.3)),
+        note: "the line is for smooth turbulent flow; at Re ≈ 1e6 part of the hull is laminar \
+               (less) and joints, seams and fouling roughen it (more)",
+    },
+    Assumption {
+        key: "hydro.form_drag_scale",
+        name: "nose and base drag at the chain's free ends (and diameter steps)",
+        value: "C_nose 0.8, C_base 0.1 on πr² (or the exposed annulus of a step)",
+        source: Source::Paper(
+            "Hoerner 1965 ch. 3: flat-faced cylinder forebody ≈ 0.8 (USM Table II's end-link C_d,x); base 0.1–0.2 (C_base inferred)",
+        ),
+        range: Some((0.5, 1.2)),
+        note: "the USM's real nose and tail are rounded to some degree (less); a flat face \
+               with sharp edges is the upper end",
+    },
+    Assumption {
+        key: "hydro.appendage_scale",
+        name: "appendage allowance (thrusters, joint gaps)",
+        value: "C_D·A 3.2e-3 m² per axial pod thruster, 7.7e-4 per tunnel thruster, 2.7e-4 per joint gap",
+        source: Source::Inferred(
+            "a 90 mm pod at C_D 0.5; a 70 mm tunnel at C_D 0.2 for its two openings; a 5 mm annular gap at C_D 0.1 on w·2πr",
+        ),
+        range: Some((0.5, 2.0)),
+        note: "30 % of usm-paper's cruise drag at 0.5 m/s (1.59 of 5.38 N); no measurement of \
+               the USM's appendages: a factor of 2 either way",
     },
     Assumption {
         key: "",
         name: "drag model",
-        value: "strip theory, 5 strips per body; axial −½ρC_d,x πr²|u|u",
+        value: "strip theory, 5 strips per body (cross-flow); hull drag shared over the bodies (axial)",
         source: Source::Inferred(
-            "the paper gives the coefficients, not how Vortex applies them (docs/model.md §2)",
+            "the paper gives the coefficients, not how Vortex applies them (docs/model.md §2 \"Hull drag\")",
         ),
         range: None,
-        note: "rotation makes cross-flow moments through the strips; the drag scale covers \
-               the model's level",
+        note: "a design file's explicit per-body cd_x keeps USM Table II's form \
+               −½ρC_d,x πr²|u|u per body; checked against NPS AUV II and REMUS 100 in \
+               results/drag/",
     },
     Assumption {
         key: "hydro.lift_slope",
@@ -602,7 +652,7 @@ mod tests {
         let md = ledger_markdown();
         assert_eq!(md.lines().count(), LEDGER.len() + 2);
         assert!(md.contains(
-            "| `hydro.roll_damping_scale` | roll damping | 0.05 N·m·s/rad per body (the rotational linear damping about x) | inferred: "
+            "| `hydro.roll_damping_scale` | roll damping | 0.136 N·m·s/rad per metre of body (the rotational linear damping about x) | inferred: "
         ));
         for line in md.lines() {
             // Six cells on every line: escaped pipes do not split cells.

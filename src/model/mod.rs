@@ -82,6 +82,13 @@ pub enum Hydro {
         /// Lift at the trailing face of *every* body, each its own blunt base, not only at
         /// the chain's free faces: an upper bound (`hydro.lift_every_body`; default false).
         lift_every_body: bool,
+        /// The body's share of the whole hull's axial drag (docs/model.md §2 "Hull drag"):
+        /// skin friction on its wetted side at the chain's Reynolds number, form drag at its
+        /// faces where they are free ends of the chain or steps in diameter, and an appendage
+        /// allowance for its thrusters and the joint gap at its rear face. Added to the
+        /// per-body `cd_x` term (0 for hull bodies). `None`: no hull drag (the per-body
+        /// coefficient model of USM Table II, and any design file that gives `cd_x`).
+        hull: Option<HullDrag>,
     },
     /// Hydrodynamic derivatives in matrix form about the body frame's origin:
     /// added mass `M_A` (6×6, symmetric PSD), linear damping `D_l` and quadratic damping
@@ -101,9 +108,91 @@ pub enum Hydro {
     Manoeuvring(Box<manoeuvring::Manoeuvring>),
 }
 
+/// Linear damping per metre of body length (docs/model.md §2 "Hull drag"), `[N·s/m per m ×3,
+/// N·m·s/rad per m ×3]`, applied as `length ×` these on the body's relative twist at its
+/// centre. **Inferred.** Surge 0.1: the order of laminar (Blasius) skin friction
+/// `0.664 ρ (νU/L)^½ · 2πr` linearised at U = 0.1 m/s on the 3.3 m, r = 0.085 m paper hull
+/// (0.07 N·s/m per m). Sway and heave 2.7, rotations 0.136: the paper design's former
+/// 1 N·s/m and 0.05 N·m·s/rad per body (9 bodies) spread over its 3.3 m, so that only the
+/// dependence on the body count changes; no source gives these (a regulariser of slow motion).
+pub const LINEAR_DAMPING_PER_METRE: [f64; 6] = [0.1, 2.7, 2.7, 0.136, 0.136, 0.136];
+
+/// The hull-drag constants a cylinder body carries (docs/model.md §2 "Hull drag"); the chain
+/// they act in (its length, free ends, diameter steps, thrusters, joints) is read once when
+/// the dynamics are built (`dynamics::hydro::HullSite`). Each field's doc gives its default
+/// ([`Default`]) and source; the ranges are checked by [`Vehicle::validate`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HullDrag {
+    /// Factor on the ITTC-57 friction line `C_F = 0.075/(log₁₀ Re − 2)²` (ITTC 1957), applied
+    /// on the body's side area `2πr l` with the chain's Reynolds number `Re = |u| L/ν`.
+    /// Default 1.
+    pub friction_scale: f64,
+    /// Form drag coefficient of a free *leading* face (the nose; on `πr²`, or on the exposed
+    /// annulus of a diameter step). Default 0.8: a flat-faced cylinder's forebody (Hoerner,
+    /// *Fluid-Dynamic Drag*, 1965, ch. 3; USM Table II's C_d,x of the end links). 0 for a
+    /// streamlined nose.
+    pub nose_cd: f64,
+    /// Base drag coefficient of a free *trailing* face (on `πr²` or the exposed annulus).
+    /// Default 0.1 (inferred: Hoerner ch. 3 gives 0.1–0.2 behind a blunt base on a long
+    /// cylinder). 0 for a tapered tail.
+    pub base_cd: f64,
+    /// Drag area `C_D A` [m²] of each thruster on the body whose direction is along the body
+    /// axis (an external pod). Default 3.2e-3 (inferred: a 90 mm pod at C_D 0.5).
+    pub pod_drag_area: f64,
+    /// Drag area `C_D A` [m²] of each other thruster (a tunnel through the hull). Default
+    /// 7.7e-4 (inferred: C_D 0.2 on a 70 mm tunnel's section for its two openings).
+    pub tunnel_drag_area: f64,
+    /// Drag area `C_D A` [m²] of the joint gap at the body's rear face (one per joint).
+    /// Default 2.7e-4 (inferred: a 5 mm annular gap round a 0.085 m radius at C_D 0.1 on
+    /// its area `w · 2πr`, a transverse groove in a turbulent boundary layer).
+    pub gap_drag_area: f64,
+    /// Factor on the three appendage drag areas. Default 1.
+    pub appendage_scale: f64,
+    /// Factor on the nose and base coefficients. Default 1.
+    pub form_scale: f64,
+    /// Kinematic viscosity ν [m²/s] of the Reynolds number. Default 1.19e-6 (seawater at
+    /// 15 °C, 35 g/kg: ITTC 7.5-02-01-03, 2011).
+    pub viscosity: f64,
+}
+
+impl Default for HullDrag {
+    fn default() -> Self {
+        Self {
+            friction_scale: 1.0,
+            nose_cd: 0.8,
+            base_cd: 0.1,
+            pod_drag_area: 3.2e-3,
+            tunnel_drag_area: 7.7e-4,
+            gap_drag_area: 2.7e-4,
+            appendage_scale: 1.0,
+            form_scale: 1.0,
+            viscosity: 1.19e-6,
+        }
+    }
+}
+
+impl HullDrag {
+    /// The fields by name, for validation and design files.
+    pub fn fields(&self) -> [(&'static str, f64); 9] {
+        [
+            ("friction_scale", self.friction_scale),
+            ("nose_cd", self.nose_cd),
+            ("base_cd", self.base_cd),
+            ("pod_drag_area", self.pod_drag_area),
+            ("tunnel_drag_area", self.tunnel_drag_area),
+            ("gap_drag_area", self.gap_drag_area),
+            ("appendage_scale", self.appendage_scale),
+            ("form_scale", self.form_scale),
+            ("viscosity", self.viscosity),
+        ]
+    }
+}
+
 impl Hydro {
-    /// The USM paper's cylinder model with the given drag coefficients and default small
-    /// linear damping (inferred defaults: 1 N·s/m on translations, 0.05 N·m·s/rad on rotations).
+    /// The USM paper's cylinder model with per-body drag coefficients (USM Table II's form:
+    /// axial `C_d,x` on `πr²` per body, no hull drag) and the former per-body linear damping
+    /// (1 N·s/m on translations, 0.05 N·m·s/rad on rotations, inferred): what a design file's
+    /// explicit `cd_x` means.
     pub fn cylinder(cd_x: f64, cd_yz: f64) -> Self {
         Hydro::Cylinder {
             cd_x,
@@ -115,6 +204,25 @@ impl Hydro {
             added_mass_scale: 1.0,
             lift_slope: 0.0,
             lift_every_body: false,
+            hull: None,
+        }
+    }
+
+    /// A body of `length` [m] in the hull-drag model (docs/model.md §2 "Hull drag"): no
+    /// per-body axial coefficient, the default [`HullDrag`], cross-flow coefficient `cd_yz`
+    /// and linear damping [`LINEAR_DAMPING_PER_METRE`] × `length`.
+    pub fn hull(length: f64, cd_yz: f64) -> Self {
+        Hydro::Cylinder {
+            cd_x: 0.0,
+            cd_y: cd_yz,
+            cd_z: cd_yz,
+            linear_damping: LINEAR_DAMPING_PER_METRE.map(|d| d * length),
+            strips: 5,
+            axial_added_mass_ratio: 0.1,
+            added_mass_scale: 1.0,
+            lift_slope: 0.0,
+            lift_every_body: false,
+            hull: Some(HullDrag::default()),
         }
     }
 }
@@ -380,7 +488,21 @@ impl Vehicle {
                     added_mass_scale,
                     lift_slope,
                     lift_every_body: _,
+                    hull,
                 } => {
+                    if let Some(h) = hull {
+                        for (name, v) in h.fields() {
+                            if !v.is_finite() || v < 0.0 {
+                                return Err(ModelError::new(
+                                    k(&format!("hydro.{name}")),
+                                    format!("must be finite and >= 0, got {v}"),
+                                ));
+                            }
+                        }
+                        if h.viscosity <= 0.0 {
+                            return Err(ModelError::new(k("hydro.viscosity"), "must be > 0"));
+                        }
+                    }
                     for (name, v) in [
                         ("cd_x", cd_x),
                         ("cd_y", cd_y),

@@ -67,22 +67,24 @@ pub(crate) fn thruster(name: &str, body: usize, x: f64, y: f64, dir: Vec3, limit
 pub fn usm_paper() -> Vehicle {
     let fluid = Fluid::default();
     let rho = fluid.rho;
-    // (name, mass kg, length m, Cd_x, Cd_y,z) — USM Table II.
-    let table: [(&str, f64, f64, f64, f64); 9] = [
-        ("L0", 14.3, 0.62, 0.8, 1.0),
-        ("J1", 6.0, 0.104, 0.1, 1.0),
-        ("L1", 12.7, 0.584, 0.1, 1.0),
-        ("J2", 6.0, 0.104, 0.1, 1.0),
-        ("L2", 9.8, 0.726, 0.1, 1.0),
-        ("J3", 6.0, 0.104, 0.1, 1.0),
-        ("L3", 12.7, 0.584, 0.1, 1.0),
-        ("J4", 6.0, 0.104, 0.1, 1.0),
-        ("L4", 7.8, 0.37, 0.8, 1.0),
+    // (name, mass kg, length m, Cd_y,z) — USM Table II. The axial drag is the hull's
+    // (docs/model.md §2 "Hull drag"), not Table II's per-body C_d,x (0.8 at the end links,
+    // 0.1 elsewhere: `Hydro::cylinder`, or `cd_x` in a design file, keeps that form).
+    let table: [(&str, f64, f64, f64); 9] = [
+        ("L0", 14.3, 0.62, 1.0),
+        ("J1", 6.0, 0.104, 1.0),
+        ("L1", 12.7, 0.584, 1.0),
+        ("J2", 6.0, 0.104, 1.0),
+        ("L2", 9.8, 0.726, 1.0),
+        ("J3", 6.0, 0.104, 1.0),
+        ("L3", 12.7, 0.584, 1.0),
+        ("J4", 6.0, 0.104, 1.0),
+        ("L4", 7.8, 0.37, 1.0),
     ];
     let r = 0.085;
     let bodies: Vec<Body> = table
         .iter()
-        .map(|&(n, m, l, cx, cyz)| neutral_body(n, m, l, r, Hydro::cylinder(cx, cyz), rho))
+        .map(|&(n, m, l, cyz)| neutral_body(n, m, l, r, Hydro::hull(l, cyz), rho))
         .collect();
     let mut joints = Vec::new();
     for (k, parent) in bodies.iter().enumerate().take(8) {

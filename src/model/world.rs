@@ -40,6 +40,15 @@ pub struct ModelScales {
     /// a longitudinal trim error, the pitch moment `ρ V g · shift` per body at level. Nominal
     /// 0; |shift| ≤ half the body's length.
     pub cb_offset_x: f64,
+    /// Factor on the hull's skin friction (`HullDrag::friction_scale`; docs/model.md §2 "Hull
+    /// drag"), on top of `drag`. Nominal 1.
+    pub skin_friction: f64,
+    /// Factor on the hull's nose and base drag (`HullDrag::form_scale`), on top of `drag`.
+    /// Nominal 1.
+    pub form_drag: f64,
+    /// Factor on the hull's appendage allowance (`HullDrag::appendage_scale`: thrusters and
+    /// joint gaps), on top of `drag`. Nominal 1.
+    pub appendage: f64,
 }
 
 impl Default for ModelScales {
@@ -55,6 +64,9 @@ impl Default for ModelScales {
             lift_every_body: false,
             cb_offset_z: 0.0,
             cb_offset_x: 0.0,
+            skin_friction: 1.0,
+            form_drag: 1.0,
+            appendage: 1.0,
         }
     }
 }
@@ -68,6 +80,9 @@ impl ModelScales {
             && self.added_mass == 1.0
             && self.lift_slope == 0.0
             && !self.lift_every_body
+            && self.skin_friction == 1.0
+            && self.form_drag == 1.0
+            && self.appendage == 1.0
     }
 
     /// Check the factors: finite, the damping, drag and added-mass factors ≥ 0, the thrust
@@ -79,6 +94,9 @@ impl ModelScales {
             (keys.drag, self.drag),
             (keys.added_mass, self.added_mass),
             (keys.lift_slope, self.lift_slope),
+            (keys.skin_friction, self.skin_friction),
+            (keys.form_drag, self.form_drag),
+            (keys.appendage, self.appendage),
         ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(ModelError::new(
@@ -132,6 +150,12 @@ pub struct ScaleKeys {
     pub cb_offset_z: &'static str,
     /// Name of [`ModelScales::cb_offset_x`].
     pub cb_offset_x: &'static str,
+    /// Name of [`ModelScales::skin_friction`].
+    pub skin_friction: &'static str,
+    /// Name of [`ModelScales::form_drag`].
+    pub form_drag: &'static str,
+    /// Name of [`ModelScales::appendage`].
+    pub appendage: &'static str,
 }
 
 impl Vehicle {
@@ -158,8 +182,14 @@ impl Vehicle {
                     added_mass_scale,
                     lift_slope,
                     lift_every_body,
+                    hull,
                     ..
                 } => {
+                    if let Some(h) = hull {
+                        h.friction_scale *= s.drag * s.skin_friction;
+                        h.form_scale *= s.drag * s.form_drag;
+                        h.appendage_scale *= s.drag * s.appendage;
+                    }
                     for d in linear_damping.iter_mut() {
                         *d *= s.linear_damping;
                     }
@@ -284,6 +314,9 @@ mod tests {
         lift_slope: "ls",
         cb_offset_z: "cbz",
         cb_offset_x: "cbx",
+        skin_friction: "sf",
+        form_drag: "fd",
+        appendage: "ap",
     };
 
     #[test]
@@ -309,6 +342,9 @@ mod tests {
             lift_every_body: true,
             cb_offset_z: 0.01,
             cb_offset_x: -0.02,
+            skin_friction: 1.5,
+            form_drag: 0.5,
+            appendage: 2.0,
         };
         v.apply_scales(&s, &KEYS).unwrap();
         for (b, b0) in v.bodies.iter().zip(&v0.bodies) {
@@ -318,6 +354,7 @@ mod tests {
                     linear_damping,
                     lift_slope,
                     lift_every_body,
+                    hull,
                     ..
                 },
                 Hydro::Cylinder {
@@ -333,6 +370,12 @@ mod tests {
             assert_eq!(linear_damping[3], 6.0 * ld0[3]);
             assert_eq!(linear_damping[4], 2.0 * ld0[4]);
             assert_eq!(*cd_x, 0.5 * cd_x0);
+            // The hull's factors: drag × their own.
+            let h = hull.expect("usm-paper bodies carry hull drag");
+            assert_eq!(
+                (h.friction_scale, h.form_scale, h.appendage_scale),
+                (0.75, 0.25, 1.0)
+            );
             assert_eq!(*lift_slope, 2.0, "set, not scaled");
             assert!(*lift_every_body);
             let (ma, ma0) = (b.added_mass(1026.0), b0.added_mass(1026.0));

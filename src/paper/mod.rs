@@ -10,7 +10,9 @@
 //!   ([`antonelli::dynamic`]) case 3 on the NPS AUV II ([`nps_auv2`]) under the sliding-mode
 //!   base control ([`sliding`]); [`antonelli_outputs`]: `paper antonelli` and the
 //!   `simulate antonelli-*` presets, their CSVs and summary; [`antonelli_figures`]: their
-//!   figures.
+//!   figures;
+//! - [`published_drag`]: the hull drag of docs/model.md §2 against the NPS AUV II and REMUS
+//!   100 (`paper drag`, `results/drag/`).
 //!
 //! The formulation these reproduce is `docs/model.md` (AC-nn, USM-nn).
 
@@ -18,6 +20,7 @@ pub mod antonelli;
 pub mod antonelli_figures;
 pub mod antonelli_outputs;
 pub mod nps_auv2;
+pub mod published_drag;
 pub mod readings;
 pub mod secondary;
 pub mod sliding;

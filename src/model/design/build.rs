@@ -7,7 +7,7 @@ use super::schema::{BodyRef, BodySpec, DesignFile, FrameSpec, HydroSpec, JointSp
 use crate::input::document::Document;
 use crate::model::generator::{BodyProfile, GeneratorSpec, ThrusterRule};
 use crate::model::presets;
-use crate::model::{Body, Fluid, Hydro, Joint, ModelError, Thruster, Vehicle};
+use crate::model::{Body, Fluid, HullDrag, Hydro, Joint, ModelError, Thruster, Vehicle};
 use crate::spatial::{rot_axis_angle, Mat3, Mat6, Se3, Vec3};
 use std::path::Path;
 
@@ -247,8 +247,8 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
         thrust_limit: g.thrust_limit.unwrap_or(d.thrust_limit),
         thrust_per_kg: g.thrust_per_kg.unwrap_or(d.thrust_per_kg),
         longitudinal_offset: g.longitudinal_offset.unwrap_or(d.longitudinal_offset),
-        cd_axial_ends: g.cd_axial_ends.unwrap_or(d.cd_axial_ends),
-        cd_axial: g.cd_axial.unwrap_or(d.cd_axial),
+        cd_axial_ends: g.cd_axial_ends.or(d.cd_axial_ends),
+        cd_axial: g.cd_axial.or(d.cd_axial),
         cd_cross: g.cd_cross.unwrap_or(d.cd_cross),
         metacentric_height: g.metacentric_height.unwrap_or(d.metacentric_height),
         wet_weight: g.wet_weight.unwrap_or(d.wet_weight),
@@ -270,8 +270,9 @@ fn build_generator(file: &DesignFile, ctx: &Ctx, name: &str) -> Result<Vehicle, 
     for (key, v) in [
         ("cd_axial_ends", spec.cd_axial_ends),
         ("cd_axial", spec.cd_axial),
-        ("cd_cross", spec.cd_cross),
+        ("cd_cross", Some(spec.cd_cross)),
     ] {
+        let Some(v) = v else { continue };
         if v.is_nan() || v < 0.0 {
             return Err(ctx.invalid(
                 &format!("generator.{key}"),
@@ -374,7 +375,7 @@ fn body(b: &BodySpec, i: usize, fluid: &Fluid, ctx: &Ctx) -> Result<Body, Design
             return Err(ctx.invalid(&key(f), format!("must be > 0, got {v}")));
         }
     }
-    let hydro = hydro(b.hydro.as_ref(), i, ctx)?;
+    let hydro = hydro(b.hydro.as_ref(), b.length, i, ctx)?;
     let mut body = Body::cylinder(&b.name, b.mass, b.length, b.radius, hydro);
     if let Some(cg) = b.cg {
         body.cg = vec3(cg);
@@ -399,9 +400,15 @@ fn body(b: &BodySpec, i: usize, fluid: &Fluid, ctx: &Ctx) -> Result<Body, Design
     Ok(body)
 }
 
-fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignError> {
+/// A body's `[body.hydro]` (module doc). The cylinder kind's axial drag: the hull drag
+/// (docs/model.md §2 "Hull drag") unless the file gives a per-body `cd_x`, which then means
+/// what it says (USM Table II's form, with the former per-body linear damping), and `hull =
+/// true` adds the hull drag on top; `linear_damping` given is per body, left out it is
+/// [`crate::model::LINEAR_DAMPING_PER_METRE`] × `length` with the hull and the former per-body default
+/// without.
+fn hydro(h: Option<&HydroSpec>, length: f64, i: usize, ctx: &Ctx) -> Result<Hydro, DesignError> {
     let Some(h) = h else {
-        return Ok(Hydro::cylinder(0.1, 1.0));
+        return Ok(Hydro::hull(length, 1.0));
     };
     let key = |f: &str| format!("body[{i}].hydro.{f}");
     let cylinder_keys = [
@@ -412,6 +419,16 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
         ("strips", h.strips.is_some()),
         ("axial_added_mass_ratio", h.axial_added_mass_ratio.is_some()),
         ("added_mass_scale", h.added_mass_scale.is_some()),
+        ("hull", h.hull.is_some()),
+        ("friction_scale", h.friction_scale.is_some()),
+        ("nose_cd", h.nose_cd.is_some()),
+        ("base_cd", h.base_cd.is_some()),
+        ("pod_drag_area", h.pod_drag_area.is_some()),
+        ("tunnel_drag_area", h.tunnel_drag_area.is_some()),
+        ("gap_drag_area", h.gap_drag_area.is_some()),
+        ("appendage_scale", h.appendage_scale.is_some()),
+        ("form_scale", h.form_scale.is_some()),
+        ("viscosity", h.viscosity.is_some()),
     ];
     let coefficient_keys = [
         ("added_mass", h.added_mass.is_some()),
@@ -427,38 +444,7 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
     match h.kind.as_deref().unwrap_or("cylinder") {
         "cylinder" => {
             misplaced(&coefficient_keys, "cylinder")?;
-            let Hydro::Cylinder {
-                cd_x,
-                cd_y,
-                cd_z,
-                linear_damping,
-                strips,
-                axial_added_mass_ratio,
-                added_mass_scale,
-                lift_slope,
-                lift_every_body,
-            } = Hydro::cylinder(0.1, 1.0)
-            else {
-                return Err(ctx.schema(&key("kind"), "internal: cylinder defaults"));
-            };
-            let strips = h.strips.unwrap_or(strips);
-            if !(1..=MAX_STRIPS).contains(&strips) {
-                return Err(ctx.invalid(
-                    &key("strips"),
-                    format!("must be between 1 and {MAX_STRIPS}, got {strips}"),
-                ));
-            }
-            Ok(Hydro::Cylinder {
-                cd_x: h.cd_x.unwrap_or(cd_x),
-                cd_y: h.cd_y.unwrap_or(cd_y),
-                cd_z: h.cd_z.unwrap_or(cd_z),
-                linear_damping: h.linear_damping.unwrap_or(linear_damping),
-                strips,
-                axial_added_mass_ratio: h.axial_added_mass_ratio.unwrap_or(axial_added_mass_ratio),
-                added_mass_scale: h.added_mass_scale.unwrap_or(added_mass_scale),
-                lift_slope,
-                lift_every_body,
-            })
+            cylinder(h, length, i, ctx)
         }
         "coefficients" => {
             misplaced(&cylinder_keys, "coefficients")?;
@@ -479,6 +465,82 @@ fn hydro(h: Option<&HydroSpec>, i: usize, ctx: &Ctx) -> Result<Hydro, DesignErro
             format!("unknown hydro kind '{other}'; valid: cylinder, coefficients"),
         )),
     }
+}
+
+/// The cylinder kind of a body's `[body.hydro]` ([`hydro`]): defaults from [`Hydro::hull`] or
+/// [`Hydro::cylinder`], overridden key by key.
+fn cylinder(h: &HydroSpec, length: f64, i: usize, ctx: &Ctx) -> Result<Hydro, DesignError> {
+    let key = |f: &str| format!("body[{i}].hydro.{f}");
+    let hull_fields = [
+        ("friction_scale", h.friction_scale),
+        ("nose_cd", h.nose_cd),
+        ("base_cd", h.base_cd),
+        ("pod_drag_area", h.pod_drag_area),
+        ("tunnel_drag_area", h.tunnel_drag_area),
+        ("gap_drag_area", h.gap_drag_area),
+        ("appendage_scale", h.appendage_scale),
+        ("form_scale", h.form_scale),
+        ("viscosity", h.viscosity),
+    ];
+    let with_hull = h.hull.unwrap_or(h.cd_x.is_none());
+    if !with_hull {
+        if let Some((f, _)) = hull_fields.iter().find(|(_, v)| v.is_some()) {
+            return Err(ctx.schema(
+                &key(f),
+                "a hull-drag key, but this body has no hull drag (it gives `cd_x` or \
+                 `hull = false`; add `hull = true` for both)",
+            ));
+        }
+    }
+    let Hydro::Cylinder {
+        cd_y,
+        cd_z,
+        linear_damping,
+        strips,
+        axial_added_mass_ratio,
+        added_mass_scale,
+        lift_slope,
+        lift_every_body,
+        hull,
+        ..
+    } = (if with_hull {
+        Hydro::hull(length, 1.0)
+    } else {
+        Hydro::cylinder(0.1, 1.0)
+    })
+    else {
+        return Err(ctx.schema(&key("kind"), "internal: cylinder defaults"));
+    };
+    let hull = hull.map(|d| HullDrag {
+        friction_scale: h.friction_scale.unwrap_or(d.friction_scale),
+        nose_cd: h.nose_cd.unwrap_or(d.nose_cd),
+        base_cd: h.base_cd.unwrap_or(d.base_cd),
+        pod_drag_area: h.pod_drag_area.unwrap_or(d.pod_drag_area),
+        tunnel_drag_area: h.tunnel_drag_area.unwrap_or(d.tunnel_drag_area),
+        gap_drag_area: h.gap_drag_area.unwrap_or(d.gap_drag_area),
+        appendage_scale: h.appendage_scale.unwrap_or(d.appendage_scale),
+        form_scale: h.form_scale.unwrap_or(d.form_scale),
+        viscosity: h.viscosity.unwrap_or(d.viscosity),
+    });
+    let strips = h.strips.unwrap_or(strips);
+    if !(1..=MAX_STRIPS).contains(&strips) {
+        return Err(ctx.invalid(
+            &key("strips"),
+            format!("must be between 1 and {MAX_STRIPS}, got {strips}"),
+        ));
+    }
+    Ok(Hydro::Cylinder {
+        cd_x: h.cd_x.unwrap_or(if with_hull { 0.0 } else { 0.1 }),
+        cd_y: h.cd_y.unwrap_or(cd_y),
+        cd_z: h.cd_z.unwrap_or(cd_z),
+        linear_damping: h.linear_damping.unwrap_or(linear_damping),
+        strips,
+        axial_added_mass_ratio: h.axial_added_mass_ratio.unwrap_or(axial_added_mass_ratio),
+        added_mass_scale: h.added_mass_scale.unwrap_or(added_mass_scale),
+        lift_slope,
+        lift_every_body,
+        hull,
+    })
 }
 
 /// Upper bound on strip-theory integration points per body (guards against absurd input).

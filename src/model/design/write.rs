@@ -131,50 +131,7 @@ pub fn design_to_toml(v: &Vehicle) -> String {
             fmat(&b.inertia, "")
         );
         let _ = writeln!(o, "[body.hydro]");
-        match &b.hydro {
-            Hydro::Cylinder {
-                cd_x,
-                cd_y,
-                cd_z,
-                linear_damping,
-                strips,
-                axial_added_mass_ratio,
-                added_mass_scale,
-                // A world property (scenario key `hydro.lift_slope`), not a design one.
-                lift_slope: _,
-                lift_every_body: _,
-            } => {
-                let _ = writeln!(o, "kind = \"cylinder\"");
-                let _ = writeln!(o, "cd_x = {}", fnum(*cd_x));
-                let _ = writeln!(o, "cd_y = {}", fnum(*cd_y));
-                let _ = writeln!(o, "cd_z = {}", fnum(*cd_z));
-                let _ = writeln!(o, "linear_damping = {}", farr(linear_damping));
-                let _ = writeln!(o, "strips = {strips}");
-                let _ = writeln!(
-                    o,
-                    "axial_added_mass_ratio = {}",
-                    fnum(*axial_added_mass_ratio)
-                );
-                if *added_mass_scale != 1.0 {
-                    let _ = writeln!(o, "added_mass_scale = {}", fnum(*added_mass_scale));
-                }
-            }
-            Hydro::Coefficients {
-                added_mass,
-                linear,
-                quadratic,
-            } => {
-                let _ = writeln!(o, "kind = \"coefficients\"");
-                let _ = writeln!(o, "added_mass = {}", fmat(added_mass, ""));
-                let _ = writeln!(o, "linear = {}", fmat(linear, ""));
-                let _ = writeln!(o, "quadratic = {}", fmat(quadratic, ""));
-            }
-            Hydro::Manoeuvring(_) => {
-                // Built-in derivative tables (paper::nps_auv2) have no design-file form:
-                // reading this back fails with "unknown hydro kind".
-                let _ = writeln!(o, "kind = \"manoeuvring\"  # built in, not readable");
-            }
-        }
+        write_hydro(&mut o, &b.hydro);
     }
     for (k, j) in v.joints.iter().enumerate() {
         let _ = writeln!(o, "\n# joint {k}: body {k} -> body {}\n[[joint]]", k + 1);
@@ -201,6 +158,66 @@ pub fn design_to_toml(v: &Vehicle) -> String {
         }
     }
     o
+}
+
+/// The `[body.hydro]` keys of one body's [`Hydro`] (the table header written by the caller).
+fn write_hydro(o: &mut String, hydro: &Hydro) {
+    match hydro {
+        Hydro::Cylinder {
+            cd_x,
+            cd_y,
+            cd_z,
+            linear_damping,
+            strips,
+            axial_added_mass_ratio,
+            added_mass_scale,
+            // A world property (scenario key `hydro.lift_slope`), not a design one.
+            lift_slope: _,
+            lift_every_body: _,
+            hull,
+        } => {
+            let _ = writeln!(o, "kind = \"cylinder\"");
+            let _ = writeln!(o, "cd_x = {}", fnum(*cd_x));
+            let _ = writeln!(o, "cd_y = {}", fnum(*cd_y));
+            let _ = writeln!(o, "cd_z = {}", fnum(*cd_z));
+            let _ = writeln!(o, "linear_damping = {}", farr(linear_damping));
+            let _ = writeln!(o, "strips = {strips}");
+            let _ = writeln!(
+                o,
+                "axial_added_mass_ratio = {}",
+                fnum(*axial_added_mass_ratio)
+            );
+            if *added_mass_scale != 1.0 {
+                let _ = writeln!(o, "added_mass_scale = {}", fnum(*added_mass_scale));
+            }
+            match hull {
+                Some(h) => {
+                    let _ = writeln!(o, "hull = true  # hull drag, docs/model.md §2");
+                    for (k, v) in h.fields() {
+                        let _ = writeln!(o, "{k} = {}", fnum(v));
+                    }
+                }
+                None => {
+                    let _ = writeln!(o, "hull = false");
+                }
+            }
+        }
+        Hydro::Coefficients {
+            added_mass,
+            linear,
+            quadratic,
+        } => {
+            let _ = writeln!(o, "kind = \"coefficients\"");
+            let _ = writeln!(o, "added_mass = {}", fmat(added_mass, ""));
+            let _ = writeln!(o, "linear = {}", fmat(linear, ""));
+            let _ = writeln!(o, "quadratic = {}", fmat(quadratic, ""));
+        }
+        Hydro::Manoeuvring(_) => {
+            // Built-in derivative tables (paper::nps_auv2) have no design-file form:
+            // reading this back fails with "unknown hydro kind".
+            let _ = writeln!(o, "kind = \"manoeuvring\"  # built in, not readable");
+        }
+    }
 }
 
 /// The comment line of body `b`'s hydrostatics (docs/model.md §4 "Restoring forces"): `CB −

@@ -130,6 +130,14 @@ pub struct HydroScaleSpec {
     /// neutrally buoyant (`scenario::nominal`). Default false: the controller cancels the
     /// plant's own terms.
     pub controller_nominal: bool,
+    /// Factor on the hull's skin friction (ITTC-57 line; docs/model.md §2 "Hull drag"), on
+    /// top of `drag_scale` (≥ 0).
+    pub skin_friction_scale: f64,
+    /// Factor on the hull's nose and base (form) drag, on top of `drag_scale` (≥ 0).
+    pub form_drag_scale: f64,
+    /// Factor on the hull's appendage allowance (thrusters, joint gaps), on top of
+    /// `drag_scale` (≥ 0).
+    pub appendage_scale: f64,
 }
 
 impl Default for HydroScaleSpec {
@@ -145,6 +153,9 @@ impl Default for HydroScaleSpec {
             cb_offset_z: 0.0,
             cb_offset_x: 0.0,
             controller_nominal: false,
+            skin_friction_scale: 1.0,
+            form_drag_scale: 1.0,
+            appendage_scale: 1.0,
         }
     }
 }
@@ -160,6 +171,9 @@ pub const SCALE_KEYS: crate::model::world::ScaleKeys = crate::model::world::Scal
     lift_slope: "hydro.lift_slope",
     cb_offset_z: "hydro.cb_offset_z",
     cb_offset_x: "hydro.cb_offset_x",
+    skin_friction: "hydro.skin_friction_scale",
+    form_drag: "hydro.form_drag_scale",
+    appendage: "hydro.appendage_scale",
 };
 
 impl HydroScaleSpec {
@@ -176,6 +190,9 @@ impl HydroScaleSpec {
             lift_every_body: self.lift_every_body,
             cb_offset_z: self.cb_offset_z,
             cb_offset_x: self.cb_offset_x,
+            skin_friction: self.skin_friction_scale,
+            form_drag: self.form_drag_scale,
+            appendage: self.appendage_scale,
         }
     }
 }

@@ -112,6 +112,7 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 added_mass_scale,
                 lift_slope,
                 lift_every_body,
+                hull,
             },
             Hydro::Cylinder {
                 cd_x: cx,
@@ -123,8 +124,19 @@ fn close_hydro(key: &str, x: &Hydro, y: &Hydro, tol: f64) -> Result<(), String> 
                 added_mass_scale: ams,
                 lift_slope: ls,
                 lift_every_body: le,
+                hull: hl,
             },
         ) => {
+            match (hull, hl) {
+                (Some(a), Some(b)) => {
+                    let (fa, fb) = (a.fields(), b.fields());
+                    for ((name, x), (_, y)) in fa.iter().zip(&fb) {
+                        num(&k(name), *x, *y, tol)?;
+                    }
+                }
+                (None, None) => {}
+                _ => return Err(k("hull")),
+            }
             nums(&k("cd"), &[*cd_x, *cd_y, *cd_z], &[*cx, *cy, *cz], tol)?;
             nums(&k("linear_damping"), linear_damping, ld, tol)?;
             num(&k("axial"), *axial_added_mass_ratio, *ar, tol)?;

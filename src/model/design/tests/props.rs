@@ -38,8 +38,8 @@ fn arb_spec() -> impl Strategy<Value = GeneratorSpec> {
                 thrust_limit: tl,
                 thrust_per_kg: 0.0,
                 longitudinal_offset: off,
-                cd_axial_ends: ce,
-                cd_axial: ca,
+                cd_axial_ends: Some(ce),
+                cd_axial: Some(ca),
                 cd_cross: cc,
                 metacentric_height: crate::model::generator::DEFAULT_METACENTRIC_HEIGHT,
                 wet_weight: 0.0,
@@ -62,8 +62,8 @@ fn generator_toml(s: &GeneratorSpec) -> String {
         ("joint_limit_deg", deg(s.joint_limit)),
         ("thrust_limit", s.thrust_limit),
         ("longitudinal_offset", s.longitudinal_offset),
-        ("cd_axial_ends", s.cd_axial_ends),
-        ("cd_axial", s.cd_axial),
+        ("cd_axial_ends", s.cd_axial_ends.unwrap_or(0.8)),
+        ("cd_axial", s.cd_axial.unwrap_or(0.1)),
         ("cd_cross", s.cd_cross),
     ] {
         let _ = writeln!(o, "{k} = {}", fnum(v));
