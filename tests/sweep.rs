@@ -264,6 +264,38 @@ fn dry_run_lists_cases() {
 }
 
 #[test]
+fn another_seed_changes_the_cases_and_not_the_file() {
+    // `--seed N` runs the study at another [study] seed: every case hash changes (the
+    // seed is part of it), the file is untouched, and without --out the output is the
+    // study's own plus `-seed-N` (the committed output of the file's seed is kept).
+    let d = tempfile::tempdir().unwrap();
+    let s = write(d.path(), "study.toml", STUDY12);
+    let hashes = |extra: &[&str]| -> Vec<String> {
+        let mut args = vec!["sweep", s.to_str().unwrap(), "--dry-run"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(str::to_string)
+            .collect()
+    };
+    let (own, other) = (hashes(&[]), hashes(&["--seed", "7"]));
+    assert_eq!(own.len(), other.len());
+    assert!(other[0].ends_with("-seed-7"), "{}", other[0]);
+    for (a, b) in own.iter().zip(&other).skip(1) {
+        assert_ne!(a.split_whitespace().nth(1), b.split_whitespace().nth(1));
+    }
+    // The file's own seed given explicitly is the file itself.
+    assert_eq!(own[1..], hashes(&["--seed", "11"])[1..]);
+    assert_eq!(std::fs::read_to_string(&s).unwrap(), STUDY12);
+    // An edited seed keeps every line where it was (error locations stay true).
+    let edited = usm_study::study::with_seed(STUDY12, 7).unwrap();
+    assert_eq!(edited.lines().count(), STUDY12.lines().count());
+    assert!(edited.contains("seed = 7\n"), "{edited}");
+}
+
+#[test]
 fn tcm_on_the_paper_design() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("tcm");

@@ -64,6 +64,22 @@ pub struct SweepArgs {
     /// Cases per Slurm array task (with --emit-slurm).
     #[arg(long, default_value_t = 10, value_name = "K")]
     pub cases_per_task: usize,
+    /// Run the study at another `[study] seed` (the worlds, the tuning and every seeded draw
+    /// change; the study file is not edited). Without --out the output goes to the study's
+    /// `output` plus `-seed-N`, so the committed output of the file's own seed is kept.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
+    pub seed: Option<u64>,
+}
+
+/// The study of `a`: the file as written, or at `--seed`.
+fn study_of(a: &SweepArgs) -> anyhow::Result<usm_study::study::Study> {
+    let Some(seed) = a.seed else {
+        return Ok(load_study(&a.study)?);
+    };
+    let text = std::fs::read_to_string(&a.study)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read the study file: {e}", a.study.display()))?;
+    let text = usm_study::study::with_seed(&text, seed)?;
+    Ok(usm_study::study::parse_study(&text, &a.study)?)
 }
 
 /// Write the Slurm submission script of `--emit-slurm`.
@@ -177,7 +193,7 @@ fn study_err(e: StudyError) -> anyhow::Error {
 
 /// Run `usm-study sweep`.
 pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
-    let study = load_study(&a.study)?;
+    let study = study_of(a)?;
     // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
     Tuner::new(&study)?;
     let shard = match &a.shard {
@@ -193,7 +209,10 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         jobs: a.jobs,
         resume: a.resume,
         shard,
-        out: a.out.clone(),
+        out: a.out.clone().or_else(|| {
+            a.seed
+                .map(|n| PathBuf::from(format!("{}-seed-{n}", study.output.display())))
+        }),
         max_cases: a.max_cases,
         case_timeout: case_budget(a.case_timeout)?,
         force: a.force,

@@ -147,6 +147,37 @@ fn base_design(
     Ok((t, format!("{} [design]", doc.origin())))
 }
 
+/// `text` with `[study] seed` set to `seed`, everything else as written: the value is replaced
+/// on its own line when the key is there (so every error location still points at the file's
+/// lines), else the key is added at the end of `[study]`. Errors: the text is not TOML, or
+/// `study` is not a table (the same errors [`parse_study`] would give, located).
+pub fn with_seed(text: &str, seed: u64) -> Result<String, InputError> {
+    let mut doc: toml_edit::DocumentMut =
+        text.parse().map_err(|e: toml_edit::TomlError| InputError {
+            at: Location::origin("study file"),
+            error: format!("not TOML: {e}"),
+        })?;
+    let study = doc
+        .entry("study")
+        .or_insert(toml_edit::table())
+        .as_table_mut()
+        .ok_or_else(|| InputError {
+            at: Location::origin("study file"),
+            error: "`study` must be a table".into(),
+        })?;
+    match study.get_mut("seed").and_then(|i| i.as_value_mut()) {
+        Some(v) => {
+            let decor = v.decor().clone();
+            *v = toml_edit::Value::from(seed as i64);
+            *v.decor_mut() = decor;
+        }
+        None => {
+            study.insert("seed", toml_edit::value(seed as i64));
+        }
+    }
+    Ok(doc.to_string())
+}
+
 /// Parse and validate study text; `path` locates relative design files and names the origin.
 pub fn parse_study(text: &str, path: &Path) -> Result<Study, InputError> {
     let origin = path.display().to_string();
