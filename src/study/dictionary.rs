@@ -110,8 +110,9 @@ const TUNING: &[ColumnDoc] = &[
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
-    c("completed", "0/1", "bool", "the run reached its duration without a numerical failure"),
+    c("completed", "0/1", "bool", "the run did not fail numerically: it reached its duration, or was ended on a certain `[success]` miss (`stopped_at`)"),
     c("simulated_time", "s", "f64", "simulated time reached"),
+    c("stopped_at", "s", "f64", "with `[success] stop_on_failure` (the default): the time the run was ended at because the criterion its verdict names could no longer be met (its metrics go that far); NaN for a run that went to its end or failed"),
     c("thruster_energy", "J", "f64", "thruster shaft energy by actuator-disk momentum theory with each thruster's axial inflow"),
     c("thruster_energy_static", "J", "f64", "the same thrusts at zero inflow"),
     c("effort_sq", "N²·s", "f64", "∫‖u‖² dt of the thrust held over each control interval"),
