@@ -52,7 +52,10 @@ k_6d = 0.3018726929028814
 /// to the end whatever its verdict (`[success] stop_on_failure = false`: these tests look at
 /// the whole capsize; tests/early_stop.rs stops the same run at the bound).
 fn run(extra: &str) -> RunResult {
-    run_with(LEADER, &format!("{extra}\n[success]\nstop_on_failure = false\n"))
+    run_with(
+        LEADER,
+        &format!("{extra}\n[success]\nstop_on_failure = false\n"),
+    )
 }
 
 /// As [`run`], from the study sections `leader`.

@@ -84,8 +84,9 @@ pub fn run_scenario_until(
     if let (Some(m), Some((t, c))) = (missed.as_mut(), run.stopped) {
         // The watch stops only on the criterion the verdict names first (scenario::watch).
         debug_assert_eq!(m.criterion, c, "a run stopped on {c} was judged {m}");
-        m.detail
-            .push_str(&format!(" (run stopped at t = {t:.3} s: this bound can no longer be met)"));
+        m.detail.push_str(&format!(
+            " (run stopped at t = {t:.3} s: this bound can no longer be met)"
+        ));
     }
     Ok(RunResult {
         name: file.scenario.name.clone(),

@@ -96,7 +96,10 @@ impl FailureWatch {
         let transport = file.scenario.mode == Mode::Transport;
         let candidates = [
             (short, Watched::Reach),
-            (transport && s.max_roll_deg > 0.0, Watched::Roll(s.max_roll_deg)),
+            (
+                transport && s.max_roll_deg > 0.0,
+                Watched::Roll(s.max_roll_deg),
+            ),
             (
                 transport && s.max_pitch_deg > 0.0,
                 Watched::Pitch(s.max_pitch_deg),
