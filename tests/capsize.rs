@@ -48,9 +48,14 @@ k_6p = 0.41125891198668474
 k_6d = 0.3018726929028814
 "#;
 
-/// The leader's run with `extra` (TOML: whole tables or `table.key = value` lines) over it.
+/// The leader's run with `extra` (TOML: whole tables or `table.key = value` lines) over it,
+/// to the end whatever its verdict (`[success] stop_on_failure = false`: these tests look at
+/// the whole capsize; tests/early_stop.rs stops the same run at the bound).
 fn run(extra: &str) -> RunResult {
-    run_with(LEADER, extra)
+    run_with(
+        LEADER,
+        &format!("{extra}\n[success]\nstop_on_failure = false\n"),
+    )
 }
 
 /// As [`run`], from the study sections `leader`.

@@ -297,6 +297,17 @@ impl EnergyIntegrator {
         self.last_on_path = Some((segment, along_track));
     }
 
+    /// The time so far with a thruster at a limit [s] (the numerator of
+    /// [`EnergyMetrics::saturation_fraction`]; it never decreases).
+    pub fn saturated_time(&self) -> f64 {
+        self.saturated
+    }
+
+    /// The largest |u_j| so far [N] ([`EnergyMetrics::peak_thrust`]).
+    pub fn peak_thrust(&self) -> f64 {
+        self.sums.peak_thrust
+    }
+
     /// The integrals so far, with the saturated fraction of the integrated time.
     pub fn metrics(&self) -> EnergyMetrics {
         EnergyMetrics {

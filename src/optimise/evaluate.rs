@@ -123,13 +123,15 @@ impl<'a> CaseEvaluator<'a> {
         .map_err(ResolveError)
     }
 
-    /// Run one resolved case (with its trajectory when `log`) through the case evaluator.
+    /// Run one resolved case (with its trajectory when `log`) through the case evaluator, to
+    /// its end whatever its verdict ([`whole_run`]).
     pub fn run_case(&self, r: &Resolved, log: bool) -> CaseResult {
         let study = &self.problem.study;
+        let scenario = whole_run(&r.scenario);
         case_eval::Evaluator::new().evaluate(&CaseInput {
             design: &r.design,
             design_hash: &r.design_hash,
-            scenario: &r.scenario,
+            scenario: &scenario,
             overrides: &[],
             seed: r.seed,
             deadline: self.deadline,
@@ -138,6 +140,23 @@ impl<'a> CaseEvaluator<'a> {
             label: "optimised design",
         })
     }
+}
+
+/// The scenario-side table `scenario` with `[success] stop_on_failure = false`: an optimiser's
+/// point (a tuning candidate) runs to its end. The solvers rank infeasible points by their
+/// total constraint violation, computed from the run's metrics; a run stopped at a certain
+/// miss has other metric values than the whole run, so stopping it would change which
+/// infeasible point ranks first and with it the search path and the tuned values (measured:
+/// docs/study-format.md "Stopping a failed run").
+fn whole_run(scenario: &toml::Table) -> toml::Table {
+    let mut t = scenario.clone();
+    let success = t
+        .entry("success")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let toml::Value::Table(s) = success {
+        s.insert("stop_on_failure".into(), toml::Value::Boolean(false));
+    }
+    t
 }
 
 /// The phases a point of `study` runs.
@@ -184,4 +203,25 @@ impl Evaluator for CaseEvaluator<'_> {
 /// The values of `names` among `named` (NaN when absent).
 pub fn pick(named: &[(String, f64)], names: &[String]) -> Vec<f64> {
     named.iter().cloned().collect::<Metrics>().pick(names)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::whole_run;
+
+    #[test]
+    fn an_optimisers_point_runs_to_its_end_whatever_the_study_says() {
+        let stop = |t: &toml::Table| t["success"]["stop_on_failure"].as_bool();
+        let none = toml::Table::new();
+        assert_eq!(stop(&whole_run(&none)), Some(false));
+        let study: toml::Table =
+            toml::from_str("[success]\nstop_on_failure = true\nmax_roll_deg = 20.0\n").unwrap();
+        assert_eq!(stop(&whole_run(&study)), Some(false));
+        // The other bounds are kept; the table given is not touched.
+        assert_eq!(
+            whole_run(&study)["success"]["max_roll_deg"].as_float(),
+            Some(20.0)
+        );
+        assert_eq!(stop(&study), Some(true));
+    }
 }

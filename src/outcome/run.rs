@@ -67,6 +67,7 @@ pub fn run_scenario_until(
     let run = run_loop(v, file, stop)?;
     let facts = RunFacts {
         failed: run.failure.is_some(),
+        stopped_at: run.stopped.map_or(f64::NAN, |(t, _)| t),
         reach: straight_reach(v),
     };
     let mut metrics = run_summary(
@@ -79,7 +80,14 @@ pub fn run_scenario_until(
     if let Some(t) = run.fault_time {
         metrics.push((FAULT_TIME_METRIC.to_string(), t));
     }
-    let missed = add_success(&mut metrics, file);
+    let mut missed = add_success(&mut metrics, file);
+    if let (Some(m), Some((t, c))) = (missed.as_mut(), run.stopped) {
+        // The watch stops only on the criterion the verdict names first (scenario::watch).
+        debug_assert_eq!(m.criterion, c, "a run stopped on {c} was judged {m}");
+        m.detail.push_str(&format!(
+            " (run stopped at t = {t:.3} s: this bound can no longer be met)"
+        ));
+    }
     Ok(RunResult {
         name: file.scenario.name.clone(),
         mode: file.scenario.mode,

@@ -21,9 +21,10 @@ type Metrics = Vec<(String, f64)>;
 /// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
 /// that computes them adds values in this order, and [`metric_catalogue`] lists them so that
 /// callers (the optimiser) can check names before anything runs.
-pub const COMMON_METRICS: [&str; 27] = [
+pub const COMMON_METRICS: [&str; 28] = [
     "completed",
     "simulated_time",
+    "stopped_at",
     "thruster_energy",
     "thruster_energy_static",
     "effort_sq",
@@ -156,6 +157,9 @@ fn channel(traj: &Trajectory, c: Channel) -> &[f64] {
 pub struct RunFacts {
     /// Whether the run stopped early.
     pub failed: bool,
+    /// The time a run stopped on a certain `[success]` miss was ended at [s]
+    /// (`scenario::LoopRun::stopped`; metric `stopped_at`); NaN when it was not.
+    pub stopped_at: f64,
     /// The design's reach [m] (`kinematics::straight_reach`, metric `reach`).
     pub reach: f64,
 }
@@ -205,6 +209,9 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 /// - `joint_energy` [J] `∫Σ|τ_q,i q̇_i|dt` from the simulator's joint motor torques and the
 ///   joint rates at the start of every physics step; `joint_torque_peak` [N·m] the largest
 ///   |τ_q,i| among them;
+/// - `stopped_at` [s]: with `[success] stop_on_failure`, the time the run was ended at because
+///   the criterion its verdict names was already certain to be missed (NaN for a run that
+///   went to its end or failed; `completed` stays 1: nothing failed numerically);
 /// - `peak_thrust` [N] at a control tick, `saturation_fraction` of the control intervals;
 /// - `singularity_exposure`, the fraction of time σ_min of the commanded rows `S·T_L` is below
 ///   `[metrics] threshold` (the controller's commanded axes, docs/model.md §6), and
@@ -245,6 +252,7 @@ fn common_metrics(
     let values = [
         if run.failed { 0.0 } else { 1.0 },
         t.last().copied().unwrap_or(0.0),
+        run.stopped_at,
         e.thruster_energy,
         e.thruster_energy_static,
         e.effort_sq,

@@ -177,7 +177,8 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
 /// the peak thrust when bounded, the work pose errors, the reach requirement as
 /// `(reach − required) / required`). Positive: every bound met with at least that relative room;
 /// negative: the worst miss relative to its bound ("missed by 1 cm of 0.1 m" is −0.1); −1 for a
-/// run that stopped early or a segment that never converged.
+/// run that failed numerically (`completed` = 0) or a segment that never converged. A run ended
+/// on a certain miss (`stopped_at`, `scenario::watch`) is measured on its metrics up to then.
 pub fn success_margin(
     spec: &SuccessSpec,
     mission: &MissionSpec,

@@ -323,7 +323,9 @@ pub fn run_reading_with(
             t.insert((*key).into(), value.clone());
         }
     }
-    let file = parse_table(&table, &src)?;
+    let mut file = parse_table(&table, &src)?;
+    // A reproduction shows the whole run, whatever its [success] verdict.
+    file.success.stop_on_failure = false;
     let v = resolve_design(&file, &src)?;
     let r = run_scenario(&v, &file)?;
     let path = file.path.clone().unwrap_or_default();

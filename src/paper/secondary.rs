@@ -100,7 +100,9 @@ pub fn run_secondary(
             sc.insert("duration".into(), toml::Value::Float(TRANSPORT_DURATION));
         }
     }
-    let file = parse_table(&table, &src)?;
+    let mut file = parse_table(&table, &src)?;
+    // A reproduction shows the whole run, whatever its [success] verdict.
+    file.success.stop_on_failure = false;
     let v = resolve_design(&file, &src)?;
     let r = run_scenario(&v, &file)?;
     let (sigma, manip) = secondary_profile(&file, &v, &r)?;

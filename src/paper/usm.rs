@@ -130,7 +130,9 @@ pub fn run_paper(
         if let Some(m) = method {
             set_allocation_method(&mut table, *m);
         }
-        let file = parse_table(&table, &src)?;
+        let mut file = parse_table(&table, &src)?;
+        // A reproduction shows the whole run, whatever its [success] verdict.
+        file.success.stop_on_failure = false;
         let v = resolve_design(&file, &src)?;
         let r = run_scenario(&v, &file)?;
         let run_dir: PathBuf = out.join(dir);

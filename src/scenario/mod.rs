@@ -41,6 +41,7 @@ pub mod run;
 mod setup;
 pub mod success;
 pub mod target;
+mod watch;
 
 pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
 pub use config::{Mode, ScenarioFile};

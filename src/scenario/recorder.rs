@@ -408,6 +408,11 @@ impl Recorder {
         self.traj.push_row(&self.row);
     }
 
+    /// The log so far.
+    pub fn trajectory(&self) -> &Trajectory {
+        &self.traj
+    }
+
     /// The trajectory, the allocation counts, the energy integrals and the timers, with the
     /// total wall time since `started`, the real-time factor and the per-step medians filled
     /// in.

@@ -15,6 +15,8 @@ use super::controller::Measurement;
 use super::error::ScenarioError;
 use super::recorder::{timed, AllocationCounts, Recorder, Timing};
 use super::setup::ClosedLoop;
+use super::success::Criterion;
+use super::watch::FailureWatch;
 use crate::dynamics::ActuatorCommand;
 use crate::kinematics::{forward_kinematics, thruster_matrix, BasePose};
 use crate::metrics::singularity::{commanded_sigma_with, CommandedDofs, ScaledGram};
@@ -34,6 +36,10 @@ pub struct LoopRun {
     pub trajectory: Trajectory,
     /// Why the run stopped early, if it did: (simulation time [s], cause).
     pub failure: Option<(f64, String)>,
+    /// With `[success] stop_on_failure`: the run was ended at this time [s] (the end of the
+    /// last control period it ran) because this criterion was certain to be missed
+    /// (`super::watch`); `None` when it ran to its end or failed.
+    pub stopped: Option<(f64, Criterion)>,
     /// Allocation outcomes.
     pub allocation_counts: AllocationCounts,
     /// Energy integrals (thrusters at the control rate, joints from the simulator).
@@ -258,16 +264,29 @@ pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun,
     let started = Instant::now();
     let mut lp = ClosedLoop::new(v, file)?;
     let mut rec = Recorder::new(&lp);
-    let failure = (0..=lp.n_control).find_map(|k| {
+    let mut watch = FailureWatch::new(v, &lp.vehicle, file, lp.n_control);
+    let dt = file.scenario.control_dt;
+    let (mut failure, mut stopped) = (None, None);
+    for k in 0..=lp.n_control {
         if let Some(cause) = stop.cause() {
-            return Some((k as f64 * file.scenario.control_dt, cause.to_string()));
+            failure = Some((k as f64 * dt, cause.to_string()));
+            break;
         }
         let period_started = Instant::now();
         let result = lp.period(k, &mut rec);
         rec.control_periods
             .push(period_started.elapsed().as_secs_f64());
-        result.err()
-    });
+        if let Err(f) = result {
+            failure = Some(f);
+            break;
+        }
+        if k < lp.n_control {
+            if let Some(c) = watch.check(rec.trajectory(), &rec.energy) {
+                stopped = Some(((k + 1) as f64 * dt, c));
+                break;
+            }
+        }
+    }
     let stats = lp.sim.step_stats();
     rec.timing.physics_steps = stats.steps;
     rec.timing.physics_rejected = stats.rejected;
@@ -279,6 +298,7 @@ pub fn run_loop(v: &Vehicle, file: &ScenarioFile, stop: Stop) -> Result<LoopRun,
     Ok(LoopRun {
         trajectory,
         failure,
+        stopped,
         allocation_counts,
         energy,
         timing,

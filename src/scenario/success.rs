@@ -16,6 +16,8 @@
 //! # work
 //! position_tolerance = 0.02      # m, final end-effector position error
 //! orientation_tolerance_deg = 2.0 # deg, final pointing error (roll excluded)
+//! # both modes
+//! stop_on_failure = true         # end a run once it certainly misses (see below)
 //! ```
 //!
 //! Criteria are checked in the order of [`Criterion::ALL`], except that the mission's reach
@@ -24,6 +26,12 @@
 //! not its symptoms); a verdict names the first one missed by its id, which is the `[success]`
 //! key that bounds it (`no_failure` has none).
 //! Studies rank and compare only successful runs (`study::summary`).
+//!
+//! With `stop_on_failure` (the default) a run ends as soon as the criterion its verdict would
+//! name is certain to be missed whatever the rest of the run does (`super::watch`): the
+//! mission's reach, or the first judged criterion of the run itself among the attitude and
+//! depth bounds, the peak thrust and the saturation fraction. The stopped run reports that
+//! criterion, `stopped_at` and its metrics up to the stop; a successful run is unaffected.
 
 use std::fmt;
 
@@ -72,6 +80,12 @@ pub struct SuccessSpec {
     /// [`SuccessSpec::cross_track_bound`]. 0 = not judged. Default 1 m (**inferred**: ten
     /// times the cross-track bound).
     pub max_vertical_error: f64,
+    /// End a run at the first control period after which the criterion its verdict would name
+    /// is certainly missed (`super::watch`, docs/study-format.md "Stopping a failed run"):
+    /// the verdict (status and criterion) is the whole run's, the metrics go as far as the
+    /// run did (metric `stopped_at` [s]). A run that meets its criteria is bit-identical
+    /// either way. Default true; false keeps the whole trajectory of every failure.
+    pub stop_on_failure: bool,
 }
 
 impl Default for SuccessSpec {
@@ -86,6 +100,7 @@ impl Default for SuccessSpec {
             max_roll_deg: 30.0,
             max_pitch_deg: 30.0,
             max_vertical_error: 1.0,
+            stop_on_failure: true,
         }
     }
 }

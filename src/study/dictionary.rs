@@ -110,8 +110,9 @@ const TUNING: &[ColumnDoc] = &[
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
-    c("completed", "0/1", "bool", "the run reached its duration without a numerical failure"),
+    c("completed", "0/1", "bool", "the run did not fail numerically: it reached its duration, or was ended on a certain `[success]` miss (`stopped_at`)"),
     c("simulated_time", "s", "f64", "simulated time reached"),
+    c("stopped_at", "s", "f64", "with `[success] stop_on_failure` (the default): the time the run was ended at because the criterion its verdict names could no longer be met (its metrics go that far); NaN for a run that went to its end or failed"),
     c("thruster_energy", "J", "f64", "thruster shaft energy by actuator-disk momentum theory with each thruster's axial inflow"),
     c("thruster_energy_static", "J", "f64", "the same thrusts at zero inflow"),
     c("effort_sq", "N²·s", "f64", "∫‖u‖² dt of the thrust held over each control interval"),
@@ -129,7 +130,7 @@ const RUN_COMMON: &[ColumnDoc] = &[
     c("slack_fraction", "–", "f64", "fraction of allocations whose slack was active"),
     c("allocation_failures", "–", "f64", "allocations that failed"),
     c("allocation_residual_fraction", "–", "f64", "fraction of control steps leaving the commanded wrench undelivered beyond `[metrics] residual_tolerance`"),
-    c("success_margin", "–", "f64", "signed, normalised distance to the `[success]` and `[mission]` bounds: the smallest (bound − value)/bound over the criteria; > 0 met with that room, < 0 missed by that fraction (missed by 1 cm of 0.1 m: −0.1), −1 stopped early or never converged"),
+    c("success_margin", "–", "f64", "signed, normalised distance to the `[success]` and `[mission]` bounds: the smallest (bound − value)/bound over the criteria; > 0 met with that room, < 0 missed by that fraction (missed by 1 cm of 0.1 m: −0.1), −1 failed numerically or never converged; a run ended on a certain miss (`stopped_at`) over its metrics up to then"),
     c("total_energy", "J", "f64", "thruster_energy + joint_energy / η_j: thruster shaft energy plus the joint drives' electrical energy (`[metrics] joint_efficiency` η_j, default 0.7)"),
     c("wrench_peak_<axis>", "N or N·m", "f64", "largest |τ_c| the base controller commanded along surge, sway, heave (N), roll, pitch, yaw (N·m) at a control tick, base frame: the required wrench of `authority_margin`"),
     c("authority_margin", "–", "f64", "smallest ratio, over the commanded axes the run asked something of, of the wrench the thrusters can deliver within their limits about the base origin (least over 15 configurations of the nominal run's log) to the peak commanded wrench `wrench_peak_<axis>`; ≥ 1: every peak demand was deliverable (static analysis and a closed loop)"),

@@ -61,12 +61,17 @@ pub fn larger_is_better(metric: &str) -> bool {
 
 /// Columns that hold a number but are identifiers or flags, not quantities to rank: a
 /// thruster's number (`worst_fault`, `n1_worst_thruster`), the under-actuation flag and axes
-/// bitmask, a criterion's index (`fault.t<j>.missed`). The report neither ranks them nor
+/// bitmask, a criterion's index (`fault.t<j>.missed`), the time a failed run was stopped at
+/// (`stopped_at`). The report neither ranks them nor
 /// lists them among the best cases by metric (docs/columns.md marks them).
 pub fn is_identifier(column: &str) -> bool {
     matches!(
         column,
-        "worst_fault" | "n1_worst_thruster" | "under_actuated" | "under_actuated_axes"
+        "worst_fault"
+            | "n1_worst_thruster"
+            | "under_actuated"
+            | "under_actuated_axes"
+            | "stopped_at"
     ) || (column.starts_with("fault.t") && column.ends_with(".missed"))
 }
 
