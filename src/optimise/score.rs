@@ -160,15 +160,7 @@ impl Scorer {
             Combine::Worst => worst_of(js),
             Combine::Cvar(alpha) => cvar(js.collect(), alpha),
         };
-        let mut violation: f64 = per_scenario
-            .iter()
-            .map(|m| {
-                (0..self.constraints.len())
-                    .filter(|&k| !self.constraints[k].chance)
-                    .map(|k| self.constraint_violation(k, m))
-                    .sum::<f64>()
-            })
-            .sum();
+        let mut violation = self.hard_violation(per_scenario);
         for (k, c) in self
             .constraints
             .iter()
@@ -195,6 +187,40 @@ impl Scorer {
             violation,
             feasible: violation == 0.0,
         }
+    }
+}
+
+impl Scorer {
+    /// The violation of the constraints that must hold in every scenario (all but the chance
+    /// constraints), summed over `per_scenario`'s rows in order: the first part of
+    /// [`Scorer::score`]'s violation, computed by the same sums.
+    pub fn hard_violation(&self, per_scenario: &[Vec<f64>]) -> f64 {
+        per_scenario
+            .iter()
+            .map(|m| {
+                (0..self.constraints.len())
+                    .filter(|&k| !self.constraints[k].chance)
+                    .map(|k| self.constraint_violation(k, m))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Racing (`[tune] race`): whether a point whose first scenarios gave `rows` is certainly
+    /// infeasible and certainly not ranked before `incumbent` ([`Score::better_than`]) however
+    /// its remaining scenarios turn out. The lower bound `L` of its total violation is the
+    /// hard violation of `rows`, plus [`NAN_VIOLATION`] when a row's objective is NaN (the
+    /// combined objective is then NaN: mean, worst and CVaR alike); the rest of the sum only
+    /// adds non-negative terms (more rows, the chance constraints), and rounding is monotone,
+    /// so the full violation is `≥ L` bit for bit. The point is out when `L > 0` (infeasible)
+    /// and the incumbent is feasible, or `L ≥` the infeasible incumbent's violation (ties go to
+    /// the earlier point).
+    pub fn cannot_rank_before(&self, rows: &[Vec<f64>], incumbent: &Score) -> bool {
+        let mut bound = self.hard_violation(rows);
+        if rows.iter().any(|m| self.scenario_objective(m).is_nan()) {
+            bound += NAN_VIOLATION;
+        }
+        bound > 0.0 && (incumbent.feasible || bound >= incumbent.violation)
     }
 }
 
