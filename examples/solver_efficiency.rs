@@ -99,6 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         journal: None,
         resume: false,
         on_record: &quiet,
+        race: false,
     };
     let seed = study.seed;
     let budget: usize = std::env::var("BUDGET")

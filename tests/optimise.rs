@@ -118,6 +118,7 @@ fn options(jobs: usize) -> Options<'static> {
         journal: None,
         resume: false,
         on_record: &quiet,
+        race: false,
     }
 }
 

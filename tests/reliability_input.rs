@@ -322,6 +322,7 @@ fn bowl(spec: &Spec) -> (usm_study::optimise::Outcome, usize) {
         journal: None,
         resume: false,
         on_record: &quiet,
+        race: false,
     };
     let o = minimise(spec, &ev, "bowl", &opts).unwrap();
     (o, ev.0.load(Ordering::Relaxed))

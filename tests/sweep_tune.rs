@@ -383,3 +383,56 @@ fn control_method_selects_its_table_iii_gains_unless_the_file_sets_them() {
     assert_eq!(m1["k_psi"].as_float(), Some(0.5));
     assert_eq!(m2["k_psi"].as_float(), Some(0.5));
 }
+
+/// `[tune] race` (issue 38 item 2): Bayesian optimisation in three tuning worlds, racing on
+/// (the default) and off. A candidate raced out is certainly infeasible and certainly not the
+/// best, and Bayesian optimisation reads only the feasibility of infeasible points, so the two
+/// tunings agree bit for bit — tuned gains, feasibility, evaluations, noise, curve — and so do
+/// the sweeps' `cases.csv` (the key is not hashed), while racing runs fewer worlds.
+#[test]
+fn racing_the_tuning_worlds_finds_what_the_full_evaluation_finds_in_fewer_runs() {
+    use usm_study::evaluate::Deadline;
+    use usm_study::optimise::tune::Tuner;
+    use usm_study::study::tune::CaseTuner;
+    let dir = tempfile::tempdir().unwrap();
+    let on = tuned_in_two_worlds()
+        .replace("[tune]\nworlds = 2\n", "[tune]\nworlds = 3\n")
+        .replace("method = \"nelder-mead\"", "method = \"bayes\"")
+        .replace("max_evals = 6", "max_evals = 9")
+        .replace(
+            "[tune.solver]",
+            "[[tune.constraint]]\nmetric = \"convergence_time\"\nop = \"<=\"\nvalue = 25.0\n\n[tune.solver]",
+        );
+    let off = on.replace("[tune]\n", "[tune]\nrace = false\n");
+    assert_ne!(on, off);
+    let tuned = |text: &str| {
+        let path = write(dir.path(), "race.toml", text);
+        let study = parse_study(text, &path).unwrap();
+        let case = &expand(&study, None).unwrap()[0];
+        let r = resolve_case(&study, case).unwrap();
+        let tuner = Tuner::new(&study).unwrap().unwrap();
+        tuner.tune(&study, case, &r, Deadline::NONE).unwrap()
+    };
+    let (a, b) = (tuned(&on), tuned(&off));
+    eprintln!(
+        "raced {} runs, full {} runs, {} evaluations",
+        a.runs, b.runs, b.evaluations
+    );
+    assert_eq!(a.x, b.x);
+    assert_eq!(a.feasible, b.feasible);
+    assert_eq!(a.evaluations, b.evaluations);
+    assert_eq!(a.noise.to_bits(), b.noise.to_bits());
+    let bits = |c: &[f64]| c.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a.curve), bits(&b.curve));
+    assert_eq!(b.runs, 3 * b.evaluations);
+    assert!(a.runs < b.runs, "nothing raced: {} runs", a.runs);
+    // The sweeps' tables: identical, hashes included.
+    let (p_on, p_off) = (
+        write(dir.path(), "on.toml", &on),
+        write(dir.path(), "off.toml", &off),
+    );
+    sweep(&p_on, &dir.path().join("on"), &[]);
+    sweep(&p_off, &dir.path().join("off"), &[]);
+    let csv = |d: &str| std::fs::read_to_string(dir.path().join(d).join("cases.csv")).unwrap();
+    assert_eq!(csv("on"), csv("off"));
+}

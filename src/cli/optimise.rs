@@ -134,6 +134,7 @@ pub fn run_optimise(a: &OptimiseArgs) -> anyhow::Result<ExitCode> {
         journal: Some(&journal),
         resume: a.resume,
         on_record: &on_record,
+        race: false,
     };
     let outcome = run(&problem, &opts)?;
     progress.finish();

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::history::{read_journal, Journal, JournalError, Record};
-use super::problem::{Problem, Spec};
+use super::problem::{Method, Problem, Spec};
 use super::score::{best_index, Scorer};
 use super::search::{run_solver, Evaluator, Search};
 
@@ -37,6 +37,10 @@ pub struct Options<'a> {
     pub resume: bool,
     /// Called for each evaluation, in order, once it is scored (progress display).
     pub on_record: &'a (dyn Fn(&Record) + Sync),
+    /// Race each point's scenarios against the best so far (`[tune] race`,
+    /// [`Search::racing`]): taken by Bayesian optimisation only, the one solver it leaves
+    /// exactly unchanged; the others run every scenario of every point.
+    pub race: bool,
 }
 
 /// The result of an optimisation.
@@ -70,6 +74,16 @@ impl Outcome {
     /// Evaluations that ran (repeats excluded).
     pub fn fresh_evaluations(&self) -> usize {
         self.records.iter().filter(|r| !r.repeat).count()
+    }
+
+    /// Scenario runs the fresh evaluations used (fewer than evaluations × scenarios when
+    /// raced).
+    pub fn scenario_runs(&self) -> usize {
+        self.records
+            .iter()
+            .filter(|r| !r.repeat)
+            .map(|r| r.metrics.len())
+            .sum()
     }
 }
 
@@ -115,7 +129,8 @@ pub fn minimise<E: Evaluator>(
         memo,
         journal,
         opts.on_record,
-    );
+    )
+    .racing(opts.race && spec.solver.method == Method::Bayes);
     search
         .start(|m| Scorer::new(&spec.objective, &spec.constraints, ev.metrics(), m))
         .map_err(|e| OptimiseError::Start(e.into()))?;

@@ -173,8 +173,17 @@ impl Evaluator for CaseEvaluator<'_> {
     }
 
     fn evaluate(&self, x: &[f64]) -> Evaluation {
+        self.evaluate_until(x, &|_: &[Vec<f64>]| false)
+    }
+
+    /// The scenarios run in order (a tuning's worlds: `w0`, `w1`, …); after each, `stop` sees
+    /// the rows so far. A failed run is a row like any other (its metrics, NaN where the run
+    /// gave none): racing stops on it when its metrics break a constraint. A raced evaluation
+    /// says so in its failure (`raced: stopped after k of n scenarios`).
+    fn evaluate_until(&self, x: &[f64], stop: &(dyn Fn(&[Vec<f64>]) -> bool + Sync)) -> Evaluation {
         let mut rows = Vec::new();
         let mut failures = Vec::new();
+        let n = self.problem.spec.variants.len();
         for (v, variant) in self.problem.spec.variants.iter().enumerate() {
             let (metrics, failure) = match self.resolve(x, v) {
                 Ok(r) => {
@@ -191,6 +200,10 @@ impl Evaluator for CaseEvaluator<'_> {
                 } else {
                     format!("{}: {f}", variant.name)
                 });
+            }
+            if v + 1 < n && stop(&rows) {
+                failures.push(format!("raced: stopped after {} of {n} scenarios", v + 1));
+                break;
             }
         }
         Evaluation {

@@ -160,15 +160,7 @@ impl Scorer {
             Combine::Worst => worst_of(js),
             Combine::Cvar(alpha) => cvar(js.collect(), alpha),
         };
-        let mut violation: f64 = per_scenario
-            .iter()
-            .map(|m| {
-                (0..self.constraints.len())
-                    .filter(|&k| !self.constraints[k].chance)
-                    .map(|k| self.constraint_violation(k, m))
-                    .sum::<f64>()
-            })
-            .sum();
+        let mut violation = self.hard_violation(per_scenario);
         for (k, c) in self
             .constraints
             .iter()
@@ -195,6 +187,40 @@ impl Scorer {
             violation,
             feasible: violation == 0.0,
         }
+    }
+}
+
+impl Scorer {
+    /// The violation of the constraints that must hold in every scenario (all but the chance
+    /// constraints), summed over `per_scenario`'s rows in order: the first part of
+    /// [`Scorer::score`]'s violation, computed by the same sums.
+    pub fn hard_violation(&self, per_scenario: &[Vec<f64>]) -> f64 {
+        per_scenario
+            .iter()
+            .map(|m| {
+                (0..self.constraints.len())
+                    .filter(|&k| !self.constraints[k].chance)
+                    .map(|k| self.constraint_violation(k, m))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Racing (`[tune] race`): whether a point whose first scenarios gave `rows` is certainly
+    /// infeasible and certainly not ranked before `incumbent` ([`Score::better_than`]) however
+    /// its remaining scenarios turn out. The lower bound `L` of its total violation is the
+    /// hard violation of `rows`, plus [`NAN_VIOLATION`] when a row's objective is NaN (the
+    /// combined objective is then NaN: mean, worst and CVaR alike); the rest of the sum only
+    /// adds non-negative terms (more rows, the chance constraints), and rounding is monotone,
+    /// so the full violation is `≥ L` bit for bit. The point is out when `L > 0` (infeasible)
+    /// and the incumbent is feasible, or `L ≥` the infeasible incumbent's violation (ties go to
+    /// the earlier point).
+    pub fn cannot_rank_before(&self, rows: &[Vec<f64>], incumbent: &Score) -> bool {
+        let mut bound = self.hard_violation(rows);
+        if rows.iter().any(|m| self.scenario_objective(m).is_nan()) {
+            bound += NAN_VIOLATION;
+        }
+        bound > 0.0 && (incumbent.feasible || bound >= incumbent.violation)
     }
 }
 
@@ -251,7 +277,64 @@ mod tests {
         assert!(cvar(vec![1.0, f64::NAN], 0.5).is_nan());
     }
 
+    /// A scorer of objective `e` (mean over the scenarios) under `e <= 1` and `c >= 0` in
+    /// every scenario and the chance constraint P(success) >= 0.5.
+    fn race_scorer() -> Scorer {
+        use super::super::problem::Term;
+        let con = |metric: &str, op, value, chance| Constraint {
+            metric: metric.into(),
+            op,
+            value,
+            tolerance: 0.0,
+            chance,
+        };
+        let objective = Objective {
+            terms: vec![Term {
+                metric: "e".into(),
+                weight: 1.0,
+            }],
+            combine: Combine::Mean,
+            normalise: false,
+        };
+        let constraints = [
+            con("e", Op::Le, 1.0, false),
+            con("c", Op::Ge, 0.0, false),
+            con("success_probability", Op::Ge, 0.5, true),
+        ];
+        let names = ["e", "c", "success"].map(String::from);
+        Scorer::new(&objective, &constraints, &names, &[vec![1.0, 1.0, 1.0]])
+    }
+
+    fn row() -> impl Strategy<Value = Vec<f64>> {
+        (
+            prop_oneof![4 => 0.0..2.0f64, 1 => Just(f64::NAN)],
+            -1.0..1.0f64,
+            prop_oneof![Just(0.0), Just(1.0)],
+        )
+            .prop_map(|(e, c, s)| vec![e, c, s])
+    }
+
     proptest! {
+        /// Racing is exact: whenever the first scenarios of a point rule it out against an
+        /// incumbent, the point scored on all its scenarios is infeasible and not ranked
+        /// before the incumbent, and its partial score (the raced record's) is not either.
+        #[test]
+        fn a_point_raced_out_could_not_have_ranked_before_the_incumbent(
+            rows in proptest::collection::vec(row(), 1..6),
+            incumbent in proptest::collection::vec(row(), 1..6),
+        ) {
+            let s = race_scorer();
+            let best = s.score(&incumbent);
+            for k in 1..=rows.len() {
+                if s.cannot_rank_before(&rows[..k], &best) {
+                    let full = s.score(&rows);
+                    prop_assert!(!full.feasible);
+                    prop_assert!(!full.better_than(&best));
+                    prop_assert!(!s.score(&rows[..k]).better_than(&best));
+                }
+            }
+        }
+
         /// Once a feasible point has been seen, the best so far stays feasible, and the cost
         /// the solvers minimise orders points as the ranking does.
         #[test]

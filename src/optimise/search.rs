@@ -52,6 +52,13 @@ pub trait Evaluator: Sync {
     fn metrics(&self) -> &[String];
     /// Evaluate the point `x` (physical values, in parameter order).
     fn evaluate(&self, x: &[f64]) -> Evaluation;
+    /// Evaluate `x` scenario by scenario in order, stopping after the first scenario at which
+    /// `stop` (given the rows so far) is true: the evaluation then holds only the rows run
+    /// (racing, [`Search::racing`]). The default runs every scenario.
+    fn evaluate_until(&self, x: &[f64], stop: &(dyn Fn(&[Vec<f64>]) -> bool + Sync)) -> Evaluation {
+        let _ = stop;
+        self.evaluate(x)
+    }
 }
 
 /// Bits of a point, the memory's key.
@@ -79,6 +86,8 @@ pub struct Search<'a, E: Evaluator> {
     budget: usize,
     iteration: Arc<AtomicU64>,
     on_record: &'a (dyn Fn(&Record) + Sync),
+    /// Race the scenarios of each point against the incumbent ([`Search::racing`]).
+    race: bool,
     state: Mutex<SearchState>,
 }
 
@@ -111,6 +120,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
             budget,
             iteration: Arc::new(AtomicU64::new(0)),
             on_record,
+            race: false,
             state: Mutex::new(SearchState {
                 records: Vec::new(),
                 memo,
@@ -122,6 +132,30 @@ impl<'a, E: Evaluator> Search<'a, E> {
                 journal_error: None,
             }),
         }
+    }
+
+    /// The same search, racing when `on`: each fresh point of a batch runs its scenarios in
+    /// order and stops at the first after which it is certainly infeasible and certainly not
+    /// ranked before the best record as the batch began ([`Scorer::cannot_rank_before`]).
+    /// Its record then holds the scenarios run: its feasibility is exact, its objective and
+    /// violation are partial (never ranked before the best). Exact for a solver that reads
+    /// only the feasibility of infeasible points (Bayesian optimisation), not for one that
+    /// ranks them by violation (the others); the incumbent is fixed per batch, so racing does
+    /// not depend on the number of threads.
+    pub fn racing(mut self, on: bool) -> Self {
+        self.race = on;
+        self
+    }
+
+    /// The scorer and the best score so far, when racing and a point has been scored.
+    fn race_against(&self) -> Option<(Scorer, Score)> {
+        if !self.race {
+            return None;
+        }
+        let st = self.lock();
+        let scorer = st.scorer.clone()?;
+        let best = super::score::best_index(st.records.iter().map(|r| r.score))?;
+        Some((scorer, st.records[best].score))
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, SearchState> {
@@ -198,7 +232,13 @@ impl<'a, E: Evaluator> Search<'a, E> {
                 })
                 .collect()
         };
-        let evaluate = |&i: &usize| self.ev.evaluate(&plan[i].x);
+        let race = self.race_against();
+        let evaluate = |&i: &usize| match &race {
+            Some((scorer, best)) => self.ev.evaluate_until(&plan[i].x, &|rows: &[Vec<f64>]| {
+                scorer.cannot_rank_before(rows, best)
+            }),
+            None => self.ev.evaluate(&plan[i].x),
+        };
         let done: Vec<Evaluation> = match self.pool {
             Some(pool) => pool.install(|| todo.par_iter().map(evaluate).collect()),
             None => todo.iter().map(evaluate).collect(),

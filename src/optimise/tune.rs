@@ -59,6 +59,10 @@ pub struct Tuner {
     /// with its own tuning worlds, start points and solver seeds; the seeds' best points are
     /// then compared in the pooled tuning worlds of all seeds (issue 36 item 5).
     seeds: usize,
+    /// Race each candidate's tuning worlds (`[tune] race`, default true): Bayesian
+    /// optimisation stops a candidate at the first world after which it is certainly
+    /// infeasible and not better than the best so far ([`super::score::Scorer::cannot_rank_before`]).
+    race: bool,
 }
 
 /// Most independent tuning seeds.
@@ -131,6 +135,11 @@ impl Tuner {
         };
         let starts = count(&mut t, "starts", MAX_STARTS, &doc)?;
         let seeds = count(&mut t, "seeds", MAX_SEEDS, &doc)?;
+        let race = match t.remove("race") {
+            None => true,
+            Some(toml::Value::Boolean(b)) => b,
+            Some(v) => return Err(doc.err("tune.race", format!("must be true or false, got {v}"))),
+        };
         let spec = parse_spec(&doc, &t, "tune", study)?;
         check_two_roads(&spec, study, &doc)?;
         if spec.solver.max_evals / starts < 2 {
@@ -156,6 +165,7 @@ impl Tuner {
             starts,
             worlds,
             seeds,
+            race,
         }))
     }
 
@@ -241,6 +251,7 @@ impl Tuner {
             journal: None,
             resume: false,
             on_record: &quiet,
+            race: self.race,
         };
         let d = spec.space.dim();
         let starts_seed = if k == 0 {
@@ -268,10 +279,12 @@ impl Tuner {
             .with_max_len(1)
             .map(|s| minimise(s, &ev, &study.hash, &opts))
             .collect();
-        let (mut best, mut bests, mut curve, mut evaluations) = (None, Vec::new(), Vec::new(), 0);
+        let (mut best, mut bests, mut curve) = (None, Vec::new(), Vec::new());
+        let (mut evaluations, mut runs) = (0, 0);
         for out in outs {
             let out = out.map_err(TuneError::from_error)?;
             evaluations += out.fresh_evaluations();
+            runs += out.scenario_runs();
             best_so_far(&out.records, &mut curve);
             // Each start normalises its objective by its own start point: compare starts by
             // the unnormalised objective, not by their scores.
@@ -292,6 +305,7 @@ impl Tuner {
             noise: relative_spread(&bests),
             curve,
             evaluations,
+            runs,
         })
     }
 }
@@ -375,6 +389,7 @@ impl CaseTuner for Tuner {
             seeds.push(run?);
         }
         let mut evaluations: usize = seeds.iter().map(|s| s.evaluations).sum();
+        let mut runs: usize = seeds.iter().map(|s| s.runs).sum();
         let mut curve = Vec::new();
         for s in &seeds {
             // Each seed's curve carries the earlier seeds' best on (as starts do).
@@ -396,6 +411,7 @@ impl CaseTuner for Tuner {
             let pooled = self.case_problem_with(study, r, WorldsOf::Pooled);
             let p = compare_in_pooled_worlds(&pooled, case.id, deadline, &seeds);
             evaluations += p.evaluations;
+            runs += p.evaluations * pooled.spec.variants.len();
             (p.pick, p.feasible, p.noise, p.success_spread)
         };
         let best = &seeds[pick].best;
@@ -411,6 +427,7 @@ impl CaseTuner for Tuner {
             resolved,
             x: best_x,
             evaluations,
+            runs,
             feasible,
             noise,
             success_spread,

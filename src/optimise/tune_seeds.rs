@@ -38,6 +38,8 @@ pub(super) struct SeedResult {
     pub curve: Vec<f64>,
     /// Fresh evaluations the seed used.
     pub evaluations: usize,
+    /// Tuning-world runs those evaluations used (fewer than evaluations × worlds when raced).
+    pub runs: usize,
 }
 
 /// Seed stream of tuning seed `k`'s solver seeds (seed 0 keeps the study's).

@@ -75,7 +75,10 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
             // variants: its row depends on them.
             let mut hashed = scenario.clone();
             if let Some(t) = t {
-                hashed.insert("tune".into(), toml::Value::Table(t.clone()));
+                // `[tune] race` changes what a tuning costs, never what it finds: not hashed.
+                let mut t = t.clone();
+                t.remove("race");
+                hashed.insert("tune".into(), toml::Value::Table(t));
             }
             if !study.robust_table.is_empty() {
                 hashed.insert(

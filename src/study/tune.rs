@@ -56,6 +56,10 @@ pub struct Tuned {
     pub x: Vec<f64>,
     /// Fresh evaluations the tuning used.
     pub evaluations: usize,
+    /// Closed-loop runs those evaluations used: one per tuning world of each evaluation, fewer
+    /// when a candidate is raced out (`[tune] race`); not a column (racing leaves every
+    /// column unchanged).
+    pub runs: usize,
     /// Whether the tuned point met every constraint.
     pub feasible: bool,
     /// Relative spread of the best feasible objective across independent tuning starts

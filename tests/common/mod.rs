@@ -86,6 +86,7 @@ pub fn optimise_study(
         journal: None,
         resume: false,
         on_record: &quiet_record,
+        race: false,
     };
     let o = usm_study::optimise::run(&p, &opts).unwrap();
     (p, o)
