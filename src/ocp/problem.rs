@@ -22,6 +22,8 @@
 //! [solver]
 //! tolerance = 1e-6           # KKT tolerance
 //! max_iterations = 200
+//! hessian = "exact"          # or "gauss_newton" (objective only, no dynamics curvature)
+//! gauss_newton_above = 1e-2  # optional: Gauss–Newton while the primal infeasibility is above
 //! ```
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
@@ -29,6 +31,7 @@
 use crate::input::document::{read_text, Document};
 use crate::input::located::{InputError, Location};
 use crate::model::design::{load_design, parse_design_value};
+use super::sqp::Hessian;
 use crate::model::Vehicle;
 use serde::Deserialize;
 use std::path::Path;
@@ -118,6 +121,10 @@ struct Solver {
     tolerance: f64,
     #[serde(default = "iters")]
     max_iterations: i64,
+    #[serde(default)]
+    hessian: Option<String>,
+    #[serde(default)]
+    gauss_newton_above: Option<f64>,
 }
 
 impl Default for Solver {
@@ -125,6 +132,8 @@ impl Default for Solver {
         Self {
             tolerance: tol(),
             max_iterations: iters(),
+            hessian: None,
+            gauss_newton_above: None,
         }
     }
 }
@@ -162,6 +171,10 @@ pub struct ProblemSpec {
     pub tolerance: f64,
     /// Most SQP iterations.
     pub max_iterations: usize,
+    /// The SQP's Hessian.
+    pub hessian: Hessian,
+    /// Gauss–Newton while the primal infeasibility exceeds this (∞: never).
+    pub gauss_newton_above: f64,
 }
 
 /// Read and validate a problem file.
@@ -250,6 +263,20 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
     if f.solver.max_iterations < 1 {
         return Err(doc.err("solver.max_iterations", "must be at least 1"));
     }
+    let hessian = match f.solver.hessian.as_deref() {
+        None | Some("exact") => Hessian::Exact,
+        Some("gauss_newton") => Hessian::GaussNewton,
+        Some(other) => {
+            return Err(doc.err(
+                "solver.hessian",
+                format!("`{other}` is not one of \"exact\", \"gauss_newton\""),
+            ))
+        }
+    };
+    let gauss_newton_above = f.solver.gauss_newton_above.unwrap_or(f64::INFINITY);
+    if gauss_newton_above <= 0.0 {
+        return Err(doc.err("solver.gauss_newton_above", "must be positive"));
+    }
     Ok(ProblemSpec {
         origin,
         vehicle,
@@ -262,5 +289,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         bounds,
         tolerance: f.solver.tolerance,
         max_iterations: f.solver.max_iterations as usize,
+        hessian,
+        gauss_newton_above,
     })
 }

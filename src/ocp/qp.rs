@@ -124,7 +124,9 @@ pub fn solve_box_qp(
         wterm.c_vec = &term.c_mat * &dx[n] + &term.c_vec;
         // Predictor (τ = 0), then corrector (τ = σμ − Δs_aff∘Δz_aff).
         let zero = |_: usize, _: usize, _: bool| 0.0;
-        let aff = newton(&mut work, stages, &wterm, lo, hi, &du, &z_lo, &z_hi, &zero)?;
+        let aff = newton(
+            &mut work, stages, &wterm, lo, hi, &du, &dx, &z_lo, &z_hi, &zero,
+        )?;
         let a_aff = step_length(lo, hi, &du, &z_lo, &z_hi, &aff, 1.0);
         let (mu_aff, _) = complementarity(lo, hi, &du, &z_lo, &z_hi, Some((a_aff, &aff)));
         let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
@@ -136,7 +138,7 @@ pub fn solve_box_qp(
             }
         };
         let st = newton(
-            &mut work, stages, &wterm, lo, hi, &du, &z_lo, &z_hi, &target,
+            &mut work, stages, &wterm, lo, hi, &du, &dx, &z_lo, &z_hi, &target,
         )?;
         let alpha = step_length(lo, hi, &du, &z_lo, &z_hi, &st, 0.995);
         for k in 0..=n {
@@ -252,7 +254,7 @@ fn barrier_hessian(
             }
             w.r_mat[(i, i)] += sig;
         }
-        w.q_vec = &s.q_mat * &dx[k] + &s.q_vec;
+        w.q_vec = &s.q_mat * &dx[k] + &s.q_vec + s.s_mat.transpose() * &du[k];
     }
 }
 
@@ -275,13 +277,14 @@ fn newton(
     lo: &[DVector<f64>],
     hi: &[DVector<f64>],
     du: &[DVector<f64>],
+    dx: &[DVector<f64>],
     z_lo: &[DVector<f64>],
     z_hi: &[DVector<f64>],
     tau: &dyn Fn(usize, usize, bool) -> f64,
 ) -> Result<Direction, LqError> {
     let nu = du.first().map_or(0, |v| v.len());
     for (k, (w, s)) in work.iter_mut().zip(stages).enumerate() {
-        w.r_vec = &s.r_mat * &du[k] + &s.r_vec;
+        w.r_vec = &s.r_mat * &du[k] + &s.r_vec + &s.s_mat * &dx[k];
         for i in 0..nu {
             if lo[k][i].is_finite() {
                 w.r_vec[i] -= tau(k, i, false) / (du[k][i] - lo[k][i]);
@@ -364,10 +367,14 @@ pub(crate) fn residuals(
     let n = stages.len();
     let mut stat: f64 = 0.0;
     for (k, s) in stages.iter().enumerate() {
-        let gu = &s.r_mat * &du[k] + &s.r_vec + s.b.transpose() * &lam[k + 1] - &z_lo[k] + &z_hi[k];
+        let gu = &s.r_mat * &du[k] + &s.r_vec + &s.s_mat * &dx[k] + s.b.transpose() * &lam[k + 1]
+            - &z_lo[k]
+            + &z_hi[k];
         stat = stat.max(gu.amax());
         if k > 0 {
-            let gx = &s.q_mat * &dx[k] + &s.q_vec + s.a.transpose() * &lam[k + 1] - &lam[k];
+            let gx = &s.q_mat * &dx[k] + &s.q_vec + s.s_mat.transpose() * &du[k]
+                + s.a.transpose() * &lam[k + 1]
+                - &lam[k];
             stat = stat.max(gx.amax());
         }
     }

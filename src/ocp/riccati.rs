@@ -2,15 +2,15 @@
 //! Riccati recursion with a parametric terminal multiplier (docs/ocp.md §3).
 //!
 //! ```text
-//! min  Σ_{k<N} ½ δu_kᵀ R_k δu_k + r_kᵀ δu_k + ½ δx_kᵀ Q_k δx_k + q_kᵀ δx_k
+//! min  Σ_{k<N} ½ δu_kᵀ R_k δu_k + r_kᵀ δu_k + ½ δx_kᵀ Q_k δx_k + q_kᵀ δx_k + δu_kᵀ S_k δx_k
 //!      + ½ δx_Nᵀ Q_N δx_N + q_Nᵀ δx_N
 //! s.t. δx_0 = 0,   δx_{k+1} = A_k δx_k + B_k δu_k + d_k,   C δx_N + c = 0
 //! ```
 //!
 //! The value function is `V_k(δx) = ½ δxᵀ P_k δx + (p_k + Γ_k ν)ᵀ δx + const`, affine in the
 //! terminal multiplier ν (nc): `P_N = Q_N`, `p_N = q_N`, `Γ_N = Cᵀ`, and backwards
-//! `H = R + BᵀPB` (Cholesky), `K = −H⁻¹BᵀPA`, `k = −H⁻¹(r + Bᵀ(P d + p))`, `K_ν = −H⁻¹BᵀΓ`,
-//! `P ← Q + AᵀPA + (BᵀPA)ᵀK`, `p ← q + Aᵀ(P d + p) + (BᵀPA)ᵀk`, `Γ ← AᵀΓ + (BᵀPA)ᵀK_ν`.
+//! `H = R + BᵀPB` (Cholesky), `G = S + BᵀPA`, `K = −H⁻¹G`, `k = −H⁻¹(r + Bᵀ(P d + p))`,
+//! `K_ν = −H⁻¹BᵀΓ`, `P ← Q + AᵀPA + GᵀK`, `p ← q + Aᵀ(P d + p) + Gᵀk`, `Γ ← AᵀΓ + GᵀK_ν`.
 //! The forward pass gives `δx_N = ξ_N + Ξ_N ν`, and the terminal equality the nc×nc system
 //! `C Ξ_N ν = −(C ξ_N + c)` (LU with full pivoting; rank-deficient means the terminal
 //! constraint is not reachable by the linearised dynamics: [`LqError::Unreachable`]). The
@@ -36,6 +36,8 @@ pub struct LqStage {
     pub q_vec: DVector<f64>,
     /// Control Hessian `R_k` (nu×nu, symmetric positive definite together with `BᵀPB`).
     pub r_mat: DMatrix<f64>,
+    /// Cross Hessian `S_k = ∂²/∂u∂x` (nu×nx; zero for the Gauss–Newton Hessian).
+    pub s_mat: DMatrix<f64>,
     /// Control gradient `r_k` (nu).
     pub r_vec: DVector<f64>,
 }
@@ -50,6 +52,7 @@ impl LqStage {
             q_mat: DMatrix::zeros(nx, nx),
             q_vec: DVector::zeros(nx),
             r_mat: DMatrix::zeros(nu, nu),
+            s_mat: DMatrix::zeros(nu, nx),
             r_vec: DVector::zeros(nu),
         }
     }
@@ -115,7 +118,7 @@ pub fn solve_lq(stages: &[LqStage], term: &LqTerminal) -> Result<LqSolution, LqE
         let pb = &p_mat * &s.b;
         let mut h = &s.r_mat + s.b.transpose() * &pb;
         h = (&h + h.transpose()) * 0.5;
-        let hux = pb.transpose() * &s.a; // BᵀPA (nu×nx)
+        let hux = pb.transpose() * &s.a + &s.s_mat; // S + BᵀPA (nu×nx)
         let pd_p = &p_mat * &s.d + &p_vec;
         let hu = &s.r_vec + s.b.transpose() * &pd_p;
         let hun = s.b.transpose() * &gamma;

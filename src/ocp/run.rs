@@ -71,6 +71,8 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
     let set = SqpSettings {
         tolerance: spec.tolerance,
         max_iterations: spec.max_iterations,
+        hessian: spec.hessian,
+        gauss_newton_above: spec.gauss_newton_above,
         ..SqpSettings::default()
     };
     let solution = solve(&mut model, &prob, None, None, &set);
@@ -143,7 +145,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     }
     atomic_write(&dir.join("trajectory.csv"), csv.as_bytes())?;
     let mut it = String::from(
-        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size\n",
+        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size,regularisation,terminal_penalty\n",
     );
     for r in &sol.log {
         let cells = [
@@ -155,6 +157,8 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
             format_f64(r.step),
             r.qp_iterations.to_string(),
             r.filter_size.to_string(),
+            format_f64(r.regularisation),
+            format_f64(r.terminal_penalty),
         ];
         it.push_str(&cells.join(","));
         it.push('\n');
@@ -184,7 +188,8 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         "knots": spec.knots,
         "dt": run.dt,
         "hydrodynamics": spec.hydrodynamics,
-        "method": "multiple shooting, Gauss-Newton SQP, Riccati interior-point QP, filter line search",
+        "method": "multiple shooting, SQP, Riccati interior-point QP, filter line search",
+        "hessian": spec.hessian,
         "derivatives": "central differences (eps 1e-6, tangent coordinates)",
         "optimum": "a local optimum from the rest trajectory (single start)",
     });
