@@ -3,6 +3,7 @@
 //!
 //! ```toml
 //! design = "designs/rigid_chain5.toml"  # preset, file (relative to this file) or [design] table
+//! actuation = "base_wrench"  # or "thrusters": the design's thrusters (bounded by their limits)
 //! [physics]
 //! hydrodynamics = false      # true: added mass, drag, restoring forces, current
 //! [horizon]
@@ -28,10 +29,10 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
+use super::sqp::Hessian;
 use crate::input::document::{read_text, Document};
 use crate::input::located::{InputError, Location};
 use crate::model::design::{load_design, parse_design_value};
-use super::sqp::Hessian;
 use crate::model::Vehicle;
 use serde::Deserialize;
 use std::path::Path;
@@ -43,6 +44,8 @@ pub const MAX_KNOTS: usize = 100_000;
 #[serde(deny_unknown_fields)]
 struct File {
     design: toml::Value,
+    #[serde(default)]
+    actuation: Option<String>,
     #[serde(default)]
     physics: Physics,
     horizon: Horizon,
@@ -155,6 +158,9 @@ pub struct ProblemSpec {
     pub vehicle: Vehicle,
     /// Hydrodynamics on (added mass, drag, restoring, current) or off (rigid bodies).
     pub hydrodynamics: bool,
+    /// Thruster actuation (thrusts within the design's limits, then joint torques); else the
+    /// base wrench.
+    pub thrusters: bool,
     /// Horizon T [s].
     pub duration: f64,
     /// Intervals N.
@@ -212,6 +218,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         _ => return Err(doc.err("design", "must be a preset name, a file name or a table")),
     };
     let n = vehicle.n_joints();
+    let thrusters = actuation(&doc, f.actuation.as_deref(), &vehicle)?;
     let h = &f.horizon;
     if h.duration <= 0.0 {
         return Err(doc.err("horizon.duration", "must be positive [s]"));
@@ -281,6 +288,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         origin,
         vehicle,
         hydrodynamics: f.physics.hydrodynamics,
+        thrusters,
         duration: h.duration,
         knots: h.knots as usize,
         joint_angles,
@@ -292,4 +300,31 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         hessian,
         gauss_newton_above,
     })
+}
+
+/// Whether `actuation` asks for thrusters (validated against the design's thrusters).
+fn actuation(doc: &Document, kind: Option<&str>, vehicle: &Vehicle) -> Result<bool, InputError> {
+    let thrusters = match kind {
+        None | Some("base_wrench") => false,
+        Some("thrusters") if vehicle.n_thrusters() > 0 => true,
+        Some("thrusters") => return Err(doc.err("actuation", "the design has no thrusters")),
+        Some(other) => {
+            return Err(doc.err(
+                "actuation",
+                format!("`{other}` is not one of \"base_wrench\", \"thrusters\""),
+            ))
+        }
+    };
+    if thrusters
+        && vehicle
+            .thrusters
+            .iter()
+            .any(|t| !(t.u_min < 0.0 && t.u_max > 0.0))
+    {
+        return Err(doc.err(
+            "actuation",
+            "thruster actuation needs every thruster's limits to straddle zero (the solver starts at zero thrust)",
+        ));
+    }
+    Ok(thrusters)
 }

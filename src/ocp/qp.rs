@@ -15,7 +15,9 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
-use super::riccati::{solve_lq, solve_lq_into, LqError, LqSolution, LqStage, LqTerminal, LqWorkspace};
+use super::riccati::{
+    solve_lq, solve_lq_into, LqError, LqSolution, LqStage, LqTerminal, LqWorkspace,
+};
 use nalgebra::DVector;
 
 /// Settings of the interior point.

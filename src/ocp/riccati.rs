@@ -12,7 +12,8 @@
 //! `H = R + BᵀPB` (Cholesky), `G = S + BᵀPA`, `K = −H⁻¹G`, `k = −H⁻¹(r + Bᵀ(P d + p))`,
 //! `K_ν = −H⁻¹BᵀΓ`, `P ← Q + AᵀPA + GᵀK`, `p ← q + Aᵀ(P d + p) + Gᵀk`, `Γ ← AᵀΓ + GᵀK_ν`.
 //! The forward pass gives `δx_N = ξ_N + Ξ_N ν`, and the terminal equality the nc×nc system
-//! `C Ξ_N ν = −(C ξ_N + c)` (LU with full pivoting; rank-deficient means the terminal
+//! `C Ξ_N ν = −(C ξ_N + c)` (LU with full pivoting; when rank-deficient, the minimum-norm
+//! solution by SVD if the system is consistent — an inconsistent one means the terminal
 //! constraint is not reachable by the linearised dynamics: [`LqError::Unreachable`]). The
 //! costates are `λ_k = P_k δx_k + p_k + Γ_k ν` (multipliers of the dynamics rows, with the
 //! Lagrangian `… + λ_{k+1}ᵀ(A δx + B δu + d − δx_{k+1})`). Cost O(N (nx + nc)³).
@@ -91,7 +92,8 @@ pub enum LqError {
     /// `R_k + B_kᵀ P_{k+1} B_k` is not positive definite at stage `k`.
     #[error("reduced Hessian of stage {0} is not positive definite")]
     NotConvex(usize),
-    /// The linearised dynamics cannot reach the terminal constraint (`C Ξ_N` singular).
+    /// The linearised dynamics cannot reach the terminal constraint (`C Ξ_N ν = −(C ξ_N + c)`
+    /// inconsistent).
     #[error("terminal constraint not reachable by the linearised dynamics (rank {rank} of {nc})")]
     Unreachable {
         /// Numerical rank of `C Ξ_N`.
@@ -306,15 +308,7 @@ pub fn solve_lq_into(
     } else {
         let lhs = &term.c_mat * &ws.big_xi[n];
         let rhs = -(&term.c_mat * &ws.xi[n] + &term.c_vec);
-        let scale = lhs.amax().max(f64::MIN_POSITIVE);
-        let lu = lhs.full_piv_lu();
-        let u = lu.u();
-        let rank = (0..nc).filter(|&i| u[(i, i)].abs() > 1e-13 * scale).count();
-        if rank < nc {
-            return Err(LqError::Unreachable { rank, nc });
-        }
-        let nu = lu.solve(&rhs).ok_or(LqError::Unreachable { rank, nc })?;
-        out.nu.copy_from(&nu);
+        out.nu.copy_from(&terminal_multiplier(lhs, &rhs)?);
     }
     for k in 0..=n {
         ws.x.copy_from(&ws.xi[k]);
@@ -332,4 +326,31 @@ pub fn solve_lq_into(
         out.dx[k].copy_from(&ws.x);
     }
     Ok(())
+}
+
+/// ν from `C Ξ_N ν = rhs`: LU with full pivoting when `C Ξ_N` has full rank; otherwise the
+/// minimum-norm solution by SVD, accepted when the system is consistent (a terminal row the
+/// linearised dynamics cannot move but already meets, e.g. a rate no actuator excites at
+/// rest) and [`LqError::Unreachable`] when it is not.
+fn terminal_multiplier(lhs: DMatrix<f64>, rhs: &DVector<f64>) -> Result<DVector<f64>, LqError> {
+    let nc = rhs.len();
+    let scale = lhs.amax().max(f64::MIN_POSITIVE);
+    let lu = lhs.clone().full_piv_lu();
+    let u = lu.u();
+    let rank = (0..nc).filter(|&i| u[(i, i)].abs() > 1e-13 * scale).count();
+    if rank == nc {
+        if let Some(nu) = lu.solve(rhs) {
+            return Ok(nu);
+        }
+    }
+    let svd = lhs.clone().svd(true, true);
+    let smax = svd.singular_values.max().max(f64::MIN_POSITIVE);
+    let nu = svd
+        .solve(rhs, 1e-12 * smax)
+        .map_err(|_| LqError::Unreachable { rank, nc })?;
+    let resid = (&lhs * &nu - rhs).amax();
+    if !resid.is_finite() || resid > 1e-6 * (1.0 + rhs.amax()) {
+        return Err(LqError::Unreachable { rank, nc });
+    }
+    Ok(nu)
 }

@@ -379,9 +379,15 @@ fn chain_weighted_hessian_predicts_the_second_order_response() {
     };
     let (r1, q1) = rem(2e-2);
     let (r2, _) = rem(1e-2);
-    assert!(q1 > 10.0 * r1, "curvature {q1} not above the remainder {r1}");
+    assert!(
+        q1 > 10.0 * r1,
+        "curvature {q1} not above the remainder {r1}"
+    );
     let ratio = r1 / r2;
-    assert!((6.0..10.0).contains(&ratio), "remainder ratio {ratio} (third order: 8)");
+    assert!(
+        (6.0..10.0).contains(&ratio),
+        "remainder ratio {ratio} (third order: 8)"
+    );
 }
 
 #[test]
@@ -393,7 +399,12 @@ fn short_chain_problem_converges_with_the_gauss_newton_hessian_too() {
         Vec3::new(2.884, 0.03, -0.02),
     );
     let n = m.n_joints();
-    let x0 = ChainModel::pack(&BasePose::default(), &vec![0.0; n], &[0.0; 6], &vec![0.0; n]);
+    let x0 = ChainModel::pack(
+        &BasePose::default(),
+        &vec![0.0; n],
+        &[0.0; 6],
+        &vec![0.0; n],
+    );
     let (nx, nu) = (m.nx(), m.nu());
     let prob = OcpProblem {
         knots: 20,
@@ -416,4 +427,30 @@ fn short_chain_problem_converges_with_the_gauss_newton_hessian_too() {
     assert_eq!(gn.status, Status::Converged, "{}", gn.message);
     assert!((exact.objective - gn.objective).abs() <= 1e-6 * gn.objective);
     assert!(exact.iterations <= gn.iterations);
+}
+
+#[test]
+fn usm_paper_with_thrusters_and_hydrodynamics_converges_within_the_limits() {
+    // A few knots of the shipped reconfiguration: cold start, full hydrodynamics, the seven
+    // thrusts and the joint torques as controls; KKT 1e-6 and no bound violated.
+    let text = std::fs::read_to_string("studies/ocp_usm_paper.toml")
+        .unwrap()
+        .replace("knots = 40", "knots = 6")
+        .replace("duration = 4.0", "duration = 1.5")
+        .replace("[0.0, 0.10, -0.05]", "[0.0, 0.02, -0.01]");
+    let path = std::path::Path::new("studies/ocp_usm_paper.toml");
+    let spec = super::problem::parse_problem(&text, path).unwrap();
+    assert!(spec.thrusters && spec.hydrodynamics);
+    let run = super::run::solve_spec(&spec);
+    let sol = &run.solution;
+    assert_eq!(sol.status, Status::Converged, "{}", sol.message);
+    assert!(sol.kkt.iter().all(|r| *r <= 1e-6), "{:?}", sol.kkt);
+    let m = spec.vehicle.n_thrusters();
+    assert_eq!(sol.us[0].len(), m + spec.vehicle.n_joints());
+    for u in &sol.us {
+        for (j, t) in spec.vehicle.thrusters.iter().enumerate() {
+            assert!(t.u_min < u[j] && u[j] < t.u_max, "thrust {} = {}", j, u[j]);
+        }
+        assert!(u[m..].iter().all(|v| v.abs() < 20.0));
+    }
 }
