@@ -454,3 +454,50 @@ fn usm_paper_with_thrusters_and_hydrodynamics_converges_within_the_limits() {
         assert!(u[m..].iter().all(|v| v.abs() < 20.0));
     }
 }
+
+#[test]
+fn thruster_chain_jacobians_are_consistent_with_the_step_on_every_preset() {
+    // Every preset, full hydrodynamics, thruster actuation: the central-difference Jacobians
+    // (the ones the SQP uses) predict the step's response to h·d with a second-order error.
+    for name in crate::model::presets::PRESETS {
+        let v = load_design(name).unwrap();
+        let mut m = ChainModel::new(v, DynOptions::full(), 0.05, Vec3::zeros()).with_thrusters();
+        let (nx, nu, nq) = (m.nx(), m.nu(), m.nq());
+        let n = m.n_joints();
+        let pose = BasePose {
+            position: Vec3::new(0.3, -0.2, 0.1),
+            orientation: nalgebra::UnitQuaternion::from_euler_angles(0.1, -0.2, 0.4),
+        };
+        let q: Vec<f64> = (0..n).map(|k| 0.2 - 0.1 * k as f64).collect();
+        let qd: Vec<f64> = (0..n).map(|k| 0.03 * k as f64 - 0.05).collect();
+        let x = ChainModel::pack(&pose, &q, &[0.2, -0.05, 0.03, 0.02, 0.05, -0.1], &qd);
+        let u: Vec<f64> = (0..nu).map(|i| 0.5 * ((i as f64) * 0.9).sin()).collect();
+        let (mut a, mut b) = (DMatrix::zeros(nx, nx), DMatrix::zeros(nx, nu));
+        m.jacobians(&x, &u, &mut a, &mut b).unwrap();
+        let mut f0 = vec![0.0; nq];
+        m.step(&x, &u, &mut f0).unwrap();
+        let mut err = |h: f64| {
+            let dx = DVector::from_fn(nx, |i, _| h * ((i as f64) * 1.3).cos());
+            let du = DVector::from_fn(nu, |i, _| h * ((i as f64) * 0.7).sin());
+            let (mut f1, mut xp) = (vec![0.0; nq], vec![0.0; nq]);
+            m.retract(&x, dx.as_slice(), &mut xp);
+            let up: Vec<f64> = u.iter().zip(du.iter()).map(|(a, b)| a + b).collect();
+            m.step(&xp, &up, &mut f1).unwrap();
+            let mut got = vec![0.0; nx];
+            m.difference(&f0, &f1, &mut got);
+            let pred = &a * &dx + &b * &du;
+            ((DVector::from_vec(got) - &pred).amax(), pred.amax())
+        };
+        let (e1, p1) = err(1e-2);
+        let (e2, _) = err(5e-3);
+        assert!(
+            e1 < 0.05 * p1,
+            "{name}: linear prediction off: {e1} vs {p1}"
+        );
+        let ratio = e1 / e2;
+        assert!(
+            (3.0..5.0).contains(&ratio),
+            "{name}: error ratio {ratio} (second order: 4)"
+        );
+    }
+}
