@@ -7,9 +7,12 @@
 //! (nx = 12 + 2n): `[δp, δθ, δq, δV, δq̇]`, with the retraction `p ⊕ δp = p + R δp`,
 //! `R ⊕ δθ = R Exp(δθ)` (both in `F_b`, ℝ³ × SO(3)) and plain addition for the rest.
 //!
-//! Controls (nu = 6 + n): the base wrench `[f; m]` in `F_b` [N, N·m] about the base origin
-//! and the joint torques [N·m] — the generalised force `τ` of USM-19 directly (idealised
-//! actuation for comparison with rigid-body tools; thrusters are not modelled here yet).
+//! Controls, by actuation: base wrench (nu = 6 + n): the base wrench `[f; m]` in `F_b`
+//! [N, N·m] about the base origin and the joint torques [N·m] — the generalised force `τ` of
+//! USM-19 directly (idealised actuation for comparison with rigid-body tools); thrusters
+//! (nu = m + n, [`ChainModel::with_thrusters`]): the thrust of each of the m thrusters [N]
+//! and the joint torques, `τ = G(q) u_T + [0; τ_q]` with `G` the generalised thrust map
+//! (USM-25/26 extended to the joints, [`generalized_thrust_map`]: base rows `T(q)`).
 //!
 //! Step (symplectic Euler, as Crocoddyl's `IntegratedActionModelEuler` with Pinocchio's
 //! free-flyer `integrate`): `ζ̇ = M(q)⁻¹(τ − h(q, ζ))` (USM-19, [`forward_dynamics`], CRBA +
@@ -25,8 +28,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::model::{ModelError, OcpModel};
-use crate::dynamics::{forward_dynamics, DynOptions, DynWorkspace};
-use crate::kinematics::{forward_kinematics, BasePose};
+use crate::dynamics::{dynamics_terms, solve_forward, DynOptions, DynWorkspace};
+use crate::kinematics::{forward_kinematics, generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
 use crate::spatial::{skew, Mat3, Vec3};
 use nalgebra::{Quaternion, UnitQuaternion};
@@ -41,6 +44,8 @@ pub struct ChainModel {
     target: Vec3,
     tau: Vec<f64>,
     zeta: Vec<f64>,
+    /// Thruster actuation: the generalised thrust map G(q), (6+n)×m (None: base wrench).
+    gmap: Option<faer::Mat<f64>>,
 }
 
 impl ChainModel {
@@ -57,7 +62,26 @@ impl ChainModel {
             target,
             tau: vec![0.0; nv],
             zeta: vec![0.0; nv],
+            gmap: None,
         }
+    }
+
+    /// The same chain actuated by its thrusters and joint torques (controls
+    /// `[u_1 … u_m, τ_1 … τ_n]`, see the module documentation).
+    pub fn with_thrusters(mut self) -> Self {
+        let nv = self.vehicle.n_dof();
+        self.gmap = Some(faer::Mat::zeros(nv, self.vehicle.n_thrusters()));
+        self
+    }
+
+    /// Whether the controls are thrusts (else a base wrench) before the joint torques.
+    pub fn thruster_actuated(&self) -> bool {
+        self.gmap.is_some()
+    }
+
+    /// Number of controls before the joint torques (m thrusters, or 6 wrench components).
+    pub fn n_body_controls(&self) -> usize {
+        self.gmap.as_ref().map_or(6, |g| g.ncols())
     }
 
     /// The vehicle.
@@ -138,7 +162,7 @@ impl OcpModel for ChainModel {
         12 + 2 * self.n_joints()
     }
     fn nu(&self) -> usize {
-        6 + self.n_joints()
+        self.n_body_controls() + self.n_joints()
     }
     fn nc(&self) -> usize {
         9 + self.n_joints()
@@ -149,17 +173,30 @@ impl OcpModel for ChainModel {
         let pose = Self::pose(x);
         let q = &x[7..7 + n];
         self.zeta.copy_from_slice(&x[7 + n..13 + 2 * n]);
-        self.tau.copy_from_slice(u);
-        forward_dynamics(
+        dynamics_terms(
             &self.vehicle,
             &mut self.ws,
             &pose,
             q,
             &self.zeta,
-            &self.tau,
             &self.opts,
-        )
-        .map_err(|e| ModelError(e.to_string()))?;
+        );
+        match self.gmap.as_mut() {
+            None => self.tau.copy_from_slice(u),
+            Some(g) => {
+                // τ = G(q) u_T + [0; τ_q] (the kinematics of q are in ws.kin).
+                generalized_thrust_map(&self.vehicle, &self.ws.kin, g);
+                let m = g.ncols();
+                for r in 0..6 + n {
+                    let mut v = if r >= 6 { u[m + r - 6] } else { 0.0 };
+                    for j in 0..m {
+                        v += g[(r, j)] * u[j];
+                    }
+                    self.tau[r] = v;
+                }
+            }
+        }
+        solve_forward(&mut self.ws, &self.tau).map_err(|e| ModelError(e.to_string()))?;
         let dt = self.dt;
         for (z, a) in self.zeta.iter_mut().zip(&self.ws.zeta_dot) {
             *z += dt * a;

@@ -1,6 +1,6 @@
 //! Optimal control (issue 40, docs/ocp.md): direct multiple shooting of the multibody chain
-//! on the base pose's Lie group, solved by a Gauss–Newton SQP whose QP is a Riccati-based
-//! interior point.
+//! on the base pose's Lie group, solved by an SQP (exact Lagrangian Hessian by second
+//! differences, or Gauss–Newton) whose QP is a Riccati-based interior point.
 //!
 //! - [`model`]: the [`OcpModel`] trait (discrete dynamics with retraction, terminal equality,
 //!   central-difference Jacobians by default) and [`LinearModel`] (closed-form tests);
@@ -27,4 +27,4 @@ pub use chain::ChainModel;
 pub use model::{LinearModel, ModelError, OcpModel};
 pub use problem::{load_problem, parse_problem, ProblemSpec};
 pub use run::{solve_spec, write_outputs, OcpRun};
-pub use sqp::{solve, IterLog, OcpProblem, OcpSolution, SqpSettings, Status, Timing};
+pub use sqp::{solve, Hessian, IterLog, OcpProblem, OcpSolution, SqpSettings, Status, Timing};

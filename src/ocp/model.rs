@@ -19,6 +19,47 @@ pub struct ModelError(pub String);
 /// Step of the central differences in tangent coordinates.
 pub const FD_STEP: f64 = 1e-6;
 
+/// Step of the forward second differences of the Lagrangian Hessians (truncation O(ε),
+/// rounding O(1e-16/ε²) relative to the weighted state).
+pub const HESS_STEP: f64 = 1e-4;
+
+/// `wᵀ (f(x ⊕ δx, u + δu) ⊖ f0)` for the perturbation `Σ_{i ∈ idx} ε e_i` of `(δx, δu)`.
+#[allow(clippy::too_many_arguments)]
+fn weighted_step<M: OcpModel + ?Sized>(
+    m: &mut M,
+    x: &[f64],
+    u: &[f64],
+    w: &[f64],
+    f0: &[f64],
+    idx: &[usize],
+    buf: &mut HessBuf,
+) -> Result<f64, ModelError> {
+    let nx = buf.e.len();
+    buf.e.fill(0.0);
+    buf.u.copy_from_slice(u);
+    for &i in idx {
+        if i < nx {
+            buf.e[i] += HESS_STEP;
+        } else {
+            buf.u[i - nx] += HESS_STEP;
+        }
+    }
+    m.retract(x, &buf.e, &mut buf.xp);
+    m.step(&buf.xp, &buf.u, &mut buf.fp)?;
+    m.difference(f0, &buf.fp, &mut buf.d);
+    Ok(w.iter().zip(&buf.d).map(|(a, b)| a * b).sum())
+}
+
+/// Scratch of [`OcpModel::weighted_hessian`].
+struct HessBuf {
+    e: Vec<f64>,
+    u: Vec<f64>,
+    xp: Vec<f64>,
+    fp: Vec<f64>,
+    d: Vec<f64>,
+    phi: Vec<f64>,
+}
+
 /// Discrete dynamics on a manifold, with a terminal equality (see the module documentation).
 pub trait OcpModel {
     /// Size of the state's representation (e.g. 13 + 2n with a unit quaternion).
@@ -81,6 +122,79 @@ pub trait OcpModel {
             }
         }
         Ok(())
+    }
+
+    /// `H = ∇²φ` ((nx+nu)², order `[δx, δu]`) of `φ(δx, δu) = wᵀ (f(x ⊕ δx, u + δu) ⊖ f(x, u))`
+    /// at 0: the dynamics' curvature weighted by the costate `w` (nx), the exact-Hessian
+    /// term of the Lagrangian. Forward second differences with step [`HESS_STEP`]:
+    /// `H_ij = (φ(εe_i + εe_j) − φ(εe_i) − φ(εe_j) + φ(0)) / ε²`, `(nx+nu)(nx+nu+3)/2 + 1`
+    /// steps. Unless overridden.
+    fn weighted_hessian(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        w: &[f64],
+        h: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        let (nq, nx, nu) = (self.nq(), self.nx(), self.nu());
+        let m = nx + nu;
+        let mut f0 = vec![0.0; nq];
+        self.step(x, u, &mut f0)?;
+        let mut buf = HessBuf {
+            e: vec![0.0; nx],
+            u: vec![0.0; nu],
+            xp: vec![0.0; nq],
+            fp: vec![0.0; nq],
+            d: vec![0.0; nx],
+            phi: vec![0.0; m],
+        };
+        for i in 0..m {
+            buf.phi[i] = weighted_step(self, x, u, w, &f0, &[i], &mut buf)?;
+        }
+        let e2 = HESS_STEP * HESS_STEP;
+        for i in 0..m {
+            for j in i..m {
+                let pij = weighted_step(self, x, u, w, &f0, &[i, j], &mut buf)?;
+                let v = (pij - buf.phi[i] - buf.phi[j]) / e2;
+                h[(i, j)] = v;
+                h[(j, i)] = v;
+            }
+        }
+        Ok(())
+    }
+
+    /// `H = ∇²ψ` (nx×nx) of `ψ(δ) = νᵀ c(x ⊕ δ)` at 0 (the terminal equality's curvature
+    /// weighted by its multiplier ν), forward second differences as
+    /// [`OcpModel::weighted_hessian`]; unless overridden.
+    fn terminal_hessian(&mut self, x: &[f64], nu: &[f64], h: &mut DMatrix<f64>) {
+        let (nq, nx, nc) = (self.nq(), self.nx(), self.nc());
+        let mut xp = vec![0.0; nq];
+        let mut c = vec![0.0; nc];
+        let mut e = vec![0.0; nx];
+        let mut psi = |this: &mut Self, e: &[f64]| -> f64 {
+            this.retract(x, e, &mut xp);
+            this.terminal(&xp, &mut c);
+            nu.iter().zip(&c).map(|(a, b)| a * b).sum()
+        };
+        let p0 = psi(self, &e);
+        let mut p1 = vec![0.0; nx];
+        for i in 0..nx {
+            e[i] = HESS_STEP;
+            p1[i] = psi(self, &e);
+            e[i] = 0.0;
+        }
+        let e2 = HESS_STEP * HESS_STEP;
+        for i in 0..nx {
+            for j in i..nx {
+                e[i] += HESS_STEP;
+                e[j] += HESS_STEP;
+                let v = (psi(self, &e) - p1[i] - p1[j] + p0) / e2;
+                e[i] = 0.0;
+                e[j] = 0.0;
+                h[(i, j)] = v;
+                h[(j, i)] = v;
+            }
+        }
     }
 
     /// `C = ∂c/∂x` (nc×nx) at x, tangent coordinates; central differences unless overridden.
@@ -167,5 +281,18 @@ impl OcpModel for LinearModel {
     }
     fn terminal_jacobian(&mut self, _x: &[f64], c: &mut DMatrix<f64>) {
         c.copy_from(&self.c);
+    }
+    fn weighted_hessian(
+        &mut self,
+        _x: &[f64],
+        _u: &[f64],
+        _w: &[f64],
+        h: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        h.fill(0.0);
+        Ok(())
+    }
+    fn terminal_hessian(&mut self, _x: &[f64], _nu: &[f64], h: &mut DMatrix<f64>) {
+        h.fill(0.0);
     }
 }

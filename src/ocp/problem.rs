@@ -3,6 +3,7 @@
 //!
 //! ```toml
 //! design = "designs/rigid_chain5.toml"  # preset, file (relative to this file) or [design] table
+//! actuation = "base_wrench"  # or "thrusters": the design's thrusters (bounded by their limits)
 //! [physics]
 //! hydrodynamics = false      # true: added mass, drag, restoring forces, current
 //! [horizon]
@@ -22,10 +23,13 @@
 //! [solver]
 //! tolerance = 1e-6           # KKT tolerance
 //! max_iterations = 200
+//! hessian = "exact"          # or "gauss_newton" (objective only, no dynamics curvature)
+//! gauss_newton_above = 1e-2  # optional: Gauss–Newton while the primal infeasibility is above
 //! ```
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
+use super::sqp::Hessian;
 use crate::input::document::{read_text, Document};
 use crate::input::located::{InputError, Location};
 use crate::model::design::{load_design, parse_design_value};
@@ -40,6 +44,8 @@ pub const MAX_KNOTS: usize = 100_000;
 #[serde(deny_unknown_fields)]
 struct File {
     design: toml::Value,
+    #[serde(default)]
+    actuation: Option<String>,
     #[serde(default)]
     physics: Physics,
     horizon: Horizon,
@@ -118,6 +124,10 @@ struct Solver {
     tolerance: f64,
     #[serde(default = "iters")]
     max_iterations: i64,
+    #[serde(default)]
+    hessian: Option<String>,
+    #[serde(default)]
+    gauss_newton_above: Option<f64>,
 }
 
 impl Default for Solver {
@@ -125,6 +135,8 @@ impl Default for Solver {
         Self {
             tolerance: tol(),
             max_iterations: iters(),
+            hessian: None,
+            gauss_newton_above: None,
         }
     }
 }
@@ -146,6 +158,9 @@ pub struct ProblemSpec {
     pub vehicle: Vehicle,
     /// Hydrodynamics on (added mass, drag, restoring, current) or off (rigid bodies).
     pub hydrodynamics: bool,
+    /// Thruster actuation (thrusts within the design's limits, then joint torques); else the
+    /// base wrench.
+    pub thrusters: bool,
     /// Horizon T [s].
     pub duration: f64,
     /// Intervals N.
@@ -162,6 +177,10 @@ pub struct ProblemSpec {
     pub tolerance: f64,
     /// Most SQP iterations.
     pub max_iterations: usize,
+    /// The SQP's Hessian.
+    pub hessian: Hessian,
+    /// Gauss–Newton while the primal infeasibility exceeds this (∞: never).
+    pub gauss_newton_above: f64,
 }
 
 /// Read and validate a problem file.
@@ -199,6 +218,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         _ => return Err(doc.err("design", "must be a preset name, a file name or a table")),
     };
     let n = vehicle.n_joints();
+    let thrusters = actuation(&doc, f.actuation.as_deref(), &vehicle)?;
     let h = &f.horizon;
     if h.duration <= 0.0 {
         return Err(doc.err("horizon.duration", "must be positive [s]"));
@@ -250,10 +270,25 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
     if f.solver.max_iterations < 1 {
         return Err(doc.err("solver.max_iterations", "must be at least 1"));
     }
+    let hessian = match f.solver.hessian.as_deref() {
+        None | Some("exact") => Hessian::Exact,
+        Some("gauss_newton") => Hessian::GaussNewton,
+        Some(other) => {
+            return Err(doc.err(
+                "solver.hessian",
+                format!("`{other}` is not one of \"exact\", \"gauss_newton\""),
+            ))
+        }
+    };
+    let gauss_newton_above = f.solver.gauss_newton_above.unwrap_or(f64::INFINITY);
+    if gauss_newton_above <= 0.0 {
+        return Err(doc.err("solver.gauss_newton_above", "must be positive"));
+    }
     Ok(ProblemSpec {
         origin,
         vehicle,
         hydrodynamics: f.physics.hydrodynamics,
+        thrusters,
         duration: h.duration,
         knots: h.knots as usize,
         joint_angles,
@@ -262,5 +297,34 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         bounds,
         tolerance: f.solver.tolerance,
         max_iterations: f.solver.max_iterations as usize,
+        hessian,
+        gauss_newton_above,
     })
+}
+
+/// Whether `actuation` asks for thrusters (validated against the design's thrusters).
+fn actuation(doc: &Document, kind: Option<&str>, vehicle: &Vehicle) -> Result<bool, InputError> {
+    let thrusters = match kind {
+        None | Some("base_wrench") => false,
+        Some("thrusters") if vehicle.n_thrusters() > 0 => true,
+        Some("thrusters") => return Err(doc.err("actuation", "the design has no thrusters")),
+        Some(other) => {
+            return Err(doc.err(
+                "actuation",
+                format!("`{other}` is not one of \"base_wrench\", \"thrusters\""),
+            ))
+        }
+    };
+    if thrusters
+        && vehicle
+            .thrusters
+            .iter()
+            .any(|t| !(t.u_min < 0.0 && t.u_max > 0.0))
+    {
+        return Err(doc.err(
+            "actuation",
+            "thruster actuation needs every thruster's limits to straddle zero (the solver starts at zero thrust)",
+        ));
+    }
+    Ok(thrusters)
 }

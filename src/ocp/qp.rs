@@ -15,7 +15,9 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
-use super::riccati::{solve_lq, LqError, LqStage, LqTerminal};
+use super::riccati::{
+    solve_lq, solve_lq_into, LqError, LqSolution, LqStage, LqTerminal, LqWorkspace,
+};
 use nalgebra::DVector;
 
 /// Settings of the interior point.
@@ -105,6 +107,10 @@ pub fn solve_box_qp(
         w.d.fill(0.0);
     }
     let mut wterm = term.clone();
+    let nc = term.c_vec.len();
+    let mut lq = LqWorkspace::new(n, nx, nu, nc);
+    let mut aff = Direction::zeros(n, nx, nu, nc);
+    let mut st = Direction::zeros(n, nx, nu, nc);
     let mut iterations = 0;
     let mut converged = false;
     for _ in 0..set.max_iterations {
@@ -120,35 +126,43 @@ pub fn solve_box_qp(
         }
         iterations += 1;
         barrier_hessian(&mut work, stages, lo, hi, &du, &dx, &z_lo, &z_hi);
-        wterm.q_vec = &term.q_mat * &dx[n] + &term.q_vec;
-        wterm.c_vec = &term.c_mat * &dx[n] + &term.c_vec;
+        wterm.q_vec.copy_from(&term.q_vec);
+        wterm.q_vec.gemv(1.0, &term.q_mat, &dx[n], 1.0);
+        wterm.c_vec.copy_from(&term.c_vec);
+        wterm.c_vec.gemv(1.0, &term.c_mat, &dx[n], 1.0);
         // Predictor (τ = 0), then corrector (τ = σμ − Δs_aff∘Δz_aff).
         let zero = |_: usize, _: usize, _: bool| 0.0;
-        let aff = newton(&mut work, stages, &wterm, lo, hi, &du, &z_lo, &z_hi, &zero)?;
+        let pt = Point {
+            lo,
+            hi,
+            du: &du,
+            dx: &dx,
+            z_lo: &z_lo,
+            z_hi: &z_hi,
+        };
+        newton(&mut work, stages, &wterm, &pt, &zero, &mut lq, &mut aff)?;
         let a_aff = step_length(lo, hi, &du, &z_lo, &z_hi, &aff, 1.0);
         let (mu_aff, _) = complementarity(lo, hi, &du, &z_lo, &z_hi, Some((a_aff, &aff)));
         let sigma = (mu_aff / mu).powi(3).clamp(0.0, 1.0);
         let target = |k: usize, i: usize, upper: bool| {
             if upper {
-                sigma * mu + aff.du[k][i] * aff.dz_hi[k][i]
+                sigma * mu + aff.sol.du[k][i] * aff.dz_hi[k][i]
             } else {
-                sigma * mu - aff.du[k][i] * aff.dz_lo[k][i]
+                sigma * mu - aff.sol.du[k][i] * aff.dz_lo[k][i]
             }
         };
-        let st = newton(
-            &mut work, stages, &wterm, lo, hi, &du, &z_lo, &z_hi, &target,
-        )?;
+        newton(&mut work, stages, &wterm, &pt, &target, &mut lq, &mut st)?;
         let alpha = step_length(lo, hi, &du, &z_lo, &z_hi, &st, 0.995);
         for k in 0..=n {
-            dx[k] += alpha * &st.dx[k];
-            lam[k] = &lam[k] + alpha * (&st.lam[k] - &lam[k]);
+            dx[k].axpy(alpha, &st.sol.dx[k], 1.0);
+            lam[k].axpy(alpha, &st.sol.lam[k], 1.0 - alpha);
         }
         for k in 0..n {
-            du[k] += alpha * &st.du[k];
-            z_lo[k] += alpha * &st.dz_lo[k];
-            z_hi[k] += alpha * &st.dz_hi[k];
+            du[k].axpy(alpha, &st.sol.du[k], 1.0);
+            z_lo[k].axpy(alpha, &st.dz_lo[k], 1.0);
+            z_hi[k].axpy(alpha, &st.dz_hi[k], 1.0);
         }
-        nuv = &nuv + alpha * (&st.nu - &nuv);
+        nuv.axpy(alpha, &st.sol.nu, 1.0 - alpha);
     }
     Ok(QpSolution {
         dx,
@@ -206,7 +220,7 @@ fn complementarity(
     for k in 0..du.len() {
         for i in 0..du[k].len() {
             let (a, ddu, dzl, dzh) = match step {
-                Some((a, d)) => (a, d.du[k][i], d.dz_lo[k][i], d.dz_hi[k][i]),
+                Some((a, d)) => (a, d.sol.du[k][i], d.dz_lo[k][i], d.dz_hi[k][i]),
                 None => (0.0, 0.0, 0.0, 0.0),
             };
             let u = du[k][i] + a * ddu;
@@ -252,36 +266,56 @@ fn barrier_hessian(
             }
             w.r_mat[(i, i)] += sig;
         }
-        w.q_vec = &s.q_mat * &dx[k] + &s.q_vec;
+        w.q_vec.copy_from(&s.q_vec);
+        w.q_vec.gemv(1.0, &s.q_mat, &dx[k], 1.0);
+        w.q_vec.gemv_tr(1.0, &s.s_mat, &du[k], 1.0);
     }
 }
 
-/// A Newton direction of the interior point.
+/// A Newton direction of the interior point (preallocated, filled by [`newton`]).
 struct Direction {
-    dx: Vec<DVector<f64>>,
-    du: Vec<DVector<f64>>,
-    lam: Vec<DVector<f64>>,
-    nu: DVector<f64>,
+    sol: LqSolution,
     dz_lo: Vec<DVector<f64>>,
     dz_hi: Vec<DVector<f64>>,
 }
 
-/// One Newton direction for complementarity targets `tau(k, i, upper)`.
-#[allow(clippy::too_many_arguments)]
+impl Direction {
+    fn zeros(n: usize, nx: usize, nu: usize, nc: usize) -> Self {
+        Self {
+            sol: LqSolution::zeros(n, nx, nu, nc),
+            dz_lo: vec![DVector::zeros(nu); n],
+            dz_hi: vec![DVector::zeros(nu); n],
+        }
+    }
+}
+
+/// The interior point's iterate: bounds, controls and states of the step, multipliers.
+struct Point<'a> {
+    lo: &'a [DVector<f64>],
+    hi: &'a [DVector<f64>],
+    du: &'a [DVector<f64>],
+    dx: &'a [DVector<f64>],
+    z_lo: &'a [DVector<f64>],
+    z_hi: &'a [DVector<f64>],
+}
+
+/// One Newton direction for complementarity targets `tau(k, i, upper)` into `out`
+/// (allocation-free: the Riccati storage `lq` is reused).
 fn newton(
     work: &mut [LqStage],
     stages: &[LqStage],
     wterm: &LqTerminal,
-    lo: &[DVector<f64>],
-    hi: &[DVector<f64>],
-    du: &[DVector<f64>],
-    z_lo: &[DVector<f64>],
-    z_hi: &[DVector<f64>],
+    pt: &Point,
     tau: &dyn Fn(usize, usize, bool) -> f64,
-) -> Result<Direction, LqError> {
+    lq: &mut LqWorkspace,
+    out: &mut Direction,
+) -> Result<(), LqError> {
+    let (lo, hi, du) = (pt.lo, pt.hi, pt.du);
     let nu = du.first().map_or(0, |v| v.len());
     for (k, (w, s)) in work.iter_mut().zip(stages).enumerate() {
-        w.r_vec = &s.r_mat * &du[k] + &s.r_vec;
+        w.r_vec.copy_from(&s.r_vec);
+        w.r_vec.gemv(1.0, &s.r_mat, &du[k], 1.0);
+        w.r_vec.gemv(1.0, &s.s_mat, &pt.dx[k], 1.0);
         for i in 0..nu {
             if lo[k][i].is_finite() {
                 w.r_vec[i] -= tau(k, i, false) / (du[k][i] - lo[k][i]);
@@ -291,30 +325,23 @@ fn newton(
             }
         }
     }
-    let sol = solve_lq(work, wterm)?;
-    let mut dz_lo = vec![DVector::zeros(nu); du.len()];
-    let mut dz_hi = vec![DVector::zeros(nu); du.len()];
+    solve_lq_into(work, wterm, lq, &mut out.sol)?;
     for k in 0..du.len() {
         for i in 0..nu {
-            let d = sol.du[k][i];
+            let d = out.sol.du[k][i];
+            out.dz_lo[k][i] = 0.0;
+            out.dz_hi[k][i] = 0.0;
             if lo[k][i].is_finite() {
                 let s = du[k][i] - lo[k][i];
-                dz_lo[k][i] = (tau(k, i, false) - s * z_lo[k][i] - z_lo[k][i] * d) / s;
+                out.dz_lo[k][i] = (tau(k, i, false) - s * pt.z_lo[k][i] - pt.z_lo[k][i] * d) / s;
             }
             if hi[k][i].is_finite() {
                 let s = hi[k][i] - du[k][i];
-                dz_hi[k][i] = (tau(k, i, true) - s * z_hi[k][i] + z_hi[k][i] * d) / s;
+                out.dz_hi[k][i] = (tau(k, i, true) - s * pt.z_hi[k][i] + pt.z_hi[k][i] * d) / s;
             }
         }
     }
-    Ok(Direction {
-        dx: sol.dx,
-        du: sol.du,
-        lam: sol.lam,
-        nu: sol.nu,
-        dz_lo,
-        dz_hi,
-    })
+    Ok(())
 }
 
 /// The largest step in (0, 1] keeping slacks and multipliers at least `(1 − frac)` of their
@@ -337,11 +364,11 @@ fn step_length(
     for k in 0..du.len() {
         for i in 0..du[k].len() {
             if lo[k][i].is_finite() {
-                limit(du[k][i] - lo[k][i], d.du[k][i]);
+                limit(du[k][i] - lo[k][i], d.sol.du[k][i]);
                 limit(z_lo[k][i], d.dz_lo[k][i]);
             }
             if hi[k][i].is_finite() {
-                limit(hi[k][i] - du[k][i], -d.du[k][i]);
+                limit(hi[k][i] - du[k][i], -d.sol.du[k][i]);
                 limit(z_hi[k][i], d.dz_hi[k][i]);
             }
         }
@@ -362,17 +389,34 @@ pub(crate) fn residuals(
     z_hi: &[DVector<f64>],
 ) -> (f64, f64) {
     let n = stages.len();
+    let nx = term.q_mat.nrows();
+    let n_u = stages.first().map_or(0, |s| s.b.ncols());
+    let (mut gu, mut gx) = (DVector::zeros(n_u), DVector::zeros(nx));
     let mut stat: f64 = 0.0;
     for (k, s) in stages.iter().enumerate() {
-        let gu = &s.r_mat * &du[k] + &s.r_vec + s.b.transpose() * &lam[k + 1] - &z_lo[k] + &z_hi[k];
+        gu.copy_from(&s.r_vec);
+        gu.gemv(1.0, &s.r_mat, &du[k], 1.0);
+        gu.gemv(1.0, &s.s_mat, &dx[k], 1.0);
+        gu.gemv_tr(1.0, &s.b, &lam[k + 1], 1.0);
+        gu -= &z_lo[k];
+        gu += &z_hi[k];
         stat = stat.max(gu.amax());
         if k > 0 {
-            let gx = &s.q_mat * &dx[k] + &s.q_vec + s.a.transpose() * &lam[k + 1] - &lam[k];
+            gx.copy_from(&s.q_vec);
+            gx.gemv(1.0, &s.q_mat, &dx[k], 1.0);
+            gx.gemv_tr(1.0, &s.s_mat, &du[k], 1.0);
+            gx.gemv_tr(1.0, &s.a, &lam[k + 1], 1.0);
+            gx -= &lam[k];
             stat = stat.max(gx.amax());
         }
     }
-    let gn = &term.q_mat * &dx[n] + &term.q_vec + term.c_mat.transpose() * nu - &lam[n];
-    stat = stat.max(gn.amax());
-    let cres = (&term.c_mat * &dx[n] + &term.c_vec).amax();
+    gx.copy_from(&term.q_vec);
+    gx.gemv(1.0, &term.q_mat, &dx[n], 1.0);
+    gx.gemv_tr(1.0, &term.c_mat, nu, 1.0);
+    gx -= &lam[n];
+    stat = stat.max(gx.amax());
+    let mut cres = term.c_vec.clone();
+    cres.gemv(1.0, &term.c_mat, &dx[n], 1.0);
+    let cres = cres.amax();
     (stat, cres)
 }

@@ -48,15 +48,23 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
     let mut model = ChainModel::new(spec.vehicle.clone(), opts, dt, Vec3::zeros());
     let target = model.ee_position(&x0) + Vec3::from(spec.ee_displacement);
     let mut model = ChainModel::new(spec.vehicle.clone(), opts, dt, target);
-    let (nx, nu) = (model.nx(), model.nu());
-    let mut u_lo = Vec::with_capacity(nu);
+    if spec.thrusters {
+        model = model.with_thrusters();
+    }
+    let (nx, nu, nb) = (model.nx(), model.nu(), model.n_body_controls());
+    let (mut u_lo, mut u_hi) = (Vec::with_capacity(nu), Vec::with_capacity(nu));
     for i in 0..nu {
-        let b = match i {
-            0..=2 => spec.bounds[0],
-            3..=5 => spec.bounds[1],
-            _ => spec.bounds[2],
+        let (lo, hi) = match i {
+            _ if i >= nb => (-spec.bounds[2], spec.bounds[2]),
+            _ if spec.thrusters => (
+                spec.vehicle.thrusters[i].u_min,
+                spec.vehicle.thrusters[i].u_max,
+            ),
+            0..=2 => (-spec.bounds[0], spec.bounds[0]),
+            _ => (-spec.bounds[1], spec.bounds[1]),
         };
-        u_lo.push(-b);
+        u_lo.push(lo);
+        u_hi.push(hi);
     }
     let prob = OcpProblem {
         knots: spec.knots,
@@ -65,12 +73,14 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
         q: DMatrix::zeros(nx, nx),
         r: DMatrix::identity(nu, nu) * (spec.effort * dt),
         q_n: DMatrix::zeros(nx, nx),
-        u_hi: u_lo.iter().map(|v| -v).collect(),
+        u_hi,
         u_lo,
     };
     let set = SqpSettings {
         tolerance: spec.tolerance,
         max_iterations: spec.max_iterations,
+        hessian: spec.hessian,
+        gauss_newton_above: spec.gauss_newton_above,
         ..SqpSettings::default()
     };
     let solution = solve(&mut model, &prob, None, None, &set);
@@ -82,8 +92,9 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
     }
 }
 
-/// The column names of `trajectory.csv`.
-pub fn trajectory_columns(n_joints: usize) -> Vec<String> {
+/// The column names of `trajectory.csv`: with `n_thrusters` = Some(m) the thrusts
+/// (`simulate`'s actual-thrust names), else the base wrench.
+pub fn trajectory_columns(n_joints: usize, n_thrusters: Option<usize>) -> Vec<String> {
     let mut c = vec![Channel::T.name()];
     c.extend(Pose::ALL.map(|p| Channel::BasePose(p).name()));
     c.extend(Twist::ALL.map(|t| Channel::BaseTwist(t).name()));
@@ -91,6 +102,10 @@ pub fn trajectory_columns(n_joints: usize) -> Vec<String> {
     c.extend((0..n_joints).map(|k| Channel::Q(k).name()));
     c.extend((0..n_joints).map(|k| Channel::Qd(k).name()));
     c.extend((0..n_joints).map(|k| Channel::Tau(k).name()));
+    if let Some(m) = n_thrusters {
+        c.extend((0..m).map(|j| Channel::U(j).name()));
+        return c;
+    }
     c.extend(
         [
             "wrench_fx",
@@ -114,7 +129,9 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     })?;
     let n = spec.vehicle.n_joints();
     let sol = &run.solution;
-    let mut csv = trajectory_columns(n).join(",");
+    let nb = run.model.n_body_controls();
+    let thrusters = run.model.thruster_actuated().then_some(nb);
+    let mut csv = trajectory_columns(n, thrusters).join(",");
     csv.push('\n');
     for (k, x) in sol.xs.iter().enumerate() {
         let pose = ChainModel::pose(x);
@@ -132,18 +149,18 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         let mut cells: Vec<String> = row.into_iter().map(format_f64).collect();
         match sol.us.get(k) {
             Some(u) => {
-                cells.extend(u[6..].iter().map(|v| format_f64(*v)));
-                cells.extend(u[..6].iter().map(|v| format_f64(*v)));
+                cells.extend(u[nb..].iter().map(|v| format_f64(*v)));
+                cells.extend(u[..nb].iter().map(|v| format_f64(*v)));
             }
             // No control at the last knot.
-            None => cells.extend(std::iter::repeat_n(String::new(), n + 6)),
+            None => cells.extend(std::iter::repeat_n(String::new(), n + nb)),
         }
         csv.push_str(&cells.join(","));
         csv.push('\n');
     }
     atomic_write(&dir.join("trajectory.csv"), csv.as_bytes())?;
     let mut it = String::from(
-        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size\n",
+        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size,regularisation,terminal_penalty\n",
     );
     for r in &sol.log {
         let cells = [
@@ -155,6 +172,8 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
             format_f64(r.step),
             r.qp_iterations.to_string(),
             r.filter_size.to_string(),
+            format_f64(r.regularisation),
+            format_f64(r.terminal_penalty),
         ];
         it.push_str(&cells.join(","));
         it.push('\n');
@@ -184,7 +203,9 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         "knots": spec.knots,
         "dt": run.dt,
         "hydrodynamics": spec.hydrodynamics,
-        "method": "multiple shooting, Gauss-Newton SQP, Riccati interior-point QP, filter line search",
+        "actuation": if spec.thrusters { "thrusters" } else { "base_wrench" },
+        "method": "multiple shooting, SQP, Riccati interior-point QP, filter line search",
+        "hessian": spec.hessian,
         "derivatives": "central differences (eps 1e-6, tangent coordinates)",
         "optimum": "a local optimum from the rest trajectory (single start)",
     });

@@ -1,4 +1,5 @@
-//! Direct multiple shooting solved by a Gauss–Newton SQP (docs/ocp.md §3).
+//! Direct multiple shooting solved by an SQP with the exact Lagrangian Hessian or the
+//! Gauss–Newton one (docs/ocp.md §3).
 //!
 //! Variables: the states `x_0 … x_N` (manifold representations, `x_0` fixed) and the
 //! controls `u_0 … u_{N−1}`. Problem:
@@ -9,10 +10,12 @@
 //! ```
 //!
 //! Each iteration linearises the defects and the terminal equality (the model's Jacobians,
-//! tangent coordinates), takes the Gauss–Newton Hessian `2Q`, `2R`, `2Q_N` (exact for the
-//! objective's least-squares terms; the curvature of the dynamics and of `⊖` is left out)
-//! and solves the QP of [`super::qp`] (Riccati-based interior point, bounds strictly
-//! feasible). The step is accepted by a backtracking filter line search (Wächter & Biegler
+//! tangent coordinates), takes the Hessian `2Q`, `2R`, `2Q_N` plus, for [`Hessian::Exact`],
+//! the dynamics' and the terminal equality's curvature weighted by the previous QP's
+//! multipliers (`∇²(λ_{k+1}ᵀ f)` per stage, with its cross block `S_k`, and `∇²(νᵀ c)`; the
+//! curvature of `⊖` on the `x_{k+1}` side is left out), convexified when a Riccati
+//! factorisation is not positive definite ([`regularised_qp`]), and solves the QP of
+//! [`super::qp`] (Riccati-based interior point, bounds strictly feasible). The step is accepted by a backtracking filter line search (Wächter & Biegler
 //! 2006) on the pair (θ, J), `θ = Σ‖d_k‖₁ + ‖c‖₁`: a trial point must not be dominated by
 //! the filter and must decrease θ or J by the margin γ = 1e-5·θ; when θ is small
 //! (≤ 1e-4·max(1, θ_start)) and the step is a descent direction of J with
@@ -59,9 +62,28 @@ pub struct OcpProblem {
     pub u_hi: Vec<f64>,
 }
 
+/// The Hessian of the SQP's subproblems.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Hessian {
+    /// `2Q`, `2R`, `2Q_N`: the objective's only (no curvature of the dynamics).
+    GaussNewton,
+    /// The Lagrangian's: the objective's plus `∇²(λ_{k+1}ᵀ f)` per stage and `∇²(νᵀ c)` at
+    /// the end, with the previous QP's multipliers (full step, whatever the line search
+    /// accepted; the first iteration has none and is Gauss–Newton)
+    /// ([`OcpModel::weighted_hessian`]), convexified by [`regularised_qp`] when a Riccati
+    /// factorisation is not positive definite.
+    Exact,
+}
+
 /// Settings of the SQP.
 #[derive(Clone, Copy, Debug)]
 pub struct SqpSettings {
+    /// The subproblems' Hessian.
+    pub hessian: Hessian,
+    /// With [`Hessian::Exact`]: the Gauss–Newton Hessian is used while the previous
+    /// iterate's primal infeasibility exceeds this (∞: exact from the second iteration).
+    pub gauss_newton_above: f64,
     /// KKT tolerance (primal, stationarity, complementarity; ∞-norms).
     pub tolerance: f64,
     /// Most SQP iterations.
@@ -73,6 +95,8 @@ pub struct SqpSettings {
 impl Default for SqpSettings {
     fn default() -> Self {
         Self {
+            hessian: Hessian::Exact,
+            gauss_newton_above: f64::INFINITY,
             tolerance: 1e-6,
             max_iterations: 200,
             qp: QpSettings::default(),
@@ -115,6 +139,10 @@ pub struct IterLog {
     pub qp_iterations: usize,
     /// Entries in the filter.
     pub filter_size: usize,
+    /// Regularisation δ added to the Hessian's diagonal (0: none).
+    pub regularisation: f64,
+    /// Terminal penalty ρ (ρ CᵀC added to `Q_N`; 0: none).
+    pub terminal_penalty: f64,
 }
 
 /// Wall-clock time by phase [s].
@@ -122,6 +150,8 @@ pub struct IterLog {
 pub struct Timing {
     /// Derivatives (dynamics and terminal Jacobians).
     pub derivatives: f64,
+    /// Of which the Lagrangian Hessians (exact Hessian only).
+    pub hessian: f64,
     /// QP solves (Riccati factorisations).
     pub qp: f64,
     /// Line search (dynamics rollouts of the trial points).
@@ -164,6 +194,8 @@ struct Eval {
     infeas1: f64,
     /// max ‖d_k‖∞, ‖c‖∞.
     infeas_max: f64,
+    /// Time spent on the Lagrangian Hessians [s].
+    hessian_time: f64,
 }
 
 /// Solve `prob` on `model` from the initial guess `us` (controls; pushed strictly inside
@@ -189,6 +221,8 @@ pub fn solve<M: OcpModel>(
         log: Vec::new(),
         timing: Timing::default(),
         iterations: 0,
+        mult: None,
+        reg: Reg::default(),
     };
     let end = iterate(model, prob, set, &mut st);
     st.timing.total = t0.elapsed().as_secs_f64();
@@ -214,6 +248,10 @@ struct SolveState {
     log: Vec<IterLog>,
     timing: Timing,
     iterations: usize,
+    /// Multiplier estimates (costates λ_0 … λ_N, terminal ν) for the exact Hessian.
+    mult: Option<(Vec<DVector<f64>>, DVector<f64>)>,
+    /// Last convexification that made every factorisation positive definite.
+    reg: Reg,
 }
 
 /// How the iteration ended.
@@ -270,11 +308,19 @@ fn iterate<M: OcpModel>(
     loop {
         let it = st.iterations;
         let ts = Instant::now();
-        let ev = match evaluate(model, prob, &st.xs, &st.us, true) {
+        let primal = st.log.last().map_or(f64::INFINITY, |r| r.primal);
+        let mult = match set.hessian {
+            Hessian::Exact if primal <= set.gauss_newton_above => {
+                st.mult.as_ref().map(|(l, v)| (l.as_slice(), v))
+            }
+            _ => None,
+        };
+        let mut ev = match evaluate(model, prob, &st.xs, &st.us, Some(mult)) {
             Ok(e) => e,
             Err(e) => return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]),
         };
         st.timing.derivatives += ts.elapsed().as_secs_f64();
+        st.timing.hessian += ev.hessian_time;
         let bound = |b: &[f64]| -> Vec<DVector<f64>> {
             let us = &st.us;
             us.iter()
@@ -284,7 +330,8 @@ fn iterate<M: OcpModel>(
         let (lo, hi) = (bound(&prob.u_lo), bound(&prob.u_hi));
         let tq = Instant::now();
         let warm = z_warm.as_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
-        let qp = solve_box_qp(&ev.stages, &ev.term, &lo, &hi, warm, &set.qp);
+        let (qp, reg) = regularised_qp(&mut ev, &lo, &hi, warm, set, st.reg);
+        st.reg = reg;
         st.timing.qp += tq.elapsed().as_secs_f64();
         let qp = match qp {
             Ok(q) => q,
@@ -307,6 +354,8 @@ fn iterate<M: OcpModel>(
             step: 0.0,
             qp_iterations: qp.iterations,
             filter_size: filter.entries.len(),
+            regularisation: reg.delta,
+            terminal_penalty: reg.rho,
         };
         if kkt.iter().all(|r| *r <= set.tolerance) {
             st.log.push(row);
@@ -330,8 +379,94 @@ fn iterate<M: OcpModel>(
         st.log.push(row);
         st.xs = xt;
         st.us = ut;
+        st.mult = Some((qp.lam, qp.nu));
         z_warm = Some((qp.z_lo, qp.z_hi));
         st.iterations += 1;
+    }
+}
+
+/// Largest regularisation tried before the subproblem is declared not convex.
+const MAX_REG: f64 = 1e12;
+
+/// Largest terminal penalty ρ of [`regularised_qp`].
+const MAX_RHO: f64 = 1e6;
+
+/// The convexifications of a subproblem: the terminal penalty ρ and the diagonal shift δ.
+#[derive(Clone, Copy, Debug, Default)]
+struct Reg {
+    rho: f64,
+    delta: f64,
+}
+
+/// The QP of `ev`, convexified when a Riccati factorisation is not positive definite.
+/// First `ρ CᵀC` is added to `Q_N` (ρ from `ρ_last/4`, times 10 up to 1e6): on the
+/// terminal equality's solution set it adds a constant, so the QP's primal solution is
+/// unchanged and ν is recovered as `ν' + ρ C δx_N`, but it makes the Riccati recursion
+/// positive definite whenever the Hessian is on the null space of the constraints
+/// (Debreu's lemma) — the stage-wise Riccati otherwise needs it on the larger space of
+/// free terminal states. Then `δ I` is added to every `Q_k`, `R_k` and `Q_N` (IPOPT's
+/// inertia correction: δ from `max(1e-8, δ_last/3)` or 1e-4, times 8). Returns the QP
+/// result and the (ρ, δ) used (left added to `ev`).
+#[allow(clippy::type_complexity)]
+fn regularised_qp(
+    ev: &mut Eval,
+    lo: &[DVector<f64>],
+    hi: &[DVector<f64>],
+    warm: Option<(&[DVector<f64>], &[DVector<f64>])>,
+    set: &SqpSettings,
+    last: Reg,
+) -> (Result<QpSolution, LqError>, Reg) {
+    let ctc = ev.term.c_mat.transpose() * &ev.term.c_mat;
+    let mut reg = Reg::default();
+    if set.hessian == Hessian::Exact && last.rho >= 4.0 {
+        reg.rho = last.rho / 4.0;
+        ev.term.q_mat += &ctc * reg.rho;
+    }
+    loop {
+        let mut qp = solve_box_qp(&ev.stages, &ev.term, lo, hi, warm, &set.qp);
+        let convex = !matches!(qp, Err(LqError::NotConvex(_)));
+        if convex || set.hessian == Hessian::GaussNewton {
+            if let Ok(q) = qp.as_mut() {
+                if reg.rho > 0.0 {
+                    let n = q.dx.len() - 1;
+                    q.nu += &ev.term.c_mat * &q.dx[n] * reg.rho;
+                }
+            }
+            return (qp, reg);
+        }
+        if reg.rho < MAX_RHO {
+            let next = (reg.rho * 10.0).max(1.0);
+            ev.term.q_mat += &ctc * (next - reg.rho);
+            reg.rho = next;
+            continue;
+        }
+        let next = if reg.delta > 0.0 {
+            reg.delta * 8.0
+        } else if last.delta > 0.0 {
+            (last.delta / 3.0).max(1e-8)
+        } else {
+            1e-4
+        };
+        if next > MAX_REG {
+            return (qp, reg);
+        }
+        shift_diagonal(ev, next - reg.delta);
+        reg.delta = next;
+    }
+}
+
+/// Add `d` to the diagonals of every stage's `Q_k`, `R_k` and of `Q_N`.
+fn shift_diagonal(ev: &mut Eval, d: f64) {
+    for s in ev.stages.iter_mut() {
+        for i in 0..s.q_mat.nrows() {
+            s.q_mat[(i, i)] += d;
+        }
+        for i in 0..s.r_mat.nrows() {
+            s.r_mat[(i, i)] += d;
+        }
+    }
+    for i in 0..ev.term.q_mat.nrows() {
+        ev.term.q_mat[(i, i)] += d;
     }
 }
 
@@ -402,7 +537,7 @@ fn line_search<M: OcpModel>(
                 }
             }
         }
-        if let Ok(e) = evaluate(model, prob, &xt, &ut, false) {
+        if let Ok(e) = evaluate(model, prob, &xt, &ut, None) {
             let (theta, j) = (e.infeas1, e.objective);
             let in_filter =
                 theta <= theta_max && filter.entries.iter().all(|&(tf, jf)| theta < tf || j < jf);
@@ -437,15 +572,24 @@ fn strictly_inside(v: f64, lo: f64, hi: f64) -> f64 {
     v.max(lo + margin).min(hi - margin)
 }
 
-/// Objective, defects and terminal residual at (xs, us); with `derivatives`, also the
-/// Jacobians and the Gauss–Newton QP data.
+/// Multiplier estimates (λ_0 … λ_N, ν) weighting the dynamics' and terminal curvature.
+type Multipliers<'a> = (&'a [DVector<f64>], &'a DVector<f64>);
+
+/// Objective, defects and terminal residual at (xs, us); with `derivatives = Some(m)`, also
+/// the Jacobians and the QP data: the Gauss–Newton Hessian, plus the Lagrangian's curvature
+/// when `m` holds multipliers.
 fn evaluate<M: OcpModel>(
     model: &mut M,
     prob: &OcpProblem,
     xs: &[Vec<f64>],
     us: &[Vec<f64>],
-    derivatives: bool,
+    derivatives: Option<Option<Multipliers>>,
 ) -> Result<Eval, ModelError> {
+    let mut hessian_time = 0.0;
+    let mut hbuf = DMatrix::zeros(0, 0);
+    if let Some(Some(_)) = derivatives {
+        hbuf = DMatrix::zeros(model.nx() + model.nu(), model.nx() + model.nu());
+    }
     let (n, nx, nu, nq, nc) = (prob.knots, model.nx(), model.nu(), model.nq(), model.nc());
     let mut stages = Vec::with_capacity(n);
     let mut f = vec![0.0; nq];
@@ -467,12 +611,20 @@ fn evaluate<M: OcpModel>(
         let ev = DVector::from_column_slice(&e);
         let uv = DVector::from_column_slice(&us[k]);
         objective += ev.dot(&(&prob.q * &ev)) + uv.dot(&(&prob.r * &uv));
-        if derivatives {
+        if let Some(mult) = derivatives {
             model.jacobians(&xs[k], &us[k], &mut s.a, &mut s.b)?;
             s.q_mat = &prob.q * 2.0;
             s.q_vec = &prob.q * &ev * 2.0;
             s.r_mat = &prob.r * 2.0;
             s.r_vec = &prob.r * &uv * 2.0;
+            if let Some((lam, _)) = mult {
+                let th = Instant::now();
+                model.weighted_hessian(&xs[k], &us[k], lam[k + 1].as_slice(), &mut hbuf)?;
+                s.q_mat += hbuf.view((0, 0), (nx, nx));
+                s.r_mat += hbuf.view((nx, nx), (nu, nu));
+                s.s_mat.copy_from(&hbuf.view((nx, 0), (nu, nx)));
+                hessian_time += th.elapsed().as_secs_f64();
+            }
         }
         stages.push(s);
     }
@@ -485,8 +637,14 @@ fn evaluate<M: OcpModel>(
     infeas1 += c_vec.lp_norm(1);
     infeas_max = infeas_max.max(c_vec.amax());
     let mut c_mat = DMatrix::zeros(nc, nx);
-    if derivatives {
+    let mut q_n = &prob.q_n * 2.0;
+    if let Some(mult) = derivatives {
         model.terminal_jacobian(&xs[n], &mut c_mat);
+        if let Some((_, nu_mult)) = mult {
+            let mut h = DMatrix::zeros(nx, nx);
+            model.terminal_hessian(&xs[n], nu_mult.as_slice(), &mut h);
+            q_n += h;
+        }
     }
     if !objective.is_finite() || !infeas1.is_finite() {
         return Err(ModelError("non-finite objective or residual".into()));
@@ -494,7 +652,7 @@ fn evaluate<M: OcpModel>(
     Ok(Eval {
         stages,
         term: LqTerminal {
-            q_mat: &prob.q_n * 2.0,
+            q_mat: q_n,
             q_vec: &prob.q_n * &ev * 2.0,
             c_mat,
             c_vec,
@@ -502,5 +660,6 @@ fn evaluate<M: OcpModel>(
         objective,
         infeas1,
         infeas_max,
+        hessian_time,
     })
 }
