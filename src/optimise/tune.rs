@@ -63,6 +63,12 @@ pub struct Tuner {
     /// optimisation stops a candidate at the first world after which it is certainly
     /// infeasible and not better than the best so far ([`super::score::Scorer::cannot_rank_before`]).
     race: bool,
+    /// Screen the tuning candidates with the cheaper fixed-step integrator (`[tune] screen =
+    /// "rk4"`: RK4 at the control period, `physics.integrator = "rk4"`, `scenario.dt =
+    /// scenario.control_dt`), issue 38 item 3. The seeds' pooled comparison and everything
+    /// the case is scored by (nominal run, worlds, variants, faults) stay at the scenario's
+    /// own integrator. Default false: candidates run as the case does.
+    screen: bool,
 }
 
 /// Most independent tuning seeds.
@@ -140,6 +146,17 @@ impl Tuner {
             Some(toml::Value::Boolean(b)) => b,
             Some(v) => return Err(doc.err("tune.race", format!("must be true or false, got {v}"))),
         };
+        let screen = match t.remove("screen") {
+            None => false,
+            Some(toml::Value::String(s)) if s == "rk4" => true,
+            Some(toml::Value::String(s)) if s == "none" => false,
+            Some(v) => {
+                return Err(doc.err(
+                    "tune.screen",
+                    format!("must be \"rk4\" or \"none\", got {v}"),
+                ))
+            }
+        };
         let spec = parse_spec(&doc, &t, "tune", study)?;
         check_two_roads(&spec, study, &doc)?;
         if spec.solver.max_evals / starts < 2 {
@@ -166,6 +183,7 @@ impl Tuner {
             worlds,
             seeds,
             race,
+            screen,
         }))
     }
 
@@ -239,7 +257,10 @@ impl Tuner {
         deadline: Deadline,
         k: usize,
     ) -> Result<SeedResult, TuneError> {
-        let problem = self.case_problem_with(study, r, WorldsOf::Seed(k));
+        let mut problem = self.case_problem_with(study, r, WorldsOf::Seed(k));
+        if self.screen {
+            screen_with_rk4(&mut problem.study.scenario_full);
+        }
         let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
         let mut spec = problem.spec.clone();
         if k > 0 {
@@ -452,6 +473,28 @@ impl CaseTuner for Tuner {
             .map_err(TuneError::from_error)?;
         s.hash = r.hash.clone();
         Ok(s)
+    }
+}
+
+/// Set `scenario` to run with RK4 at its control period (`[tune] screen = "rk4"`): physics
+/// steps of `scenario.control_dt` (default [`crate::scenario::config::DEFAULT_CONTROL_DT`]),
+/// one per control period, instead of the adaptive Dormand–Prince steps.
+fn screen_with_rk4(scenario: &mut toml::Table) {
+    let sc = scenario
+        .entry("scenario")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(sc) = sc.as_table_mut() {
+        let control_dt = sc
+            .get("control_dt")
+            .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+            .unwrap_or(crate::scenario::config::DEFAULT_CONTROL_DT);
+        sc.insert("dt".into(), toml::Value::Float(control_dt));
+    }
+    let ph = scenario
+        .entry("physics")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    if let Some(ph) = ph.as_table_mut() {
+        ph.insert("integrator".into(), toml::Value::String("rk4".into()));
     }
 }
 

@@ -153,8 +153,11 @@ fn default_duration() -> f64 {
 fn default_dt() -> f64 {
     0.01
 }
+/// Default control period `scenario.control_dt` [s].
+pub const DEFAULT_CONTROL_DT: f64 = 0.05;
+
 fn default_control_dt() -> f64 {
-    0.05
+    DEFAULT_CONTROL_DT
 }
 fn default_log_dt() -> f64 {
     0.1
