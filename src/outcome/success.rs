@@ -176,7 +176,7 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
 /// `mission.tracking_weight`): a run that misses either cannot be ranked.
 fn judge_progress(get: &dyn Fn(&str) -> f64) -> Option<Missed> {
     let progress = get("path_progress");
-    if !(progress > 0.0) {
+    if progress.is_nan() || progress <= 0.0 {
         return Some(Missed {
             criterion: Criterion::ForwardProgress,
             detail: format!(
