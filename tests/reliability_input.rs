@@ -563,3 +563,114 @@ fn misspelt_axis_names_and_keys_get_a_did_you_mean() {
         stderr(&o)
     );
 }
+
+/// A transport study whose worlds, variants or axes hand a key a value it refuses (issue 39):
+/// the head of every case below.
+const VALUES_HEAD: &str = r#"[study]
+name = "values"
+seed = 1
+
+[design]
+preset = "usm-paper"
+
+[scenario]
+mode = "transport"
+duration = 8.0
+
+"#;
+
+#[test]
+fn values_a_key_refuses_are_refused_at_load_with_file_line_and_key() {
+    let d = tempfile::tempdir().unwrap();
+    let world = |name: &str, dist: &str| {
+        format!(
+            "[uncertainty]\nworlds = 4\n\n[[uncertainty.param]]\nname = \"{name}\"\n\
+             distribution = {dist}\n"
+        )
+    };
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        (
+            "string_choice",
+            world(
+                "physics.current_speed",
+                r#"{ kind = "choice", values = [0.1, "fast"] }"#,
+            ),
+            "distribution = ",
+            "uncertainty.param[0].distribution: the value \"fast\" of `physics.current_speed` is refused",
+        ),
+        (
+            "huge_uniform",
+            world(
+                "physics.current_speed",
+                r#"{ kind = "uniform", low = -1e308, high = 1e308 }"#,
+            ),
+            "distribution = ",
+            "must be a finite number",
+        ),
+        (
+            "duration_world",
+            world(
+                "scenario.duration",
+                r#"{ kind = "uniform", low = -1.0, high = 8.0 }"#,
+            ),
+            "distribution = ",
+            "of `scenario.duration` is refused: must be a finite number > 0",
+        ),
+        (
+            "duration_axis",
+            "[[axis]]\nname = \"scenario.duration\"\nvalues = [8.0, 0.0]\n".to_string(),
+            "values = ",
+            "axis[0].values: the value 0.0 of `scenario.duration` is refused",
+        ),
+        (
+            "negative_payload",
+            world(
+                "mission.payload_mass",
+                r#"{ kind = "uniform", low = -1.0, high = 1.0 }"#,
+            ),
+            "distribution = ",
+            "of `mission.payload_mass` is refused: must be a finite number >= 0",
+        ),
+        (
+            "validate_fast",
+            "[[validate]]\nname = \"fast\"\nset = { \"physics.current_speed\" = \"fast\" }\n"
+                .to_string(),
+            "set = ",
+            "validate[0].set.physics.current_speed: the value \"fast\" of `physics.current_speed` is refused",
+        ),
+        (
+            "nan_choice",
+            world(
+                "physics.current_speed",
+                r#"{ kind = "choice", values = [0.1, nan] }"#,
+            ),
+            "distribution = ",
+            "the value nan of `physics.current_speed` is refused: must be a finite number",
+        ),
+        (
+            "scale_tail",
+            world(
+                "hydro.linear_damping_scale",
+                r#"{ kind = "normal", mean = 1.0, std = 0.5 }"#,
+            ),
+            "distribution = ",
+            "of `hydro.linear_damping_scale` is refused: must be finite and >= 0",
+        ),
+    ];
+    for (name, tail, line_start, message) in cases {
+        let text = format!("{VALUES_HEAD}{tail}");
+        let line = line_of(&text, line_start);
+        sweep_refuses(d.path(), &format!("{name}.toml"), &text, line, &[message]);
+    }
+    // A valid world and variant still load.
+    let text = format!(
+        "{VALUES_HEAD}{}[[validate]]\nname = \"calm\"\nset = {{ \"physics.current_speed\" = 0.0 }}\n",
+        world(
+            "physics.current_speed",
+            r#"{ kind = "uniform", low = 0.0, high = 0.2 }"#
+        )
+    );
+    let p = write(d.path(), "valid.toml", &text);
+    let o = run(&["sweep", arg(&p), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}

@@ -67,9 +67,9 @@ pub fn judge(
         return m;
     }
     match mode {
-        Mode::Transport => {
-            judge_transport(spec, &get).or_else(|| judge_deadline(mission.deadline, &get))
-        }
+        Mode::Transport => judge_transport(spec, &get)
+            .or_else(|| judge_deadline(mission.deadline, &get))
+            .or_else(|| judge_progress(&get)),
         Mode::Work => {
             let (p, a) = (spec.position_tolerance, spec.orientation_tolerance_deg);
             check(
@@ -170,6 +170,30 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
     None
 }
 
+/// Transport, last (issue 39): the run advanced along the path (`path_progress` > 0 — a run
+/// carried backwards by a current meets every bound on the path's error) and its objective
+/// `mission_cost` is finite (NaN without progress, infinite with an overflowing
+/// `mission.tracking_weight`): a run that misses either cannot be ranked.
+fn judge_progress(get: &dyn Fn(&str) -> f64) -> Option<Missed> {
+    let progress = get("path_progress");
+    if progress.is_nan() || progress <= 0.0 {
+        return Some(Missed {
+            criterion: Criterion::ForwardProgress,
+            detail: format!(
+                "path_progress = {progress:.3} m: the run did not advance along the path"
+            ),
+        });
+    }
+    let cost = get("mission_cost");
+    if !cost.is_finite() {
+        return Some(Missed {
+            criterion: Criterion::FiniteObjective,
+            detail: format!("mission_cost = {cost}: the objective is not a finite number"),
+        });
+    }
+    None
+}
+
 /// The run's signed, normalised distance to its `[success]` and `[mission]` bounds (metric
 /// `success_margin`): the smallest over the criteria that apply of `(bound − value) / bound`
 /// (`|final_cross_track|`, each reached segment's convergence time, the judged attitude and
@@ -244,6 +268,9 @@ pub fn success_margin(
             for k in 0..n {
                 m = m.min(room(get(&format!("seg{k}_convergence_time")), window));
             }
+            if judge_progress(&get).is_some() {
+                m = m.min(-1.0);
+            }
         }
         Mode::Work => {
             m = m.min(room(get("final_position_error"), spec.position_tolerance));
@@ -301,6 +328,8 @@ mod tests {
                 .map(|(k, c)| (format!("seg{k}_convergence_time"), *c)),
         );
         m.extend(metrics(&[
+            ("path_progress", 5.0),
+            ("mission_cost", 12.0),
             ("segments_reached", seg.len() as f64),
             ("final_cross_track", final_ct),
             ("max_abs_roll_deg", 0.5),
@@ -428,6 +457,21 @@ mod tests {
             &transport(0.0, &[1.0]),
         );
         assert_eq!(m.map(|x| x.criterion), Some(Criterion::MaxPeakThrust));
+
+        // Last: the run advanced along the path and its objective is finite (issue 39).
+        let ok = transport(0.0, &[1.0]);
+        for (k, x, c) in [
+            ("path_progress", -1.08, Criterion::ForwardProgress),
+            ("path_progress", f64::NAN, Criterion::ForwardProgress),
+            ("mission_cost", f64::INFINITY, Criterion::FiniteObjective),
+            ("mission_cost", f64::NAN, Criterion::FiniteObjective),
+        ] {
+            let m = with(ok.clone(), k, x);
+            assert_eq!(id(&m), Some(c), "{k} = {x}");
+            let margin = success_margin(&s, &MissionSpec::default(), Mode::Transport, &m);
+            assert_eq!(margin, -1.0, "{k} = {x}");
+        }
+        assert!(judge(&s, &MissionSpec::default(), Mode::Transport, &ok).is_none());
     }
 
     #[test]

@@ -23,7 +23,9 @@
 //! Criteria are checked in the order of [`Criterion::ALL`], except that the mission's reach
 //! comes first and the transport attitude and depth bounds come right after `no_failure` (a
 //! capsize saturates the thrusters and leaves the path: the verdict names the cause, the roll,
-//! not its symptoms); a verdict names the first one missed by its id, which is the `[success]`
+//! not its symptoms), and a transport run's forward progress (`forward_progress`:
+//! `path_progress` > 0) and finite objective (`finite_objective`: `mission_cost`) come last
+//! (issue 39); a verdict names the first one missed by its id, which is the `[success]`
 //! key that bounds it (`no_failure` has none).
 //! Studies rank and compare only successful runs (`study::summary`).
 //!
@@ -185,6 +187,11 @@ pub enum Criterion {
     MaxPitch,
     /// [`SuccessSpec::max_vertical_error`] (transport): left the path's depth.
     MaxVerticalError,
+    /// Transport: the run advanced along the path (`path_progress` > 0); judged last.
+    ForwardProgress,
+    /// Transport: the objective `mission_cost` is finite; judged last, after
+    /// [`Criterion::ForwardProgress`].
+    FiniteObjective,
 }
 
 impl Criterion {
@@ -192,9 +199,11 @@ impl Criterion {
     /// requirement [`Criterion::MissionReach`] comes first (a design that cannot reach fails
     /// the mission whatever its run did) and the attitude and depth bounds
     /// ([`Criterion::MaxRoll`], [`Criterion::MaxPitch`], [`Criterion::MaxVerticalError`]) right
-    /// after [`Criterion::NoFailure`]; new criteria are appended, so an index into this list
-    /// stays valid across versions.
-    pub const ALL: [Criterion; 12] = [
+    /// after [`Criterion::NoFailure`], and the transport run's forward progress and finite
+    /// objective ([`Criterion::ForwardProgress`], [`Criterion::FiniteObjective`]) come last,
+    /// after `mission.deadline`; new criteria are appended, so an index into this list stays
+    /// valid across versions.
+    pub const ALL: [Criterion; 14] = [
         Criterion::NoFailure,
         Criterion::MaxPeakThrust,
         Criterion::MaxSaturationFraction,
@@ -207,6 +216,8 @@ impl Criterion {
         Criterion::MaxRoll,
         Criterion::MaxPitch,
         Criterion::MaxVerticalError,
+        Criterion::ForwardProgress,
+        Criterion::FiniteObjective,
     ];
 
     /// The machine-readable id.
@@ -224,6 +235,8 @@ impl Criterion {
             Criterion::MaxRoll => "max_roll_deg",
             Criterion::MaxPitch => "max_pitch_deg",
             Criterion::MaxVerticalError => "max_vertical_error",
+            Criterion::ForwardProgress => "forward_progress",
+            Criterion::FiniteObjective => "finite_objective",
         }
     }
 

@@ -287,6 +287,7 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
             ));
         }
     }
+    super::admit::check_values(&study, doc)?;
     if let Some(f) = &file.faults {
         (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
     }

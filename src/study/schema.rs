@@ -396,6 +396,17 @@ pub struct UncertainParam {
     pub integer: bool,
 }
 
+impl UncertainParam {
+    /// The value a world at probability `u` ∈ (0, 1) gives the key: the distribution's
+    /// inverse CDF ([`WorldDist::value`]), rounded for an integer key.
+    pub fn value(&self, u: f64) -> toml::Value {
+        match (self.dist.value(u), self.integer) {
+            (toml::Value::Float(f), true) => toml::Value::Integer(f.round() as i64),
+            (v, _) => v,
+        }
+    }
+}
+
 /// The validated `[uncertainty]` section.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Uncertainty {
@@ -477,10 +488,7 @@ impl Uncertainty {
                     .params
                     .iter()
                     .zip(&u)
-                    .map(|(p, &x)| match (p.dist.value(x), p.integer) {
-                        (toml::Value::Float(f), true) => toml::Value::Integer(f.round() as i64),
-                        (v, _) => v,
-                    })
+                    .map(|(p, &x)| p.value(x))
                     .collect(),
             })
             .collect()
