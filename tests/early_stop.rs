@@ -222,11 +222,11 @@ sampling = "sobol"
 
 [[uncertainty.param]]
 name = "physics.current[2]"
-distribution = { kind = "uniform", low = 0.0, high = 0.00002 }
+distribution = { kind = "uniform", low = 0.002, high = 0.02 }
 
 [[validate]]
 name = "cross_current"
-set = { "physics.current[2]" = 0.00002 }
+set = { "physics.current[2]" = 0.02 }
 
 [[axis]]
 name = "design.metacentric_height"

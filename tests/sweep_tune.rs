@@ -466,7 +466,7 @@ fn screened_tuning_scores_the_tuned_point_at_full_accuracy() {
         .collect();
     assert!(!tuned.is_empty());
     // The same case, untuned, at the tuned values (written in shortest round-trip form).
-    let mut fixed = format!("{BASE}").replace("values = [3, 4]", "values = [4]");
+    let mut fixed = BASE.replace("values = [3, 4]", "values = [4]");
     let mut control = String::from("\n[control]\n");
     for (k, v) in &tuned {
         control.push_str(&format!("{} = {v:?}\n", k.trim_start_matches("control.")));
