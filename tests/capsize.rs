@@ -6,47 +6,10 @@
 //! bounded the attitude, the first was judged on `max_saturation_fraction` and the second
 //! passed (the study's `fault_tolerance` 0.83 counted it as survived).
 
-use usm_study::outcome::{run_scenario, RunResult};
-use usm_study::scenario::{default_table, parse_table, resolve_design, Mode, Source};
+mod common;
 
-/// The study's scenario-side sections for case 47 (design axes, mission, allocation, metrics)
-/// and its tuned gains.
-const LEADER: &str = r#"
-[scenario]
-name = "ends-4-0.14"
-mode = "transport"
-duration = 140.0
-
-[design.generator]
-links = 4
-body_profile = "paper"
-thrust_limit = 40.0
-thruster_rule = "ends"
-longitudinal_offset = 0.14
-# As committed in wave 3: every body neutral with CB = CG (no hydrostatic restoring moment).
-# The generator's default since issue 36 item 1 raises the CB 0.02 m above the CG; the second
-# test below runs the same leader with that default.
-metacentric_height = 0.0
-
-[mission]
-payload_mass = 2.0
-reach = 2.5
-tracking_weight = 0.1
-
-[allocation]
-method = "pinv"
-lambda = 0.1
-
-[metrics]
-propeller_diameter = 0.07
-efficiency = 0.5
-
-[control]
-k_psi = 0.300961678493135
-look_ahead = 1.1990433931350695
-k_6p = 0.41125891198668474
-k_6d = 0.3018726929028814
-"#;
+use common::leader::{metric, missed, run_layers, LEADER};
+use usm_study::outcome::RunResult;
 
 /// The leader's run with `extra` (TOML: whole tables or `table.key = value` lines) over it,
 /// to the end whatever its verdict (`[success] stop_on_failure = false`: these tests look at
@@ -60,30 +23,7 @@ fn run(extra: &str) -> RunResult {
 
 /// As [`run`], from the study sections `leader`.
 fn run_with(leader: &str, extra: &str) -> RunResult {
-    let mut t = default_table(Mode::Transport).unwrap();
-    for text in [leader, extra] {
-        let over: toml::Table = toml::from_str(text).unwrap();
-        for (k, v) in over {
-            match (t.get_mut(&k), v) {
-                (Some(toml::Value::Table(base)), toml::Value::Table(v)) => base.extend(v),
-                (_, v) => {
-                    t.insert(k, v);
-                }
-            }
-        }
-    }
-    let src = Source::unplaced("ends-4-0.14");
-    let f = parse_table(&t, &src).unwrap();
-    let v = resolve_design(&f, &src).unwrap();
-    run_scenario(&v, &f).unwrap()
-}
-
-fn metric(r: &RunResult, k: &str) -> f64 {
-    r.metric(k).unwrap_or_else(|| panic!("metric {k}"))
-}
-
-fn missed(r: &RunResult) -> Option<&'static str> {
-    r.missed.as_ref().map(|m| m.criterion.as_str())
+    run_layers(&[leader, extra])
 }
 
 #[test]

@@ -10,72 +10,15 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use common::leader::{metric, missed, run_layers, LEADER};
 use common::{stderr, sweep, write};
-use usm_study::outcome::{run_scenario, RunResult};
-use usm_study::scenario::{default_table, parse_table, resolve_design, Mode, Source};
-
-const LEADER: &str = r#"
-[scenario]
-name = "ends-4-0.14"
-mode = "transport"
-duration = 140.0
-
-[design.generator]
-links = 4
-body_profile = "paper"
-thrust_limit = 40.0
-thruster_rule = "ends"
-longitudinal_offset = 0.14
-metacentric_height = 0.0
-
-[mission]
-payload_mass = 2.0
-reach = 2.5
-tracking_weight = 0.1
-
-[allocation]
-method = "pinv"
-lambda = 0.1
-
-[metrics]
-propeller_diameter = 0.07
-efficiency = 0.5
-
-[control]
-k_psi = 0.300961678493135
-look_ahead = 1.1990433931350695
-k_6p = 0.41125891198668474
-k_6d = 0.3018726929028814
-"#;
+use usm_study::outcome::RunResult;
 
 /// The leader with `extra` (whole tables or `table.key = value` lines) over it, with
 /// `[success] stop_on_failure = stop`.
 fn run(extra: &str, stop: bool) -> RunResult {
-    let mut t = default_table(Mode::Transport).unwrap();
     let switch = format!("[success]\nstop_on_failure = {stop}\n");
-    for text in [LEADER, extra, &switch] {
-        let over: toml::Table = toml::from_str(text).unwrap();
-        for (k, v) in over {
-            match (t.get_mut(&k), v) {
-                (Some(toml::Value::Table(base)), toml::Value::Table(v)) => base.extend(v),
-                (_, v) => {
-                    t.insert(k, v);
-                }
-            }
-        }
-    }
-    let src = Source::unplaced("ends-4-0.14");
-    let f = parse_table(&t, &src).unwrap();
-    let v = resolve_design(&f, &src).unwrap();
-    run_scenario(&v, &f).unwrap()
-}
-
-fn metric(r: &RunResult, k: &str) -> f64 {
-    r.metric(k).unwrap_or_else(|| panic!("metric {k}"))
-}
-
-fn missed(r: &RunResult) -> Option<&'static str> {
-    r.missed.as_ref().map(|m| m.criterion.as_str())
+    run_layers(&[LEADER, extra, &switch])
 }
 
 /// Run `extra` with the stop off and on: both unsuccessful on `criterion`, the stopped one

@@ -3,6 +3,8 @@
 //! helpers are unused in some files.
 #![allow(dead_code)]
 
+pub mod leader;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
