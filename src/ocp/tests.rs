@@ -272,24 +272,20 @@ fn chain_at_rest_without_controls_stays_at_rest() {
     assert_eq!(x, y);
 }
 
-#[test]
-fn chain_jacobians_are_consistent_with_the_step() {
-    // The central-difference Jacobians predict the step's response to a perturbation h·d
-    // with an error of second order: halving h divides it by about 4 (by 2 if A or B were
-    // wrong) — a check of the tangent-space bookkeeping of retract/difference.
-    let mut m = chain();
+/// The error of the Jacobians' prediction `A dx + B du` of the step's response to the
+/// perturbation `h·(cos 1.3i, sin(w i))` at `h` = 1e-2 and 5e-3, each with the prediction's
+/// size: (error, |prediction|)∞. Second-order Jacobians make the error ratio about 4.
+fn linear_prediction_errors(m: &mut ChainModel, x: &[f64], u: &[f64], w: f64) -> [(f64, f64); 2] {
     let (nx, nu, nq) = (m.nx(), m.nu(), m.nq());
-    let x = state(&m);
-    let u: Vec<f64> = (0..nu).map(|i| 0.2 * (i as f64 - 4.0)).collect();
     let (mut a, mut b) = (DMatrix::zeros(nx, nx), DMatrix::zeros(nx, nu));
-    m.jacobians(&x, &u, &mut a, &mut b).unwrap();
+    m.jacobians(x, u, &mut a, &mut b).unwrap();
     let mut f0 = vec![0.0; nq];
-    m.step(&x, &u, &mut f0).unwrap();
+    m.step(x, u, &mut f0).unwrap();
     let mut err = |h: f64| {
         let dx = DVector::from_fn(nx, |i, _| h * ((i as f64) * 1.3).cos());
-        let du = DVector::from_fn(nu, |i, _| h * ((i as f64) * 0.9).sin());
+        let du = DVector::from_fn(nu, |i, _| h * ((i as f64) * w).sin());
         let (mut f1, mut xp) = (vec![0.0; nq], vec![0.0; nq]);
-        m.retract(&x, dx.as_slice(), &mut xp);
+        m.retract(x, dx.as_slice(), &mut xp);
         let up: Vec<f64> = u.iter().zip(du.iter()).map(|(a, b)| a + b).collect();
         m.step(&xp, &up, &mut f1).unwrap();
         let mut got = vec![0.0; nx];
@@ -297,8 +293,18 @@ fn chain_jacobians_are_consistent_with_the_step() {
         let pred = &a * &dx + &b * &du;
         ((DVector::from_vec(got) - &pred).amax(), pred.amax())
     };
-    let (e1, p1) = err(1e-2);
-    let (e2, _) = err(5e-3);
+    [err(1e-2), err(5e-3)]
+}
+
+#[test]
+fn chain_jacobians_are_consistent_with_the_step() {
+    // The central-difference Jacobians predict the step's response to a perturbation h·d
+    // with an error of second order: halving h divides it by about 4 (by 2 if A or B were
+    // wrong) — a check of the tangent-space bookkeeping of retract/difference.
+    let mut m = chain();
+    let x = state(&m);
+    let u: Vec<f64> = (0..m.nu()).map(|i| 0.2 * (i as f64 - 4.0)).collect();
+    let [(e1, p1), (e2, _)] = linear_prediction_errors(&mut m, &x, &u, 0.9);
     assert!(e1 < 0.05 * p1, "linear prediction off: {e1} vs {p1}");
     let ratio = e1 / e2;
     assert!(
@@ -462,7 +468,7 @@ fn thruster_chain_jacobians_are_consistent_with_the_step_on_every_preset() {
     for name in crate::model::presets::PRESETS {
         let v = load_design(name).unwrap();
         let mut m = ChainModel::new(v, DynOptions::full(), 0.05, Vec3::zeros()).with_thrusters();
-        let (nx, nu, nq) = (m.nx(), m.nu(), m.nq());
+        let nu = m.nu();
         let n = m.n_joints();
         let pose = BasePose {
             position: Vec3::new(0.3, -0.2, 0.1),
@@ -472,24 +478,7 @@ fn thruster_chain_jacobians_are_consistent_with_the_step_on_every_preset() {
         let qd: Vec<f64> = (0..n).map(|k| 0.03 * k as f64 - 0.05).collect();
         let x = ChainModel::pack(&pose, &q, &[0.2, -0.05, 0.03, 0.02, 0.05, -0.1], &qd);
         let u: Vec<f64> = (0..nu).map(|i| 0.5 * ((i as f64) * 0.9).sin()).collect();
-        let (mut a, mut b) = (DMatrix::zeros(nx, nx), DMatrix::zeros(nx, nu));
-        m.jacobians(&x, &u, &mut a, &mut b).unwrap();
-        let mut f0 = vec![0.0; nq];
-        m.step(&x, &u, &mut f0).unwrap();
-        let mut err = |h: f64| {
-            let dx = DVector::from_fn(nx, |i, _| h * ((i as f64) * 1.3).cos());
-            let du = DVector::from_fn(nu, |i, _| h * ((i as f64) * 0.7).sin());
-            let (mut f1, mut xp) = (vec![0.0; nq], vec![0.0; nq]);
-            m.retract(&x, dx.as_slice(), &mut xp);
-            let up: Vec<f64> = u.iter().zip(du.iter()).map(|(a, b)| a + b).collect();
-            m.step(&xp, &up, &mut f1).unwrap();
-            let mut got = vec![0.0; nx];
-            m.difference(&f0, &f1, &mut got);
-            let pred = &a * &dx + &b * &du;
-            ((DVector::from_vec(got) - &pred).amax(), pred.amax())
-        };
-        let (e1, p1) = err(1e-2);
-        let (e2, _) = err(5e-3);
+        let [(e1, p1), (e2, _)] = linear_prediction_errors(&mut m, &x, &u, 0.7);
         assert!(
             e1 < 0.05 * p1,
             "{name}: linear prediction off: {e1} vs {p1}"
