@@ -21,7 +21,7 @@ use usm_study::study::outdir;
 use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::study::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
 use usm_study::study::{
-    load_study, merge, report_ranked, run_sweep, Reported, Rerank, StudyError, SweepOptions,
+    load_study_at, merge, report_ranked, run_sweep, Reported, Rerank, StudyError, SweepOptions,
 };
 
 /// Arguments of `sweep`.
@@ -69,17 +69,6 @@ pub struct SweepArgs {
     /// `output` plus `-seed-N`, so the committed output of the file's own seed is kept.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
     pub seed: Option<u64>,
-}
-
-/// The study of `a`: the file as written, or at `--seed`.
-fn study_of(a: &SweepArgs) -> anyhow::Result<usm_study::study::Study> {
-    let Some(seed) = a.seed else {
-        return Ok(load_study(&a.study)?);
-    };
-    let text = std::fs::read_to_string(&a.study)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read the study file: {e}", a.study.display()))?;
-    let text = usm_study::study::with_seed(&text, seed)?;
-    Ok(usm_study::study::parse_study(&text, &a.study)?)
 }
 
 /// Write the Slurm submission script of `--emit-slurm`.
@@ -193,7 +182,7 @@ fn study_err(e: StudyError) -> anyhow::Error {
 
 /// Run `usm-study sweep`.
 pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
-    let study = study_of(a)?;
+    let study = load_study_at(&a.study, a.seed)?;
     // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
     Tuner::new(&study)?;
     let shard = match &a.shard {

@@ -72,7 +72,7 @@ pub mod worlds;
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use error::{InputError, StudyError};
 pub use finish::{report, report_ranked, Reported};
-pub use parse::{load_study, parse_study, with_seed};
+pub use parse::{load_study, load_study_at, parse_study, with_seed};
 pub use records::CaseStatus;
 pub use rerank::Rerank;
 pub use schema::{DoeKind, Study};

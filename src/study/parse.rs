@@ -89,12 +89,21 @@ fn merge_into(base: &mut toml::Table, over: &toml::Table) {
 
 /// Read and validate a study file.
 pub fn load_study(path: &Path) -> Result<Study, InputError> {
+    load_study_at(path, None)
+}
+
+/// [`load_study`] at `seed` instead of the file's own `[study] seed` ([`with_seed`]; `None`:
+/// the file as written). `sweep --seed`.
+pub fn load_study_at(path: &Path, seed: Option<u64>) -> Result<Study, InputError> {
     let origin = path.display().to_string();
     let text = crate::input::document::read_text(path).map_err(|e| InputError {
         at: Location::origin(&origin),
         error: format!("cannot read the study file: {e}"),
     })?;
-    parse_study(&text, path)
+    match seed {
+        None => parse_study(&text, path),
+        Some(seed) => parse_study(&with_seed(&text, seed)?, path),
+    }
 }
 
 fn base_design(
