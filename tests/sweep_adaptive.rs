@@ -286,3 +286,60 @@ fn adaptive_worlds_refuse_shards_and_bad_keys_exit_2_naming_the_key() {
         "{e}"
     );
 }
+
+/// A tuned study (`[tune]`, six Nelder–Mead evaluations per case, the pattern of
+/// tests/sweep_tune.rs): the added worlds run at each case's tuned values as its row records
+/// them, so `worlds.csv` is byte-identical to the tuned study with `worlds = 8`.
+#[test]
+fn tuned_cases_meet_their_added_worlds_at_their_tuned_values() {
+    const TUNE: &str = r#"
+[tune]
+[[tune.param]]
+name = "control.k_psi"
+lower = 0.15
+upper = 1.35
+scale = "log"
+
+[[tune.param]]
+name = "control.k_6p"
+lower = 0.002
+upper = 0.5
+scale = "log"
+
+[tune.objective]
+[[tune.objective.term]]
+metric = "energy_per_metre"
+weight = 1.0
+
+[[tune.constraint]]
+metric = "completed"
+op = "=="
+value = 1
+
+[tune.solver]
+method = "nelder-mead"
+max_evals = 6
+step = 0.3
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let read = |p: std::path::PathBuf| std::fs::read_to_string(p).unwrap();
+    let a = write(
+        dir.path(),
+        "t.toml",
+        &(read(study(dir.path(), "t.toml", 4, "adaptive_worlds = 16")) + TUNE),
+    );
+    let p = write(
+        dir.path(),
+        "t8.toml",
+        &(read(study(dir.path(), "t8.toml", 8, "")) + TUNE),
+    );
+    let (oa, op) = (dir.path().join("t"), dir.path().join("t8"));
+    ok(&sweep(&a, &oa, &["--jobs", "2"]));
+    ok(&sweep(&p, &op, &["--jobs", "2"]));
+    assert_eq!(column(&oa, "worlds_met"), vec!["8", "8"]);
+    assert_eq!(
+        column(&oa, "tuned.control.k_psi"),
+        column(&op, "tuned.control.k_psi")
+    );
+    assert_eq!(text(&oa, "worlds.csv"), text(&op, "worlds.csv"));
+}

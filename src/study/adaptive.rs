@@ -98,7 +98,7 @@ pub fn contention(sv: &StudyVerdict, delta: f64) -> Vec<usize> {
 pub struct Rounds<'a> {
     /// The study.
     pub study: &'a Study,
-    /// Every case of the study (`expand(study, None)`), indexed by id.
+    /// Every case of the study (`expand(study, None)`).
     pub cases: &'a [Case],
     /// The per-case tuner (`[tune]`): the added worlds run at the tuned values of the row.
     pub tuner: Option<&'a dyn CaseTuner>,
@@ -198,21 +198,31 @@ fn one_round(
     let from = todo.iter().map(|&r| met[r]).min().unwrap_or(target);
     let worlds = u.sample_range(study.seed, from..target);
     // Each case at its values as scored (tuned values through the tuner).
+    // Each case at its values as scored (tuned values through the tuner). A case that cannot be
+    // rebuilt (its overrides or tuned values no longer apply) fails with the reason; the
+    // others go on.
     let mut resolved = Vec::with_capacity(todo.len());
     for &r in todo {
-        let id = usize::try_from(ids[r]).map_err(|_| StudyError::Input("case id".into()))?;
-        let case = rounds
-            .cases
-            .get(id)
-            .ok_or_else(|| StudyError::Input(format!("case {id} is not in the study")))?;
-        let mut res = resolve_case(study, case).map_err(|e| StudyError::Input(e.to_string()))?;
-        if let Some(t) = rounds.tuner {
-            let x: Vec<f64> = tuned.iter().map(|c| c[r]).collect();
-            res = t
-                .at(study, case, &res, &x)
-                .map_err(|e| StudyError::Input(e.to_string()))?;
+        let case = usize::try_from(ids[r])
+            .ok()
+            .and_then(|id| rounds.cases.iter().find(|c| c.id == id))
+            .ok_or_else(|| StudyError::Input(format!("case {} is not in the study", ids[r])))?;
+        let rebuilt = resolve_case(study, case)
+            .map_err(|e| e.to_string())
+            .and_then(|res| match rounds.tuner {
+                Some(t) => {
+                    let x: Vec<f64> = tuned.iter().map(|c| c[r]).collect();
+                    t.at(study, case, &res, &x).map_err(|e| e.to_string())
+                }
+                None => Ok(res),
+            });
+        match rebuilt {
+            Ok(res) => resolved.push((r, case.id, res)),
+            Err(e) => {
+                set_str(table, STATUS, r, CaseStatus::Failed.as_str())?;
+                set_str(table, REASON, r, &format!("adaptive worlds: {e}"))?;
+            }
         }
-        resolved.push((r, id, res));
     }
     let jobs: Vec<(usize, usize)> = (0..resolved.len())
         .flat_map(|i| {
