@@ -24,6 +24,10 @@
 //! starting `timeout`, and the batch goes on. Timed-out rows depend on the machine's speed;
 //! every other row does not.
 //!
+//! With `adaptive_worlds` in `[uncertainty]`, the designs in contention then meet further
+//! worlds before the final tables are written ([`super::adaptive`]); such a study is not
+//! sharded, and `--resume` runs the rounds again from the resumed cases.
+//!
 //! Determinism: a case's row depends only on the study and the case id (per-case seed
 //! `derive_seed(study_seed, case_id)`, no parallel reductions), and rows are sorted by id,
 //! so `cases.csv` is bit-identical for any `--jobs` and any sharding.
