@@ -343,3 +343,36 @@ step = 0.3
     );
     assert_eq!(text(&oa, "worlds.csv"), text(&op, "worlds.csv"));
 }
+
+/// A scenario file (`simulate`) has no verdict to decide: `adaptive_worlds` there exits 2 naming
+/// the file and the key, before the nominal run.
+#[test]
+fn a_scenario_file_refuses_adaptive_worlds() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"[scenario]
+name = "t1_worlds"
+mode = "transport"
+design = "usm-paper"
+duration = 30.0
+
+[path]
+segments = [ { from = [0.0, 0.0], to = [200.0, 0.0] } ]
+
+[uncertainty]
+worlds = 4
+adaptive_worlds = 8
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.0, high = 2.0 }
+"#;
+    let p = write(dir.path(), "s.toml", text);
+    let out = dir.path().join("out");
+    let o = run(&["simulate", arg(&p), "--no-plots", "--out", arg(&out)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("s.toml") && e.contains("uncertainty.adaptive_worlds"),
+        "{e}"
+    );
+    assert!(!out.join("summary.json").exists());
+}
