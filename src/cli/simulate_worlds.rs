@@ -69,6 +69,21 @@ pub fn prepare(
     }
     study.insert("uncertainty".into(), toml::Value::Table(uncertainty));
     let study = parse_study_table(&src.doc, &study, Path::new(&src.origin))?;
+    if study
+        .uncertainty
+        .as_ref()
+        .is_some_and(|u| u.adaptive.is_some())
+    {
+        // One scenario has no verdict to decide: adaptive worlds are a study's.
+        return Err(src
+            .doc
+            .err(
+                "uncertainty.adaptive_worlds",
+                "is for studies (more worlds for the designs whose verdict is not decided); a \
+                 scenario file runs its `worlds`",
+            )
+            .into());
+    }
     let info = RobustInfo::of(&study).context("the [uncertainty] section")?;
     Ok(Worlds { study, info })
 }

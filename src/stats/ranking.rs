@@ -3,8 +3,10 @@
 //! Inputs are `obj[c][w]`, case c's objective in world w (smaller is better: callers negate
 //! maximised objectives), and `ok[c][w]`, whether case c met its success criteria in world w.
 //! Every case meets the same worlds (common random numbers), so comparisons are paired world by
-//! world. A case whose objective is not finite in a world counts as failed there. Rows longer
-//! than the shortest one are read up to its length.
+//! world. A case whose objective is not finite in a world counts as failed there. The ranks
+//! read rows up to the shortest one's length; the verdict compares two cases over the worlds
+//! both met (the shorter row's length: with adaptive worlds, the designs in contention meet
+//! more worlds of the same sequence, so the worlds of a shorter row are a prefix of a longer).
 
 use super::confidence::{holm, holm_adjusted, sign_test_p, worlds_at_share};
 use super::describe::quantile_sorted;
@@ -223,6 +225,11 @@ impl Verdict {
     }
 }
 
+/// The worlds case `c` met: its row's length.
+fn met(obj: &[Vec<f64>], ok: &[Vec<bool>], c: usize) -> usize {
+    obj[c].len().min(ok[c].len())
+}
+
 /// Mean objective of case `c` over the worlds where it succeeds (NaN when it never does).
 fn mean_success(obj: &[Vec<f64>], ok: &[Vec<bool>], c: usize, nw: usize) -> f64 {
     let v: Vec<f64> = (0..nw)
@@ -303,6 +310,10 @@ fn by_margin(a: &Contender, b: &Contender) -> std::cmp::Ordering {
 /// Names a winner only when the data support it with the stated confidence
 /// (`docs/statistics.md`, "The verdict").
 ///
+/// Rows may differ in length (adaptive worlds): each case's mean is over its own row, each
+/// comparison over the worlds both cases met (`W` = the shorter row's length); with rows of
+/// one length this is the same as reading every row up to that length.
+///
 /// The leader is the eligible case (`eligible[c]`; missing entries count as not eligible) with
 /// the lowest mean objective over the worlds where it succeeds (cases that never succeed come
 /// last; ties go to the lower index). For every other eligible case c, the leader *wins* a
@@ -324,10 +335,9 @@ pub fn verdict(
     s: &VerdictSettings,
 ) -> Verdict {
     let cases = obj.len().min(ok.len()).min(eligible.len());
-    let nw = worlds(&obj[..cases], &ok[..cases]);
     let candidates: Vec<(usize, f64)> = (0..cases)
         .filter(|&c| eligible[c])
-        .map(|c| (c, mean_success(obj, ok, c, nw)))
+        .map(|c| (c, mean_success(obj, ok, c, met(obj, ok, c))))
         .collect();
     let Some(&(leader, _)) = candidates.iter().min_by(|a, b| {
         a.1.is_nan()
@@ -342,7 +352,10 @@ pub fn verdict(
     let mut others: Vec<Contender> = candidates
         .iter()
         .filter(|&&(c, _)| c != leader)
-        .map(|&(c, _)| contend(obj, ok, leader, c, nw, delta))
+        .map(|&(c, _)| {
+            let nw = met(obj, ok, leader).min(met(obj, ok, c));
+            contend(obj, ok, leader, c, nw, delta)
+        })
         .collect();
     let p: Vec<f64> = others.iter().map(|c| c.p_value).collect();
     let rejected = holm(&p, alpha);
@@ -353,6 +366,7 @@ pub fn verdict(
     let m_open = rejected.iter().filter(|r| !**r).count().max(1);
     for (c, r) in others.iter_mut().zip(&rejected) {
         if !*r && c.margin > delta {
+            let nw = met(obj, ok, leader).min(met(obj, ok, c.case));
             c.needs_worlds = worlds_to_reach(c.wins, nw, alpha / m_open as f64);
         }
     }
@@ -391,7 +405,7 @@ pub fn verdict(
             .iter()
             .filter_map(|c| c.needs_worlds)
             .max()
-            .unwrap_or(nw);
+            .unwrap_or(met(obj, ok, leader));
         return Verdict::Undecided {
             leader,
             open: others,

@@ -387,3 +387,44 @@ proptest! {
         }
     }
 }
+
+/// Adaptive worlds: rows of different lengths. Each comparison is over the worlds both cases
+/// met (the shorter row); an ineligible case with a short row does not shorten the others'.
+#[test]
+fn each_comparison_is_over_the_worlds_both_cases_met() {
+    // Case 0 is 10 % cheaper than case 1 in every world; both met 8 worlds, case 2 (not
+    // eligible) only 4, case 3 (eligible, 30 % dearer) only 6.
+    let base: Vec<f64> = (0..8).map(|w| 50.0 * wobble(w, 0.1)).collect();
+    let obj = vec![
+        base.clone(),
+        base.iter().map(|x| 1.1 * x).collect(),
+        base[..4].to_vec(),
+        base[..6].iter().map(|x| 1.3 * x).collect(),
+    ];
+    let ok: Vec<Vec<bool>> = obj.iter().map(|r| vec![true; r.len()]).collect();
+    let s = VerdictSettings::default();
+    // Without case 3: 8 of 8 wins against case 1 (p = 2⁻⁸) whatever case 2's row is.
+    let v = verdict(&obj, &ok, &[true, true, false, false], &s);
+    let Verdict::Winner {
+        leader: 0,
+        runner_up: 1,
+        p_beats,
+        ..
+    } = v
+    else {
+        panic!("expected a winner, got {v:?}");
+    };
+    assert_eq!(p_beats, 1.0);
+    // With case 3: its comparison is over its 6 worlds, 6 of 6 (p = 2⁻⁶); Holm over the two:
+    // 2⁻⁸ ≤ 0.025, then 2⁻⁶ ≤ 0.05: still a winner, largest adjusted p = 2⁻⁶.
+    let v = verdict(&obj, &ok, &[true, true, false, true], &s);
+    let Verdict::Winner { p_value, .. } = v else {
+        panic!("expected a winner, got {v:?}");
+    };
+    assert!((p_value - 2f64.powi(-6)).abs() < 1e-15, "{p_value}");
+    // Rows of one length read as before: the same verdict as rows cut to the shortest.
+    let cut: Vec<Vec<f64>> = obj.iter().map(|r| r[..4].to_vec()).collect();
+    let ok4 = all_ok(4, 4);
+    let v = verdict(&cut, &ok4, &[true, true, false, true], &s);
+    assert!(matches!(v, Verdict::Undecided { leader: 0, .. }), "{v:?}");
+}

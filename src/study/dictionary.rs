@@ -217,6 +217,7 @@ const WORLDS: &[ColumnDoc] = &[
     c("<m>_mean, <m>_std, <m>_p05, <m>_p95", "as <m>", "f64", "mean, sample standard deviation and 5 %/95 % quantiles of tracked metric <m> over the sampled worlds (the plain <m> is the nominal world)"),
     c("<m>_worst", "as <m>", "f64", "the worst value of <m> over the worlds, by its direction (largest for costs, smallest for σ_min and outcomes, largest |x| for signed metrics)"),
     c("success_probability", "–", "f64", "fraction of the worlds in which the run met every `[success]` criterion"),
+    c("worlds_met", "–", "i64", "a study with adaptive_worlds: the worlds the case met (the first `worlds`, more while in contention; 0 when it did not run in worlds); its summaries over worlds are over these"),
     c("success_probability_lower", "–", "f64", "one-sided Wilson lower confidence bound of success_probability at the study's confidence (docs/statistics.md): a case is ranked when it reaches min_success_probability; NaN when the case did not run in worlds"),
     c("p_best", "–", "f64", "fraction of the paired worlds in which the case is best on the objective among the ranked cases (ties share); NaN when not ranked"),
     c("rank_p05, rank_p50, rank_p95", "–", "f64", "5 %, 50 % and 95 % quantiles of the case's rank (1 = best) over the worlds among the ranked cases"),

@@ -24,6 +24,10 @@
 //! starting `timeout`, and the batch goes on. Timed-out rows depend on the machine's speed;
 //! every other row does not.
 //!
+//! With `adaptive_worlds` in `[uncertainty]`, the designs in contention then meet further
+//! worlds before the final tables are written ([`super::adaptive`]); such a study is not
+//! sharded, and `--resume` runs the rounds again from the resumed cases.
+//!
 //! Determinism: a case's row depends only on the study and the case id (per-case seed
 //! `derive_seed(study_seed, case_id)`, no parallel reductions), and rows are sorted by id,
 //! so `cases.csv` is bit-identical for any `--jobs` and any sharding.
@@ -50,7 +54,7 @@ use super::records::{
     axis_text, compact, raw_schema, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE,
     PARTIAL_STUDY_FILE, STUDY_COPY,
 };
-use super::robust::{write_tables, RobustInfo};
+use super::robust::{write_tables_with, RobustInfo};
 use super::runner::TIMEOUT;
 use super::schema::Study;
 use super::tune::{case_tuner, CaseTuner, TuningHook};
@@ -156,6 +160,7 @@ pub fn run_sweep(
             )));
         }
     }
+    super::adaptive::refuse_shards(study, opts.shard)?;
     let tuner = case_tuner(study, opts.tuning)?;
     let cases = expand(study, opts.shard)?;
     let out = outdir::resolve(&output_dir(study, opts))?;
@@ -219,12 +224,18 @@ pub fn run_sweep(
         &read_csv_typed(&partial, &schema)?,
         Some(&streamed.plan_hashes),
     )?;
-    let axes: Vec<&str> = study.axes.iter().map(|a| a.name.as_str()).collect();
-    let table = write_tables(raw, &out, RobustInfo::of(study).as_ref(), &axes)?;
+    let rounds = super::adaptive::Rounds {
+        study,
+        cases: &cases,
+        tuner: tuner.as_deref(),
+        budget: opts.case_timeout,
+    };
+    let (table, robust) = final_tables(&rounds, raw, &out, &pool)?;
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;
     let mut manifest = sweep_manifest(study, &schema, start_time, elapsed, jobs);
+    manifest.robust = robust;
     manifest.shard = opts.shard.map(|(i, n)| [i, n]);
     manifest.throughput_cases_per_s = if elapsed > 0.0 {
         ev.ran as f64 / elapsed
@@ -254,6 +265,24 @@ pub fn run_sweep(
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;
     }
     Ok(outcome)
+}
+
+/// The final tables of a sweep (`write_tables_with`), the adaptive rounds of a study with
+/// `adaptive_worlds` run inside the sweep's pool (`--jobs`) on the way; the table and the
+/// record of the worlds for the manifest.
+fn final_tables(
+    rounds: &super::adaptive::Rounds,
+    raw: crate::report::Table,
+    out: &Path,
+    pool: &rayon::ThreadPool,
+) -> Result<(crate::report::Table, Option<RobustInfo>), StudyError> {
+    let study = rounds.study;
+    let axes: Vec<&str> = study.axes.iter().map(|a| a.name.as_str()).collect();
+    pool.install(|| {
+        write_tables_with(raw, out, RobustInfo::of(study), &axes, |t, info| {
+            super::adaptive::run_rounds(rounds, t, info)
+        })
+    })
 }
 
 /// With `--resume` and no journal: the outcome of an output that is already complete for

@@ -35,6 +35,7 @@
 //! - [`engine`]: running, resuming and sharding a sweep.
 //! - [`shards`]: merging shard outputs.
 
+pub mod adaptive;
 pub mod admit;
 pub mod axes;
 pub mod cases;

@@ -70,14 +70,36 @@ pub struct RobustInfo {
     pub equivalence: f64,
     /// The validation variants' names.
     pub validate: Vec<String>,
+    /// Adaptive worlds (`adaptive_worlds`): the budget, the batch, the rounds run and why
+    /// they stopped; absent without the key.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<AdaptiveInfo>,
+}
+
+/// What `manifest.json` records of a study's adaptive worlds (docs/statistics.md § Adaptive
+/// worlds).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdaptiveInfo {
+    /// Most worlds a design may meet (`adaptive_worlds`).
+    pub budget: usize,
+    /// Worlds added per round (`adaptive_batch`).
+    pub batch: usize,
+    /// Rounds of added worlds run.
+    pub rounds: usize,
+    /// Most worlds any design met.
+    pub worlds_used: usize,
+    /// Why the rounds stopped ([`super::adaptive::Stop`] as text).
+    pub stopped: String,
 }
 
 impl RobustInfo {
     /// The record of `study`'s `[uncertainty]` (`None` without it).
     pub fn of(study: &Study) -> Option<RobustInfo> {
         let u: &Uncertainty = study.uncertainty.as_ref()?;
+        // With adaptive worlds, every world the budget allows (the sweep trims the list to the
+        // worlds used).
         let world_values = u
-            .sample(study.seed)
+            .sample_range(study.seed, 0..u.max_worlds())
             .iter()
             .map(|w| {
                 w.values
@@ -107,6 +129,13 @@ impl RobustInfo {
             confidence: u.confidence,
             equivalence: u.equivalence,
             validate: study.validate.iter().map(|v| v.name.clone()).collect(),
+            adaptive: u.adaptive.map(|a| AdaptiveInfo {
+                budget: a.budget,
+                batch: a.batch,
+                rounds: 0,
+                worlds_used: u.worlds,
+                stopped: String::new(),
+            }),
         })
     }
 
@@ -180,27 +209,41 @@ pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
     let n_worlds = per.keys().map(|(k, _)| k + 1).max().unwrap_or(0);
     let mut metric_names: Vec<String> = info.metrics.clone();
     metric_names.push(SUCCESS.into());
-    let rows = n_worlds * ids.len();
+    // With adaptive worlds, a case meets the worlds beyond the first `worlds` only while it is
+    // in contention: those it did not meet (success NaN) are not rows.
+    let base = if info.adaptive.is_some() {
+        info.worlds
+    } else {
+        usize::MAX
+    };
+    let kept: Vec<(usize, usize)> = (0..n_worlds)
+        .flat_map(|k| (0..ids.len()).map(move |r| (k, r)))
+        .filter(|&(k, r)| {
+            k < base
+                || per
+                    .get(&(k, SUCCESS.to_string()))
+                    .is_some_and(|v| !v[r].is_nan())
+        })
+        .collect();
+    let rows = kept.len();
     let mut world_col = Vec::with_capacity(rows);
     let mut case_col = Vec::with_capacity(rows);
     let mut params: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); info.params.len()];
     let mut metrics: Vec<Vec<f64>> = vec![Vec::with_capacity(rows); metric_names.len()];
-    for k in 0..n_worlds {
-        for (r, id) in ids.iter().enumerate() {
-            world_col.push(k as i64);
-            case_col.push(*id);
-            for (j, p) in params.iter_mut().enumerate() {
-                p.push(
-                    info.world_values
-                        .get(k)
-                        .and_then(|w| w.get(j))
-                        .copied()
-                        .unwrap_or(f64::NAN),
-                );
-            }
-            for (m, col) in metric_names.iter().zip(metrics.iter_mut()) {
-                col.push(per.get(&(k, m.clone())).map_or(f64::NAN, |v| v[r]));
-            }
+    for &(k, r) in &kept {
+        world_col.push(k as i64);
+        case_col.push(ids[r]);
+        for (j, p) in params.iter_mut().enumerate() {
+            p.push(
+                info.world_values
+                    .get(k)
+                    .and_then(|w| w.get(j))
+                    .copied()
+                    .unwrap_or(f64::NAN),
+            );
+        }
+        for (m, col) in metric_names.iter().zip(metrics.iter_mut()) {
+            col.push(per.get(&(k, m.clone())).map_or(f64::NAN, |v| v[r]));
         }
     }
     let mut cols = vec![
@@ -225,9 +268,9 @@ pub fn split_worlds(table: &mut Table, info: &RobustInfo) -> Option<Table> {
             data: ColumnData::F64(v),
         });
     }
-    let missed: Vec<String> = (0..n_worlds)
-        .flat_map(|k| (0..ids.len()).map(move |r| (k, r)))
-        .map(|(k, r)| {
+    let missed: Vec<String> = kept
+        .iter()
+        .map(|&(k, r)| {
             per.get(&(k, MISSED.to_string()))
                 .and_then(|v| v[r].is_finite().then(|| v[r] as usize))
                 .and_then(|i| Criterion::ALL.get(i))
@@ -287,6 +330,9 @@ pub struct Paired {
     /// The one-sided Wilson lower bound of case `c`'s success probability at the study's
     /// confidence ([`wilson_lower`]).
     pub lower: Vec<f64>,
+    /// Worlds case `c` met: the length of its rows `obj[c]`, `ok[c]` (the same for every case
+    /// but with adaptive worlds, which give the designs in contention more).
+    pub met: Vec<usize>,
 }
 
 /// The paired data of `table`'s cases from `worlds` (see [`Paired`]).
@@ -303,9 +349,18 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
         .iter()
         .max()
         .map_or(0, |m| *m as usize + 1);
-    let mut obj = vec![vec![f64::NAN; n_worlds]; ids.len()];
-    let mut ok = vec![vec![false; n_worlds]; ids.len()];
     let (wc, cc) = (worlds.i64("world").ok()?, worlds.i64(CASE_ID).ok()?);
+    // Every case met worlds 0..met (a prefix of the sequence): all `n_worlds` without adaptive
+    // worlds.
+    let mut met = vec![0usize; ids.len()];
+    for (w, c) in wc.iter().zip(cc) {
+        if let Some(&r) = row_of.get(c) {
+            met[r] = met[r].max(*w as usize + 1);
+        }
+    }
+    debug_assert!(met.iter().all(|m| *m <= n_worlds));
+    let mut obj: Vec<Vec<f64>> = met.iter().map(|&m| vec![f64::NAN; m]).collect();
+    let mut ok: Vec<Vec<bool>> = met.iter().map(|&m| vec![false; m]).collect();
     let (wo, ws) = (worlds.f64(objective).ok()?, worlds.f64(SUCCESS).ok()?);
     let sign = if larger_is_better(objective) {
         -1.0
@@ -348,7 +403,8 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
         .collect();
     let lower: Vec<f64> = successes
         .iter()
-        .map(|&k| wilson_lower(k, n_worlds, info.confidence))
+        .zip(&met)
+        .map(|(&k, &n)| wilson_lower(k, n, info.confidence))
         .collect();
     let eligible = (0..ids.len())
         .map(|r| ran[r] && lower[r] >= info.min_success_probability)
@@ -360,6 +416,7 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
         eligible,
         successes,
         lower,
+        met,
     })
 }
 
@@ -489,16 +546,15 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
     let below_requirement = (0..pd.eligible.len())
         .filter(|&r| pd.ran[r] && !pd.eligible[r])
         .count();
-    let n_worlds = pd.obj.first().map_or(0, Vec::len);
     let pending = (0..pd.eligible.len())
         .filter(|&r| {
             pd.ran[r]
                 && !pd.eligible[r]
-                && n_worlds > 0
-                && pd.successes[r] as f64 >= info.min_success_probability * n_worlds as f64
+                && pd.met[r] > 0
+                && pd.successes[r] as f64 >= info.min_success_probability * pd.met[r] as f64
         })
         .map(|r| {
-            let share = pd.successes[r] as f64 / n_worlds as f64;
+            let share = pd.successes[r] as f64 / pd.met[r] as f64;
             Pending {
                 row: r,
                 worlds_needed: worlds_for_share(share, info),
@@ -530,19 +586,34 @@ pub fn write_tables(
     robust: Option<&RobustInfo>,
     axes: &[&str],
 ) -> Result<Table, StudyError> {
+    write_tables_with(raw, out, robust.cloned(), axes, |_, _| Ok(())).map(|(t, _)| t)
+}
+
+/// [`write_tables`] with `extend` run on the final table (its per-world columns still in it)
+/// and the record of the worlds before the worlds are split off — the adaptive rounds of a
+/// study with `adaptive_worlds` (`super::adaptive::run_rounds`); returns the table and the
+/// record of the worlds.
+pub fn write_tables_with(
+    raw: Table,
+    out: &Path,
+    mut robust: Option<RobustInfo>,
+    axes: &[&str],
+    extend: impl FnOnce(&mut Table, &mut RobustInfo) -> Result<(), StudyError>,
+) -> Result<(Table, Option<RobustInfo>), StudyError> {
     write_csv_streamed(&raw, &out.join(PARTIAL_FILE))?;
     let mut table = final_table(raw)?;
     if let Some(curves) = split_tuning(&mut table) {
         write_csv_streamed(&curves, &out.join(TUNING_CSV))?;
     }
-    if let Some(info) = robust {
+    if let Some(info) = robust.as_mut() {
+        extend(&mut table, info)?;
         if let Some(worlds) = split_worlds(&mut table, info) {
             write_csv_streamed(&worlds, &out.join(WORLDS_CSV))?;
             add_rank_columns(&mut table, &worlds, info);
         }
     }
     write_case_files(&mut table, out, axes)?;
-    Ok(table)
+    Ok((table, robust))
 }
 
 /// Write `table` to [`CASES_CSV`] and [`CASES_PARQUET`] in `out`: whole-number columns as

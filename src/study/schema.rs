@@ -425,6 +425,19 @@ pub struct Uncertainty {
     pub confidence: f64,
     /// Relative margin below which two designs are called tied (default 0.01).
     pub equivalence: f64,
+    /// Adaptive worlds (`adaptive_worlds`, `adaptive_batch`; `None`: the `worlds` only).
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Adaptive worlds (issue 36 item 6, docs/statistics.md § Adaptive worlds): after the first
+/// `worlds`, the designs still in contention meet further points of the same Sobol sequence,
+/// `batch` at a time, until the verdict is decided or each has met `budget` worlds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Adaptive {
+    /// Most worlds a design meets (`adaptive_worlds`, > `worlds`).
+    pub budget: usize,
+    /// Worlds added per round (`adaptive_batch`, default `worlds`).
+    pub batch: usize,
 }
 
 /// A held-out validation variant (`[[validate]]`): overrides not used in tuning, scored at
@@ -462,15 +475,37 @@ impl Uncertainty {
 
     /// The worlds of a study with seed `seed`: the same for every case.
     pub fn sample(&self, seed: u64) -> Vec<World> {
+        self.sample_range(seed, 0..self.worlds)
+    }
+
+    /// The most worlds a design of the study can meet: the adaptive budget, else
+    /// [`Uncertainty::n_worlds`].
+    pub fn max_worlds(&self) -> usize {
+        self.adaptive.map_or(self.n_worlds(), |a| a.budget)
+    }
+
+    /// Worlds `range` of a study with seed `seed` (with points sampling; Saltelli's design is
+    /// whole, `range` ignored). A Sobol or random point depends only on the seed and its index
+    /// ([`Sampler::point`]), so worlds beyond `worlds` are the next points of the same
+    /// sequence and `sample_range(seed, 0..n)` starts with `sample(seed)`.
+    pub fn sample_range(&self, seed: u64, range: std::ops::Range<usize>) -> Vec<World> {
         let d = self.params.len();
         let seed = derive_seed(seed, WORLD_STREAM);
+        let start = range.start;
         let units: Vec<Vec<f64>> = match self.sampling {
             WorldSampling::Saltelli => SaltelliDesign { n: self.worlds, d }.points(seed),
             WorldSampling::Points(s) => {
-                let Ok(sampler) = Sampler::new(s, self.worlds, d, seed) else {
+                // An LHS point depends on the count: it is always drawn for `worlds` points
+                // (parse() allows adaptive worlds with Sobol sampling only).
+                let n = if s == Sampling::Lhs {
+                    self.worlds
+                } else {
+                    range.end
+                };
+                let Ok(sampler) = Sampler::new(s, n, d, seed) else {
                     return Vec::new(); // parse() checked the sizes
                 };
-                (0..self.worlds)
+                range
                     .map(|i| {
                         let mut u = vec![0.0; d];
                         sampler.point(i, &mut u);
@@ -479,11 +514,16 @@ impl Uncertainty {
                     .collect()
             }
         };
+        let start = if self.sampling == WorldSampling::Saltelli {
+            0
+        } else {
+            start
+        };
         units
             .into_iter()
             .enumerate()
-            .map(|(index, u)| World {
-                index,
+            .map(|(i, u)| World {
+                index: start + i,
                 values: self
                     .params
                     .iter()

@@ -188,19 +188,29 @@ impl<'a> Robust<'a> {
             .iter()
             .map(|p| format!("`{}` {}", p.name, p.distribution))
             .collect();
+        let (worlds, every) = match &self.info.adaptive {
+            Some(a) if a.worlds_used > self.info.worlds => (
+                format!("{}–{}", self.info.worlds, a.worlds_used),
+                format!(
+                    "Every design met the same first {} worlds and the designs in contention \
+                     further points of the same sequence, up to {} (adaptive worlds; \
+                     `worlds_met`)",
+                    self.info.worlds, a.worlds_used
+                ),
+            ),
+            _ => (
+                self.info.worlds.to_string(),
+                format!("Every design met the same {} worlds", self.info.worlds),
+            ),
+        };
+        let _ = writeln!(md, "## Ranking over {worlds} uncertain worlds\n");
         let _ = writeln!(
             md,
-            "## Ranking over {} uncertain worlds\n",
-            self.info.worlds
-        );
-        let _ = writeln!(
-            md,
-            "Every design met the same {} worlds ({} sampling; common random numbers, so \
+            "{every} ({} sampling; common random numbers, so \
              comparisons are paired): {}. The nominal world is reported apart (the plain \
              metric columns). **{} designs are ranked**; {} ran but are not ranked because \
              their success probability is below {} (`{SUCCESS_PROBABILITY}`: fraction of \
              worlds meeting every `[success]` criterion).\n",
-            self.info.worlds,
             self.info.sampling,
             params.join(", "),
             self.verdict.ranked,

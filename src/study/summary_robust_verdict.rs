@@ -2,14 +2,124 @@
 //! Undecided (with the worlds it needs) or no winner, with the confidence, the tests and the
 //! designs pending more worlds (`docs/statistics.md`). A child of `summary_robust`.
 
+use std::collections::BTreeMap;
+
 use super::{Robust, TOP};
 use crate::stats::ranking::{Contender, Verdict};
+use crate::study::records::CASE_ID;
 
 impl Robust<'_> {
-    /// The line the summary opens with.
+    /// The line the summary opens with: the verdict, then (with adaptive worlds) the rounds,
+    /// why they stopped and the worlds each design met.
     pub fn verdict_line(&self) -> String {
+        let mut line = self.verdict_sentence();
+        line.push_str(&self.adaptive_text());
+        line
+    }
+
+    /// The worlds row `r` met (its rows in `worlds.csv`).
+    pub(super) fn worlds_met(&self, r: usize) -> usize {
+        let Ok(case) = self.worlds.i64(CASE_ID) else {
+            return 0;
+        };
+        case.iter().filter(|c| **c == self.ids[r]).count()
+    }
+
+    /// Whether row `r` ran in its worlds (its success probability is a number).
+    fn ran(&self, r: usize) -> bool {
+        self.table
+            .f64(crate::study::worlds::SUCCESS_PROBABILITY)
+            .is_ok_and(|p| p[r].is_finite())
+    }
+
+    /// The worlds the verdict's leader met (the first `worlds` without a leader): what the
+    /// verdict sentence says it was judged over.
+    fn judged_worlds(&self) -> usize {
+        match (self.leader(), &self.info.adaptive) {
+            (_, None) => self.info.worlds,
+            (Some(l), Some(_)) => self.worlds_met(l),
+            (None, Some(a)) => a.worlds_used,
+        }
+    }
+
+    /// With adaptive worlds: the rounds run, why they stopped (and what is still in
+    /// contention when the budget stopped them), and the worlds each design met.
+    fn adaptive_text(&self) -> String {
+        let Some(a) = &self.info.adaptive else {
+            return String::new();
+        };
+        let ran: Vec<usize> = (0..self.ids.len())
+            .filter(|&r| self.worlds_met(r) > 0 && self.ran(r))
+            .collect();
+        let mut by_count: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+        for &r in &ran {
+            by_count.entry(self.worlds_met(r)).or_default().push(r);
+        }
+        let groups: Vec<String> = by_count
+            .iter()
+            .rev()
+            .map(|(n, rows)| {
+                if *n == self.info.worlds && by_count.len() > 1 {
+                    format!("{n} by the other {} that ran", rows.len())
+                } else {
+                    let ids: Vec<String> = rows
+                        .iter()
+                        .take(TOP)
+                        .map(|r| format!("#{}", self.ids[*r]))
+                        .collect();
+                    let more = rows.len().saturating_sub(TOP);
+                    format!(
+                        "{n} by {}{}",
+                        ids.join(", "),
+                        if more > 0 {
+                            format!(" and {more} more")
+                        } else {
+                            String::new()
+                        }
+                    )
+                }
+            })
+            .collect();
+        let delta = self.info.equivalence.max(self.verdict.noise);
+        let why = match a.stopped.as_str() {
+            "decided" => "stopped: the verdict is decided (no design left that more worlds \
+                          could rank or separate from the leader)"
+                .to_string(),
+            _ => {
+                let open: Vec<String> = crate::study::adaptive::contention(&self.verdict, delta)
+                    .iter()
+                    .take(TOP)
+                    .map(|r| format!("#{}", self.ids[*r]))
+                    .collect();
+                format!(
+                    "stopped: the budget of {} worlds is spent with {} still in contention \
+                     ({})",
+                    a.budget,
+                    if open.len() == 1 {
+                        "1 design".to_string()
+                    } else {
+                        format!("{} designs", open.len())
+                    },
+                    open.join(", ")
+                )
+            }
+        };
+        format!(
+            " Adaptive worlds (`adaptive_worlds` = {}, batch {}): {} round{} after the first {} \
+             worlds, {why}. Worlds met: {}.",
+            a.budget,
+            a.batch,
+            a.rounds,
+            if a.rounds == 1 { "" } else { "s" },
+            self.info.worlds,
+            groups.join("; ")
+        )
+    }
+
+    /// The verdict itself.
+    fn verdict_sentence(&self) -> String {
         let v = &self.verdict;
-        let n = self.info.worlds;
+        let n = self.judged_worlds();
         let o = self.info.objective();
         let noise = if v.noise_measured {
             format!(
@@ -85,7 +195,7 @@ impl Robust<'_> {
 
     /// The verdict sentence of a tie: the leader and the cases it does not beat.
     fn tied_line(&self, leader: usize, tied: &[Contender], noise: &str) -> String {
-        let (n, o) = (self.info.worlds, self.info.objective());
+        let (n, o) = (self.judged_worlds(), self.info.objective());
         let list: Vec<String> = std::iter::once(format!("#{}", self.ids[leader]))
             .chain(
                 tied.iter()
@@ -128,7 +238,7 @@ impl Robust<'_> {
         needs_worlds: usize,
         noise: &str,
     ) -> String {
-        let (n, o) = (self.info.worlds, self.info.objective());
+        let (n, o) = (self.judged_worlds(), self.info.objective());
         let margins: Vec<String> = open
             .iter()
             .take(5)

@@ -10,10 +10,10 @@ use std::collections::BTreeSet;
 
 use serde::Deserialize;
 
-use super::schema::{Study, Target};
 pub use super::schema::{
-    UncertainParam, Uncertainty, Variant, World, WorldDist, WorldSampling, MAX_WORLDS,
+    Adaptive, UncertainParam, Uncertainty, Variant, World, WorldDist, WorldSampling, MAX_WORLDS,
 };
+use super::schema::{Study, Target};
 use crate::input::document::Document;
 use crate::input::located::InputError;
 use crate::sampling::Sampler;
@@ -27,6 +27,8 @@ struct UncertaintyFile {
     min_success_probability: Option<f64>,
     confidence: Option<f64>,
     equivalence: Option<f64>,
+    adaptive_worlds: Option<usize>,
+    adaptive_batch: Option<usize>,
     param: Option<Vec<ParamFile>>,
 }
 
@@ -130,6 +132,7 @@ pub fn parse_uncertainty(
         Sampler::new(s, worlds, params.len(), 0)
             .map_err(|e| doc.err("uncertainty.param", e.to_string()))?;
     }
+    let adaptive = parse_adaptive(&f, worlds, sampling, doc)?;
     let metrics = match f.metrics {
         Some(m) if m.is_empty() => return Err(doc.err("uncertainty.metrics", "is empty")),
         Some(m) => m,
@@ -146,6 +149,7 @@ pub fn parse_uncertainty(
         }
     }
     Ok(Some(Uncertainty {
+        adaptive,
         worlds,
         sampling,
         params,
@@ -168,6 +172,55 @@ pub fn parse_uncertainty(
         },
         equivalence: probability(f.equivalence, "uncertainty.equivalence", 0.01)?,
     }))
+}
+
+/// `adaptive_worlds` (the budget: most worlds a design meets, more than `worlds`) and
+/// `adaptive_batch` (worlds added per round, default `worlds`, at most the budget's excess);
+/// Sobol sampling only: its further points extend the same low-discrepancy sequence.
+fn parse_adaptive(
+    f: &UncertaintyFile,
+    worlds: usize,
+    sampling: WorldSampling,
+    doc: &Document,
+) -> Result<Option<Adaptive>, InputError> {
+    let Some(budget) = f.adaptive_worlds else {
+        if f.adaptive_batch.is_some() {
+            return Err(doc.err(
+                "uncertainty.adaptive_batch",
+                "needs `adaptive_worlds` (the most worlds a design may meet)",
+            ));
+        }
+        return Ok(None);
+    };
+    let key = "uncertainty.adaptive_worlds";
+    if sampling != WorldSampling::Points(crate::sampling::Sampling::Sobol) {
+        return Err(doc.err(
+            key,
+            "needs sampling = \"sobol\": adaptive worlds are further points of the same \
+             low-discrepancy sequence (an LHS or Saltelli design cannot be extended)",
+        ));
+    }
+    if budget <= worlds || budget > MAX_WORLDS {
+        return Err(doc.err(
+            key,
+            format!(
+                "must be more than `worlds` ({worlds}) and at most {MAX_WORLDS} (the most \
+                 worlds a design may meet), got {budget}"
+            ),
+        ));
+    }
+    let batch = f.adaptive_batch.unwrap_or(worlds).min(budget - worlds);
+    if batch == 0 || f.adaptive_batch.is_some_and(|b| b > budget - worlds) {
+        return Err(doc.err(
+            "uncertainty.adaptive_batch",
+            format!(
+                "must be between 1 and adaptive_worlds − worlds ({}), got {}",
+                budget - worlds,
+                f.adaptive_batch.unwrap_or(0)
+            ),
+        ));
+    }
+    Ok(Some(Adaptive { budget, batch }))
 }
 
 fn parse_params(

@@ -92,7 +92,7 @@ fn worst(metric: &str, xs: &[f64]) -> f64 {
 }
 
 /// One case's run in one world.
-struct WorldRun {
+pub(super) struct WorldRun {
     ok: bool,
     metrics: Metrics,
     missed: f64,
@@ -105,6 +105,119 @@ struct WorldRun {
 pub struct WorldTimeout {
     /// The world being run.
     pub world: usize,
+}
+
+/// Run resolved case `r` (at its tuned values) in `worlds` of `u`, in world order. The worlds
+/// of one case are independent runs: run side by side (a sweep with fewer cases than threads
+/// keeps every thread busy), one evaluator per rayon work split (its vehicle cache serves
+/// every world of an unchanged design), collected in world order so nothing depends on the
+/// thread count. A world whose overrides do not apply counts as unsuccessful with NaN metrics.
+pub(super) fn run_worlds(
+    u: &super::schema::Uncertainty,
+    worlds: &[World],
+    id: usize,
+    r: &Resolved,
+    deadline: Deadline,
+) -> Vec<WorldRun> {
+    worlds
+        .par_iter()
+        .map_init(Evaluator::new, |evaluator, w| {
+            run_world(evaluator, u, w, id, r, deadline)
+        })
+        .collect()
+}
+
+/// Case `r` in world `w` of `u` (see [`run_worlds`]).
+pub(super) fn run_world(
+    evaluator: &mut Evaluator,
+    u: &super::schema::Uncertainty,
+    w: &World,
+    id: usize,
+    r: &Resolved,
+    deadline: Deadline,
+) -> WorldRun {
+    let overrides = u
+        .params
+        .iter()
+        .zip(&w.values)
+        .map(|(p, v)| (p.name.as_str(), &p.target, v));
+    match apply(r, overrides) {
+        Ok(rw) => {
+            let res = run(evaluator, &rw, id, deadline);
+            let timeout = timed_out(&res);
+            let missed = missed_criterion(res.status, &res.reason)
+                .and_then(Criterion::parse)
+                .map_or(f64::NAN, criterion_index);
+            WorldRun {
+                ok: res.status == CaseStatus::Ok,
+                metrics: res.metrics,
+                missed,
+                timeout,
+            }
+        }
+        Err(_) => WorldRun {
+            ok: false,
+            metrics: Metrics::new(),
+            missed: criterion_index(Criterion::NoFailure),
+            timeout: false,
+        },
+    }
+}
+
+impl WorldRun {
+    /// Whether the run stopped at the case's wall-clock budget.
+    pub(super) fn timed_out(&self) -> bool {
+        self.timeout
+    }
+}
+
+/// The per-world columns of run `wr` in world `k` (`world.<k>.missed`, `world.<k>.<m>` per
+/// tracked metric, `world.<k>.success`), pushed in that order.
+pub(super) fn push_world_columns(
+    u: &super::schema::Uncertainty,
+    k: usize,
+    wr: &WorldRun,
+    metrics: &mut Metrics,
+) {
+    metrics.push(format!("{WORLD_PREFIX}{k}.{MISSED}"), wr.missed);
+    for name in &u.metrics {
+        metrics.push(format!("{WORLD_PREFIX}{k}.{name}"), wr.metrics.value(name));
+    }
+    metrics.push(
+        format!("{WORLD_PREFIX}{k}.{SUCCESS}"),
+        f64::from(u8::from(wr.ok)),
+    );
+}
+
+/// The summaries over worlds (`m_mean`, `m_std`, `m_p05`, `m_p95`, `m_worst` per tracked metric
+/// `m` of `u`, from `values[m]` in world order; `success_probability` = `successes` / worlds),
+/// each handed to `set` by name. One function for the first worlds and for adaptive ones, so a
+/// case that met `n` worlds adaptively has the summaries of a study with `worlds = n`.
+pub(super) fn set_world_summaries(
+    u: &super::schema::Uncertainty,
+    values: &[Vec<f64>],
+    successes: usize,
+    mut set: impl FnMut(&str, f64),
+) {
+    let n = values.first().map_or(0, Vec::len);
+    for (name, xs) in u.metrics.iter().zip(values) {
+        let d = describe(xs);
+        for (suffix, x) in [
+            ("mean", d.mean),
+            ("std", d.std),
+            ("p05", d.p05),
+            ("p95", d.p95),
+            ("worst", worst(name, xs)),
+        ] {
+            set(&format!("{name}_{suffix}"), x);
+        }
+    }
+    let p = if n == 0 {
+        f64::NAN
+    } else {
+        successes as f64 / n as f64
+    };
+    set(SUCCESS_PROBABILITY, p);
 }
 
 /// Score resolved case `r` (at its tuned values) in `worlds` and the study's validation
@@ -120,77 +233,20 @@ pub fn score_worlds(
     metrics: &mut Metrics,
 ) -> Result<(), WorldTimeout> {
     if let Some(u) = &study.uncertainty {
-        // The worlds of one case are independent runs: run them side by side (a sweep with
-        // fewer cases than threads keeps every thread busy), one evaluator per rayon work
-        // split (its vehicle cache serves every world of an unchanged design), collected in world order
-        // so the row does not depend on the thread count.
-        let runs: Vec<WorldRun> = worlds
-            .par_iter()
-            .map_init(Evaluator::new, |evaluator, w| {
-                let overrides = u
-                    .params
-                    .iter()
-                    .zip(&w.values)
-                    .map(|(p, v)| (p.name.as_str(), &p.target, v));
-                match apply(r, overrides) {
-                    Ok(rw) => {
-                        let res = run(evaluator, &rw, id, deadline);
-                        let timeout = timed_out(&res);
-                        let missed = missed_criterion(res.status, &res.reason)
-                            .and_then(Criterion::parse)
-                            .map_or(f64::NAN, criterion_index);
-                        WorldRun {
-                            ok: res.status == CaseStatus::Ok,
-                            metrics: res.metrics,
-                            missed,
-                            timeout,
-                        }
-                    }
-                    Err(_) => WorldRun {
-                        ok: false,
-                        metrics: Metrics::new(),
-                        missed: criterion_index(Criterion::NoFailure),
-                        timeout: false,
-                    },
-                }
-            })
-            .collect();
-        let mut values: Vec<Vec<f64>> = vec![Vec::with_capacity(worlds.len()); u.metrics.len()];
-        let mut successes = 0usize;
+        let runs = run_worlds(u, worlds, id, r, deadline);
         for (w, wr) in worlds.iter().zip(&runs) {
             if wr.timeout {
                 return Err(WorldTimeout { world: w.index });
             }
-            metrics.push(format!("{WORLD_PREFIX}{}.{MISSED}", w.index), wr.missed);
-            successes += usize::from(wr.ok);
-            for (name, col) in u.metrics.iter().zip(values.iter_mut()) {
-                let x = wr.metrics.value(name);
-                col.push(x);
-                metrics.push(format!("{WORLD_PREFIX}{}.{name}", w.index), x);
-            }
-            metrics.push(
-                format!("{WORLD_PREFIX}{}.{SUCCESS}", w.index),
-                f64::from(u8::from(wr.ok)),
-            );
+            push_world_columns(u, w.index, wr, metrics);
         }
-        for (name, xs) in u.metrics.iter().zip(&values) {
-            let d = describe(xs);
-            for (suffix, x) in [
-                ("mean", d.mean),
-                ("std", d.std),
-                ("p05", d.p05),
-                ("p95", d.p95),
-                ("worst", worst(name, xs)),
-            ] {
-                metrics.set(&format!("{name}_{suffix}"), x);
-            }
-        }
-        let p = if worlds.is_empty() {
-            f64::NAN
-        } else {
-            successes as f64 / worlds.len() as f64
-        };
-        metrics.set(SUCCESS_PROBABILITY, p);
+        let values: Vec<Vec<f64>> = u
+            .metrics
+            .iter()
+            .map(|name| runs.iter().map(|wr| wr.metrics.value(name)).collect())
+            .collect();
+        let successes = runs.iter().filter(|wr| wr.ok).count();
+        set_world_summaries(u, &values, successes, |name, x| metrics.set(name, x));
     }
     score_variants(evaluator, study, id, r, deadline, metrics)
 }
