@@ -182,6 +182,7 @@ pub fn optimise<'py>(
             journal: Some(&journal),
             resume,
             on_record: &|_| {},
+            race: false,
         };
         let outcome = run_problem(&problem, &opts).map_err(|e| err(&e))?;
         write_outputs(&problem, &outcome, &out, OptimiseFiles { plots }).map_err(|e| err(&e))?;
