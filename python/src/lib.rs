@@ -8,7 +8,7 @@
 //! Files:
 //! - [`convert`]: Python values → TOML values, overrides, error conversion;
 //! - [`run`]: `simulate`, `simulate_many` and the `Run` class;
-//! - [`verbs`]: `design`, `scenario_info`, `sweep`, `optimise`, `tcm`;
+//! - [`verbs`]: `design`, `scenario_info`, `sweep`, `optimise`, `tcm`, `ocp`;
 //! - [`problem`]: the ask/tell `Problem` class.
 
 use pyo3::prelude::*;
@@ -39,5 +39,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(verbs::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::optimise, m)?)?;
     m.add_function(wrap_pyfunction!(verbs::tcm, m)?)?;
+    m.add_function(wrap_pyfunction!(verbs::ocp, m)?)?;
     Ok(())
 }

@@ -1,4 +1,4 @@
-//! The other verbs: `design`, `scenario_info`, `sweep`, `optimise` and `tcm`, each calling the
+//! The other verbs: `design`, `scenario_info`, `sweep`, `optimise`, `tcm` and `ocp`, each calling the
 //! library as the command of the same name does and writing the same files.
 
 use std::path::{Path, PathBuf};
@@ -274,6 +274,23 @@ pub fn tcm(
             ))
         })?;
         Ok((text, config.out.display().to_string()))
+    })?;
+    Ok(r)
+}
+
+/// `usm-study ocp PROBLEM --out DIR`: solve an optimal-control problem file and write
+/// `trajectory.csv`, `iterations.csv` and `summary.json` into `out`; returns
+/// `(out, summary.json's text)` (the solve's status is data: a solve that did not converge
+/// is not an error).
+#[pyfunction]
+pub fn ocp(py: Python<'_>, problem: PathBuf, out: PathBuf) -> PyResult<(String, String)> {
+    let r = py.detach(move || -> Result<(String, String), Failure> {
+        let spec = usm_study::ocp::load_problem(&problem).map_err(|e| err(&e))?;
+        let mut run = usm_study::ocp::solve_spec(&spec).map_err(|e| err(&e))?;
+        usm_study::ocp::write_outputs(&out, &spec, &mut run).map_err(|e| err(&e))?;
+        let summary = std::fs::read_to_string(out.join("summary.json"))
+            .map_err(|e| msg(format!("{}: {e}", out.display())))?;
+        Ok((out.display().to_string(), summary))
     })?;
     Ok(r)
 }

@@ -186,3 +186,19 @@ def test_sweep_writes_the_cli_outputs(tmp_path):
     assert r.cases.height == 4 and r.cases.equals(cli_cases)
     for f in ("cases.csv", "summary.md", "manifest.json", "report.html"):
         assert (tmp_path / "py" / f).is_file(), f
+
+
+def test_ocp_returns_the_trajectory_and_equals_the_cli(tmp_path):
+    problem = DATA / "ocp_small.toml"
+    r = usm_study.ocp(problem, out=tmp_path / "py")
+    assert r.status == "converged" and r.summary["kkt"]["primal"] <= 1e-6
+    assert isinstance(r.trajectory, pl.DataFrame) and r.trajectory.height == 7
+    assert "u_1" in r.trajectory.columns and "q_1" in r.trajectory.columns
+    p = cli("ocp", str(problem), "--out", str(tmp_path / "cli"))
+    assert p.returncode == 0, p.stderr
+    cli_csv = (tmp_path / "cli" / "trajectory.csv").read_text()
+    assert (tmp_path / "py" / "trajectory.csv").read_text() == cli_csv
+    cli_summary = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert r.objective == cli_summary["objective"]
+    terms = r.summary["objective_terms"]["path_costs"]["values"]
+    assert terms["thruster_energy_static"] > 0.0

@@ -34,6 +34,7 @@ __all__ = [
     "SweepResult",
     "OptimiseResult",
     "TcmResult",
+    "OcpResult",
     "design",
     "scenario",
     "simulate",
@@ -41,6 +42,7 @@ __all__ = [
     "sweep",
     "optimise",
     "tcm",
+    "ocp",
 ]
 
 Value = Union[bool, int, float, str, Sequence[Any], Mapping[str, Any]]
@@ -451,3 +453,37 @@ class Problem:
 
     def __repr__(self) -> str:
         return f"Problem({self.name!r}, {len(self.params)} params)"
+
+
+@dataclass(frozen=True)
+class OcpResult:
+    """An optimal-control solve (docs/ocp.md): ``trajectory`` is ``trajectory.csv`` as a polars
+    DataFrame (N + 1 rows, ``simulate``'s time-series column names; the controls of row k act
+    over [t_k, t_{k+1}], the last row has none), ``summary`` is ``summary.json`` (status,
+    objective and its terms, KKT residuals, iterations, time per phase, every start of a
+    multi-start and their spread)."""
+
+    out: str
+    trajectory: pl.DataFrame
+    summary: Dict[str, Any]
+
+    @property
+    def status(self) -> str:
+        return self.summary["status"]
+
+    @property
+    def objective(self) -> float:
+        return self.summary["objective"]
+
+
+def ocp(
+    problem: Union[str, "os.PathLike[str]"],
+    out: Union[str, "os.PathLike[str]"],
+) -> OcpResult:
+    """Solve an optimal-control problem file, as ``usm-study ocp PROBLEM --out OUT``: the same
+    solver and the same files in ``out``. A solve that does not converge is not an error: its
+    ``status`` says how it ended (``converged``, ``max_iterations``, ``infeasible``,
+    ``diverged``, ``stalled``)."""
+    o, summary = _native.ocp(_path(problem), _path(out))
+    trajectory = pl.read_csv(os.path.join(o, "trajectory.csv"))
+    return OcpResult(out=o, trajectory=trajectory, summary=json.loads(summary))

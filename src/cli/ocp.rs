@@ -23,7 +23,7 @@ pub struct OcpArgs {
 /// Run `ocp`.
 pub fn run(args: &OcpArgs) -> anyhow::Result<ExitCode> {
     let spec = load_problem(&args.problem)?;
-    let mut run = solve_spec(&spec);
+    let mut run = solve_spec(&spec)?;
     write_outputs(&args.out, &spec, &mut run)?;
     let s = &run.solution;
     println!(

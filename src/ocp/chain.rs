@@ -19,20 +19,64 @@
 //! Cholesky; hydrodynamics per [`DynOptions`]), `ζ⁺ = ζ + Δt ζ̇`, `g⁺ = g Exp_SE(3)(Δt V_b⁺)`,
 //! `q⁺ = q + Δt q̇⁺`.
 //!
-//! Terminal equality (nc = 9 + n): end-effector origin at `target` (inertial [m]), base
-//! twist and joint rates zero.
+//! Terminal equality ([`TerminalSpec`], rows in this order, each optional): end-effector
+//! origin at a target (3, inertial [m]), end-effector orientation (3: `Log(R_tᵀ R_Ie)` [rad]),
+//! base position (3, inertial [m]), base orientation (3: `Log(R_tᵀ R_Ib)`), joint angles (n
+//! [rad]), base twist and joint rates zero (6 + n). [`ChainModel::new`] sets the end-effector
+//! position and the velocities (nc = 9 + n).
+//!
+//! Path costs beyond the quadratic effort ([`PathCosts`], docs/ocp.md §1): thruster energy,
+//! joint energy and the joint-limit barrier, analytic in `(q, q̇, u)`.
 //!
 //! Derivatives: the trait's central differences (ε = 1e-6 in tangent coordinates) — not yet
 //! analytic nor automatic (docs/ocp.md §5).
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
+use super::cost::PathCosts;
 use super::model::{ModelError, OcpModel};
 use crate::dynamics::{dynamics_terms, solve_forward, DynOptions, DynWorkspace};
 use crate::kinematics::{forward_kinematics, generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
-use crate::spatial::{skew, Mat3, Vec3};
-use nalgebra::{Quaternion, UnitQuaternion};
+use crate::spatial::{ang, lin, skew, Mat3, Vec3, Vec6};
+use nalgebra::{DMatrix, Quaternion, Rotation3, UnitQuaternion};
+
+/// The terminal equality's rows (module documentation); `None`: that row group is free.
+#[derive(Clone, Debug, Default)]
+pub struct TerminalSpec {
+    /// End-effector origin, inertial [m].
+    pub ee_position: Option<Vec3>,
+    /// End-effector orientation `R_Ie`.
+    pub ee_rotation: Option<Mat3>,
+    /// Base origin, inertial [m].
+    pub base_position: Option<Vec3>,
+    /// Base orientation `R_Ib`.
+    pub base_rotation: Option<Mat3>,
+    /// Joint angles [rad] (n).
+    pub joint_angles: Option<Vec<f64>>,
+    /// Base twist and joint rates zero.
+    pub zero_velocity: bool,
+}
+
+impl TerminalSpec {
+    /// Number of rows for `n` joints.
+    pub fn rows(&self, n: usize) -> usize {
+        let three = [
+            self.ee_position.is_some(),
+            self.ee_rotation.is_some(),
+            self.base_position.is_some(),
+            self.base_rotation.is_some(),
+        ];
+        3 * three.iter().filter(|b| **b).count()
+            + self.joint_angles.as_ref().map_or(0, |_| n)
+            + if self.zero_velocity { 6 + n } else { 0 }
+    }
+}
+
+/// `Log(R_tᵀ R)` [rad] (the rotation from the target to `r`, in the target's frame).
+fn rotation_error(target: &Mat3, r: &Mat3) -> Vec3 {
+    Rotation3::from_matrix_unchecked(target.transpose() * r).scaled_axis()
+}
 
 /// The chain's discrete dynamics and terminal constraint.
 #[derive(Clone, Debug)]
@@ -41,7 +85,8 @@ pub struct ChainModel {
     ws: DynWorkspace,
     opts: DynOptions,
     dt: f64,
-    target: Vec3,
+    terminal: TerminalSpec,
+    costs: Option<PathCosts>,
     tau: Vec<f64>,
     zeta: Vec<f64>,
     /// Thruster actuation: the generalised thrust map G(q), (6+n)×m (None: base wrench).
@@ -59,7 +104,12 @@ impl ChainModel {
             ws,
             opts,
             dt,
-            target,
+            terminal: TerminalSpec {
+                ee_position: Some(target),
+                zero_velocity: true,
+                ..TerminalSpec::default()
+            },
+            costs: None,
             tau: vec![0.0; nv],
             zeta: vec![0.0; nv],
             gmap: None,
@@ -72,6 +122,33 @@ impl ChainModel {
         let nv = self.vehicle.n_dof();
         self.gmap = Some(faer::Mat::zeros(nv, self.vehicle.n_thrusters()));
         self
+    }
+
+    /// The same chain with the terminal equality `terminal` instead.
+    pub fn with_terminal(mut self, terminal: TerminalSpec) -> Self {
+        self.terminal = terminal;
+        self
+    }
+
+    /// The same chain with the path costs `costs` added to the objective.
+    pub fn with_costs(mut self, costs: PathCosts) -> Self {
+        self.costs = Some(costs);
+        self
+    }
+
+    /// The path costs, if any.
+    pub fn costs(&self) -> Option<&PathCosts> {
+        self.costs.as_ref()
+    }
+
+    /// The terminal equality.
+    pub fn terminal_spec(&self) -> &TerminalSpec {
+        &self.terminal
+    }
+
+    /// Step Δt [s].
+    pub fn dt(&self) -> f64 {
+        self.dt
     }
 
     /// Whether the controls are thrusts (else a base wrench) before the joint torques.
@@ -135,6 +212,34 @@ impl ChainModel {
     }
 }
 
+impl ChainModel {
+    /// Axial inflow `V_a` [m/s] of every thruster at state `x` for thrusts `thrust` [N], as
+    /// the closed loop's recorder computes it (docs/model.md §6): the thruster point's
+    /// velocity relative to the water projected on `sign(u_j) d_j`.
+    pub fn thruster_inflows(&mut self, x: &[f64], thrust: &[f64]) -> Vec<f64> {
+        let n = self.n_joints();
+        forward_kinematics(&self.vehicle, &x[7..7 + n], &mut self.ws.kin);
+        let pose = Self::pose(x);
+        let water_b = pose
+            .orientation
+            .inverse_transform_vector(&self.vehicle.fluid.current);
+        let base = Vec6::from_column_slice(&x[7 + n..13 + n]);
+        let qd = &x[13 + n..13 + 2 * n];
+        let kin = &self.ws.kin;
+        let th = self.vehicle.thrusters.iter().zip(thrust);
+        th.map(|(t, u)| {
+            let g = &kin.g_b[t.body];
+            let mut tw = base;
+            for (xi, r) in kin.joint_twist_b.iter().zip(qd).take(t.body) {
+                tw += xi * *r;
+            }
+            let v_rel = lin(&tw) + ang(&tw).cross(&g.act_point(&t.position)) - water_b;
+            u.signum() * g.act_vector(&t.direction).dot(&v_rel)
+        })
+        .collect()
+    }
+}
+
 /// `Exp` of SO(3) and the left Jacobian `J(φ)` of SE(3)'s exponential:
 /// `Exp_SE(3)([v; φ]) = (Exp(φ), J(φ) v)`, `J = I + (1−cos θ)/θ² [φ]× + (θ−sin θ)/θ³ [φ]×²`
 /// (series below θ = 1e-4).
@@ -165,7 +270,7 @@ impl OcpModel for ChainModel {
         self.n_body_controls() + self.n_joints()
     }
     fn nc(&self) -> usize {
-        9 + self.n_joints()
+        self.terminal.rows(self.n_joints())
     }
 
     fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
@@ -243,8 +348,74 @@ impl OcpModel for ChainModel {
 
     fn terminal(&mut self, x: &[f64], out: &mut [f64]) {
         let n = self.n_joints();
-        let e = self.ee_position(x) - self.target;
-        out[..3].copy_from_slice(e.as_slice());
-        out[3..9 + n].copy_from_slice(&x[7 + n..13 + 2 * n]);
+        let (r_e, p_e) = self.ee_pose(x);
+        let pose = Self::pose(x);
+        let r_b = *pose.orientation.to_rotation_matrix().matrix();
+        let t = &self.terminal;
+        let mut i = 0;
+        let mut put = |v: &[f64]| {
+            out[i..i + v.len()].copy_from_slice(v);
+            i += v.len();
+        };
+        if let Some(p) = t.ee_position {
+            put((p_e - p).as_slice());
+        }
+        if let Some(r) = t.ee_rotation {
+            put(rotation_error(&r, &r_e).as_slice());
+        }
+        if let Some(p) = t.base_position {
+            put((pose.position - p).as_slice());
+        }
+        if let Some(r) = t.base_rotation {
+            put(rotation_error(&r, &r_b).as_slice());
+        }
+        if let Some(q) = &t.joint_angles {
+            for k in 0..n {
+                put(&[x[7 + k] - q[k]]);
+            }
+        }
+        if t.zero_velocity {
+            put(&x[7 + n..13 + 2 * n]);
+        }
+    }
+
+    fn has_path_costs(&self) -> bool {
+        self.costs.is_some()
+    }
+
+    fn stage_cost(&mut self, x: &[f64], u: &[f64]) -> f64 {
+        let n = self.n_joints();
+        self.costs.as_ref().map_or(0.0, |c| c.stage(n, x, u))
+    }
+
+    fn stage_cost_derivatives(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        exact: bool,
+        g: &mut [f64],
+        h: &mut DMatrix<f64>,
+    ) {
+        let n = self.n_joints();
+        if let Some(c) = self.costs.as_ref() {
+            c.stage_derivatives(n, x, u, exact, g, h);
+        }
+    }
+
+    fn max_step(&self, x: &[f64], dx: &[f64]) -> f64 {
+        let n = self.n_joints();
+        self.costs.as_ref().map_or(1.0, |c| c.max_step(n, x, dx))
+    }
+
+    fn terminal_cost(&mut self, x: &[f64]) -> f64 {
+        let n = self.n_joints();
+        self.costs.as_ref().map_or(0.0, |c| c.barrier(n, x))
+    }
+
+    fn terminal_cost_derivatives(&mut self, x: &[f64], g: &mut [f64], h: &mut DMatrix<f64>) {
+        let n = self.n_joints();
+        if let Some(c) = self.costs.as_ref() {
+            c.barrier_derivatives(n, x, g, h);
+        }
     }
 }

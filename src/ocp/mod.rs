@@ -10,21 +10,29 @@
 //!   parametric multiplier);
 //! - [`qp`]: the box-bounded QP (Mehrotra interior point over the Riccati solve);
 //! - [`sqp`]: the SQP with the filter line search, KKT residuals, status and log;
+//! - [`cost`]: [`PathCosts`], thruster and joint energy (smoothed) and the joint-limit
+//!   barrier, analytic derivatives;
+//! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
 
 pub mod chain;
+pub mod cost;
 pub mod model;
 pub mod problem;
 pub mod qp;
 pub mod riccati;
 pub mod run;
 pub mod sqp;
+pub mod start;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_costs;
 
-pub use chain::ChainModel;
+pub use chain::{ChainModel, TerminalSpec};
+pub use cost::{CostBreakdown, PathCosts};
 pub use model::{LinearModel, ModelError, OcpModel};
 pub use problem::{load_problem, parse_problem, ProblemSpec};
-pub use run::{solve_spec, write_outputs, OcpRun};
+pub use run::{build_model, solve_spec, write_outputs, OcpRun, StartRecord};
 pub use sqp::{solve, Hessian, IterLog, OcpProblem, OcpSolution, SqpSettings, Status, Timing};

@@ -79,6 +79,46 @@ pub trait OcpModel {
     /// `out = c(x)` (nc).
     fn terminal(&mut self, x: &[f64], out: &mut [f64]);
 
+    /// Whether the model adds path costs ([`OcpModel::stage_cost`],
+    /// [`OcpModel::terminal_cost`]) to the quadratic objective. Default no.
+    fn has_path_costs(&self) -> bool {
+        false
+    }
+
+    /// Stage cost `l(x_k, u_k)` added to the objective for every k < N (0 unless
+    /// overridden); `+∞` outside its domain (a barrier), which the line search rejects.
+    fn stage_cost(&mut self, _x: &[f64], _u: &[f64]) -> f64 {
+        0.0
+    }
+
+    /// Add the gradient (`g`, nx + nu, order `[δx, δu]`, tangent coordinates at x) and the
+    /// Hessian (`h`, (nx+nu)²) of [`OcpModel::stage_cost`]; with `exact` false, a positive
+    /// semidefinite part of the Hessian only (for Gauss–Newton iterations, which are not
+    /// convexified).
+    fn stage_cost_derivatives(
+        &mut self,
+        _x: &[f64],
+        _u: &[f64],
+        _exact: bool,
+        _g: &mut [f64],
+        _h: &mut DMatrix<f64>,
+    ) {
+    }
+
+    /// Largest step α ≤ 1 along the tangent step `dx` at x that keeps the stage cost's
+    /// barrier domain by the fraction to the boundary (1 unless overridden).
+    fn max_step(&self, _x: &[f64], _dx: &[f64]) -> f64 {
+        1.0
+    }
+
+    /// Terminal cost `l_N(x_N)` added to the objective (0 unless overridden).
+    fn terminal_cost(&mut self, _x: &[f64]) -> f64 {
+        0.0
+    }
+
+    /// Add the gradient (nx) and Hessian (nx×nx) of [`OcpModel::terminal_cost`].
+    fn terminal_cost_derivatives(&mut self, _x: &[f64], _g: &mut [f64], _h: &mut DMatrix<f64>) {}
+
     /// `A = ∂f/∂x` (nx×nx) and `B = ∂f/∂u` (nx×nu) at (x, u), tangent coordinates; central
     /// differences unless overridden.
     fn jacobians(

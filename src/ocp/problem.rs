@@ -6,25 +6,40 @@
 //! actuation = "base_wrench"  # or "thrusters": the design's thrusters (bounded by their limits)
 //! [physics]
 //! hydrodynamics = false      # true: added mass, drag, restoring forces, current
+//! current = [0.2, 0.0, 0.0]  # optional: the fluid's current, inertial [m/s] (replaces the design's)
 //! [horizon]
 //! duration = 10.0            # T [s]
 //! knots = 100                # N intervals, Δt = T/N
 //! [initial]                  # optional: at rest at the origin
 //! joint_angles = [0.0, 0.0, 0.0, 0.0]   # [rad]
-//! [terminal]
+//! [terminal]                 # every row group optional (at least one)
 //! ee_displacement = [0.0, 0.3, -0.2]    # end-effector target minus its start, inertial [m]
-//! zero_velocity = true       # base twist and joint rates zero at T (required for now)
-//! [objective]
-//! effort = 1.0               # J = effort · Σ_k Δt ‖u_k‖²
+//! ee_rpy_deg = [0.0, 10.0, 25.0]        # end-effector orientation, inertial (ZYX) [deg]
+//! base_displacement = [2.0, 1.0, 0.0]   # base origin target minus its start [m]
+//! base_rpy_deg = [0.0, 0.0, 90.0]       # base orientation [deg]
+//! joint_angles = [0.0, 0.0, 0.0, 0.0]   # [rad]
+//! zero_velocity = true       # base twist and joint rates zero at T (default true)
+//! [objective]                # J = Σ_k effort Δt ‖u_k‖² + path costs (docs/ocp.md §1)
+//! effort = 1.0               # > 0
+//! thruster_energy = 0.0      # weight of Σ Δt Σ_j c φ(u_j) (smoothed |u|^{3/2}; thrusters only)
+//! joint_energy = 0.0         # weight of Σ Δt Σ_i ψ(τ_i q̇_i) (smoothed |τ q̇|)
+//! thrust_smoothing = 0.01    # ε_u [N]
+//! power_smoothing = 0.01     # ε_p [W]
 //! [bounds]                   # optional, symmetric: |f_i| ≤ base_force, …
 //! base_force = 50.0          # [N]
 //! base_moment = 50.0         # [N·m]
 //! joint_torque = 50.0        # [N·m]
+//! joint_angle = 1.0          # |q_i| ≤ value [rad], by a logarithmic barrier (strictly inside)
+//! barrier = 1e-3             # the barrier's weight μ
 //! [solver]
 //! tolerance = 1e-6           # KKT tolerance
 //! max_iterations = 200
 //! hessian = "exact"          # or "gauss_newton" (objective only, no dynamics curvature)
 //! gauss_newton_above = 1e-2  # optional: Gauss–Newton while the primal infeasibility is above
+//! warm_start = "trajectory.csv"  # optional: an `ocp` trajectory (same design, actuation, knots)
+//! starts = 1                 # multi-start: start 0 as given, the others perturbed
+//! seed = 0                   # of the perturbations (ChaCha8 per start)
+//! perturbation = 0.1         # uniform ± this × the bound (or × 1 where unbounded)
 //! ```
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
@@ -65,6 +80,8 @@ struct File {
 struct Physics {
     #[serde(default)]
     hydrodynamics: bool,
+    #[serde(default)]
+    current: Option<[f64; 3]>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -83,7 +100,16 @@ struct Initial {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Terminal {
-    ee_displacement: [f64; 3],
+    #[serde(default)]
+    ee_displacement: Option<[f64; 3]>,
+    #[serde(default)]
+    ee_rpy_deg: Option<[f64; 3]>,
+    #[serde(default)]
+    base_displacement: Option<[f64; 3]>,
+    #[serde(default)]
+    base_rpy_deg: Option<[f64; 3]>,
+    #[serde(default)]
+    joint_angles: Option<Vec<f64>>,
     #[serde(default = "yes")]
     zero_velocity: bool,
 }
@@ -97,12 +123,30 @@ fn yes() -> bool {
 struct Objective {
     #[serde(default = "one")]
     effort: f64,
+    #[serde(default)]
+    thruster_energy: f64,
+    #[serde(default)]
+    joint_energy: f64,
+    #[serde(default = "smoothing")]
+    thrust_smoothing: f64,
+    #[serde(default = "smoothing")]
+    power_smoothing: f64,
 }
 
 impl Default for Objective {
     fn default() -> Self {
-        Self { effort: 1.0 }
+        Self {
+            effort: 1.0,
+            thruster_energy: 0.0,
+            joint_energy: 0.0,
+            thrust_smoothing: smoothing(),
+            power_smoothing: smoothing(),
+        }
     }
+}
+
+fn smoothing() -> f64 {
+    0.01
 }
 
 fn one() -> f64 {
@@ -115,6 +159,8 @@ struct Bounds {
     base_force: Option<f64>,
     base_moment: Option<f64>,
     joint_torque: Option<f64>,
+    joint_angle: Option<f64>,
+    barrier: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -128,6 +174,14 @@ struct Solver {
     hessian: Option<String>,
     #[serde(default)]
     gauss_newton_above: Option<f64>,
+    #[serde(default)]
+    warm_start: Option<String>,
+    #[serde(default = "one_start")]
+    starts: i64,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default = "perturbation")]
+    perturbation: f64,
 }
 
 impl Default for Solver {
@@ -137,8 +191,20 @@ impl Default for Solver {
             max_iterations: iters(),
             hessian: None,
             gauss_newton_above: None,
+            warm_start: None,
+            starts: 1,
+            seed: 0,
+            perturbation: perturbation(),
         }
     }
+}
+
+fn one_start() -> i64 {
+    1
+}
+
+fn perturbation() -> f64 {
+    0.1
 }
 
 fn tol() -> f64 {
@@ -167,12 +233,30 @@ pub struct ProblemSpec {
     pub knots: usize,
     /// Initial joint angles [rad] (n).
     pub joint_angles: Vec<f64>,
+    /// The fluid's current, inertial [m/s] (`None`: the design's).
+    pub current: Option<[f64; 3]>,
     /// End-effector target minus its initial position, inertial frame [m].
-    pub ee_displacement: [f64; 3],
+    pub ee_displacement: Option<[f64; 3]>,
+    /// End-effector orientation target, roll-pitch-yaw (ZYX) [rad].
+    pub ee_rpy: Option<[f64; 3]>,
+    /// Base origin target minus its initial position [m].
+    pub base_displacement: Option<[f64; 3]>,
+    /// Base orientation target, roll-pitch-yaw [rad].
+    pub base_rpy: Option<[f64; 3]>,
+    /// Terminal joint angles [rad].
+    pub terminal_joints: Option<Vec<f64>>,
+    /// Base twist and joint rates zero at T.
+    pub zero_velocity: bool,
     /// Effort weight w of `J = w Σ Δt ‖u‖²`.
     pub effort: f64,
+    /// Weights of the thruster energy and the joint energy (0: off).
+    pub energy: [f64; 2],
+    /// Smoothing ε_u [N] and ε_p [W] (docs/ocp.md §1).
+    pub smoothing: [f64; 2],
     /// Symmetric bounds: base force [N], base moment [N·m], joint torque [N·m] (∞: none).
     pub bounds: [f64; 3],
+    /// Symmetric joint-angle limit [rad] (∞: none) and the barrier weight μ.
+    pub joint_limit: (f64, f64),
     /// KKT tolerance.
     pub tolerance: f64,
     /// Most SQP iterations.
@@ -181,6 +265,14 @@ pub struct ProblemSpec {
     pub hessian: Hessian,
     /// Gauss–Newton while the primal infeasibility exceeds this (∞: never).
     pub gauss_newton_above: f64,
+    /// Warm start: the trajectory file (resolved against the problem file's directory).
+    pub warm_start: Option<std::path::PathBuf>,
+    /// Number of starts (multi-start), the perturbations' seed and amplitude.
+    pub starts: usize,
+    /// Seed of the perturbed starts.
+    pub seed: u64,
+    /// Amplitude of the perturbed starts (fraction of each control bound).
+    pub perturbation: f64,
 }
 
 /// Read and validate a problem file.
@@ -229,7 +321,11 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             format!("must be between 1 and {MAX_KNOTS}"),
         ));
     }
-    let joint_angles = f.initial.joint_angles.unwrap_or_else(|| vec![0.0; n]);
+    let joint_angles = f
+        .initial
+        .joint_angles
+        .clone()
+        .unwrap_or_else(|| vec![0.0; n]);
     if joint_angles.len() != n {
         return Err(doc.err(
             "initial.joint_angles",
@@ -239,15 +335,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             ),
         ));
     }
-    if !f.terminal.zero_velocity {
-        return Err(doc.err(
-            "terminal.zero_velocity",
-            "only `true` is supported (the terminal equality fixes every velocity)",
-        ));
-    }
-    if f.objective.effort <= 0.0 {
-        return Err(doc.err("objective.effort", "must be positive"));
-    }
+    check_terminal_objective(&doc, &f, n, thrusters)?;
     let mut bounds = [f64::INFINITY; 3];
     for (i, (k, v)) in [
         ("bounds.base_force", f.bounds.base_force),
@@ -264,26 +352,24 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             bounds[i] = v;
         }
     }
-    if f.solver.tolerance <= 0.0 {
-        return Err(doc.err("solver.tolerance", "must be positive"));
+    let joint_limit = (
+        f.bounds.joint_angle.unwrap_or(f64::INFINITY),
+        f.bounds.barrier.unwrap_or(1e-3),
+    );
+    if joint_limit.0 <= 0.0 {
+        return Err(doc.err("bounds.joint_angle", "must be positive [rad]"));
     }
-    if f.solver.max_iterations < 1 {
-        return Err(doc.err("solver.max_iterations", "must be at least 1"));
+    if joint_limit.1 <= 0.0 {
+        return Err(doc.err("bounds.barrier", "must be positive"));
     }
-    let hessian = match f.solver.hessian.as_deref() {
-        None | Some("exact") => Hessian::Exact,
-        Some("gauss_newton") => Hessian::GaussNewton,
-        Some(other) => {
-            return Err(doc.err(
-                "solver.hessian",
-                format!("`{other}` is not one of \"exact\", \"gauss_newton\""),
-            ))
-        }
-    };
-    let gauss_newton_above = f.solver.gauss_newton_above.unwrap_or(f64::INFINITY);
-    if gauss_newton_above <= 0.0 {
-        return Err(doc.err("solver.gauss_newton_above", "must be positive"));
+    if joint_angles.iter().any(|q| q.abs() >= joint_limit.0) {
+        return Err(doc.err(
+            "bounds.joint_angle",
+            "the initial joint angles must be strictly inside the limit",
+        ));
     }
+    let sv = &f.solver;
+    let (hessian, gauss_newton_above, warm_start) = check_solver(&doc, sv, path)?;
     Ok(ProblemSpec {
         origin,
         vehicle,
@@ -292,13 +378,26 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         duration: h.duration,
         knots: h.knots as usize,
         joint_angles,
+        current: f.physics.current,
         ee_displacement: f.terminal.ee_displacement,
+        ee_rpy: f.terminal.ee_rpy_deg.map(|a| a.map(f64::to_radians)),
+        base_displacement: f.terminal.base_displacement,
+        base_rpy: f.terminal.base_rpy_deg.map(|a| a.map(f64::to_radians)),
+        terminal_joints: f.terminal.joint_angles.clone(),
+        zero_velocity: f.terminal.zero_velocity,
         effort: f.objective.effort,
+        energy: [f.objective.thruster_energy, f.objective.joint_energy],
+        smoothing: [f.objective.thrust_smoothing, f.objective.power_smoothing],
         bounds,
+        joint_limit,
         tolerance: f.solver.tolerance,
         max_iterations: f.solver.max_iterations as usize,
         hessian,
         gauss_newton_above,
+        warm_start,
+        starts: sv.starts as usize,
+        seed: sv.seed,
+        perturbation: sv.perturbation,
     })
 }
 
@@ -327,4 +426,107 @@ fn actuation(doc: &Document, kind: Option<&str>, vehicle: &Vehicle) -> Result<bo
         ));
     }
     Ok(thrusters)
+}
+
+/// The terminal rows and the objective's weights of `f` (n joints, thruster actuation or not).
+fn check_terminal_objective(
+    doc: &Document,
+    f: &File,
+    n: usize,
+    thrusters: bool,
+) -> Result<(), InputError> {
+    let t = &f.terminal;
+    if let Some(q) = &t.joint_angles {
+        if q.len() != n {
+            return Err(doc.err(
+                "terminal.joint_angles",
+                format!("has {} entries, the design has {n} joints", q.len()),
+            ));
+        }
+    }
+    let any = t.ee_displacement.is_some()
+        || t.ee_rpy_deg.is_some()
+        || t.base_displacement.is_some()
+        || t.base_rpy_deg.is_some()
+        || t.joint_angles.is_some()
+        || t.zero_velocity;
+    if !any {
+        return Err(doc.err("terminal", "fixes nothing: give at least one target"));
+    }
+    let ob = &f.objective;
+    if ob.effort <= 0.0 {
+        return Err(doc.err("objective.effort", "must be positive"));
+    }
+    for (k, v) in [
+        ("objective.thruster_energy", ob.thruster_energy),
+        ("objective.joint_energy", ob.joint_energy),
+    ] {
+        if v < 0.0 {
+            return Err(doc.err(k, "must be at least 0 (0: off)"));
+        }
+    }
+    if ob.thruster_energy > 0.0 && !thrusters {
+        return Err(doc.err(
+            "objective.thruster_energy",
+            "needs actuation = \"thrusters\"",
+        ));
+    }
+    for (k, v) in [
+        ("objective.thrust_smoothing", ob.thrust_smoothing),
+        ("objective.power_smoothing", ob.power_smoothing),
+    ] {
+        if v <= 0.0 {
+            return Err(doc.err(k, "must be positive"));
+        }
+    }
+    Ok(())
+}
+
+/// The solver section's checks: the Hessian, the Gauss–Newton threshold and the warm-start
+/// file (resolved against the problem file's directory).
+#[allow(clippy::type_complexity)]
+fn check_solver(
+    doc: &Document,
+    sv: &Solver,
+    path: &Path,
+) -> Result<(Hessian, f64, Option<std::path::PathBuf>), InputError> {
+    if sv.starts < 1 || sv.starts > 1000 {
+        return Err(doc.err("solver.starts", "must be between 1 and 1000"));
+    }
+    if sv.perturbation < 0.0 {
+        return Err(doc.err("solver.perturbation", "must be at least 0"));
+    }
+    let warm_start = sv
+        .warm_start
+        .as_ref()
+        .map(|w| path.parent().unwrap_or(Path::new("")).join(w));
+    if let Some(w) = &warm_start {
+        if !w.is_file() {
+            return Err(doc.err(
+                "solver.warm_start",
+                format!("{} is not a file", w.display()),
+            ));
+        }
+    }
+    if sv.tolerance <= 0.0 {
+        return Err(doc.err("solver.tolerance", "must be positive"));
+    }
+    if sv.max_iterations < 1 {
+        return Err(doc.err("solver.max_iterations", "must be at least 1"));
+    }
+    let hessian = match sv.hessian.as_deref() {
+        None | Some("exact") => Hessian::Exact,
+        Some("gauss_newton") => Hessian::GaussNewton,
+        Some(other) => {
+            return Err(doc.err(
+                "solver.hessian",
+                format!("`{other}` is not one of \"exact\", \"gauss_newton\""),
+            ))
+        }
+    };
+    let gauss_newton_above = sv.gauss_newton_above.unwrap_or(f64::INFINITY);
+    if gauss_newton_above <= 0.0 {
+        return Err(doc.err("solver.gauss_newton_above", "must be positive"));
+    }
+    Ok((hessian, gauss_newton_above, warm_start))
 }

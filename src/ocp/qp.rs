@@ -58,6 +58,10 @@ pub struct QpSolution {
     pub iterations: usize,
     /// Whether the tolerance was met (else the last iterate).
     pub converged: bool,
+    /// Whether the terminal system was inconsistent (least-squares ν, see
+    /// [`super::riccati::LqSolution::least_squares`]); the terminal residual is then not
+    /// part of the stopping test.
+    pub least_squares: bool,
 }
 
 /// Solve the bounded subproblem: `stages`/`term` as in [`solve_lq`], `lo`/`hi` one vector per
@@ -90,6 +94,7 @@ pub fn solve_box_qp(
             z_hi: zeros,
             iterations: 1,
             converged: true,
+            least_squares: s.least_squares,
         });
     }
     let nx = term.q_mat.nrows();
@@ -113,13 +118,14 @@ pub fn solve_box_qp(
     let mut st = Direction::zeros(n, nx, nu, nc);
     let mut iterations = 0;
     let mut converged = false;
+    let mut least_squares = false;
     for _ in 0..set.max_iterations {
         let (mu, comp_max) = complementarity(lo, hi, &du, &z_lo, &z_hi, None);
         let res = residuals(stages, term, &dx, &du, &lam, &nuv, &z_lo, &z_hi);
         if iterations > 0
             && comp_max <= set.tolerance
             && res.0 <= set.tolerance
-            && res.1 <= set.tolerance
+            && (res.1 <= set.tolerance || least_squares)
         {
             converged = true;
             break;
@@ -152,6 +158,7 @@ pub fn solve_box_qp(
             }
         };
         newton(&mut work, stages, &wterm, &pt, &target, &mut lq, &mut st)?;
+        least_squares = st.sol.least_squares;
         let alpha = step_length(lo, hi, &du, &z_lo, &z_hi, &st, 0.995);
         for k in 0..=n {
             dx[k].axpy(alpha, &st.sol.dx[k], 1.0);
@@ -173,6 +180,7 @@ pub fn solve_box_qp(
         z_hi,
         iterations,
         converged,
+        least_squares,
     })
 }
 

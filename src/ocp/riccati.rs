@@ -13,8 +13,9 @@
 //! `K_ν = −H⁻¹BᵀΓ`, `P ← Q + AᵀPA + GᵀK`, `p ← q + Aᵀ(P d + p) + Gᵀk`, `Γ ← AᵀΓ + GᵀK_ν`.
 //! The forward pass gives `δx_N = ξ_N + Ξ_N ν`, and the terminal equality the nc×nc system
 //! `C Ξ_N ν = −(C ξ_N + c)` (LU with full pivoting; when rank-deficient, the minimum-norm
-//! solution by SVD if the system is consistent — an inconsistent one means the terminal
-//! constraint is not reachable by the linearised dynamics: [`LqError::Unreachable`]). The
+//! least-squares solution by SVD — when the system is inconsistent, the terminal constraint
+//! is not reachable by the linearised dynamics and the step meets only its reachable part:
+//! [`LqSolution::least_squares`]). The
 //! costates are `λ_k = P_k δx_k + p_k + Γ_k ν` (multipliers of the dynamics rows, with the
 //! Lagrangian `… + λ_{k+1}ᵀ(A δx + B δu + d − δx_{k+1})`). Cost O(N (nx + nc)³).
 // Stage and component loops read clearest with indices (k: knot, i: component).
@@ -84,6 +85,11 @@ pub struct LqSolution {
     pub lam: Vec<DVector<f64>>,
     /// Terminal multiplier ν (nc).
     pub nu: DVector<f64>,
+    /// Whether `C Ξ_N ν = −(C ξ_N + c)` was inconsistent and ν is its least-squares
+    /// (minimum-norm) solution: the step then meets the terminal rows the linearised dynamics
+    /// can move and leaves the others (a singular configuration; the SQP reports
+    /// `infeasible` if it ends unconverged after such a step).
+    pub least_squares: bool,
 }
 
 /// Why the subproblem has no solution.
@@ -158,6 +164,7 @@ impl LqSolution {
             du: vec![DVector::zeros(nu); n],
             lam: vec![DVector::zeros(nx); n + 1],
             nu: DVector::zeros(nc),
+            least_squares: false,
         }
     }
 }
@@ -303,12 +310,15 @@ pub fn solve_lq_into(
         bx_hi[0].gemm(1.0, &s.a, &bx_lo[k], 0.0);
         bx_hi[0].gemm(1.0, &s.b, &ws.u1, 1.0);
     }
+    out.least_squares = false;
     if nc == 0 {
         out.nu.fill(0.0);
     } else {
         let lhs = &term.c_mat * &ws.big_xi[n];
         let rhs = -(&term.c_mat * &ws.xi[n] + &term.c_vec);
-        out.nu.copy_from(&terminal_multiplier(lhs, &rhs)?);
+        let (nu, ls) = terminal_multiplier(lhs, &rhs)?;
+        out.nu.copy_from(&nu);
+        out.least_squares = ls;
     }
     for k in 0..=n {
         ws.x.copy_from(&ws.xi[k]);
@@ -329,10 +339,15 @@ pub fn solve_lq_into(
 }
 
 /// ν from `C Ξ_N ν = rhs`: LU with full pivoting when `C Ξ_N` has full rank; otherwise the
-/// minimum-norm solution by SVD, accepted when the system is consistent (a terminal row the
-/// linearised dynamics cannot move but already meets, e.g. a rate no actuator excites at
-/// rest) and [`LqError::Unreachable`] when it is not.
-fn terminal_multiplier(lhs: DMatrix<f64>, rhs: &DVector<f64>) -> Result<DVector<f64>, LqError> {
+/// minimum-norm least-squares solution by SVD (singular values below 1e-12 of the largest
+/// dropped), flagged (`true`) when the system is inconsistent — a terminal row the
+/// linearised dynamics cannot move and that is not met (a singular configuration, e.g. the
+/// straight body asked to shorten). [`LqError::Unreachable`] only when the SVD fails or
+/// gives non-finite values.
+fn terminal_multiplier(
+    lhs: DMatrix<f64>,
+    rhs: &DVector<f64>,
+) -> Result<(DVector<f64>, bool), LqError> {
     let nc = rhs.len();
     let scale = lhs.amax().max(f64::MIN_POSITIVE);
     let lu = lhs.clone().full_piv_lu();
@@ -340,7 +355,7 @@ fn terminal_multiplier(lhs: DMatrix<f64>, rhs: &DVector<f64>) -> Result<DVector<
     let rank = (0..nc).filter(|&i| u[(i, i)].abs() > 1e-13 * scale).count();
     if rank == nc {
         if let Some(nu) = lu.solve(rhs) {
-            return Ok(nu);
+            return Ok((nu, false));
         }
     }
     let svd = lhs.clone().svd(true, true);
@@ -349,8 +364,8 @@ fn terminal_multiplier(lhs: DMatrix<f64>, rhs: &DVector<f64>) -> Result<DVector<
         .solve(rhs, 1e-12 * smax)
         .map_err(|_| LqError::Unreachable { rank, nc })?;
     let resid = (&lhs * &nu - rhs).amax();
-    if !resid.is_finite() || resid > 1e-6 * (1.0 + rhs.amax()) {
+    if !resid.is_finite() || nu.iter().any(|v| !v.is_finite()) {
         return Err(LqError::Unreachable { rank, nc });
     }
-    Ok(nu)
+    Ok((nu, resid > 1e-6 * (1.0 + rhs.amax())))
 }

@@ -5,33 +5,59 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
-use super::chain::ChainModel;
+use super::chain::{ChainModel, TerminalSpec};
+use super::cost::PathCosts;
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
-use super::sqp::{solve, OcpProblem, OcpSolution, SqpSettings};
+use super::sqp::{solve, OcpProblem, OcpSolution, SqpSettings, Status};
+pub use super::start::trajectory_columns;
+use super::start::{perturbed_controls, read_warm_start};
 use crate::dynamics::DynOptions;
+use crate::input::located::InputError;
 use crate::kinematics::BasePose;
+use crate::metrics::trajectory::PowerModel;
 use crate::report::{atomic_write, format_f64, ReportError};
-use crate::scenario::channels::{Channel, Pose, Twist};
 use crate::spatial::{euler_zyx, Vec3};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, UnitQuaternion};
+use serde::Serialize;
 use std::path::Path;
 
-/// A solved problem: the model (for post-processing), the step and the solution.
+/// One start of a multi-start solve.
+#[derive(Clone, Debug, Serialize)]
+pub struct StartRecord {
+    /// Start index (0: cold or warm start as given; ≥ 1 perturbed).
+    pub start: usize,
+    /// How it ended.
+    pub status: Status,
+    /// Objective J at its last iterate.
+    pub objective: f64,
+    /// SQP iterations.
+    pub iterations: usize,
+    /// KKT residuals (primal, stationarity, complementarity).
+    pub kkt: [f64; 3],
+    /// Wall time [s].
+    pub time_s: f64,
+}
+
+/// A solved problem: the model (for post-processing), the step and the best solution.
 #[derive(Debug)]
 pub struct OcpRun {
     /// The chain model the problem was solved on.
     pub model: ChainModel,
     /// Δt = T/N [s].
     pub dt: f64,
-    /// End-effector target, inertial [m].
+    /// End-effector target, inertial [m] (its start when the end effector is free).
     pub target: Vec3,
-    /// The solution.
+    /// The best start's solution (lowest objective among the converged, else among all).
     pub solution: OcpSolution,
+    /// Which start that is.
+    pub best_start: usize,
+    /// Every start.
+    pub starts: Vec<StartRecord>,
 }
 
-/// Solve a validated problem from the rest trajectory (zero controls rolled out).
-pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
+/// The chain model of a problem (terminal rows and path costs) and its initial state.
+pub fn build_model(spec: &ProblemSpec) -> (ChainModel, Vec<f64>) {
     let n = spec.vehicle.n_joints();
     let dt = spec.duration / spec.knots as f64;
     let opts = if spec.hydrodynamics {
@@ -39,22 +65,55 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
     } else {
         DynOptions::rigid()
     };
-    let x0 = ChainModel::pack(
-        &BasePose::default(),
-        &spec.joint_angles,
-        &[0.0; 6],
-        &vec![0.0; n],
-    );
-    let mut model = ChainModel::new(spec.vehicle.clone(), opts, dt, Vec3::zeros());
-    let target = model.ee_position(&x0) + Vec3::from(spec.ee_displacement);
-    let mut model = ChainModel::new(spec.vehicle.clone(), opts, dt, target);
+    let mut vehicle = spec.vehicle.clone();
+    if let Some(c) = spec.current {
+        vehicle.fluid.current = Vec3::from(c);
+    }
+    let start = BasePose::default();
+    let x0 = ChainModel::pack(&start, &spec.joint_angles, &[0.0; 6], &vec![0.0; n]);
+    let mut model = ChainModel::new(vehicle, opts, dt, Vec3::zeros());
     if spec.thrusters {
         model = model.with_thrusters();
     }
-    let (nx, nu, nb) = (model.nx(), model.nu(), model.n_body_controls());
-    let (mut u_lo, mut u_hi) = (Vec::with_capacity(nu), Vec::with_capacity(nu));
-    for i in 0..nu {
-        let (lo, hi) = match i {
+    let ee0 = model.ee_position(&x0);
+    let rot = |a: [f64; 3]| {
+        *UnitQuaternion::from_euler_angles(a[0], a[1], a[2])
+            .to_rotation_matrix()
+            .matrix()
+    };
+    let terminal = TerminalSpec {
+        ee_position: spec.ee_displacement.map(|d| ee0 + Vec3::from(d)),
+        ee_rotation: spec.ee_rpy.map(rot),
+        base_position: spec
+            .base_displacement
+            .map(|d| start.position + Vec3::from(d)),
+        base_rotation: spec.base_rpy.map(rot),
+        joint_angles: spec.terminal_joints.clone(),
+        zero_velocity: spec.zero_velocity,
+    };
+    let nb = model.n_body_controls();
+    let mut costs = PathCosts::new(dt, nb, spec.thrusters);
+    costs.thruster_energy = spec.energy[0];
+    costs.joint_energy = spec.energy[1];
+    costs.thrust_smoothing = spec.smoothing[0];
+    costs.power_smoothing = spec.smoothing[1];
+    if spec.joint_limit.0.is_finite() {
+        costs.joint_limits = Some(vec![(-spec.joint_limit.0, spec.joint_limit.0); n]);
+        costs.barrier = spec.joint_limit.1;
+    }
+    let paths = spec.energy.iter().any(|w| *w > 0.0) || costs.joint_limits.is_some();
+    model = model.with_terminal(terminal);
+    if paths {
+        model = model.with_costs(costs);
+    }
+    (model, x0)
+}
+
+/// The control bounds `(u_lo, u_hi)` of a problem.
+fn control_bounds(spec: &ProblemSpec, model: &ChainModel) -> (Vec<f64>, Vec<f64>) {
+    let (nu, nb) = (model.nu(), model.n_body_controls());
+    (0..nu)
+        .map(|i| match i {
             _ if i >= nb => (-spec.bounds[2], spec.bounds[2]),
             _ if spec.thrusters => (
                 spec.vehicle.thrusters[i].u_min,
@@ -62,10 +121,18 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
             ),
             0..=2 => (-spec.bounds[0], spec.bounds[0]),
             _ => (-spec.bounds[1], spec.bounds[1]),
-        };
-        u_lo.push(lo);
-        u_hi.push(hi);
-    }
+        })
+        .unzip()
+}
+
+/// Solve a validated problem from each of its starts (docs/ocp.md §4): start 0 from the
+/// warm start (or zero controls rolled out), the others perturbed; the best local optimum
+/// found is returned as such. Errors: an unreadable or mismatched warm-start file.
+pub fn solve_spec(spec: &ProblemSpec) -> Result<OcpRun, InputError> {
+    let (mut model, x0) = build_model(spec);
+    let (nx, nu) = (model.nx(), model.nu());
+    let dt = model.dt();
+    let (u_lo, u_hi) = control_bounds(spec, &model);
     let prob = OcpProblem {
         knots: spec.knots,
         x_ref: x0.clone(),
@@ -83,41 +150,73 @@ pub fn solve_spec(spec: &ProblemSpec) -> OcpRun {
         gauss_newton_above: spec.gauss_newton_above,
         ..SqpSettings::default()
     };
-    let solution = solve(&mut model, &prob, None, None, &set);
-    OcpRun {
+    let (warm_xs, warm_us) = match &spec.warm_start {
+        Some(p) => {
+            let (xs, us) = read_warm_start(p, &model, spec.knots)?;
+            (Some(xs), us)
+        }
+        None => (None, vec![vec![0.0; nu]; spec.knots]),
+    };
+    let mut best: Option<(usize, OcpSolution)> = None;
+    let mut starts = Vec::with_capacity(spec.starts);
+    for s in 0..spec.starts {
+        let (lo, hi) = (&prob.u_lo, &prob.u_hi);
+        let us = perturbed_controls(&warm_us, lo, hi, spec.perturbation, spec.seed, s);
+        let xs = if s == 0 { warm_xs.clone() } else { None };
+        let sol = solve(&mut model, &prob, Some(us), xs, &set);
+        starts.push(StartRecord {
+            start: s,
+            status: sol.status,
+            objective: sol.objective,
+            iterations: sol.iterations,
+            kkt: sol.kkt,
+            time_s: sol.timing.total,
+        });
+        if better(&sol, best.as_ref().map(|b| &b.1)) {
+            best = Some((s, sol));
+        }
+    }
+    let (best_start, solution) = best.expect("at least one start (validated)");
+    let target = match model.terminal_spec().ee_position {
+        Some(p) => p,
+        None => model.ee_position(&prob.x0),
+    };
+    Ok(OcpRun {
         model,
         dt,
         target,
         solution,
-    }
+        best_start,
+        starts,
+    })
 }
 
-/// The column names of `trajectory.csv`: with `n_thrusters` = Some(m) the thrusts
-/// (`simulate`'s actual-thrust names), else the base wrench.
-pub fn trajectory_columns(n_joints: usize, n_thrusters: Option<usize>) -> Vec<String> {
-    let mut c = vec![Channel::T.name()];
-    c.extend(Pose::ALL.map(|p| Channel::BasePose(p).name()));
-    c.extend(Twist::ALL.map(|t| Channel::BaseTwist(t).name()));
-    c.extend(Pose::ALL.map(|p| Channel::EePose(p).name()));
-    c.extend((0..n_joints).map(|k| Channel::Q(k).name()));
-    c.extend((0..n_joints).map(|k| Channel::Qd(k).name()));
-    c.extend((0..n_joints).map(|k| Channel::Tau(k).name()));
-    if let Some(m) = n_thrusters {
-        c.extend((0..m).map(|j| Channel::U(j).name()));
-        return c;
-    }
-    c.extend(
-        [
-            "wrench_fx",
-            "wrench_fy",
-            "wrench_fz",
-            "wrench_mx",
-            "wrench_my",
-            "wrench_mz",
-        ]
-        .map(String::from),
-    );
-    c
+/// Whether `a` beats `b`: converged before not; among converged the lower objective, among
+/// the others the lower primal infeasibility (non-finite last), then the lower objective.
+fn better(a: &OcpSolution, b: Option<&OcpSolution>) -> bool {
+    let Some(b) = b else {
+        return true;
+    };
+    let key = |s: &OcpSolution| {
+        let conv = s.status == Status::Converged;
+        let primal = if conv || !s.kkt[0].is_finite() {
+            if conv {
+                0.0
+            } else {
+                f64::INFINITY
+            }
+        } else {
+            s.kkt[0]
+        };
+        let j = if s.objective.is_finite() {
+            s.objective
+        } else {
+            f64::INFINITY
+        };
+        (!conv, primal, j)
+    };
+    let (ka, kb) = (key(a), key(b));
+    (ka.0, ka.1, ka.2) < (kb.0, kb.1, kb.2)
 }
 
 /// Write `trajectory.csv`, `iterations.csv` and `summary.json` into `dir` (created).
@@ -207,9 +306,98 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         "method": "multiple shooting, SQP, Riccati interior-point QP, filter line search",
         "hessian": spec.hessian,
         "derivatives": "central differences (eps 1e-6, tangent coordinates)",
-        "optimum": "a local optimum from the rest trajectory (single start)",
+        "objective_terms": objective_terms(run),
+        "optimum": optimum_text(spec, run),
+        "best_start": run.best_start,
+        "spread": spread(&run.starts),
+        "starts": run.starts,
     });
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     atomic_write(&dir.join("summary.json"), text.as_bytes())?;
     Ok(())
+}
+
+/// The objective's terms at the returned solution: effort `w Σ Δt ‖u‖²` and the path
+/// costs' breakdown (smoothed, exact).
+fn objective_terms(run: &OcpRun) -> serde_json::Value {
+    let sol = &run.solution;
+    let n = run.model.n_joints();
+    let sq: f64 = sol.us.iter().flatten().map(|v| v * v).sum();
+    let costs = run.model.costs().map(|c| {
+        let b = c.breakdown(n, &sol.xs, &sol.us);
+        serde_json::json!({
+            "weights": {"thruster_energy": c.thruster_energy, "joint_energy": c.joint_energy,
+                        "barrier": c.joint_limits.as_ref().map(|_| c.barrier)},
+            "smoothing": {"thrust_n": c.thrust_smoothing, "power_w": c.power_smoothing},
+            "values": b,
+        })
+    });
+    serde_json::json!({
+        "effort_sum_dt_u2": sq * run.dt,
+        "path_costs": costs,
+        "thruster_energy_with_inflow": inflow_energy(run),
+    })
+}
+
+/// `Σ_k Δt Σ_j P_j(u_kj, V_a,kj)/η` [J] at the knots (the project's `thruster_energy`,
+/// [`PowerModel::shaft_power`] with the inflow of [`ChainModel::thruster_inflows`]);
+/// `None` under base-wrench actuation.
+fn inflow_energy(run: &OcpRun) -> Option<f64> {
+    let mut model = run.model.clone();
+    if !model.thruster_actuated() {
+        return None;
+    }
+    let (pm, m) = (PowerModel::default(), model.n_body_controls());
+    let mut e = 0.0;
+    for (x, u) in run.solution.xs.iter().zip(&run.solution.us) {
+        let va = model.thruster_inflows(x, &u[..m]);
+        e += run.dt
+            * u[..m]
+                .iter()
+                .zip(&va)
+                .map(|(u, v)| pm.shaft_power(*u, *v))
+                .sum::<f64>();
+    }
+    Some(e)
+}
+
+/// What the returned optimum is, in words.
+fn optimum_text(spec: &ProblemSpec, run: &OcpRun) -> String {
+    let from = if spec.warm_start.is_some() {
+        "the warm start"
+    } else {
+        "the rest trajectory"
+    };
+    if run.starts.len() == 1 {
+        return format!("a local optimum from {from} (single start)");
+    }
+    format!(
+        "the best local optimum found over {} starts (start 0 from {from}, the others perturbed by ±{} of the bounds, seed {}): start {}",
+        run.starts.len(),
+        spec.perturbation,
+        spec.seed,
+        run.best_start
+    )
+}
+
+/// Objectives of the converged starts: count, min, median, max.
+fn spread(starts: &[StartRecord]) -> serde_json::Value {
+    let mut j: Vec<f64> = starts
+        .iter()
+        .filter(|s| s.status == Status::Converged)
+        .map(|s| s.objective)
+        .collect();
+    j.sort_by(f64::total_cmp);
+    let med = match j.len() {
+        0 => f64::NAN,
+        m if m % 2 == 1 => j[m / 2],
+        m => 0.5 * (j[m / 2 - 1] + j[m / 2]),
+    };
+    serde_json::json!({
+        "starts": starts.len(),
+        "converged": j.len(),
+        "objective_min": j.first(),
+        "objective_median": if j.is_empty() { None } else { Some(med) },
+        "objective_max": j.last(),
+    })
 }

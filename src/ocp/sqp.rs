@@ -31,6 +31,7 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
+use super::cost::add_path_cost;
 use super::model::{ModelError, OcpModel};
 use super::qp::{residuals, solve_box_qp, QpSettings, QpSolution};
 use super::riccati::{LqError, LqStage, LqTerminal};
@@ -372,6 +373,10 @@ fn iterate<M: OcpModel>(
         st.timing.line_search += tl.elapsed().as_secs_f64();
         let Some((alpha, xt, ut)) = step else {
             st.log.push(row);
+            if qp.least_squares {
+                let msg = "terminal constraint not reachable by the linearised dynamics (least-squares step) and no acceptable step".to_string();
+                return End::new(Status::Infeasible, msg, Some(ev), kkt);
+            }
             let msg = "the filter line search found no acceptable step".to_string();
             return End::new(Status::Stalled, msg, Some(ev), kkt);
         };
@@ -520,7 +525,10 @@ fn line_search<M: OcpModel>(
     let (theta0, j0) = (ev.infeas1, ev.objective);
     let scale = *filter.theta_first.get_or_insert(theta0.max(1.0));
     let (theta_min, theta_max) = (1e-4 * scale, 1e4 * scale);
-    let mut alpha = 1.0;
+    // Fraction to the boundary of the model's barrier domain (IPOPT's τ = 0.99).
+    let mut alpha = (1..=n).fold(1.0f64, |a, k| {
+        a.min(model.max_step(&st.xs[k], qp.dx[k].as_slice()))
+    });
     let (mut xt, mut ut) = (st.xs.clone(), st.us.clone());
     let mut dxk = vec![0.0; model.nx()];
     while alpha >= 1e-10 {
@@ -591,6 +599,8 @@ fn evaluate<M: OcpModel>(
         hbuf = DMatrix::zeros(model.nx() + model.nu(), model.nx() + model.nu());
     }
     let (n, nx, nu, nq, nc) = (prob.knots, model.nx(), model.nu(), model.nq(), model.nc());
+    let paths = model.has_path_costs();
+    let mut pbuf = (vec![0.0; nx + nu], DMatrix::zeros(nx + nu, nx + nu));
     let mut stages = Vec::with_capacity(n);
     let mut f = vec![0.0; nq];
     let mut d = vec![0.0; nx];
@@ -611,6 +621,9 @@ fn evaluate<M: OcpModel>(
         let ev = DVector::from_column_slice(&e);
         let uv = DVector::from_column_slice(&us[k]);
         objective += ev.dot(&(&prob.q * &ev)) + uv.dot(&(&prob.r * &uv));
+        if paths {
+            objective += model.stage_cost(&xs[k], &us[k]);
+        }
         if let Some(mult) = derivatives {
             model.jacobians(&xs[k], &us[k], &mut s.a, &mut s.b)?;
             s.q_mat = &prob.q * 2.0;
@@ -625,19 +638,33 @@ fn evaluate<M: OcpModel>(
                 s.s_mat.copy_from(&hbuf.view((nx, 0), (nu, nx)));
                 hessian_time += th.elapsed().as_secs_f64();
             }
+            if paths {
+                add_path_cost(model, &xs[k], &us[k], mult.is_some(), &mut s, &mut pbuf);
+            }
         }
         stages.push(s);
     }
     model.difference(&prob.x_ref, &xs[n], &mut e);
     let ev = DVector::from_column_slice(&e);
     objective += ev.dot(&(&prob.q_n * &ev));
+    let mut q_vec_n = &prob.q_n * &ev * 2.0;
+    let mut q_n = &prob.q_n * 2.0;
+    if paths {
+        objective += model.terminal_cost(&xs[n]);
+        if derivatives.is_some() {
+            let mut g = vec![0.0; nx];
+            let mut h = DMatrix::zeros(nx, nx);
+            model.terminal_cost_derivatives(&xs[n], &mut g, &mut h);
+            q_vec_n += DVector::from_vec(g);
+            q_n += h;
+        }
+    }
     let mut c = vec![0.0; nc];
     model.terminal(&xs[n], &mut c);
     let c_vec = DVector::from_vec(c);
     infeas1 += c_vec.lp_norm(1);
     infeas_max = infeas_max.max(c_vec.amax());
     let mut c_mat = DMatrix::zeros(nc, nx);
-    let mut q_n = &prob.q_n * 2.0;
     if let Some(mult) = derivatives {
         model.terminal_jacobian(&xs[n], &mut c_mat);
         if let Some((_, nu_mult)) = mult {
@@ -653,7 +680,7 @@ fn evaluate<M: OcpModel>(
         stages,
         term: LqTerminal {
             q_mat: q_n,
-            q_vec: &prob.q_n * &ev * 2.0,
+            q_vec: q_vec_n,
             c_mat,
             c_vec,
         },

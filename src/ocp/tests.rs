@@ -447,7 +447,7 @@ fn usm_paper_with_thrusters_and_hydrodynamics_converges_within_the_limits() {
     let path = std::path::Path::new("studies/ocp_usm_paper.toml");
     let spec = super::problem::parse_problem(&text, path).unwrap();
     assert!(spec.thrusters && spec.hydrodynamics);
-    let run = super::run::solve_spec(&spec);
+    let run = super::run::solve_spec(&spec).unwrap();
     let sol = &run.solution;
     assert_eq!(sol.status, Status::Converged, "{}", sol.message);
     assert!(sol.kkt.iter().all(|r| *r <= 1e-6), "{:?}", sol.kkt);
