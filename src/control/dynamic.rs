@@ -79,6 +79,17 @@ impl DynamicGains {
         Self::work_mode()
     }
 
+    /// Tracking of a full-state reference (`[reference] file`, [`super::tracking`]): the
+    /// work-mode gains with the nonlinear term `n` of USM-33 (drag, restoring, Coriolis
+    /// cancelled by the model), so that the base follows a moving reference without the
+    /// steady lag a drag-uncompensated velocity loop leaves.
+    pub fn tracking() -> Self {
+        Self {
+            nonlinear: true,
+            ..Self::work_mode()
+        }
+    }
+
     /// Check the values; errors name `dynamic.<key>`.
     pub fn validate(&self) -> Result<(), ControlError> {
         for i in 0..6 {

@@ -1,0 +1,92 @@
+//! `simulate SCENARIO --reference FILE`: the scenario's plant (design, physics, current,
+//! allocation, servos) follows a trajectory file with the tracking law of
+//! `usm_study::control::tracking` (work mode, `[reference] file`), and the run is compared with
+//! the reference (`tracking.json`: base path error, effort, the controller's price).
+
+use std::path::{Path, PathBuf};
+use usm_study::control::{Reference, TrajectoryTable};
+use usm_study::model::Vehicle;
+use usm_study::report::atomic_write;
+use usm_study::scenario::{compare_with_reference, ScenarioFile, Trajectory, TrackingComparison};
+use usm_study::spatial::euler_zyx;
+
+/// Make the scenario table follow `file`: work mode with `[reference] file` (absolute, as the
+/// user named it from the current directory); a transport scenario's `[control]`, `[path]` and
+/// `[success]` (transport criteria) are dropped. Runs before the `--set` overrides, so that
+/// they can set the tracking gains (`reference.k_position`).
+pub fn follow(table: &mut toml::Table, file: &Path) -> anyhow::Result<()> {
+    let abs = std::path::absolute(file)
+        .map_err(|e| anyhow::anyhow!("--reference {}: {e}", file.display()))?;
+    let section = table
+        .entry("scenario")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(section) = section.as_table_mut() else {
+        anyhow::bail!("scenario: must be a table");
+    };
+    let was_work = section.get("mode").and_then(|m| m.as_str()) == Some("work");
+    section.insert("mode".into(), toml::Value::String("work".into()));
+    if !was_work {
+        for key in ["control", "path", "success"] {
+            table.remove(key);
+        }
+    }
+    let mut r = toml::Table::new();
+    r.insert(
+        "file".into(),
+        toml::Value::String(abs.display().to_string()),
+    );
+    table.insert("reference".into(), toml::Value::Table(r));
+    Ok(())
+}
+
+/// Start the run where the reference starts (its first row's base position, yaw and joint
+/// angles) and end it at the reference's last time, unless `--set` gave `initial.*` or
+/// `scenario.duration`; returns the reference read (for [`write_comparison`]).
+pub fn start_at_reference(
+    file: &mut ScenarioFile,
+    vehicle: &Vehicle,
+    sets: &[String],
+) -> anyhow::Result<TrajectoryTable> {
+    let path = PathBuf::from(file.reference_file().unwrap_or_default());
+    let table = TrajectoryTable::read(&path, vehicle.n_joints())?;
+    let given = |key: &str| sets.iter().any(|s| s.trim_start().starts_with(key));
+    let (t0, t1) = table.span();
+    let mut r = Reference::new(vehicle.n_joints());
+    table.sample_into(t0, &mut r);
+    if !given("initial") {
+        file.initial.position = r.base_position.into();
+        let rot = r.base_orientation.to_rotation_matrix();
+        file.initial.yaw_deg = euler_zyx(rot.matrix()).z.to_degrees();
+        file.initial.joint_angles_deg = r.q.iter().map(|q| q.to_degrees()).collect();
+    }
+    if !given("scenario.duration") {
+        file.scenario.duration = t1;
+    }
+    file.validate()
+        .map_err(|e| anyhow::anyhow!("--reference {}: {e}", path.display()))?;
+    Ok(table)
+}
+
+/// Compare the run with its reference, print it and write `tracking.json` into `out`.
+pub fn write_comparison(
+    table: &TrajectoryTable,
+    trajectory: &Trajectory,
+    out: &Path,
+) -> anyhow::Result<TrackingComparison> {
+    let c = compare_with_reference(table, trajectory);
+    println!(
+        "  tracking: base error max {:.4} m, rms {:.4} m, final {:.4} m; effort {:.6} (reference {}{})",
+        c.base_error_max,
+        c.base_error_rms,
+        c.base_error_final,
+        c.tracked_effort,
+        c.reference_effort
+            .map_or("has no controls".to_string(), |j| format!("{j:.6}")),
+        c.price
+            .map_or(String::new(), |p| format!(", price {p:.6}")),
+    );
+    let mut text = serde_json::to_string_pretty(&c)?;
+    text.push('\n');
+    atomic_write(&out.join("tracking.json"), text.as_bytes())?;
+    Ok(c)
+}
