@@ -106,7 +106,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);
     if let Some(table) = &reference {
-        super::simulate_reference::write_comparison(table, &r.trajectory, &out)?;
+        super::simulate_reference::write_comparison(table, &file, &vehicle, &r.trajectory, &out)?;
     }
     if let Some((t, INTERRUPTED)) = r.failure.as_ref().map(|(t, c)| (t, c.as_str())) {
         eprintln!(

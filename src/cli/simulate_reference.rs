@@ -11,9 +11,11 @@ use usm_study::scenario::{compare_with_reference, ScenarioFile, Trajectory, Trac
 use usm_study::spatial::euler_zyx;
 
 /// Make the scenario table follow `file`: work mode with `[reference] file` (absolute, as the
-/// user named it from the current directory); a transport scenario's `[control]`, `[path]` and
-/// `[success]` (transport criteria) are dropped. Runs before the `--set` overrides, so that
-/// they can set the tracking gains (`reference.k_position`).
+/// user named it from the current directory); the scenario's own `[control]` and
+/// `[base_control]` (gains of another law) are dropped, so the tracking defaults apply
+/// (`control::tracking`, `DynamicGains::tracking`), and so are a transport scenario's `[path]`
+/// and `[success]` (transport criteria). Runs before the `--set` overrides, so that they can
+/// set any of these again (`reference.k_position`, `base_control.kp`).
 pub fn follow(table: &mut toml::Table, file: &Path) -> anyhow::Result<()> {
     let abs = std::path::absolute(file)
         .map_err(|e| anyhow::anyhow!("--reference {}: {e}", file.display()))?;
@@ -25,8 +27,11 @@ pub fn follow(table: &mut toml::Table, file: &Path) -> anyhow::Result<()> {
     };
     let was_work = section.get("mode").and_then(|m| m.as_str()) == Some("work");
     section.insert("mode".into(), toml::Value::String("work".into()));
+    for key in ["control", "base_control"] {
+        table.remove(key);
+    }
     if !was_work {
-        for key in ["control", "path", "success"] {
+        for key in ["path", "success"] {
             table.remove(key);
         }
     }
@@ -70,10 +75,13 @@ pub fn start_at_reference(
 /// Compare the run with its reference, print it and write `tracking.json` into `out`.
 pub fn write_comparison(
     table: &TrajectoryTable,
+    file: &ScenarioFile,
+    vehicle: &Vehicle,
     trajectory: &Trajectory,
     out: &Path,
 ) -> anyhow::Result<TrackingComparison> {
-    let c = compare_with_reference(table, trajectory);
+    let power = file.power_model(vehicle.fluid.rho);
+    let c = compare_with_reference(table, trajectory, &power);
     println!(
         "  tracking: base error max {:.4} m, rms {:.4} m, final {:.4} m; effort {:.6} (reference {}{})",
         c.base_error_max,
@@ -85,6 +93,12 @@ pub fn write_comparison(
         c.price
             .map_or(String::new(), |p| format!(", price {p:.6}")),
     );
+    if let Some(e) = c.reference_thruster_energy_static {
+        println!(
+            "  thruster energy (static actuator disk): tracked {:.6} J, reference {e:.6} J",
+            c.tracked_thruster_energy_static
+        );
+    }
     let mut text = serde_json::to_string_pretty(&c)?;
     text.push('\n');
     atomic_write(&out.join("tracking.json"), text.as_bytes())?;

@@ -414,6 +414,19 @@ impl TrajectoryTable {
         Some(j)
     }
 
+    /// `Σ_k (t_{k+1} − t_k) Σ_j f(u_jk)` over the thrust columns `u_j` and the rows before the
+    /// last (e.g. `f` the static actuator-disk power: the reference's thruster energy [J]);
+    /// `None` without thrust columns.
+    pub fn thrust_integral(&self, f: impl Fn(f64) -> f64) -> Option<f64> {
+        let (m, u) = self.thrust.as_ref()?;
+        let mut e = 0.0;
+        for k in 0..self.t.len() - 1 {
+            let p: f64 = u[k * m..(k + 1) * m].iter().map(|x| f(*x)).sum();
+            e += (self.t[k + 1] - self.t[k]) * p;
+        }
+        Some(e)
+    }
+
     /// Fill `out` with the reference at `t` [s] by the rule of the module docs; sets the base,
     /// the joints and, when the file has them, the end effector (with zero twist), the wrench
     /// and the torques. Allocation-free.

@@ -7,10 +7,14 @@
 //! `effort` objective of `usm-study ocp` (weight 1; with base-wrench actuation the reference's
 //! wrench takes the thrusts' place). For the run it is the rectangle rule over the logged rows
 //! (exact when `scenario.log_dt = scenario.control_dt`, the zero-order hold of the thrusts).
+//! Thruster energy, both sides, is the static actuator-disk figure `Σ Δt Σ_j P_0(u_j)`
+//! (docs/model.md §6; no inflow, which the reference does not know); the run's own
+//! `thruster_energy` metric, with inflow, is in its summary.
 
 use super::channels::{Channel, Pose, Trajectory};
 use crate::control::reference::Reference;
 use crate::control::trajectory_file::TrajectoryTable;
+use crate::metrics::trajectory::PowerModel;
 use crate::spatial::Vec3;
 use serde::Serialize;
 
@@ -30,12 +34,17 @@ pub struct TrackingComparison {
     /// `tracked_effort − reference_effort`: what closing the loop costs; `None` without
     /// reference controls.
     pub price: Option<f64>,
+    /// The run's static thruster energy over the logged rows [J].
+    pub tracked_thruster_energy_static: f64,
+    /// The reference's static thruster energy from its thrust columns [J]; `None` without.
+    pub reference_thruster_energy_static: Option<f64>,
 }
 
 /// Compare the logged `trajectory` of a run with the reference `table` it followed.
 pub fn compare_with_reference(
     table: &TrajectoryTable,
     trajectory: &Trajectory,
+    power: &PowerModel,
 ) -> TrackingComparison {
     let col = |c: Channel| trajectory.get(c).unwrap_or(&[]);
     let t = col(Channel::T);
@@ -55,10 +64,12 @@ pub fn compare_with_reference(
     }
     let u = trajectory.indexed(Channel::U);
     let tau = trajectory.indexed(Channel::Tau);
-    let mut effort = 0.0;
+    let (mut effort, mut energy) = (0.0, 0.0);
     for k in 0..t.len().saturating_sub(1) {
         let s: f64 = (u.iter().chain(&tau)).map(|c| c[k] * c[k]).sum();
         effort += (t[k + 1] - t[k]) * s;
+        let p: f64 = u.iter().map(|c| power.static_power(c[k])).sum();
+        energy += (t[k + 1] - t[k]) * p;
     }
     let reference_effort = table.effort();
     TrackingComparison {
@@ -68,5 +79,7 @@ pub fn compare_with_reference(
         tracked_effort: effort,
         reference_effort,
         price: reference_effort.map(|j| effort - j),
+        tracked_thruster_energy_static: energy,
+        reference_thruster_energy_static: table.thrust_integral(|u| power.static_power(u)),
     }
 }
