@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use usm_study::control::{Reference, TrajectoryTable};
 use usm_study::model::Vehicle;
 use usm_study::report::atomic_write;
-use usm_study::scenario::{compare_with_reference, ScenarioFile, Trajectory, TrackingComparison};
+use usm_study::scenario::{compare_with_reference, ScenarioFile, TrackingComparison, Trajectory};
 use usm_study::spatial::euler_zyx;
 
 /// Make the scenario table follow `file`: work mode with `[reference] file` (absolute, as the

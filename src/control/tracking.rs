@@ -111,8 +111,7 @@ mod tests {
         assert!((v_r[0] - 0.4 - 0.5 * 0.2).abs() < 1e-12, "{v_r}");
         // Yawed left of the reference: a negative yaw-rate correction.
         let mut yawed = on;
-        yawed.orientation =
-            r.base_orientation * UnitQuaternion::from_euler_angles(0.0, 0.0, 0.1);
+        yawed.orientation = r.base_orientation * UnitQuaternion::from_euler_angles(0.0, 0.0, 0.1);
         let (v_r, _) = g.base_reference(&yawed, &r);
         assert!(v_r[5] < -0.1 - 0.04, "{v_r}");
     }

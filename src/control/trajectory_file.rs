@@ -329,9 +329,7 @@ impl TrajectoryTable {
         let tau_names: Vec<String> = (1..=n_joints).map(|k| format!("tau_{k}")).collect();
         let tau = cells.group(&tau_names)?.map(|c| row_major(&c, rows));
         let twist = match cells.group(&BASE_TWIST)? {
-            Some(c) => (0..rows)
-                .map(|k| Vec6::from_fn(|i, _| c[i][k]))
-                .collect(),
+            Some(c) => (0..rows).map(|k| Vec6::from_fn(|i, _| c[i][k])).collect(),
             None => vec![Vec6::zeros(); rows],
         };
         let ee = cells.group(&EE_POSE)?.map(|c| {
@@ -600,7 +598,11 @@ mod tests {
             m.matrix()[(1, 0)].atan2(m.matrix()[(0, 0)])
         };
         tab.sample_into(0.5, &mut r);
-        assert!((yaw(&r).abs() - std::f64::consts::PI).abs() < 1e-12, "{}", yaw(&r));
+        assert!(
+            (yaw(&r).abs() - std::f64::consts::PI).abs() < 1e-12,
+            "{}",
+            yaw(&r)
+        );
         // Zero-order hold of the torques from the interval's first row.
         assert_eq!(r.torques, vec![1.0, 2.0]);
         assert!(r.has_torques && r.wrench.is_none() && r.ee.is_none());
@@ -616,25 +618,46 @@ mod tests {
 
     #[test]
     fn a_bad_file_names_its_line_and_column() {
-        let err = |t: &str| TrajectoryTable::parse(t, "r.csv", 2).unwrap_err().to_string();
-        let e = err(&text(&["0,0,0,0,0,0,0,0,0,0,0,0,0,0", "1,0,x,0,0,0,0,0,0,0,0,0,0,0"]));
+        let err = |t: &str| {
+            TrajectoryTable::parse(t, "r.csv", 2)
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err(&text(&[
+            "0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+            "1,0,x,0,0,0,0,0,0,0,0,0,0,0",
+        ]));
         assert_eq!(e, "r.csv:3: column `base_y`: `x` is not a finite number");
-        let e = err(&text(&["0,0,0,0,0,0,0,0,0,0,0,0,0,0", "1,0,0,0,0,0,0,nan,0,0,0,0,0,0"]));
+        let e = err(&text(&[
+            "0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+            "1,0,0,0,0,0,0,nan,0,0,0,0,0,0",
+        ]));
         assert_eq!(e, "r.csv:3: column `q_1`: `nan` is not a finite number");
-        let e = err(&text(&["0,0,0,0,0,0,0,0,0,0,0,0,0,0", "0,0,0,0,0,0,0,0,0,0,0,0,0,0"]));
+        let e = err(&text(&[
+            "0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+            "0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+        ]));
         assert!(e.starts_with("r.csv:3: t = 0 does not increase"), "{e}");
         let e = err(&text(&["0,0,0,0,0,0,0,0,0,0,0,0,0,0", "1,0,0"]));
         assert_eq!(e, "r.csv:3: 3 cells, the header has 14");
         let e = err(&text(&["0,0,0,0,0,0,0,0,0,0,0,0,0,0"]));
         assert_eq!(e, "r.csv: 1 data rows; a reference needs at least 2");
-        let e = TrajectoryTable::parse(&text(&[]), "r.csv", 3).unwrap_err().to_string();
+        let e = TrajectoryTable::parse(&text(&[]), "r.csv", 3)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("r.csv:1: no column `q_3`"), "{e}");
-        let e = TrajectoryTable::parse(&text(&[]), "r.csv", 1).unwrap_err().to_string();
+        let e = TrajectoryTable::parse(&text(&[]), "r.csv", 1)
+            .unwrap_err()
+            .to_string();
         assert_eq!(e, "r.csv:1: column `q_2`, but the design has 1 joints");
         let partial = "t,base_x,base_y,base_z,base_roll,base_pitch,base_yaw,q_1,base_u\n";
-        let e = TrajectoryTable::parse(partial, "r.csv", 1).unwrap_err().to_string();
+        let e = TrajectoryTable::parse(partial, "r.csv", 1)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("r.csv:1: no column `base_v`"), "{e}");
-        let e = TrajectoryTable::parse("t,t\n", "r.csv", 0).unwrap_err().to_string();
+        let e = TrajectoryTable::parse("t,t\n", "r.csv", 0)
+            .unwrap_err()
+            .to_string();
         assert_eq!(e, "r.csv:1: column `t` appears twice");
         let e = TrajectoryTable::read(Path::new("/no/such/file.csv"), 0).unwrap_err();
         assert!(matches!(e, ReferenceFileError::Io { .. }), "{e}");

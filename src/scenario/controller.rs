@@ -355,10 +355,8 @@ fn track(v: &Vehicle, file: &ScenarioFile) -> Result<ModeController, ScenarioErr
     let path = spec.file.as_deref().unwrap_or_default();
     let table = TrajectoryTable::read(std::path::Path::new(path), v.n_joints())?;
     let law = spec.tracking_gains();
-    law.validate().map_err(|source| ScenarioError::Control {
-        prefix: "",
-        source,
-    })?;
+    law.validate()
+        .map_err(|source| ScenarioError::Control { prefix: "", source })?;
     Ok(ModeController::Track {
         law,
         source: Box::new((ReferenceSource::Table(table), Reference::new(v.n_joints()))),

@@ -115,8 +115,7 @@ impl ReferenceSpec {
                     "a reference file takes no via-points",
                 ));
             }
-            return (self.tracking_gains().validate())
-                .map_err(|e| KeyError::new(e.key, e.message));
+            return (self.tracking_gains().validate()).map_err(|e| KeyError::new(e.key, e.message));
         }
         for (key, set) in [
             ("reference.k_position", self.k_position.is_some()),
