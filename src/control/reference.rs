@@ -1,11 +1,11 @@
 //! The time-parameterised reference the closed loop follows (docs/model.md §5 "References"):
 //! one [`Reference`] sample — base pose and twist, joint positions and rates, optionally an
 //! end-effector pose and twist, a feed-forward base wrench and joint torques — filled every
-//! control period by a [`ReferenceSource`]:
+//! control period by a [`super::reference_source::ReferenceSource`]:
 //!
-//! - [`ReferenceSource::EndEffector`]: the work-mode timed path of [`super::spline`] (natural
+//! - `ReferenceSource::EndEffector`: the work-mode timed path of [`super::spline`] (natural
 //!   spline through via-points, quintic timing; fills only the end-effector part);
-//! - [`ReferenceSource::Table`]: a trajectory read from a file with the time-series column
+//! - `ReferenceSource::Table`: a trajectory read from a file with the time-series column
 //!   names ([`super::trajectory_file`]), interpolated in time; fills the base, the joints and,
 //!   when the file has them, the end effector and the feed-forward terms.
 //!
@@ -19,9 +19,7 @@
 //! [N, N·m]; joint angles [rad], rates [rad/s], torques [N·m]. Sampling never allocates: the
 //! joint vectors are sized once by [`Reference::new`].
 
-use super::spline::{pose_and_twist, PoseReference};
-use super::trajectory_file::TrajectoryTable;
-use crate::spatial::{Mat3, Vec3, Vec6};
+use crate::spatial::{Vec3, Vec6};
 use nalgebra::UnitQuaternion;
 
 /// The end-effector part of a reference: desired pose in `I` and twist in the measured `F_e`.
@@ -82,43 +80,6 @@ impl Reference {
             wrench: None,
             has_torques: false,
             torques: vec![0.0; n_joints],
-        }
-    }
-}
-
-/// Where a [`Reference`] comes from (module docs).
-#[derive(Clone, Debug)]
-pub enum ReferenceSource {
-    /// A timed end-effector path (work mode's `[reference]` with `duration` and via-points).
-    EndEffector(PoseReference),
-    /// A trajectory file, interpolated in time.
-    Table(TrajectoryTable),
-}
-
-impl ReferenceSource {
-    /// Fill `out` with the reference at time `t` [s]. `r_ie` is the measured end-effector
-    /// orientation in `I`, in whose frame an end-effector twist is expressed (USM-42).
-    /// Allocation-free.
-    pub fn sample_into(&self, t: f64, r_ie: &Mat3, out: &mut Reference) {
-        out.t = t;
-        match self {
-            ReferenceSource::EndEffector(path) => {
-                let (position, orientation, twist) = pose_and_twist(&path.sample(t), r_ie);
-                out.ee = Some(EeReference {
-                    position,
-                    orientation,
-                    twist,
-                });
-            }
-            ReferenceSource::Table(table) => table.sample_into(t, out),
-        }
-    }
-
-    /// The number of joints the source's samples carry (`None`: no joint part).
-    pub fn n_joints(&self) -> Option<usize> {
-        match self {
-            ReferenceSource::EndEffector(_) => None,
-            ReferenceSource::Table(table) => Some(table.n_joints()),
         }
     }
 }
