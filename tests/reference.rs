@@ -2,7 +2,8 @@
 //! docs/model.md §5 "References"): a recorded `timeseries.csv` of `transport-method1` fed back
 //! through `simulate --reference` reproduces its own base path within the original run's
 //! tracking error; an `ocp` optimum (`studies/ocp_usm_paper.toml`) is tracked in closed loop and
-//! priced beside the open-loop optimum; a bad reference file or scenario key is a located
+//! priced beside the open-loop optimum; the Parquet time series is the same reference as the
+//! CSV one; a bad reference file or scenario key is a located
 //! error with exit code 2.
 
 mod common;
@@ -100,6 +101,19 @@ fn a_recorded_transport_run_fed_back_reproduces_its_base_path() {
     let t = json(&tr.join("tracking.json"));
     assert!((t["base_error_rms"].as_f64().unwrap() - rms).abs() < 1e-9);
     assert!(t["reference_effort"].as_f64().unwrap() > 0.0);
+    // The Parquet time series is the same reference: the tracked run is bit-identical.
+    let pq = d.path().join("from_parquet");
+    let parquet = rec.join("timeseries.parquet");
+    let args = [
+        "simulate",
+        "transport-method1",
+        "--reference",
+        arg(&parquet),
+    ];
+    simulate(&[&args[..], &["--out", arg(&pq), "--no-plots"]].concat());
+    let csv = |dir: &Path| std::fs::read(dir.join("timeseries.csv")).unwrap();
+    assert!(csv(&pq) == csv(&tr), "Parquet and CSV references differ");
+    assert!(pq.join("reference.csv").is_file());
 }
 
 #[test]

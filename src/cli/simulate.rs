@@ -38,7 +38,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub no_plots: bool,
     /// Follow a trajectory file (CSV with the time-series column names: `simulate`'s
-    /// timeseries.csv, `ocp`'s trajectory.csv) with the scenario's plant: work mode with
+    /// timeseries.csv or .parquet, `ocp`'s trajectory.csv) with the scenario's plant: work mode with
     /// `[reference] file`, starting at its first row and lasting to its last; writes
     /// tracking.json (base error, effort beside the reference's, the controller's price).
     #[arg(long, value_name = "FILE")]
@@ -69,12 +69,6 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     };
     let mut file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
-    let reference = match &a.reference {
-        Some(_) => Some(super::simulate_reference::start_at_reference(
-            &mut file, &vehicle, &a.set,
-        )?),
-        None => None,
-    };
     let worlds = match uncertainty {
         Some(u) => Some(super::simulate_worlds::prepare(
             &table,
@@ -88,6 +82,12 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         PathBuf::from("out").join(usm_study::report::file_stem_safe(&file.scenario.name))
     });
     create_dir(&out)?;
+    let reference = match &a.reference {
+        Some(_) => Some(super::simulate_reference::start_at_reference(
+            &mut file, &vehicle, &a.set, &out,
+        )?),
+        None => None,
+    };
     eprintln!(
         "[simulate] {} ({} mode, design {}, {} s, allocation {})",
         file.scenario.name,

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use usm_study::control::{Reference, TrajectoryTable};
 use usm_study::model::Vehicle;
-use usm_study::report::atomic_write;
+use usm_study::report::{atomic_write, read_parquet, write_csv};
 use usm_study::scenario::{compare_with_reference, ScenarioFile, TrackingComparison, Trajectory};
 use usm_study::spatial::euler_zyx;
 
@@ -46,13 +46,24 @@ pub fn follow(table: &mut toml::Table, file: &Path) -> anyhow::Result<()> {
 
 /// Start the run where the reference starts (its first row's base position, yaw and joint
 /// angles) and end it at the reference's last time, unless `--set` gave `initial.*` or
-/// `scenario.duration`; returns the reference read (for [`write_comparison`]).
+/// `scenario.duration`; returns the reference read (for [`write_comparison`]). A `.parquet`
+/// reference (e.g. `timeseries.parquet`) is first written as `out/reference.csv` (the same
+/// columns, every number round-tripped exactly) and that file is followed.
 pub fn start_at_reference(
     file: &mut ScenarioFile,
     vehicle: &Vehicle,
     sets: &[String],
+    out: &Path,
 ) -> anyhow::Result<TrajectoryTable> {
-    let path = PathBuf::from(file.reference_file().unwrap_or_default());
+    let mut path = PathBuf::from(file.reference_file().unwrap_or_default());
+    if path.extension().is_some_and(|e| e == "parquet") {
+        let csv = out.join("reference.csv");
+        write_csv(&read_parquet(&path)?, &csv)?;
+        path = std::path::absolute(&csv)?;
+        if let Some(r) = file.reference.as_mut() {
+            r.file = Some(path.display().to_string());
+        }
+    }
     let table = TrajectoryTable::read(&path, vehicle.n_joints())?;
     let given = |key: &str| sets.iter().any(|s| s.trim_start().starts_with(key));
     let (t0, t1) = table.span();
