@@ -34,12 +34,4 @@ impl ReferenceSource {
             ReferenceSource::Table(table) => table.sample_into(t, out),
         }
     }
-
-    /// The number of joints the source's samples carry (`None`: no joint part).
-    pub fn n_joints(&self) -> Option<usize> {
-        match self {
-            ReferenceSource::EndEffector(_) => None,
-            ReferenceSource::Table(table) => Some(table.n_joints()),
-        }
-    }
 }

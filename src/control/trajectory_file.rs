@@ -371,21 +371,6 @@ impl TrajectoryTable {
         (self.t[0], self.t[self.t.len() - 1])
     }
 
-    /// Whether the file gave a feed-forward base wrench.
-    pub fn has_wrench(&self) -> bool {
-        self.wrench.is_some()
-    }
-
-    /// The base position of every row, in `I` [m] (for comparing a run with its reference).
-    pub fn base_positions(&self) -> &[Vec3] {
-        &self.position
-    }
-
-    /// The row times [s].
-    pub fn times(&self) -> &[f64] {
-        &self.t
-    }
-
     /// The control effort of the table, `J = Σ_k (t_{k+1} − t_k) (‖u_k‖² + ‖τ_k‖² + ‖w_k‖²)`
     /// over the rows before the last, with the thrusts `u`, joint torques `τ` and wrench `w`
     /// it has (the `effort` objective of `usm-study ocp` when its weight is 1); `None` when it
