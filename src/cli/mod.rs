@@ -13,6 +13,7 @@ mod optimise;
 mod paper;
 mod progress;
 mod simulate;
+mod simulate_reference;
 mod simulate_worlds;
 mod sweep;
 mod tcm;

@@ -1,4 +1,5 @@
-//! `usm-study simulate SCENARIO [--out DIR] [--allocation METHOD] [--set key=value ...]`.
+//! `usm-study simulate SCENARIO [--out DIR] [--allocation METHOD] [--reference FILE]
+//! [--set key=value ...]`.
 //!
 //! Ctrl-C (SIGINT) or SIGTERM stops the run at its next control period: the outputs of the
 //! run up to then are written, what was written is printed, and the exit code is 130.
@@ -36,6 +37,12 @@ pub struct SimulateArgs {
     /// Do not write the SVG figure, shapes.svg and animation.svg.
     #[arg(long)]
     pub no_plots: bool,
+    /// Follow a trajectory file (CSV with the time-series column names: `simulate`'s
+    /// timeseries.csv or .parquet, `ocp`'s trajectory.csv) with the scenario's plant: work mode with
+    /// `[reference] file`, starting at its first row and lasting to its last; writes
+    /// tracking.json (base error, effort beside the reference's, the controller's price).
+    #[arg(long, value_name = "FILE")]
+    pub reference: Option<PathBuf>,
 }
 
 /// Run `simulate`.
@@ -47,6 +54,9 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     if let Some(m) = a.allocation {
         set_allocation_method(&mut table, m);
     }
+    if let Some(f) = &a.reference {
+        super::simulate_reference::follow(&mut table, f)?;
+    }
     for s in &a.set {
         let (path, value) = parse_override(s)?;
         set(&mut table, &path.0, value, s).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
@@ -57,7 +67,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         Some(_) => anyhow::bail!("{}: uncertainty: must be a table", src.origin),
         None => None,
     };
-    let file = parse_table(&table, &src)?;
+    let mut file = parse_table(&table, &src)?;
     let vehicle = resolve_design(&file, &src)?;
     let worlds = match uncertainty {
         Some(u) => Some(super::simulate_worlds::prepare(
@@ -72,6 +82,12 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
         PathBuf::from("out").join(usm_study::report::file_stem_safe(&file.scenario.name))
     });
     create_dir(&out)?;
+    let reference = match &a.reference {
+        Some(_) => Some(super::simulate_reference::start_at_reference(
+            &mut file, &vehicle, &a.set, &out,
+        )?),
+        None => None,
+    };
     eprintln!(
         "[simulate] {} ({} mode, design {}, {} s, allocation {})",
         file.scenario.name,
@@ -89,6 +105,9 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     };
     write_run_outputs(&r, &out, &vehicle, files)?;
     print_summary(&r);
+    if let Some(table) = &reference {
+        super::simulate_reference::write_comparison(table, &file, &vehicle, &r.trajectory, &out)?;
+    }
     if let Some((t, INTERRUPTED)) = r.failure.as_ref().map(|(t, c)| (t, c.as_str())) {
         eprintln!(
             "[simulate] interrupted at t = {t:.3} s of {} s: wrote the run up to then to {} \

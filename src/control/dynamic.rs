@@ -79,6 +79,22 @@ impl DynamicGains {
         Self::work_mode()
     }
 
+    /// Tracking of a full-state reference (`[reference] file`, [`super::tracking`]): the
+    /// work-mode gains with the nonlinear term `n` of USM-33 (drag, restoring, Coriolis
+    /// cancelled by the model, so a moving reference leaves no steady lag) and without the
+    /// `V̇_r` feed-forward. Inferred from runs: `M_11 V̇_r` ignores the joints' reaction on the
+    /// base (`M_12 q̈`, already in the reference's base motion), so feeding it forward fights
+    /// that reaction — replaying `transport-method1` with it peaks at 2839 N sway and fails one
+    /// allocation (0.45 m largest base error), without it 487 N and none (0.38 m); tracking the
+    /// `studies/ocp_usm_paper.toml` optimum costs an effort of 8.57 with it and 1.21 without.
+    pub fn tracking() -> Self {
+        Self {
+            nonlinear: true,
+            feedforward: false,
+            ..Self::work_mode()
+        }
+    }
+
     /// Check the values; errors name `dynamic.<key>`.
     pub fn validate(&self) -> Result<(), ControlError> {
         for i in 0..6 {

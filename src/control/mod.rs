@@ -5,6 +5,10 @@
 //! |---|---|---|
 //! | [`guidance`] | line-of-sight guidance along straight segments | USM-39 |
 //! | [`kinematic`] | damped weighted pseudoinverse, SRMTP task priority, task errors, inertial-frame task variables | USM-28…32, AC-7…13 |
+//! | [`reference`] | the time-parameterised reference the loop follows | §5 "References" |
+//! | [`reference_source`] | its sources: the timed end-effector path, a trajectory file | §5 "References" |
+//! | [`trajectory_file`] | a reference read from a trajectory file (time-series columns), interpolated | §5 "References" |
+//! | [`tracking`] | base pose tracking of a full-state reference into `V_r` | §5 "References", USM-33/34 |
 //! | [`quintic`] | quintic point-to-point references (zero end rates and accelerations) | AC §5 |
 //! | [`spline`] | timed end-effector paths: natural spline through via-points, quintic timing | AC §5, USM-42 |
 //! | [`transport`] | transport mode: joint references, surge and yaw accelerations | USM-38, 40, 41 |
@@ -25,7 +29,11 @@ pub mod dynamic;
 pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
+pub mod reference;
+pub mod reference_source;
 pub mod spline;
+pub mod tracking;
+pub mod trajectory_file;
 pub mod transport;
 pub mod work;
 
@@ -40,6 +48,10 @@ pub use kinematic::{
     JointLimitSettings, JointLimitTask, PinvWorkspace, Srmtp, TaskInverse, TaskVariable,
 };
 pub use quintic::Quintic;
+pub use reference::{EeReference, Reference};
+pub use reference_source::ReferenceSource;
+pub use tracking::TrackingGains;
+pub use trajectory_file::{ReferenceFileError, TrajectoryTable};
 pub use transport::{
     measure_transport, yaw_joint_mask, SurgeLaw, SurgeSource, TransportController, TransportGains,
     TransportMeasurement, TransportMethod, TransportOutput, YawRateSource,

@@ -377,6 +377,7 @@ impl ScenarioFile {
             .clone()
             .unwrap_or(match self.scenario.mode {
                 Mode::Transport => DynamicGains::transport(),
+                Mode::Work if self.reference_file().is_some() => DynamicGains::tracking(),
                 Mode::Work => DynamicGains::work_mode(),
             })
     }
@@ -395,6 +396,11 @@ impl ScenarioFile {
     pub fn commanded(&self) -> CommandedDofs {
         self.commanded_dofs()
             .unwrap_or_else(|_| self.scenario.mode.default_commanded_dofs())
+    }
+
+    /// The trajectory file of `[reference] file`, if the run follows one.
+    pub fn reference_file(&self) -> Option<&str> {
+        self.reference.as_ref().and_then(|r| r.file.as_deref())
     }
 
     /// The characteristic length L [m] of the scaled TCM: `metrics.char_length`, or half the
@@ -505,7 +511,7 @@ impl ScenarioFile {
             Mode::Transport if self.path.is_none() => {
                 return Err(KeyError::new("path", "transport mode needs a [path] table"))
             }
-            Mode::Work if self.setpoint.is_none() => {
+            Mode::Work if self.setpoint.is_none() && self.reference_file().is_none() => {
                 return Err(KeyError::new(
                     "setpoint",
                     "work mode needs a [setpoint] table",

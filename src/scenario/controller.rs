@@ -11,7 +11,11 @@ use super::error::ScenarioError;
 use crate::control::dynamic::DynamicController;
 use crate::control::guidance::PathSpec;
 use crate::control::kinematic::{ee_pose, SecondaryTasks};
-use crate::control::spline::{pose_and_twist, PoseReference};
+use crate::control::reference::Reference;
+use crate::control::reference_source::ReferenceSource;
+use crate::control::spline::PoseReference;
+use crate::control::tracking::TrackingGains;
+use crate::control::trajectory_file::TrajectoryTable;
 use crate::control::transport::{measure_transport, TransportController};
 use crate::control::work::{WorkController, WorkTarget};
 use crate::kinematics::{forward_kinematics, BasePose, KinWorkspace};
@@ -62,7 +66,18 @@ pub(crate) enum ModeController {
     Work {
         law: Box<WorkController>,
         target: WorkTarget,
-        reference: Option<Box<PoseReference>>,
+        reference: Option<Box<(ReferenceSource, Reference)>>,
+        signals: WorkSignals,
+    },
+    /// Work mode following a whole-state reference from a file (`[reference] file`): the base
+    /// by [`TrackingGains::base_reference`] into the dynamic control, the joints by their
+    /// servos; `ws` holds the forward kinematics of the reference (its end effector is the
+    /// logged setpoint).
+    Track {
+        law: TrackingGains,
+        source: Box<(ReferenceSource, Reference)>,
+        ws: Box<KinWorkspace>,
+        vehicle: Box<Vehicle>,
         signals: WorkSignals,
     },
 }
@@ -152,6 +167,7 @@ impl ModeController {
                     signals: TransportSignals::default(),
                 }
             }
+            ModeGains::Work(_) if file.reference_file().is_some() => track(v, file)?,
             ModeGains::Work(g) => {
                 let sp = file.setpoint.as_ref().ok_or(ScenarioError::MissingTable {
                     table: "setpoint",
@@ -179,12 +195,12 @@ impl ModeController {
                         let [x, y, z] = sp.position;
                         let end = [x, y, z, r[0], r[1], r[2]];
                         let via = spec.via_points();
-                        Some(Box::new(PoseReference::new(
-                            start,
-                            end,
-                            spec.duration,
-                            &via,
-                        )?))
+                        let path = PoseReference::new(start, end, spec.duration, &via)?;
+                        let n = v.n_joints();
+                        Some(Box::new((
+                            ReferenceSource::EndEffector(path),
+                            Reference::new(n),
+                        )))
                     }
                     None => None,
                 };
@@ -257,8 +273,12 @@ impl ModeController {
             } => {
                 let g_ie = meas.base.to_se3().compose(&meas.ws.g_be);
                 if let Some(r) = reference {
-                    (target.ee_position, target.ee_orientation, target.ee_twist) =
-                        pose_and_twist(&r.sample(t), &g_ie.r);
+                    let (source, sample) = &mut **r;
+                    source.sample_into(t, &g_ie.r, sample);
+                    if let Some(ee) = sample.ee {
+                        (target.ee_position, target.ee_orientation, target.ee_twist) =
+                            (ee.position, ee.orientation, ee.twist);
+                    }
                 }
                 let out = law.step(meas.base, meas.ws, target, dt);
                 cmd.q_ref.copy_from_slice(law.q_ref());
@@ -279,6 +299,70 @@ impl ModeController {
                     twist_ref: out.v_r,
                 };
             }
+            ModeController::Track {
+                law,
+                source,
+                ws,
+                vehicle,
+                signals,
+            } => {
+                let g_ie = meas.base.to_se3().compose(&meas.ws.g_be);
+                let (src, r) = &mut **source;
+                src.sample_into(t, &g_ie.r, r);
+                let (v_r, ff) = law.base_reference(meas.base, r);
+                cmd.q_ref.copy_from_slice(&r.q);
+                cmd.qd_ref.copy_from_slice(&r.qd);
+                let d = base_ctl.velocity_control(meas.m11, meas.nvec, meas.v_b, &v_r, dt);
+                cmd.tau_c = d.tau_c + ff;
+                forward_kinematics(vehicle, &r.q, ws);
+                *signals = track_signals(&g_ie, r, ws, v_r);
+            }
         }
     }
+}
+
+/// The work-mode channels of a tracked run: the reference's end effector (forward kinematics
+/// of its base pose and joint angles, already in `ws`) as the setpoint, and the errors of the
+/// measured end effector `g_ie` from it.
+fn track_signals(
+    g_ie: &crate::spatial::Se3,
+    r: &Reference,
+    ws: &mut KinWorkspace,
+    v_r: Vec6,
+) -> WorkSignals {
+    let base = BasePose {
+        orientation: r.base_orientation,
+        position: r.base_position,
+    };
+    let g_d = ee_pose(&base, &ws.g_be);
+    let x_d = g_d.r * Vec3::x();
+    let x_e = g_ie.r * Vec3::x();
+    let sp = euler_zyx(&g_d.r);
+    WorkSignals {
+        setpoint: [g_d.p.x, g_d.p.y, g_d.p.z, sp.x, sp.y, sp.z],
+        position_error: (g_ie.p - g_d.p).norm(),
+        orientation_error: x_d.dot(&x_e).clamp(-1.0, 1.0).acos(),
+        damping: 0.0,
+        twist_ref: v_r,
+    }
+}
+
+/// The controller of a work-mode run following `[reference] file` (read here, once).
+fn track(v: &Vehicle, file: &ScenarioFile) -> Result<ModeController, ScenarioError> {
+    let spec = file.reference.as_ref().ok_or(ScenarioError::MissingTable {
+        table: "reference",
+        mode: "work",
+    })?;
+    let path = spec.file.as_deref().unwrap_or_default();
+    let table = TrajectoryTable::read(std::path::Path::new(path), v.n_joints())?;
+    let law = spec.tracking_gains();
+    law.validate()
+        .map_err(|source| ScenarioError::Control { prefix: "", source })?;
+    Ok(ModeController::Track {
+        law,
+        source: Box::new((ReferenceSource::Table(table), Reference::new(v.n_joints()))),
+        ws: Box::new(KinWorkspace::new(v)),
+        vehicle: Box::new(v.clone()),
+        signals: WorkSignals::default(),
+    })
 }

@@ -51,6 +51,9 @@ pub enum ScenarioError {
     /// A table could not be written out as TOML (a value TOML cannot hold).
     #[error("{0}")]
     Serialize(#[source] toml::ser::Error),
+    /// The trajectory file of `[reference] file` cannot be a reference (file, line, column).
+    #[error("reference.file: {0}")]
+    Reference(#[from] crate::control::ReferenceFileError),
     /// A control law refused its settings; the message is the law's key path under `prefix`.
     #[error("{prefix}{source}")]
     Control {

@@ -41,6 +41,7 @@ pub mod run;
 mod setup;
 pub mod success;
 pub mod target;
+pub mod tracked;
 mod watch;
 
 pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
@@ -48,6 +49,7 @@ pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
 pub use run::{run_loop, LoopRun, Stop, INTERRUPTED, TIMEOUT};
+pub use tracked::{compare_with_reference, TrackingComparison};
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::KeyError;
@@ -299,8 +301,15 @@ fn parse_source(
 /// Parse a scenario table (after any overrides) read from `src`; errors name the file, the
 /// key and, for keys of the file, the line.
 pub fn parse_table(table: &toml::Table, src: &Source) -> Result<ScenarioFile, ScenarioError> {
-    let f: ScenarioFile = deserialize_table(table, "").map_err(|e| src.invalid(e))?;
+    let mut f: ScenarioFile = deserialize_table(table, "").map_err(|e| src.invalid(e))?;
     f.validate().map_err(|e| src.invalid(e))?;
+    // A reference file is named relative to the scenario file, like its design.
+    if let Some(p) = f.reference.as_mut().and_then(|r| r.file.as_mut()) {
+        let rel = src.dir.join(&*p);
+        if Path::new(p).is_relative() && rel.is_file() {
+            *p = rel.display().to_string();
+        }
+    }
     if let Some(fault) = &f.fault {
         fault.validate().map_err(|e| src.invalid(e))?;
     }

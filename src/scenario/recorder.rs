@@ -366,7 +366,7 @@ impl Recorder {
                 (Channel::BaseCrossTrack, s.base_cross_track),
                 (Channel::PathY, s.path_y),
             ]),
-            ModeController::Work { signals: s, .. } => {
+            ModeController::Work { signals: s, .. } | ModeController::Track { signals: s, .. } => {
                 w.put_all(Pose::ALL.map(Channel::Setpoint).into_iter().zip(s.setpoint));
                 w.put(Channel::EePositionError, s.position_error);
                 w.put(Channel::EeOrientationError, s.orientation_error);

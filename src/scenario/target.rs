@@ -21,8 +21,24 @@
 //! the setpoint at `T` and holding it; the desired twist is fed forward (USM-42's `V_e,d`).
 //! Sweep axes and `[[param]]` reach every number: `reference.duration`,
 //! `reference.via[0].time`, `reference.via[0].position[1]`.
+//!
+//! Or the reference is a trajectory file (`simulate --reference FILE` sets this):
+//!
+//! ```toml
+//! [reference]
+//! file = "timeseries.csv"        # time-series column names (control::trajectory_file)
+//! k_position = [0.5, 0.5, 0.5]   # optional tracking gains, 1/s (control::tracking)
+//! k_attitude = [1.0, 1.0, 1.0]
+//! feedforward = false            # add the file's wrench_* columns to tau_c
+//! ```
+//!
+//! The whole state is then followed — base pose and twist by the tracking law of
+//! [`crate::control::tracking`] into the dynamic control, the joints by their servos — and
+//! `[setpoint]` may be left out (the work-mode channels compare the end effector with the
+//! reference's). The file's path is relative to the scenario file.
 
 use crate::control::spline::Via;
+use crate::control::tracking::TrackingGains;
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
 use serde::{Deserialize, Serialize};
@@ -48,8 +64,22 @@ pub struct SetpointSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
-    /// Arrival time `T` at the setpoint [s], `0 < T <= scenario.duration`.
+    /// Arrival time `T` at the setpoint [s], `0 < T <= scenario.duration` (unused, and may be
+    /// left out, with `file`).
+    #[serde(default)]
     pub duration: f64,
+    /// A trajectory file to follow instead of the timed path (module docs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// With `file`: the base position gain of the tracking law [1/s].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_position: Option<[f64; 3]>,
+    /// With `file`: the base attitude gain of the tracking law [1/s].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_attitude: Option<[f64; 3]>,
+    /// With `file`: whether the file's base wrench is fed forward.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feedforward: Option<bool>,
     /// Via-points, times strictly increasing inside `(0, T)`; empty: the quintic straight line.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub via: Vec<ViaSpec>,
@@ -77,6 +107,24 @@ impl ReferenceSpec {
                 "reference",
                 "only work mode takes a [reference]",
             ));
+        }
+        if self.file.is_some() {
+            if !self.via.is_empty() {
+                return Err(KeyError::new(
+                    "reference.via",
+                    "a reference file takes no via-points",
+                ));
+            }
+            return (self.tracking_gains().validate()).map_err(|e| KeyError::new(e.key, e.message));
+        }
+        for (key, set) in [
+            ("reference.k_position", self.k_position.is_some()),
+            ("reference.k_attitude", self.k_attitude.is_some()),
+            ("reference.feedforward", self.feedforward.is_some()),
+        ] {
+            if set {
+                return Err(KeyError::new(key, "applies only with reference.file"));
+            }
         }
         let t = self.duration;
         if !t.is_finite() || t <= 0.0 || t > run_duration {
@@ -119,6 +167,16 @@ impl ReferenceSpec {
             }
         }
         Ok(())
+    }
+
+    /// The tracking gains of a file reference: the file's keys over the defaults.
+    pub fn tracking_gains(&self) -> TrackingGains {
+        let d = TrackingGains::default();
+        TrackingGains {
+            k_position: self.k_position.unwrap_or(d.k_position),
+            k_attitude: self.k_attitude.unwrap_or(d.k_attitude),
+            feedforward: self.feedforward.unwrap_or(d.feedforward),
+        }
     }
 
     /// The via-points in the units of [`crate::control::spline::PoseReference`] (rad).
