@@ -155,16 +155,27 @@ impl Walk<'_> {
         };
         let h = plugins.hydro.get(&l.name);
         let com = l.inertial.map_or(Vec3::zeros(), |(_, f, _)| f.p);
-        if let Some(h) = h {
-            let v = if h.neutral {
+        let given = h.and_then(|h| {
+            if h.neutral {
                 Some(m / self.rho)
             } else {
                 h.volume
-            };
-            if let Some(v) = v {
+            }
+        });
+        match (h, given) {
+            (Some(h), Some(v)) => {
                 let c = h.cob.unwrap_or(if h.neutral { com } else { Vec3::zeros() });
                 acc.vol.push((v, t.act_point(&c)));
             }
+            // gz-sim's Buoyancy system: the volume of the collision shapes.
+            _ if !plugins.any_uuv => {
+                for (f, s) in &l.collision {
+                    acc.vol.push((s.volume(), t.compose(f).p));
+                }
+            }
+            _ => {}
+        }
+        if let Some(h) = h {
             if h.added_mass.is_some() || h.linear.is_some() || h.quadratic.is_some() {
                 let z = Mat6::zeros();
                 let mv = |x: Option<Mat6>| {
@@ -187,11 +198,6 @@ impl Walk<'_> {
             for n in &h.notes {
                 self.ledger
                     .push(Inferred::new(format!("body {}", acc.name), n.clone()));
-            }
-        } else if !plugins.any_uuv {
-            for (f, s) in &l.collision {
-                let c = t.compose(f).p;
-                acc.vol.push((s.volume(), c));
             }
         }
         let shapes = if l.collision.is_empty() {

@@ -285,7 +285,7 @@ pub fn vehicle_to_urdf(v: &Vehicle) -> Result<String, ExportError> {
     let _ = writeln!(o, "<?xml version=\"1.0\"?>");
     let _ = writeln!(
         o,
-        "<!-- Written by `usm-study design export --format urdf` from the design {}.\n     \
+        "<!-- Written by `usm-study design export` (format urdf) from the design {}.\n     \
          Conventions (docs/urdf.md): SI units; hydrodynamic matrices in UUV Simulator's frame\n     \
          (the link frame turned 180 deg about x) about the link origin. Cylinder-model bodies: the\n     \
          added mass is exact, the Fossen damping an equivalent (usm-study reads the usm_study block).\n     \

@@ -75,7 +75,7 @@ pub fn vehicle_to_mjcf(v: &Vehicle) -> Result<String, ExportError> {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "<!-- Written by `usm-study design export --format mjcf` from the design {}.\n{}\n-->",
+        "<!-- Written by `usm-study design export` (format mjcf) from the design {}.\n{}\n-->",
         v.name.replace("--", "- -"),
         CAVEATS
     );

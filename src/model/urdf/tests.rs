@@ -297,15 +297,15 @@ fn arb_design() -> impl Strategy<Value = Vehicle> {
             let mut v = spec.build("gen").unwrap();
             let rot = |a: f64, b: f64, c: f64| super::parse::rot_rpy(&Vec3::new(a, b / 2.0, c));
             for (k, j) in v.joints.iter_mut().enumerate() {
-                j.placement.r = rot(r[k], r[k + 8], r[k + 16]);
-                j.axis = Vec3::new(r[k + 24], r[k + 32], 1.0).normalize();
+                j.placement.r = rot(r[(k) % 80], r[(k + 8) % 80], r[(k + 16) % 80]);
+                j.axis = Vec3::new(r[(k + 24) % 80], r[(k + 32) % 80], 1.0).normalize();
             }
             for (k, b) in v.bodies.iter_mut().enumerate() {
-                b.cg += Vec3::new(0.01 * r[k + 40], 0.01 * r[k + 48], 0.0);
-                b.cb = b.cg + Vec3::new(0.0, 0.0, 0.01 * r[k + 56].abs());
-                let q = rot(r[k + 64], r[k + 72], r[k]);
+                b.cg += Vec3::new(0.01 * r[(k + 40) % 80], 0.01 * r[(k + 48) % 80], 0.0);
+                b.cb = b.cg + Vec3::new(0.0, 0.0, 0.01 * r[(k + 56) % 80].abs());
+                let q = rot(r[(k + 64) % 80], r[(k + 72) % 80], r[(k) % 80]);
                 b.inertia = q * b.inertia * q.transpose();
-                if flags[k] {
+                if flags[k % 8] {
                     let a = Mat6::from_fn(|i, jj| r[(i * 6 + jj + k) % 80] / 3.0);
                     b.hydro = Hydro::Coefficients {
                         added_mass: a * a.transpose() * 10.0,
