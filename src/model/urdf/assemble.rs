@@ -406,7 +406,7 @@ fn finish(
     let mut bodies = Vec::new();
     for (bi, a) in accs.iter().enumerate() {
         let (mass, cg, inertia) = combine(&a.mass);
-        if !(mass > 0.0) {
+        if mass <= 0.0 || !mass.is_finite() {
             return Err(at(
                 w.origin,
                 a.line,

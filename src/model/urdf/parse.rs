@@ -281,7 +281,7 @@ fn joint_of(origin: &str, j: Node) -> Result<UJoint, UrdfError> {
             let v = attr_floats(origin, a, "xyz", 3, None)?;
             let v = Vec3::new(v[0], v[1], v[2]);
             let n = v.norm();
-            if !(n > 1e-9) {
+            if n <= 1e-9 || !n.is_finite() {
                 return Err(err_at(origin, a, "axis must be a nonzero vector"));
             }
             if (n - 1.0).abs() > 1e-15 {
