@@ -5,9 +5,9 @@
 //! with two moving child joints (a branching tree) is refused. Values no element gives are
 //! filled by the project's rules and listed in the import's ledger.
 
+use super::error::{Inferred, UrdfError};
 use super::parse::{JointKind, Link, Shape, Tree, UJoint};
 use super::plugins::{Plugins, ThrusterSpec};
-use super::{Inferred, UrdfError};
 use crate::model::{Body, Fluid, Hydro, Joint, Thruster, Vehicle, GRAVITY, RHO_SEAWATER};
 use crate::spatial::{skew, Mat3, Mat6, Se3, Vec3};
 use std::collections::BTreeMap;
@@ -240,13 +240,13 @@ fn combine(parts: &[(f64, Vec3, Mat3)]) -> (f64, Vec3, Mat3) {
     (m, c, i)
 }
 
-/// Turn the tree into a vehicle; the second value lists what was inferred.
-pub(super) fn assemble(
+/// Links by name, the child joints of each link and the root link; errors for a joint naming
+/// a missing link, a link with two parent joints, a loop or a disconnected tree.
+#[allow(clippy::type_complexity)]
+fn tree_shape<'t>(
     origin: &str,
-    tree: &Tree,
-    plugins: &Plugins,
-    opts: &ImportOptions,
-) -> Result<(Vehicle, Vec<Inferred>), UrdfError> {
+    tree: &'t Tree,
+) -> Result<(BTreeMap<&'t str, usize>, Vec<Vec<usize>>, usize), UrdfError> {
     let links: BTreeMap<&str, usize> = tree
         .links
         .iter()
@@ -321,6 +321,17 @@ pub(super) fn assemble(
             ));
         }
     };
+    Ok((links, kids, root))
+}
+
+/// Turn the tree into a vehicle; the second value lists what was inferred.
+pub(super) fn assemble(
+    origin: &str,
+    tree: &Tree,
+    plugins: &Plugins,
+    opts: &ImportOptions,
+) -> Result<(Vehicle, Vec<Inferred>), UrdfError> {
+    let (links, kids, root) = tree_shape(origin, tree)?;
     let mut ledger = Vec::new();
     let rho = match (plugins.rho, plugins.thruster_rho) {
         (Some(r), _) => r,

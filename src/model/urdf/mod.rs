@@ -13,6 +13,7 @@
 //! `assemble` (tree → Vehicle, the rules), `export` (Vehicle → URDF), `mjcf` (Vehicle → MJCF).
 
 mod assemble;
+mod error;
 mod export;
 mod mjcf;
 mod parse;
@@ -21,45 +22,13 @@ mod plugins;
 mod tests;
 
 pub use assemble::{ImportOptions, DEFAULT_THRUST_LIMIT};
+pub use error::{Inferred, UrdfError};
 pub use export::{vehicle_to_urdf, ExportError};
 pub use mjcf::vehicle_to_mjcf;
 
 use super::design::design_to_toml;
 use super::Vehicle;
 use std::fmt::Write as _;
-use thiserror::Error;
-
-/// A bad URDF: the file, the 1-based line of the element, the element and what is wrong.
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("{file}:{line}: {element}: {message}")]
-pub struct UrdfError {
-    /// File name (or origin label).
-    pub file: String,
-    /// 1-based line the element starts on.
-    pub line: usize,
-    /// The element, e.g. `<joint name="q1">`.
-    pub element: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-/// One value of an imported design the file did not give: filled by the project's rules.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Inferred {
-    /// What (e.g. `body[0].volume (base_link)`).
-    pub key: String,
-    /// The rule applied.
-    pub note: String,
-}
-
-impl Inferred {
-    pub(crate) fn new(key: impl Into<String>, note: impl Into<String>) -> Self {
-        Self {
-            key: key.into(),
-            note: note.into(),
-        }
-    }
-}
 
 /// An imported design and its ledger of inferred values.
 #[derive(Clone, Debug)]

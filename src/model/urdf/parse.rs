@@ -2,7 +2,7 @@
 //! with type, origin, axis and limits, each with the 1-based line it starts on
 //! (docs/urdf.md "Elements read"). No model rules here: [`super::assemble`] applies them.
 
-use super::UrdfError;
+use super::error::UrdfError;
 use crate::spatial::{rot_axis_angle, Mat3, Se3, Vec3};
 use roxmltree::Node;
 

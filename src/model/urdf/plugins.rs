@@ -5,8 +5,8 @@
 //! the model's convention (docs/model.md §2): body frame x forward, y left, z up; added mass
 //! `M_A` positive; damping wrench `−(D_l ν + D_q (|ν| ∘ ν))` about the link frame's origin.
 
+use super::error::UrdfError;
 use super::parse::{child, children, err_at, floats, line_of};
-use super::UrdfError;
 use crate::model::{HullDrag, Hydro};
 use crate::spatial::{Mat3, Mat6, Se3, Vec3};
 use roxmltree::Node;
