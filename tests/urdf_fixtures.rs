@@ -242,3 +242,41 @@ fn a_urdf_is_accepted_wherever_a_design_is() {
     ]);
     assert_eq!(j["design"], "bluerov2");
 }
+
+#[test]
+fn a_malformed_urdf_exits_2_naming_the_element_and_its_line() {
+    let d = tempfile::tempdir().unwrap();
+    let good = std::fs::read_to_string(format!("{DIR}/bluerov2.urdf")).unwrap();
+    // Unknown joint type on the tilt joint; a zero axis (the unit tests cover the rest).
+    let line_of = |pat: &str| good.lines().position(|l| l.contains(pat)).unwrap() + 1;
+    let cases = [
+        (
+            good.replace(
+                "name=\"tilt\" type=\"revolute\"",
+                "name=\"tilt\" type=\"hinge\"",
+            ),
+            format!(
+                "{}: <joint name=\"tilt\">: unknown joint type",
+                line_of("name=\"tilt\"")
+            ),
+        ),
+        (
+            good.replace("<axis xyz=\"0 1 0\"/>", "<axis xyz=\"0 0 0\"/>"),
+            format!(
+                "{}: <axis>: axis must be a nonzero vector",
+                line_of("<axis xyz=\"0 1 0\"/>")
+            ),
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        let p = d.path().join(format!("bad{k}.urdf"));
+        std::fs::write(&p, text).unwrap();
+        let o = run(&["design", "import", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(want.as_str()),
+            "want `{want}` in {}",
+            stderr(&o)
+        );
+    }
+}
