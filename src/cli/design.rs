@@ -6,7 +6,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use usm_study::model::design::{design_to_toml, load_design};
 use usm_study::model::presets::PRESETS;
+use usm_study::model::urdf::{
+    imported_to_toml, load_urdf, vehicle_to_mjcf, vehicle_to_urdf, ImportOptions,
+};
 use usm_study::pipeline::draw::write_drawing;
+use usm_study::report::atomic::atomic_write;
 use usm_study::report::file_stem_safe;
 use usm_study::state::{load_state, VehicleState};
 
@@ -21,6 +25,31 @@ pub enum DesignCommand {
     },
     /// List the built-in presets.
     List,
+    /// Import a URDF (with UUV Simulator / Plankton or gz-sim hydrodynamic plugin blocks) as a
+    /// design file (docs/urdf.md); values the file does not give are listed as inferred.
+    Import {
+        /// The URDF file (expand xacro first).
+        urdf: PathBuf,
+        /// Output design file. Default: print to stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Symmetric thrust limit [N] for thrusters whose plugin gives no finite limit
+        /// (default 40, marked inferred).
+        #[arg(long)]
+        thrust_limit: Option<f64>,
+    },
+    /// Export a design (preset or file) as URDF with UUV Simulator plugin blocks, or as MuJoCo
+    /// MJCF (docs/urdf.md).
+    Export {
+        /// Preset name or path to a design file.
+        design: String,
+        /// `urdf` or `mjcf`.
+        #[arg(long, value_parser = ["urdf", "mjcf"])]
+        format: String,
+        /// Output file. Default: print to stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Draw a design at a state: top, side and front views to scale, thrusters as arrows,
     /// joint axes, base and end-effector frames, and the singular values of T(q), as SVG.
     Draw {
@@ -47,6 +76,40 @@ pub fn run(cmd: &DesignCommand) -> anyhow::Result<ExitCode> {
                 println!("{p}");
             }
         }
+        DesignCommand::Import {
+            urdf,
+            out,
+            thrust_limit,
+        } => {
+            if let Some(l) = thrust_limit {
+                anyhow::ensure!(
+                    l.is_finite() && *l > 0.0,
+                    "--thrust-limit must be finite and > 0, got {l}"
+                );
+            }
+            let opts = ImportOptions {
+                thrust_limit: *thrust_limit,
+            };
+            let imp = load_urdf(urdf, &opts)?;
+            let text = imported_to_toml(&imp, &urdf.display().to_string());
+            for i in &imp.inferred {
+                eprintln!("[design import] inferred: {}: {}", i.key, i.note);
+            }
+            emit(&text, out.as_ref())?;
+        }
+        DesignCommand::Export {
+            design,
+            format,
+            out,
+        } => {
+            let v = load_design(design)?;
+            let text = if format == "mjcf" {
+                vehicle_to_mjcf(&v)?
+            } else {
+                vehicle_to_urdf(&v)?
+            };
+            emit(&text, out.as_ref())?;
+        }
         DesignCommand::Draw { design, state, out } => {
             let v = load_design(design)?;
             let (s, label) = match state {
@@ -65,4 +128,16 @@ pub fn run(cmd: &DesignCommand) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Print `text`, or write it to `out` through the atomic writer.
+fn emit(text: &str, out: Option<&PathBuf>) -> anyhow::Result<()> {
+    match out {
+        None => print!("{text}"),
+        Some(p) => {
+            atomic_write(p, text.as_bytes()).with_context(|| format!("writing {}", p.display()))?;
+            println!("wrote {}", p.display());
+        }
+    }
+    Ok(())
 }

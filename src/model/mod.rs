@@ -11,6 +11,7 @@ pub mod generator;
 pub mod ledger;
 pub mod manoeuvring;
 pub mod presets;
+pub mod urdf;
 pub mod world;
 
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};

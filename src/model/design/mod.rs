@@ -76,6 +76,9 @@ use std::path::Path;
 /// Load a design: `arg` is a path to a `.toml` design file or the name of a preset
 /// ([`PRESETS`]). An existing file wins over a preset of the same name.
 pub fn load_design(arg: &str) -> Result<Vehicle, DesignError> {
+    if is_urdf(arg) {
+        return load_urdf_design(arg);
+    }
     if Path::new(arg).is_file() {
         let text = read_file(arg)?;
         return parse_design(&text, arg);
@@ -91,7 +94,9 @@ pub fn load_design(arg: &str) -> Result<Vehicle, DesignError> {
 /// line numbers); a preset name gives the preset's explicit form ([`design_to_toml`]), so
 /// that keys like `thruster[2].position` exist to be overridden.
 pub fn load_design_table(arg: &str) -> Result<toml::Table, DesignError> {
-    let (text, origin) = if Path::new(arg).is_file() {
+    let (text, origin) = if is_urdf(arg) {
+        (design_to_toml(&load_urdf_design(arg)?), arg.to_string())
+    } else if Path::new(arg).is_file() {
         (read_file(arg)?, arg.to_string())
     } else if PRESETS.contains(&arg) {
         let v = presets::preset(arg).map_err(|e| not_found(arg, e.message))?;
@@ -137,6 +142,30 @@ pub fn parse_design_value(value: &toml::Value, origin: &str) -> Result<Vehicle, 
             format!("a design must be a table, got a {}", other.type_str()),
         )),
     }
+}
+
+/// Whether `arg` is an existing `.urdf` file: a design given as a URDF (docs/urdf.md).
+fn is_urdf(arg: &str) -> bool {
+    arg.ends_with(".urdf") && Path::new(arg).is_file()
+}
+
+/// Import a URDF design with the default options; its error keeps the URDF's line and element.
+fn load_urdf_design(arg: &str) -> Result<Vehicle, DesignError> {
+    let opts = super::urdf::ImportOptions::default();
+    super::urdf::load_urdf(Path::new(arg), &opts)
+        .map(|i| i.vehicle)
+        .map_err(|e| DesignError {
+            at: crate::input::located::Location {
+                origin: e.file.clone(),
+                line: Some(e.line),
+                column: None,
+                key: e.element.clone(),
+            },
+            error: error::DesignFault {
+                kind: DesignErrorKind::Invalid,
+                message: e.message,
+            },
+        })
 }
 
 fn read_file(path: &str) -> Result<String, DesignError> {
