@@ -310,6 +310,7 @@ fn settings(method: Method, max_iters: u64, max_evals: usize, restarts: usize) -
         seed: 3,
         particles: 4,
         step: 0.1,
+        polish: None,
     }
 }
 
