@@ -75,6 +75,7 @@ fn settings(
         seed,
         particles: 12,
         step,
+        polish: None,
     }
 }
 

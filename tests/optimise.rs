@@ -11,7 +11,7 @@ use usm_study::input::keypath::KeyPath;
 use usm_study::optimise::evaluate::pick;
 use usm_study::optimise::history::{history_table, Evaluation, Record, JOURNAL_FILE};
 use usm_study::optimise::problem::{
-    Combine, Method, Objective, SolverSettings, Spec, Term, Variant,
+    Combine, Method, Objective, Polish, SolverSettings, Spec, Term, Variant,
 };
 use usm_study::optimise::search::Evaluator;
 use usm_study::optimise::space::{Param, Scale, Space};
@@ -99,6 +99,7 @@ fn solver(method: Method, max_iters: u64, max_evals: usize, tolerance: f64) -> S
         seed: 11,
         particles: 24,
         step: 0.1,
+        polish: None,
     }
 }
 
@@ -582,4 +583,54 @@ distribution = { kind = "uniform", low = 0.0, high = 2.0 }
         .unwrap_err()
         .to_string();
     assert!(e.contains("objective.alpha"), "{e}");
+}
+
+#[test]
+fn a_polish_keeps_the_methods_runs_and_spends_the_rest_on_nelder_mead() {
+    // Bayesian optimisation of the bounded quadratic: 40 evaluations, then 40 of a
+    // Nelder–Mead polish from its best point.
+    let box2 = || vec![param("a.x", 0.0, 1.0, 0.8), param("a.y", 0.0, 1.0, 0.2)];
+    let alone = solver(Method::Bayes, 1000, 40, 1e-12);
+    let polished = SolverSettings {
+        polish: Some(Polish {
+            evals: 40,
+            step: 0.05,
+        }),
+        ..solver(Method::Bayes, 1000, 80, 1e-12)
+    };
+    let a = solve(bounded_quadratic, &spec(box2(), alone), 1);
+    let runs: Vec<Outcome> = [1, 2]
+        .iter()
+        .map(|&j| solve(bounded_quadratic, &spec(box2(), polished.clone()), j))
+        .collect();
+    let p = &runs[0];
+    assert_eq!(p.records.len(), 80, "{:?}", p.stops);
+    // The method's runs are those of its 40 evaluations without a polish, bit for bit.
+    for (r, q) in a.records.iter().zip(&p.records[..40]) {
+        assert_eq!((r.run, r.iteration), (q.run, q.iteration));
+        assert_eq!(
+            r.x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            q.x.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
+    }
+    // The polish is run 2 (one method run, no restarts) and starts from the best point.
+    assert!(p.records[40..].iter().all(|r| r.run == 2));
+    assert_eq!(p.records[40].x, a.best().x, "first vertex: the best so far");
+    assert!(
+        p.stops.last().unwrap().starts_with("polish (run 2)"),
+        "{:?}",
+        p.stops
+    );
+    let b = &p.best().x;
+    assert!(p.best().score.objective <= a.best().score.objective);
+    assert!(
+        (b[0] - 0.3).abs() < 1e-3 && (b[1] - 1.0).abs() < 1e-3,
+        "best {b:?}, without the polish {:?}",
+        a.best().x
+    );
+    // Any number of threads: the same history.
+    for (r, q) in p.records.iter().zip(&runs[1].records) {
+        assert_eq!(r.x, q.x);
+        assert_eq!(r.score.objective.to_bits(), q.score.objective.to_bits());
+    }
 }

@@ -237,6 +237,15 @@ fn optimiser_budgets_are_bounded_before_running() {
             "method = \"nelder-mead\"\nmax_iters = 1\nrestarts = 1000000000",
             "solver.restarts: 1000000000 restarts cannot run within max_evals = 5",
         ),
+        (
+            "method = \"bayes\"\nrestarts = 1\npolish = 4",
+            "solver.polish: a polish of 4 evaluations leaves the method's 2 run(s) nothing of \
+             max_evals = 5",
+        ),
+        (
+            "method = \"bayes\"\npolish = 2\npolish_step = 0.9",
+            "solver.polish_step: must be in (0, 0.5]",
+        ),
     ];
     for (i, (solver, message)) in cases.iter().enumerate() {
         let text = PROBLEM.replace("method = \"nelder-mead\"", solver);
@@ -310,6 +319,7 @@ fn settings(method: Method, max_iters: u64, max_evals: usize, restarts: usize) -
         seed: 3,
         particles: 4,
         step: 0.1,
+        polish: None,
     }
 }
 

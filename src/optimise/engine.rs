@@ -130,7 +130,9 @@ pub fn minimise<E: Evaluator>(
         journal,
         opts.on_record,
     )
-    .racing(opts.race && spec.solver.method == Method::Bayes);
+    // Racing is exact for a method that reads only the feasibility of infeasible points
+    // (bayes), not for the Nelder–Mead of a polish.
+    .racing(opts.race && spec.solver.method == Method::Bayes && spec.solver.polish.is_none());
     search
         .start(|m| Scorer::new(&spec.objective, &spec.constraints, ev.metrics(), m))
         .map_err(|e| OptimiseError::Start(e.into()))?;

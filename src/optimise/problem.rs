@@ -12,7 +12,7 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::solver::{parse_solver, SolverFile};
-pub use super::solver::{Method, SolverSettings, MAX_EVALS, MAX_PARTICLES};
+pub use super::solver::{Method, Polish, SolverSettings, MAX_EVALS, MAX_PARTICLES};
 use super::space::{Param, Scale, Space};
 use crate::input::document::{deserialize_table, Document};
 use crate::input::keypath::join_key;

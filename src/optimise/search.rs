@@ -73,6 +73,9 @@ struct SearchState {
     seen: HashSet<Vec<u64>>,
     scorer: Option<Scorer>,
     exhausted: bool,
+    /// Records the current phase may reach: the budget, less a polish kept back
+    /// ([`run_solver`]).
+    limit: usize,
     run: usize,
     journal: Option<Journal>,
     journal_error: Option<JournalError>,
@@ -127,6 +130,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
                 seen: HashSet::new(),
                 scorer: None,
                 exhausted: false,
+                limit: budget,
                 run: 0,
                 journal,
                 journal_error: None,
@@ -185,7 +189,7 @@ impl<'a, E: Evaluator> Search<'a, E> {
         let used = st.records.len();
         let mut plan = Vec::new();
         for u in us {
-            if used + plan.len() >= self.budget {
+            if used + plan.len() >= st.limit.min(self.budget) {
                 return (plan, true);
             }
             let (u, d2) = self.space.project(u.borrow());
@@ -376,9 +380,44 @@ impl<I: State> Observe<I> for IterationObserver {
     }
 }
 
-/// Run the configured solver (and its restarts) on a started search; returns one line per
-/// run saying why it stopped.
+/// Run the configured solver (and its restarts) on a started search, then its polish if
+/// any; returns one line per run saying why it stopped.
+///
+/// With `[solver] polish = N` the method's runs end at `max_evals − N` records (their budget
+/// error, as at the full budget); the last N go to a Nelder–Mead from the best point so far
+/// with simplex edge `polish_step` (history run `restarts + 2`). The method's runs are those
+/// of `max_evals − N` without a polish, bit for bit.
 pub fn run_solver<E: Evaluator>(search: &Search<'_, E>, s: &SolverSettings) -> Vec<String> {
+    let mut reasons = run_method(search, s);
+    if let Some(p) = s.polish {
+        let run = s.restarts + 2;
+        {
+            let mut st = search.lock();
+            st.limit = search.budget;
+            st.exhausted = false;
+            st.run = run;
+        }
+        search.iteration.store(0, Ordering::Relaxed);
+        let polish = SolverSettings {
+            step: p.step,
+            ..s.clone()
+        };
+        reasons.push(match nelder_mead(search, search.best_u(), &polish) {
+            Ok(r) => format!("polish (run {run}): {r}"),
+            Err(_) if search.exhausted() => {
+                format!("polish (run {run}): evaluation budget reached")
+            }
+            Err(e) => format!("polish (run {run}): stopped: {e}"),
+        });
+    }
+    reasons
+}
+
+/// The method's runs (the first and its restarts), within the budget less the polish.
+fn run_method<E: Evaluator>(search: &Search<'_, E>, s: &SolverSettings) -> Vec<String> {
+    if let Some(p) = s.polish {
+        search.lock().limit = search.budget.saturating_sub(p.evals);
+    }
     let mut reasons = Vec::new();
     for run in 0..=s.restarts {
         search.lock().run = run + 1;

@@ -74,6 +74,20 @@ pub struct SolverSettings {
     /// Nelder–Mead initial simplex edge, CMA-ES initial step size σ0, in the unit box of the
     /// normalised parameters (default 0.1; 0.3 for CMA-ES).
     pub step: f64,
+    /// `polish` > 0: a final Nelder–Mead from the best point of the method's runs (none by
+    /// default; the manifest then omits the key).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub polish: Option<Polish>,
+}
+
+/// `[solver] polish` and `polish_step`: the last `evals` evaluations of `max_evals` go to a
+/// Nelder–Mead from the best point so far, initial simplex `u + step·e_i` in the unit box.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Polish {
+    /// Evaluations of the polish, kept back from `max_evals`.
+    pub evals: usize,
+    /// Initial simplex edge (default 0.05).
+    pub step: f64,
 }
 
 /// Largest `[solver] max_evals` (every evaluation is kept in memory and in the history).
@@ -94,6 +108,8 @@ pub(super) struct SolverFile {
     seed: Option<u64>,
     particles: Option<usize>,
     step: Option<f64>,
+    polish: Option<usize>,
+    polish_step: Option<f64>,
 }
 
 pub(super) fn parse_solver(
@@ -127,6 +143,10 @@ pub(super) fn parse_solver(
         step: s
             .step
             .unwrap_or(if method == Method::Cmaes { 0.3 } else { 0.1 }),
+        polish: s.polish.filter(|&n| n > 0).map(|evals| Polish {
+            evals,
+            step: s.polish_step.unwrap_or(0.05),
+        }),
     };
     if out.max_iters == 0 {
         return Err(doc.err(&k("max_iters"), "must be >= 1"));
@@ -164,6 +184,24 @@ pub(super) fn parse_solver(
     }
     if !(out.step > 0.0 && out.step <= 0.5) {
         return Err(doc.err(&k("step"), "must be in (0, 0.5]"));
+    }
+    let polish_step = s.polish_step.unwrap_or(0.05);
+    if !(polish_step > 0.0 && polish_step <= 0.5) {
+        return Err(doc.err(&k("polish_step"), "must be in (0, 0.5]"));
+    }
+    if let Some(p) = out.polish {
+        if p.evals + out.restarts >= out.max_evals {
+            return Err(doc.err(
+                &k("polish"),
+                format!(
+                    "a polish of {} evaluations leaves the method's {} run(s) nothing of \
+                     max_evals = {}; use polish + restarts < max_evals",
+                    p.evals,
+                    out.restarts + 1,
+                    out.max_evals
+                ),
+            ));
+        }
     }
     Ok(out)
 }

@@ -75,14 +75,28 @@ pub fn sweep(study: &Path, out: &Path, extra: &[&str]) -> Output {
 fn quiet_record(_: &usm_study::optimise::history::Record) {}
 
 /// Load the shipped optimisation study `file` (relative to the repository root), cut its budget
-/// to `max_evals` evaluations and run it on two threads, quietly; returns the problem and the
-/// outcome.
+/// to `max_evals` evaluations (a polish keeps its share of the budget) and run it on two
+/// threads, quietly; returns the problem and the outcome.
 pub fn optimise_study(
     file: &str,
     max_evals: usize,
 ) -> (usm_study::optimise::Problem, usm_study::optimise::Outcome) {
+    optimise_study_with(file, max_evals, |_| {})
+}
+
+/// [`optimise_study`] with the solver settings edited by `edit` after the cut.
+pub fn optimise_study_with(
+    file: &str,
+    max_evals: usize,
+    edit: impl FnOnce(&mut usm_study::optimise::problem::SolverSettings),
+) -> (usm_study::optimise::Problem, usm_study::optimise::Outcome) {
     let mut p = usm_study::optimise::load_problem(Path::new(file)).unwrap();
+    let full = p.spec.solver.max_evals;
     p.spec.solver.max_evals = max_evals;
+    if let Some(polish) = p.spec.solver.polish.as_mut() {
+        polish.evals = polish.evals * max_evals / full;
+    }
+    edit(&mut p.spec.solver);
     let opts = usm_study::optimise::Options {
         jobs: 2,
         journal: None,
