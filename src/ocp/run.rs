@@ -122,7 +122,7 @@ pub fn trajectory_columns(n_joints: usize, n_thrusters: Option<usize>) -> Vec<St
 
 /// Write `trajectory.csv`, `iterations.csv` and `summary.json` into `dir` (created).
 pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result<(), ReportError> {
-    std::fs::create_dir_all(dir).map_err(|e| ReportError::Io {
+    crate::report::prepare_dir(dir).map_err(|e| ReportError::Io {
         path: dir.to_path_buf(),
         action: "creating",
         source: e,

@@ -194,7 +194,7 @@ pub fn git_commit() -> Option<String> {
 pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), StudyError> {
     let text = serde_json::to_string_pretty(m).map_err(|e| StudyError::Other(e.to_string()))?;
     let p = dir.join(MANIFEST_FILE);
-    std::fs::write(&p, text + "\n").map_err(|e| StudyError::io(&p, e))
+    crate::report::atomic_write(&p, (text + "\n").as_bytes()).map_err(StudyError::from)
 }
 
 /// Read `manifest.json` of an output directory.

@@ -127,6 +127,17 @@ pub fn score_worlds(
         let runs: Vec<WorldRun> = worlds
             .par_iter()
             .map_init(Evaluator::new, |evaluator, w| {
+                if deadline.passed() {
+                    // Past the budget: the remaining worlds are not started (each would build
+                    // its vehicle before its first deadline check; 100 000 of them overran a
+                    // 5 s budget by 10 s).
+                    return WorldRun {
+                        ok: false,
+                        metrics: Metrics::new(),
+                        missed: f64::NAN,
+                        timeout: true,
+                    };
+                }
                 let overrides = u
                     .params
                     .iter()
@@ -211,6 +222,9 @@ fn score_variants(
         .unwrap_or_else(|| super::directions::TRANSPORT_OBJECTIVE.to_string());
     let nominal = metrics.value(&objective);
     for v in &study.validate {
+        if deadline.passed() {
+            return Err(WorldTimeout { world: usize::MAX });
+        }
         let overrides = v.set.iter().map(|(n, t, x)| (n.as_str(), t, x));
         let (ok, x) = match apply(r, overrides) {
             Ok(rv) => {
