@@ -163,3 +163,55 @@ fn a_study_costly_to_parse_is_refused_at_its_line() {
         stderr(&o)
     );
 }
+
+/// Issue 39 item 3: 100 000 worlds of a 60 s run (1200 control periods each) cannot run in a
+/// 5 s budget even at 1 µs a period on every thread: refused at load (they ran 12–15 s per
+/// case against `--case-timeout 5`); without a budget, or with one they fit in, the dry run
+/// lists the cases.
+#[test]
+fn worlds_a_case_cannot_run_in_its_budget_are_refused_at_load() {
+    let d = tempfile::tempdir().unwrap();
+    let s = write(
+        d.path(),
+        "many.toml",
+        r#"[study]
+name = "many"
+[design]
+preset = "usm-paper"
+[scenario]
+mode = "transport"
+duration = 60.0
+[[axis]]
+name = "control.k_psi"
+values = [0.5, 0.6]
+[uncertainty]
+worlds = 100000
+[[uncertainty.param]]
+name = "hydro.linear_damping_scale"
+distribution = { kind = "uniform", low = 0.5, high = 1.5 }
+"#,
+    );
+    let dry = |timeout: &str| {
+        run(&[
+            "sweep",
+            s.to_str().unwrap(),
+            "--dry-run",
+            "--jobs",
+            "2",
+            "--case-timeout",
+            timeout,
+        ])
+    };
+    let o = dry("5");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("many.toml:12:1: uncertainty.worlds: 100001 runs per case")
+            && e.contains("more than the --case-timeout of 5 s"),
+        "{e}"
+    );
+    for ok in ["0", "600"] {
+        let o = dry(ok);
+        assert_eq!(o.status.code(), Some(0), "{ok}: {}", stderr(&o));
+    }
+}

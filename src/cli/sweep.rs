@@ -185,6 +185,12 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     let study = load_study_at(&a.study, a.seed)?;
     // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
     Tuner::new(&study)?;
+    // Worlds a case cannot run within its budget are refused here, not timed out case by case.
+    let threads = match a.jobs {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        j => j,
+    };
+    usm_study::study::worlds::check_world_budget(&study, a.case_timeout, threads)?;
     let shard = match &a.shard {
         None => None,
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),

@@ -225,6 +225,7 @@ pub fn run_sweep(
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;
     let mut manifest = sweep_manifest(study, &schema, start_time, elapsed, jobs);
+    manifest.case_timeout_s = opts.case_timeout.map(|d| d.as_secs_f64());
     manifest.shard = opts.shard.map(|(i, n)| [i, n]);
     manifest.throughput_cases_per_s = if elapsed > 0.0 {
         ev.ran as f64 / elapsed
@@ -578,6 +579,7 @@ fn sweep_manifest(
             .collect(),
         report: study.report.clone(),
         robust: RobustInfo::of(study),
+        case_timeout_s: None,
         ledger: super::robust::study_ledger(study),
     }
 }

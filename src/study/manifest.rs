@@ -123,6 +123,10 @@ pub struct Manifest {
     /// The uncertain worlds and the ranking rule (studies with `[uncertainty]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robust: Option<super::robust::RobustInfo>,
+    /// The case's wall-clock budget (`--case-timeout`) [s], also the budget of the report's
+    /// best/worst reruns (in a merge too); absent = none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub case_timeout_s: Option<f64>,
     /// The assumption ledger: every inferred model parameter with its value, source and
     /// range (studies with `[uncertainty]`; docs/assumptions.md).
     #[serde(default, skip_serializing_if = "Option::is_none")]
