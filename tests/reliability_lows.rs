@@ -215,3 +215,49 @@ distribution = { kind = "uniform", low = 0.5, high = 1.5 }
         assert_eq!(o.status.code(), Some(0), "{ok}: {}", stderr(&o));
     }
 }
+
+/// Issue 39: the docs say a `[tune]` parameter without `start` starts each case from its own
+/// value clamped to the bounds, but a base value outside them was refused at load. Code and
+/// docs now agree: clamped; an explicit `start` outside the bounds is refused at its line.
+#[test]
+fn a_tune_start_from_the_case_is_clamped_and_an_explicit_one_must_fit() {
+    let d = tempfile::tempdir().unwrap();
+    let text = r#"[study]
+name = "tn"
+[design]
+preset = "usm-paper"
+[scenario]
+mode = "transport"
+duration = 3.0
+[[axis]]
+name = "control.look_ahead"
+values = [2.0, 3.0]
+[tune]
+[[tune.param]]
+name = "control.k_psi"
+lower = 5.0
+upper = 6.0
+[tune.objective]
+[[tune.objective.term]]
+metric = "thruster_energy"
+weight = 1.0
+[tune.solver]
+method = "nelder-mead"
+max_evals = 3
+"#;
+    let s = write(d.path(), "tune.toml", text);
+    let o = run(&["sweep", s.to_str().unwrap(), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let s = write(
+        d.path(),
+        "start.toml",
+        &text.replace("upper = 6.0", "upper = 6.0\nstart = 7.0"),
+    );
+    let o = run(&["sweep", s.to_str().unwrap(), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("start.toml:16:1: tune.param[0].start: start (7) is outside [5, 6]"),
+        "{}",
+        stderr(&o)
+    );
+}
