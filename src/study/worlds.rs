@@ -262,7 +262,7 @@ pub fn check_world_budget(
     let Some(u) = &study.uncertainty else {
         return Ok(());
     };
-    if !(budget_s > 0.0) || !study.mode.is_dynamic() {
+    if budget_s.is_nan() || budget_s <= 0.0 || !study.mode.is_dynamic() {
         return Ok(());
     }
     let sc = study.scenario_full.get("scenario");
