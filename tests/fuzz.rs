@@ -1,6 +1,6 @@
 //! A fuzz harness on stable Rust: seeded mutations of the shipped input files (study files,
 //! problem files, design files and presets, scenario presets, `--set KEY=VALUE` lists, an
-//! allocation case) at the byte and token level, fed to every parser and, for inputs that
+//! allocation case, a sweep journal) at the byte and token level, fed to every parser and, for inputs that
 //! parse, to the allocator (all four methods), the study's case resolution, the optimiser's
 //! parameter space, and the scenario a `--set` list edits. Nothing may panic, abort or hang.
 //!
@@ -57,6 +57,49 @@ enum Kind {
     /// `--set KEY=VALUE` lines applied to a scenario preset.
     Overrides,
     AllocationCase,
+    /// A sweep journal (`cases.partial.csv`) as `--resume` reads it.
+    JournalRows,
+}
+
+/// The raw schema of the shipped transport study (its journal has packed scenario metrics).
+fn journal_schema() -> &'static [(String, usm_study::report::ColumnKind)] {
+    static S: std::sync::OnceLock<Vec<(String, usm_study::report::ColumnKind)>> =
+        std::sync::OnceLock::new();
+    S.get_or_init(|| {
+        let study = parse_study(
+            &std::fs::read_to_string("studies/thrusters.toml").unwrap(),
+            Path::new("studies/thrusters.toml"),
+        )
+        .unwrap();
+        usm_study::study::records::raw_schema(&study)
+    })
+}
+
+/// A journal of `journal_schema` with a header and three rows.
+fn journal_text() -> String {
+    use usm_study::report::ColumnKind;
+    let schema = journal_schema();
+    let header: Vec<&str> = schema.iter().map(|(n, _)| n.as_str()).collect();
+    let mut text = header.join(",") + "\n";
+    for (r, status) in ["ok", "failed", "skipped"].iter().enumerate() {
+        let cells: Vec<String> = schema
+            .iter()
+            .map(|(n, k)| match (n.as_str(), k) {
+                ("status", _) => status.to_string(),
+                ("hash", _) => format!("ab{r}f"),
+                ("scenario_metrics", _) => {
+                    format!("world.0.mission_cost={r}.25;x=NaN;y=-inf;seg0_time=1e308")
+                }
+                (_, ColumnKind::I64) => r.to_string(),
+                (_, ColumnKind::F64) => format!("{r}.5"),
+                (_, ColumnKind::Bool) => "true".into(),
+                (_, ColumnKind::Str) => "\"a, \"\"b\"\"\"".into(),
+            })
+            .collect();
+        text.push_str(&cells.join(","));
+        text.push('\n');
+    }
+    text
 }
 
 /// Key paths and values of `table` as `--set` lines (`control.k_psi=0.45`), arrays by element.
@@ -142,6 +185,7 @@ fn corpus() -> Vec<(Kind, String)> {
         }
         c.push((Kind::Scenario, text));
     }
+    c.push((Kind::JournalRows, journal_text()));
     c.push((
         Kind::AllocationCase,
         r#"{"T": [[1,0,0,1,0,0,1],[0,1,0,0,1,0,0],[0,0,1,0,0,1,0],[0,0,0.3,0,0,-0.3,0],
@@ -338,6 +382,20 @@ fn exercise(kind: Kind, text: &str) {
             if let Ok(f) = usm_study::scenario::parse_table(&t, &src) {
                 let _ = usm_study::scenario::resolve_design(&f, &src);
             }
+        }
+        Kind::JournalRows => {
+            // As `--resume` reads it: repaired (malformed rows dropped), then read typed.
+            thread_local! {
+                static DIR: tempfile::TempDir = tempfile::tempdir().unwrap();
+            }
+            DIR.with(|d| {
+                let p = d.path().join("cases.partial.csv");
+                std::fs::write(&p, text).unwrap();
+                let schema = journal_schema();
+                if usm_study::study::journal::repair(&p, schema).is_ok() {
+                    let _ = usm_study::report::read_csv_typed(&p, schema);
+                }
+            });
         }
         Kind::AllocationCase => {
             if let Ok(case) = parse_case(text) {

@@ -185,6 +185,12 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     let study = load_study_at(&a.study, a.seed)?;
     // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
     Tuner::new(&study)?;
+    // Worlds a case cannot run within its budget are refused here, not timed out case by case.
+    let threads = match a.jobs {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        j => j,
+    };
+    usm_study::study::worlds::check_world_budget(&study, a.case_timeout, threads)?;
     let shard = match &a.shard {
         None => None,
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),
@@ -441,6 +447,13 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
     )
     .map_err(study_err)?;
     outdir::check_contained(dir).map_err(study_err)?;
+    let stale = usm_study::report::remove_dead_temporaries(dir);
+    if stale > 0 {
+        eprintln!(
+            "[report] removed {stale} temporary files of killed runs in {}",
+            a.dir.display()
+        );
+    }
     if !dir.join("manifest.json").is_file() {
         let hint = if dir.join("summary.json").is_file() {
             "it holds a single run's summary.json (a `simulate`, `tcm` or `paper` folder: its \
@@ -455,6 +468,18 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
             )
         };
         bail!("{} is not a study output: {hint}", a.dir.display());
+    }
+    if let Some([i, n]) = usm_study::study::manifest::read_manifest(dir)
+        .ok()
+        .and_then(|m| m.shard)
+    {
+        bail!(
+            "{} is shard {i}/{n} of a sweep: its raw rows are what `merge` reads, and a report \
+             here would be of {} shard only; merge the shards (`usm-study merge …`) and report \
+             the merged output",
+            a.dir.display(),
+            if n > 1 { "one" } else { "this" }
+        );
     }
     let rerank = Rerank {
         objective: a.objective.clone(),

@@ -63,6 +63,9 @@ impl Document {
             entries: Vec::new(),
             non_finite: Vec::new(),
         };
+        if let Err((offset, message)) = check_cost(text) {
+            return Err(doc.at_offset(Some(offset), String::new(), message));
+        }
         match ImDocument::parse(text) {
             Ok(root) => {
                 doc.index_table("", root.as_table());
@@ -247,6 +250,118 @@ impl Document {
     }
 }
 
+/// Most tables (`[headers]`, `[[arrays of tables]]` and `{ inline tables }`) an input text may
+/// hold: hand-written input has a few dozen; a 15 MiB file of a million one-key tables took
+/// 31 s and 2.9 GB to parse before its first error (issue 39).
+pub const MAX_TABLES: usize = 10_000;
+/// Most `key = value` pairs an input text may hold.
+pub const MAX_KEYS: usize = 200_000;
+/// Deepest nesting of arrays and inline tables in an input text.
+pub const MAX_NESTING: usize = 64;
+
+/// The scanner state of [`check_cost`].
+#[derive(Clone, Copy, PartialEq)]
+enum Lex {
+    Normal,
+    Basic,
+    Literal,
+    MultiBasic,
+    MultiLiteral,
+}
+
+/// Bound the cost of parsing `text` before it is parsed: one pass over its bytes counting
+/// tables, keys and nesting outside strings and comments ([`MAX_TABLES`], [`MAX_KEYS`],
+/// [`MAX_NESTING`]). The byte offset and message of the first excess.
+fn check_cost(text: &str) -> Result<(), (usize, String)> {
+    let b = text.as_bytes();
+    let (mut tables, mut keys, mut depth) = (0usize, 0usize, 0usize);
+    let mut line_start = true;
+    let mut lex = Lex::Normal;
+    let mut i = 0;
+    let triple = |i: usize, c: u8| b.get(i + 1) == Some(&c) && b.get(i + 2) == Some(&c);
+    let over = |i: usize, what: &str, limit: usize| {
+        Err((
+            i,
+            format!(
+                "the text holds more than {limit} {what}, the limit of an input file (its cost \
+                 to parse is bounded, not only its size); is it the right file?"
+            ),
+        ))
+    };
+    while i < b.len() {
+        let c = b[i];
+        match lex {
+            Lex::Normal => match c {
+                b'#' => {
+                    while i < b.len() && b[i] != b'\n' {
+                        i += 1;
+                    }
+                    continue;
+                }
+                b'"' | b'\'' => {
+                    let multi = triple(i, c);
+                    lex = match (c, multi) {
+                        (b'"', false) => Lex::Basic,
+                        (b'"', true) => Lex::MultiBasic,
+                        (_, false) => Lex::Literal,
+                        (_, true) => Lex::MultiLiteral,
+                    };
+                    i += if multi { 3 } else { 1 };
+                    line_start = false;
+                    continue;
+                }
+                b'[' if line_start && depth == 0 => {
+                    tables += 1;
+                    // The header's keys: up to its closing bracket (or the line's end).
+                    while i < b.len() && b[i] != b'\n' && b[i] != b']' {
+                        i += 1;
+                    }
+                    while i < b.len() && b[i] == b']' {
+                        i += 1;
+                    }
+                    line_start = false;
+                    continue;
+                }
+                b'[' | b'{' => {
+                    tables += usize::from(c == b'{');
+                    depth += 1;
+                }
+                b']' | b'}' => depth = depth.saturating_sub(1),
+                b'=' => keys += 1,
+                _ => {}
+            },
+            Lex::Basic | Lex::MultiBasic if c == b'\\' => i += 1,
+            Lex::Basic if c == b'"' || c == b'\n' => lex = Lex::Normal,
+            Lex::Literal if c == b'\'' || c == b'\n' => lex = Lex::Normal,
+            Lex::MultiBasic if c == b'"' && triple(i, c) => {
+                lex = Lex::Normal;
+                i += 2;
+            }
+            Lex::MultiLiteral if c == b'\'' && triple(i, c) => {
+                lex = Lex::Normal;
+                i += 2;
+            }
+            _ => {}
+        }
+        if tables > MAX_TABLES {
+            return over(i, "tables", MAX_TABLES);
+        }
+        if keys > MAX_KEYS {
+            return over(i, "keys", MAX_KEYS);
+        }
+        if depth > MAX_NESTING {
+            return over(i, "levels of nested arrays and inline tables", MAX_NESTING);
+        }
+        if c == b'\n' {
+            line_start = true;
+        } else if !c.is_ascii_whitespace() {
+            line_start = false;
+        }
+        i += 1;
+    }
+    Ok(())
+}
+
 /// Largest input file (study, problem, design, scenario, state, case file) read [bytes]:
 /// hand-written input is a few kB; anything past this is refused before it fills memory.
 pub const MAX_INPUT_BYTES: u64 = 16 << 20;
@@ -326,6 +441,47 @@ pub fn deserialize_table<T: DeserializeOwned>(
 
 #[cfg(test)]
 mod tests {
+    /// Issue 39: a 15 MiB file of a million one-key tables took 31 s and 2.9 GB before its
+    /// first error; it is now refused by a scan before parsing, at the first table too many.
+    /// Brackets, braces and `=` inside strings and comments do not count.
+    #[test]
+    fn a_text_costly_to_parse_is_refused_before_parsing() {
+        let mut text = String::new();
+        for i in 0..1_000_000 {
+            text.push_str(&format!("[t{i}]\nk = 1\n"));
+        }
+        let e = super::Document::parse(&text, "big.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("more than 10000 tables") && e.contains("big.toml:20001:"),
+            "{e}"
+        );
+        let keys: String = (0..200_001).map(|i| format!("k{i} = 1\n")).collect();
+        let e = super::Document::parse(&keys, "k.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than 200000 keys"), "{e}");
+        let deep = format!("a = {}{}", "[".repeat(65), "]".repeat(65));
+        let e = super::Document::parse(&deep, "d.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("levels of nested"), "{e}");
+        let quoted = format!(
+            "s = \"{}\"\nl = '{}'\nm = \"\"\"\n{}\"\"\"\n# {}\n[x]\ny = {{ a = [1, [2]] }}\n",
+            "[{=".repeat(20_000),
+            "[{=".repeat(20_000),
+            "\n[t]\n{=".repeat(20_000),
+            "[{=".repeat(20_000),
+        );
+        let d = super::Document::parse(&quoted, "q.toml").unwrap();
+        assert!(d.text.len() > 100_000);
+        for f in ["studies/thrusters.toml", "studies/gains.toml"] {
+            let t = std::fs::read_to_string(f).unwrap();
+            assert!(super::check_cost(&t).is_ok(), "{f}");
+        }
+    }
+
     #[test]
     fn an_unknown_field_gets_the_closest_expected_name() {
         let m = "unknown field `k_pis`, expected one of `method`, `u0`, `k_psi`, `k_6p`";

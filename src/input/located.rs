@@ -34,6 +34,17 @@ pub fn fmt_exact(x: f64) -> String {
     }
 }
 
+/// A number with `decimals` decimals for a run's reason (`reach = 0.812 m`), scientific with
+/// three beyond `1e-3 <= |x| < 1e6` (`1.000e308`, `1.000e-300`): never hundreds of digits, nor
+/// a small value shown as `0.000`.
+pub fn fmt_fixed(x: f64, decimals: usize) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Where in the user's input a problem is.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Location {
@@ -133,6 +144,16 @@ mod tests {
         assert_eq!(line_col(t, 10), (2, 4));
         assert_eq!(line_col(t, 8), (2, 2)); // inside 'é': clamped back
         assert_eq!(line_col(t, 999).0, 4);
+    }
+
+    #[test]
+    fn reason_numbers_stay_short() {
+        assert_eq!(fmt_fixed(1e308, 3), "1.000e308");
+        assert_eq!(fmt_fixed(-1.08, 3), "-1.080");
+        assert_eq!(fmt_fixed(1e-300, 1), "1.000e-300");
+        assert_eq!(fmt_fixed(f64::INFINITY, 1), "inf");
+        assert_eq!(fmt_exact(1e308), "1e308");
+        assert_eq!(fmt_exact(200.0), "200");
     }
 
     #[test]

@@ -221,7 +221,7 @@ fn better(a: &OcpSolution, b: Option<&OcpSolution>) -> bool {
 
 /// Write `trajectory.csv`, `iterations.csv` and `summary.json` into `dir` (created).
 pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result<(), ReportError> {
-    std::fs::create_dir_all(dir).map_err(|e| ReportError::Io {
+    crate::report::prepare_dir(dir).map_err(|e| ReportError::Io {
         path: dir.to_path_buf(),
         action: "creating",
         source: e,

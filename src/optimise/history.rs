@@ -126,7 +126,7 @@ fn floats(v: &[u64]) -> Vec<f64> {
 impl Journal {
     /// Start a new journal for the problem with hash `hash` (replacing any old one).
     pub fn create(path: &Path, hash: &str) -> Result<Journal, JournalError> {
-        let mut file = std::fs::File::create(path).map_err(io_error(path))?;
+        let mut file = crate::report::create_file(path).map_err(io_error(path))?;
         let h = serde_json::to_string(&Header {
             problem_hash: hash.to_string(),
         })?;
@@ -139,10 +139,7 @@ impl Journal {
 
     /// Append to an existing journal.
     pub fn append_to(path: &Path) -> Result<Journal, JournalError> {
-        let file = std::fs::OpenOptions::new()
-            .append(true)
-            .open(path)
-            .map_err(io_error(path))?;
+        let file = crate::report::open_existing(path, true).map_err(io_error(path))?;
         Ok(Journal {
             path: path.to_path_buf(),
             file,

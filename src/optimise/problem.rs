@@ -454,6 +454,14 @@ fn parse_param(
             ))
         }
     };
+    // A `[tune]` parameter without `start` starts every case from the case's own value clamped
+    // to the bounds (`optimise::tune`), so the base file's value is clamped here too; an
+    // explicit `start` (or a problem file's current value) must lie in the bounds.
+    let start = if at.starts_with("tune.") && from == "name" && start.is_finite() {
+        start.clamp(p.lower, p.upper)
+    } else {
+        start
+    };
     if !(start >= p.lower && start <= p.upper) {
         let what = if from == "start" {
             "start".to_string()

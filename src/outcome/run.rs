@@ -134,9 +134,15 @@ pub fn run_case(
         trajectory: if log { Some(r.trajectory) } else { None },
         failure: r.failure.map(|(t, c)| {
             if c == TIMEOUT {
-                format!("{TIMEOUT}: the case's wall-clock budget ran out at t = {t:.3} s")
+                format!(
+                    "{TIMEOUT}: the case's wall-clock budget ran out at t = {} s",
+                    crate::input::located::fmt_fixed(t, 3)
+                )
             } else {
-                format!("run stopped at t = {t:.3} s: {c}")
+                format!(
+                    "run stopped at t = {} s: {c}",
+                    crate::input::located::fmt_fixed(t, 3)
+                )
             }
         }),
         missed: r.missed.map(|m| m.to_string()),

@@ -1,6 +1,7 @@
 //! The verdict on a closed-loop run (docs/model.md §6 "Success"): its summary metrics judged against
 //! the scenario's `[success]` criteria ([`SuccessSpec`]), in the order of [`Criterion::ALL`].
 
+use crate::input::located::{fmt_exact as num, fmt_fixed as fixed};
 use crate::scenario::config::{MissionSpec, Mode};
 use crate::scenario::success::{Criterion, Missed, SuccessSpec};
 
@@ -27,8 +28,9 @@ pub fn judge(
         return Some(Missed {
             criterion: Criterion::MissionReach,
             detail: format!(
-                "reach = {reach:.3} m < the mission's {} m (the end effector cannot get there)",
-                mission.reach
+                "reach = {} m < the mission's {} m (the end effector cannot get there)",
+                fixed(reach, 3),
+                num(mission.reach)
             ),
         });
     }
@@ -94,7 +96,7 @@ pub fn judge(
 fn exceeds(criterion: Criterion, label: &str, x: f64, limit: f64, unit: &str) -> Option<Missed> {
     (x.is_nan() || x > limit).then(|| Missed {
         criterion,
-        detail: format!("{label} = {x:.4}{unit} > {limit}{unit}"),
+        detail: format!("{label} = {}{unit} > {}{unit}", fixed(x, 4), num(limit)),
     })
 }
 
@@ -156,8 +158,9 @@ fn judge_transport(spec: &SuccessSpec, get: &dyn Fn(&str) -> f64) -> Option<Miss
             format!("segment {k} never stayed within metrics.band before it ended")
         } else if c > spec.convergence_window {
             format!(
-                "segment {k} converged after {c:.1} s > {} s",
-                spec.convergence_window
+                "segment {k} converged after {} s > {} s",
+                fixed(c, 1),
+                num(spec.convergence_window)
             )
         } else {
             continue;
@@ -180,7 +183,8 @@ fn judge_progress(get: &dyn Fn(&str) -> f64) -> Option<Missed> {
         return Some(Missed {
             criterion: Criterion::ForwardProgress,
             detail: format!(
-                "path_progress = {progress:.3} m: the run did not advance along the path"
+                "path_progress = {} m: the run did not advance along the path",
+                fixed(progress, 3)
             ),
         });
     }
@@ -188,7 +192,10 @@ fn judge_progress(get: &dyn Fn(&str) -> f64) -> Option<Missed> {
     if !cost.is_finite() {
         return Some(Missed {
             criterion: Criterion::FiniteObjective,
-            detail: format!("mission_cost = {cost}: the objective is not a finite number"),
+            detail: format!(
+                "mission_cost = {}: the objective is not a finite number",
+                num(cost)
+            ),
         });
     }
     None
@@ -299,7 +306,11 @@ fn judge_deadline(deadline: f64, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
         let c = get(&format!("seg{k}_convergence_time"));
         (c.is_nan() || c > deadline).then(|| Missed {
             criterion: Criterion::MissionDeadline,
-            detail: format!("segment {k} converged after {c:.1} s > the mission's {deadline} s"),
+            detail: format!(
+                "segment {k} converged after {} s > the mission's {} s",
+                fixed(c, 1),
+                num(deadline)
+            ),
         })
     })
 }
@@ -309,6 +320,23 @@ mod tests {
     use crate::outcome::success::{judge, success_margin};
     use crate::scenario::config::{MissionSpec, Mode};
     use crate::scenario::success::{Criterion, SuccessSpec};
+
+    /// Issue 39: a reason printed a limit of 1e308 as 309 digits and 1e-300 as `0.0000`.
+    #[test]
+    fn numbers_in_reasons_are_short() {
+        let m = super::exceeds(
+            Criterion::MaxPeakThrust,
+            "peak_thrust",
+            1e-300,
+            1e-308,
+            " N",
+        )
+        .unwrap();
+        assert_eq!(m.detail, "peak_thrust = 1.000e-300 N > 1e-308 N");
+        let m =
+            super::exceeds(Criterion::MaxPeakThrust, "peak_thrust", 1e308, 1e300, " N").unwrap();
+        assert_eq!(m.detail, "peak_thrust = 1.000e308 N > 1e300 N");
+    }
 
     fn metrics(kv: &[(&str, f64)]) -> Vec<(String, f64)> {
         kv.iter().map(|(k, v)| (k.to_string(), *v)).collect()

@@ -306,11 +306,15 @@ pub fn comparison_markdown(rows: &[Row], usm: &[(String, f64, f64)]) -> String {
 
 /// Write `comparison.csv` and `comparison.md` into `out`; the rows.
 pub fn run_drag_comparison(out: &Path) -> std::io::Result<Vec<Row>> {
-    std::fs::create_dir_all(out)?;
+    crate::report::prepare_dir(out)?;
     let rows = comparison();
-    std::fs::write(out.join("comparison.csv"), comparison_csv(&rows))?;
-    std::fs::write(
-        out.join("comparison.md"),
+    let write = |name: &str, text: String| {
+        crate::report::atomic_write(&out.join(name), text.as_bytes())
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    };
+    write("comparison.csv", comparison_csv(&rows))?;
+    write(
+        "comparison.md",
         comparison_markdown(&rows, &usm_cruise_drag()),
     )?;
     Ok(rows)

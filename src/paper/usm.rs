@@ -12,7 +12,7 @@ use super::secondary::run_secondary_comparison;
 use super::transport_claims::run_readings_and_claims;
 use crate::allocation::Method;
 use crate::outcome::run_scenario;
-use crate::pipeline::error::{create_dir, PipelineError};
+use crate::pipeline::error::{create_dir, create_subdir, PipelineError};
 use crate::pipeline::simulate::{set_allocation_method, write_run_outputs, RunFiles};
 use crate::report::{atomic_write, fmt_num, MarkdownTable};
 use crate::scenario::{load_table, parse_table, preset_names, resolve_design};
@@ -136,7 +136,7 @@ pub fn run_paper(
         let v = resolve_design(&file, &src)?;
         let r = run_scenario(&v, &file)?;
         let run_dir: PathBuf = out.join(dir);
-        create_dir(&run_dir)?;
+        create_subdir(&run_dir)?;
         write_run_outputs(&r, &run_dir, &v, files)?;
         if !timeseries {
             // A time series left by an earlier run with `timeseries` would not match this run.

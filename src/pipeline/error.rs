@@ -77,9 +77,22 @@ pub enum PipelineError {
     Dynamics(#[source] DynError),
 }
 
-/// Creates `dir` and its parents; errors name the directory.
+/// Creates the output folder `dir` and its parents and removes the temporaries a killed run of
+/// any verb left there (`report::prepare_dir`); errors name the directory.
 pub fn create_dir(dir: &std::path::Path) -> Result<(), PipelineError> {
-    std::fs::create_dir_all(dir).map_err(|source| PipelineError::Io {
+    crate::report::prepare_dir(dir)
+        .map(drop)
+        .map_err(|source| PipelineError::Io {
+            action: "creating",
+            path: dir.to_path_buf(),
+            source,
+        })
+}
+
+/// Creates `dir`, a folder inside an output, refusing a symbolic link at its name
+/// (`report::create_subdir`); errors name the directory.
+pub fn create_subdir(dir: &std::path::Path) -> Result<(), PipelineError> {
+    crate::report::create_subdir(dir).map_err(|source| PipelineError::Io {
         action: "creating",
         path: dir.to_path_buf(),
         source,

@@ -101,7 +101,7 @@ impl CsvAppender {
     /// Creates (or truncates) `path` and writes the header for `schema`.
     pub fn create(path: &Path, schema: &[(String, ColumnKind)]) -> Result<Self> {
         check_schema_names(schema)?;
-        let mut file = File::create(path).map_err(|source| ReportError::Io {
+        let mut file = super::atomic::create_file(path).map_err(|source| ReportError::Io {
             path: path.to_path_buf(),
             action: "creating",
             source,
@@ -167,10 +167,7 @@ impl CsvAppender {
             .iter()
             .filter(|&&b| b == b'\n')
             .count();
-        let mut file = std::fs::OpenOptions::new()
-            .write(true)
-            .open(path)
-            .map_err(io("opening"))?;
+        let mut file = super::atomic::open_existing(path, false).map_err(io("opening"))?;
         if keep < existing.len() {
             file.set_len(keep as u64).map_err(io("truncating"))?;
         }

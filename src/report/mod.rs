@@ -36,7 +36,10 @@ pub mod plot;
 pub mod table;
 pub mod table_io;
 
-pub use atomic::{atomic_write, file_stem_safe, run_token, temporary_suffix};
+pub use atomic::{
+    atomic_write, create_file, create_subdir, file_stem_safe, open_existing, prepare_dir,
+    process_alive, remove_dead_temporaries, run_token, temporary_suffix,
+};
 pub use csv_append::{push_csv_row, write_csv_streamed, CsvAppender};
 pub use error::{ReportError, Result};
 pub use markdown::MarkdownTable;

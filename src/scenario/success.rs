@@ -113,7 +113,10 @@ impl SuccessSpec {
         let bad = |k: &str, what: &str, v: f64| {
             Err(KeyError::new(
                 format!("success.{k}"),
-                format!("must be {what}, got {v}"),
+                format!(
+                    "must be {what}, got {}",
+                    crate::input::located::fmt_exact(v)
+                ),
             ))
         };
         for (k, v) in [

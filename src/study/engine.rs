@@ -236,6 +236,7 @@ pub fn run_sweep(
     outcome.elapsed_s = elapsed;
     let mut manifest = sweep_manifest(study, &schema, start_time, elapsed, jobs);
     manifest.robust = robust;
+    manifest.case_timeout_s = opts.case_timeout.map(|d| d.as_secs_f64());
     manifest.shard = opts.shard.map(|(i, n)| [i, n]);
     manifest.throughput_cases_per_s = if elapsed > 0.0 {
         ev.ran as f64 / elapsed
@@ -607,6 +608,7 @@ fn sweep_manifest(
             .collect(),
         report: study.report.clone(),
         robust: RobustInfo::of(study),
+        case_timeout_s: None,
         ledger: super::robust::study_ledger(study),
     }
 }

@@ -7,7 +7,7 @@ use super::cases::{resolve_case, CaseError};
 use super::doe::expand;
 use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
-use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use super::records::{final_table, CaseStatus, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::rerank::Rerank;
 use super::schema::Study;
 use super::selection::Selection;
@@ -38,6 +38,9 @@ pub enum RerunError {
     /// The case's tuned values do not apply.
     #[error(transparent)]
     Tune(#[from] TuneError),
+    /// The rerun ran out of the case's `--case-timeout`.
+    #[error("the rerun ran out of the case's --case-timeout ({0}); no time series written")]
+    Timeout(String),
 }
 
 /// Write the report, rerunning the best and worst cases of dynamic studies for their
@@ -93,7 +96,15 @@ fn rerun_extremes(
             r = t.at(study, case, &r, &x)?;
         }
         let mut ev = Evaluator::new();
-        let res = evaluate_resolved(&mut ev, study, case.id, &r, true, Deadline::NONE);
+        // The case's own budget (`--case-timeout`, recorded in the manifest) bounds the rerun.
+        let budget = manifest
+            .case_timeout_s
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .map(std::time::Duration::from_secs_f64);
+        let res = evaluate_resolved(&mut ev, study, case.id, &r, true, Deadline::after(budget));
+        if res.status == CaseStatus::Failed && res.reason.starts_with(crate::evaluate::TIMEOUT) {
+            return Err(RerunError::Timeout(res.reason));
+        }
         if let Some(t) = res.trajectory {
             write_csv(&t, &out.join(which.trajectory_file()))?;
         }

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use super::error::{Notes, StudyError};
-use super::records::{CaseStatus, HASH, STATUS};
+use super::records::{CaseStatus, HASH, SCENARIO_METRICS_COLUMN, STATUS};
 use crate::report::{atomic_write, ColumnKind};
 
 /// Split one CSV line (quotes as written by `CsvAppender`: `"…"` with `""` inside) into its
@@ -38,6 +38,15 @@ fn split_fields(line: &str) -> Option<Vec<String>> {
     Some(fields)
 }
 
+/// Whether a packed metrics cell (`name=value;…`, `records::pack_metrics`) reads back: every
+/// item a non-empty name and a number (`NaN` and `inf` as the float format writes them).
+fn packed_ok(cell: &str) -> bool {
+    cell.split(';').filter(|x| !x.is_empty()).all(|kv| {
+        kv.split_once('=')
+            .is_some_and(|(k, v)| !k.is_empty() && v.parse::<f64>().is_ok())
+    })
+}
+
 /// What is wrong with one journal line, if anything.
 fn check_line(line: &str, schema: &[(String, ColumnKind)]) -> Option<String> {
     let Some(fields) = split_fields(line) else {
@@ -59,6 +68,7 @@ fn check_line(line: &str, schema: &[(String, ColumnKind)]) -> Option<String> {
             ColumnKind::Str if name == HASH => {
                 !f.is_empty() && f.bytes().all(|b| b.is_ascii_hexdigit())
             }
+            ColumnKind::Str if name == SCENARIO_METRICS_COLUMN => packed_ok(f),
             ColumnKind::Str => true,
         };
         if !ok {
@@ -119,6 +129,21 @@ mod tests {
         .into_iter()
         .map(|(n, k)| (n.to_string(), k))
         .collect()
+    }
+
+    /// Issue 39: the packed run metrics were read as NaN when garbled
+    /// (`world.0.mission_cost=abc`); now such a row is reported and its case runs again.
+    #[test]
+    fn garbled_packed_metrics_are_malformed() {
+        let mut s = schema();
+        s.push((SCENARIO_METRICS_COLUMN.to_string(), ColumnKind::Str));
+        let ok = "0,ab12,ok,\"\",1.5,world.0.mission_cost=1.25;x=NaN;y=-inf";
+        assert_eq!(check_line(ok, &s), None);
+        assert_eq!(check_line("0,ab12,ok,\"\",1.5,", &s), None);
+        for bad in ["world.0.mission_cost=abc", "x=1;=2", "x", "x=1;y="] {
+            let line = format!("0,ab12,ok,\"\",1.5,{bad}");
+            assert!(check_line(&line, &s).is_some(), "{bad}");
+        }
     }
 
     #[test]

@@ -25,6 +25,7 @@ use std::time::{Duration, SystemTime};
 
 use super::error::StudyError;
 use super::manifest::now_rfc3339;
+use crate::report::process_alive;
 
 /// The lock file's name in an output directory.
 pub const LOCK_FILE: &str = ".usm-study.lock";
@@ -140,24 +141,6 @@ pub fn host_name() -> String {
         .filter(|s| !s.is_empty())
         .or_else(|| std::env::var("HOSTNAME").ok())
         .unwrap_or_else(|| "?".into())
-}
-
-/// Whether a process `pid` exists on this host (signal 0; a process of another user counts).
-fn process_alive(pid: u32) -> bool {
-    #[cfg(unix)]
-    {
-        let Ok(p) = libc::pid_t::try_from(pid) else {
-            return false;
-        };
-        // SAFETY: signal 0 only checks that `p` exists and may be signalled; nothing is sent.
-        let r = unsafe { libc::kill(p, 0) };
-        r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = pid;
-        true
-    }
 }
 
 fn env_nonempty(k: &str) -> Option<String> {

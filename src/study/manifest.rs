@@ -123,6 +123,10 @@ pub struct Manifest {
     /// The uncertain worlds and the ranking rule (studies with `[uncertainty]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robust: Option<super::robust::RobustInfo>,
+    /// The case's wall-clock budget (`--case-timeout`) [s], also the budget of the report's
+    /// best/worst reruns (in a merge too); absent = none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub case_timeout_s: Option<f64>,
     /// The assumption ledger: every inferred model parameter with its value, source and
     /// range (studies with `[uncertainty]`; docs/assumptions.md).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -194,7 +198,7 @@ pub fn git_commit() -> Option<String> {
 pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), StudyError> {
     let text = serde_json::to_string_pretty(m).map_err(|e| StudyError::Other(e.to_string()))?;
     let p = dir.join(MANIFEST_FILE);
-    std::fs::write(&p, text + "\n").map_err(|e| StudyError::io(&p, e))
+    crate::report::atomic_write(&p, (text + "\n").as_bytes()).map_err(StudyError::from)
 }
 
 /// Read `manifest.json` of an output directory.

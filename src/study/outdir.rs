@@ -167,6 +167,14 @@ pub fn claim(dir: &Path, lock: &OutputLock, c: &Claim) -> Result<Notes, StudyErr
             ));
         }
     }
+    // And those of a killed run of any other verb (no lock: `tcm`, `simulate`, …).
+    let dead = crate::report::remove_dead_temporaries(dir);
+    if dead > 0 {
+        notes.push(format!(
+            "removed {dead} temporary files of killed runs (their process is gone) in {}",
+            dir.display()
+        ));
+    }
     let released = dir.join(RELEASED_FILE);
     if released.exists() {
         std::fs::remove_file(&released).map_err(|e| StudyError::io(&released, e))?;

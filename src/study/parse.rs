@@ -55,6 +55,7 @@ struct StudyFile {
     validate: Option<Vec<toml::Table>>,
     faults: Option<toml::Table>,
     fault: Option<toml::Table>,
+    secondary: Option<toml::Table>,
 }
 
 #[derive(Deserialize)]
@@ -459,6 +460,7 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
         ("success", &file.success),
         ("mission", &file.mission),
         ("fault", &file.fault),
+        ("secondary", &file.secondary),
     ] {
         if let Some(t) = t {
             own.insert(k.into(), toml::Value::Table(t.clone()));
@@ -494,6 +496,10 @@ fn scenario_side(file: &StudyFile, doc: &Document) -> Result<ScenarioSide, Input
     if mode.is_dynamic() {
         sc_names.insert("fault".into());
         sc_names.extend(FAULT_KEYS.iter().map(|k| format!("fault.{k}")));
+    }
+    // `mission.payload_volume` is optional (absent = neutral buoyancy), so not in the defaults.
+    if mode.is_dynamic() {
+        sc_names.insert("mission.payload_volume".into());
     }
     // Reject unknown keys of the study's own scenario-side tables.
     let (mut own_names, mut own_arrays) = (BTreeSet::new(), BTreeSet::new());

@@ -53,7 +53,7 @@ impl From<SettingsError> for String {
 
 /// Top-level tables of the scenario side of a study file (besides the batch engine's own
 /// `[static]`); must cover the top-level keys of [`default_table`].
-pub const SCENARIO_TABLES: [&str; 16] = [
+pub const SCENARIO_TABLES: [&str; 17] = [
     "scenario",
     "hydro",
     "control",
@@ -70,6 +70,7 @@ pub const SCENARIO_TABLES: [&str; 16] = [
     "success",
     "mission",
     "fault",
+    "secondary",
 ];
 
 /// The mode of a study (`scenario.mode`; written as lower-case text in study files and

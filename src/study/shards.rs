@@ -48,6 +48,17 @@ pub fn merge(
         .map(|d| read_manifest(d))
         .collect::<Result<_, _>>()?;
     let m0 = &manifests[0];
+    let canonical = |d: &Path| std::fs::canonicalize(d).ok();
+    if let Some(o) = canonical(out) {
+        if let Some(d) = dirs.iter().find(|d| canonical(d).as_ref() == Some(&o)) {
+            return Err(StudyError::Input(format!(
+                "merge --out {}: is one of the shards being merged ({}); its manifest would be \
+                 replaced and the shards could not be merged again: use another --out",
+                out.display(),
+                d.display()
+            )));
+        }
+    }
     check_same_study(dirs, &manifests)?;
     let mut warnings = check_shard_set(dirs, &manifests, opts.partial)?;
     let schema = m0.schema()?;
@@ -72,7 +83,7 @@ pub fn merge(
     let axes: Vec<&str> = m0.axes.iter().map(|a| a.name.as_str()).collect();
     let table = write_tables(raw, out, m0.robust.as_ref(), &axes)?;
     if let Ok(text) = std::fs::read_to_string(first_dir.join(STUDY_COPY)) {
-        std::fs::write(out.join(STUDY_COPY), text).map_err(|e| StudyError::io(out, e))?;
+        crate::report::atomic_write(&out.join(STUDY_COPY), text.as_bytes())?;
     }
     let mut m = m0.clone();
     m.start_time = start_time;
@@ -197,6 +208,18 @@ fn check_same_study(dirs: &[PathBuf], manifests: &[Manifest]) -> Result<(), Stud
                 first_dir.display()
             )));
         }
+        if m.report != m0.report {
+            // The merged report would take whichever shard came first's.
+            return Err(StudyError::Input(format!(
+                "{}: its report settings ({:?}) differ from {}'s ({:?}); the merged report \
+                 would depend on the order of the shards: rerun the shard or give the same \
+                 `[report]`",
+                d.display(),
+                m.report,
+                first_dir.display(),
+                m0.report
+            )));
+        }
     }
     Ok(())
 }
@@ -282,13 +305,15 @@ export USM_EXE={exe}
 export USM_STUDY={study}
 export USM_OUT={out}
 mkdir -p -- "$USM_OUT"
+# sbatch expands %A, %a, %j, … in --output: a % of the path itself is written %%.
+log_dir=${{USM_OUT//'%'/%%}}
 for ((i = 0; i < {n}; i++)); do printf 'shard-%d-of-{n}\n' "$i"; done >"$USM_OUT/{list}"
 array=$(sbatch --parsable --export=ALL --job-name={jname}-sweep --array=0-{last} \
-  --cpus-per-task={cpus}{time} --output="$USM_OUT/slurm-%A_%a.log" \
+  --cpus-per-task={cpus}{time} --output="$log_dir/slurm-%A_%a.log" \
   --wrap='exec "$USM_EXE" sweep "$USM_STUDY" --shard slurm --resume{force} --jobs {cpus} --case-timeout {timeout} --out "$USM_OUT/shard-$SLURM_ARRAY_TASK_ID-of-{n}"')
 array=${{array%%;*}}
 merge=$(sbatch --parsable --export=ALL --job-name={jname}-merge --dependency=afterok:"$array" \
-  --output="$USM_OUT/slurm-merge-%j.log" \
+  --output="$log_dir/slurm-merge-%j.log" \
   --wrap='exec "$USM_EXE" merge --list "$USM_OUT/{list}" --out "$USM_OUT"{force}')
 printf 'array job %s ({n} tasks), merge job %s; merged output in %s\n' "$array" "${{merge%%;*}}" "$USM_OUT"
 "#,
@@ -344,6 +369,41 @@ mod tests {
             1,
             "only inside the quoted study path: {s}"
         );
+    }
+
+    /// Issue 39: sbatch expands `%A`, `%a`, `%j` in `--output`; a `%` of the output path must
+    /// reach it as `%%`, and every `--output` goes through that escaped folder.
+    #[test]
+    fn a_percent_in_the_output_path_is_escaped_for_sbatch() {
+        let p = SlurmPlan {
+            exe: "/x/usm-study".into(),
+            study: "/w/s.toml".into(),
+            out: "/w/50%A_%j it's".into(),
+            cases: 4,
+            cases_per_task: 2,
+            cpus: 1,
+            case_timeout_s: 0.0,
+            name: "s".into(),
+            force: false,
+        };
+        let s = slurm_script(&p);
+        let lines: Vec<&str> = s
+            .lines()
+            .filter(|l| l.starts_with("export USM_OUT=") || l.starts_with("log_dir="))
+            .collect();
+        assert_eq!(lines.len(), 2, "{s}");
+        let o = std::process::Command::new("bash")
+            .arg("-c")
+            .arg(format!(
+                "{}
+printf %s \"$log_dir\"",
+                lines.join("\n")
+            ))
+            .output()
+            .unwrap();
+        assert_eq!(String::from_utf8_lossy(&o.stdout), "/w/50%%A_%%j it's");
+        assert_eq!(s.matches("--output=\"$log_dir/").count(), 2, "{s}");
+        assert!(!s.contains("--output=\"$USM_OUT"), "{s}");
     }
 
     #[test]
