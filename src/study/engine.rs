@@ -238,11 +238,7 @@ pub fn run_sweep(
     manifest.robust = robust;
     manifest.case_timeout_s = opts.case_timeout.map(|d| d.as_secs_f64());
     manifest.shard = opts.shard.map(|(i, n)| [i, n]);
-    manifest.throughput_cases_per_s = if elapsed > 0.0 {
-        ev.ran as f64 / elapsed
-    } else {
-        0.0
-    };
+    manifest.throughput_cases_per_s = per_second(ev.ran, elapsed);
     manifest.cases = Counts {
         planned: outcome.planned,
         in_output: table.n_rows(),
@@ -610,5 +606,14 @@ fn sweep_manifest(
         robust: RobustInfo::of(study),
         case_timeout_s: None,
         ledger: super::robust::study_ledger(study),
+    }
+}
+
+/// `n` events in `elapsed` seconds, per second (0 for no elapsed time).
+fn per_second(n: usize, elapsed: f64) -> f64 {
+    if elapsed > 0.0 {
+        n as f64 / elapsed
+    } else {
+        0.0
     }
 }
