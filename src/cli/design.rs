@@ -135,6 +135,12 @@ fn emit(text: &str, out: Option<&PathBuf>) -> anyhow::Result<()> {
     match out {
         None => print!("{text}"),
         Some(p) => {
+            // Its folder is made as `design draw --out` makes its own (the file, not the
+            // folder, is the tool's output; an existing folder is left as it is).
+            if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)
+                    .with_context(|| format!("creating the folder {}", dir.display()))?;
+            }
             atomic_write(p, text.as_bytes()).with_context(|| format!("writing {}", p.display()))?;
             println!("wrote {}", p.display());
         }
