@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{read, run, stderr, sweep, write};
+use common::{read, run, stderr, sweep, write, QUICK};
 
 /// Three work-mode cases of 60 s simulated time (about a second of wall time each).
 const SLOW: &str = r#"
@@ -24,22 +24,6 @@ duration = 60.0
 [[axis]]
 name = "control.damping"
 values = [0.1, 0.2, 0.3]
-"#;
-
-/// Four quick static cases.
-const QUICK: &str = r#"
-[study]
-name = "quick"
-
-[design.generator]
-links = 5
-
-[static]
-samples = 32
-
-[[axis]]
-name = "design.links"
-values = [4, 5, 6, 7]
 "#;
 
 #[test]

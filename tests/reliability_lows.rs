@@ -5,22 +5,7 @@
 
 mod common;
 
-use common::{read, run, stderr, sweep, write};
-
-const QUICK: &str = r#"
-[study]
-name = "quick"
-
-[design.generator]
-links = 5
-
-[static]
-samples = 32
-
-[[axis]]
-name = "design.links"
-values = [4, 5, 6, 7]
-"#;
+use common::{read, run, stderr, sweep, write, QUICK};
 
 #[test]
 fn payload_volume_is_a_study_key_as_documented() {

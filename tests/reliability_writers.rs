@@ -11,22 +11,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{read, run, stderr, write};
-
-const QUICK: &str = r#"
-[study]
-name = "quick"
-
-[design.generator]
-links = 5
-
-[static]
-samples = 32
-
-[[axis]]
-name = "design.links"
-values = [4, 5, 6, 7]
-"#;
+use common::{read, run, stderr, write, QUICK};
 
 const SCENARIO: &str = r#"[scenario]
 name = "w"

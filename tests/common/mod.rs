@@ -8,6 +8,23 @@ pub mod leader;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// Four quick static cases (a 5-link generator body, 32 static samples, 4 to 7 links): the
+/// study the reliability tests run and corrupt.
+pub const QUICK: &str = r#"
+[study]
+name = "quick"
+
+[design.generator]
+links = 5
+
+[static]
+samples = 32
+
+[[axis]]
+name = "design.links"
+values = [4, 5, 6, 7]
+"#;
+
 /// The `usm-study` binary built for these tests.
 pub fn usm_study() -> Command {
     Command::new(env!("CARGO_BIN_EXE_usm-study"))
