@@ -24,6 +24,7 @@ pub mod dynamics;
 pub mod evaluate;
 pub mod input;
 pub mod kinematics;
+pub(crate) mod linalg;
 pub mod metrics;
 pub mod model;
 pub mod ocp;

@@ -1154,3 +1154,126 @@ fn sources_cite_the_repository_formulation() {
         "cite docs/model.md, not SPEC: {outside:?}"
     );
 }
+
+/// The items `error.rs` of a room defines (`struct`, `enum`, `fn`, `type` names).
+fn error_items(text: &str) -> BTreeSet<String> {
+    let toks = tokens(&strip(text));
+    toks.windows(2)
+        .filter(|w| matches!(w[0].as_str(), "struct" | "enum" | "fn" | "type"))
+        .map(|w| w[1].clone())
+        .collect()
+}
+
+/// Errors live in `error.rs` (issue 37 item 5): the `mod.rs` of no room directory defines an
+/// error type (`thiserror::Error`), and no file of a room with an `error.rs` imports one of its
+/// items through the room's `mod.rs` (`super::X`, `crate::room::X`) instead of `error::X`.
+fn error_placement(base: &Path) -> Vec<String> {
+    let mut bad = Vec::new();
+    let mut dirs = vec![base.join("src")];
+    while let Some(d) = dirs.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.path().is_dir() {
+                dirs.push(e.path());
+            }
+        }
+        let modrs = d.join("mod.rs");
+        if let Ok(t) = std::fs::read_to_string(&modrs) {
+            let s = strip(&t);
+            if s.contains("thiserror::Error") || s.contains("thiserror :: Error") {
+                bad.push(format!(
+                    "{}: defines an error (move it to error.rs)",
+                    rel(base, &modrs)
+                ));
+            }
+        }
+        let Ok(err) = std::fs::read_to_string(d.join("error.rs")) else {
+            continue;
+        };
+        let items = error_items(&err);
+        let room = rel(&base.join("src"), &d).replace('/', "::");
+        let mut children = Vec::new();
+        let mut stack = vec![d.clone()];
+        while let Some(p) = stack.pop() {
+            if p.is_dir() {
+                if let Ok(es) = std::fs::read_dir(&p) {
+                    stack.extend(es.flatten().map(|e| e.path()));
+                }
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                children.push(p);
+            }
+        }
+        for p in children {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            if name == "mod.rs" && p.parent() == Some(d.as_path()) || name == "error.rs" {
+                continue;
+            }
+            let text = strip(&std::fs::read_to_string(&p).unwrap());
+            let direct = p.parent() == Some(d.as_path());
+            let mut prefixes = vec![format!("crate::{room}::")];
+            prefixes.push(if direct { "super::" } else { "super::super::" }.to_string());
+            for stmt in text.split(';') {
+                let Some(u) = stmt.trim().strip_prefix("use ") else {
+                    continue;
+                };
+                let u: String = u.chars().filter(|c| !c.is_whitespace()).collect();
+                let Some(rest) = prefixes.iter().find_map(|pre| u.strip_prefix(pre.as_str()))
+                else {
+                    continue;
+                };
+                if rest.starts_with("error::") || (!direct && rest.starts_with("super::")) {
+                    continue;
+                }
+                let top: Vec<&str> = rest
+                    .trim_start_matches('{')
+                    .trim_end_matches('}')
+                    .split(',')
+                    .map(|x| x.split("::").next().unwrap_or(x))
+                    .collect();
+                for x in top.iter().filter(|x| items.contains(**x)) {
+                    bad.push(format!(
+                        "{}: imports `{x}` through the room's mod.rs (use {}error::{x})",
+                        rel(base, &p),
+                        prefixes[1]
+                    ));
+                }
+            }
+        }
+    }
+    bad.sort();
+    bad.dedup();
+    bad
+}
+
+#[test]
+fn errors_live_in_error_rs_and_are_imported_from_there() {
+    let bad = error_placement(&root());
+    assert!(bad.is_empty(), "errors out of place:\n{}", bad.join("\n"));
+}
+
+#[test]
+fn the_error_check_sees_an_error_in_mod_rs_and_an_import_through_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let room = dir.path().join("src/room");
+    std::fs::create_dir_all(&room).unwrap();
+    std::fs::write(
+        room.join("mod.rs"),
+        "mod error;\npub use error::RoomError;\n#[derive(thiserror::Error, Debug)]\n#[error(\"x\")]\npub struct Other;\n",
+    )
+    .unwrap();
+    std::fs::write(room.join("error.rs"), "pub struct RoomError;\n").unwrap();
+    std::fs::write(
+        room.join("child.rs"),
+        "use super::{Other, RoomError};\nuse super::error::RoomError as E;\n",
+    )
+    .unwrap();
+    let bad = error_placement(dir.path());
+    assert_eq!(bad.len(), 2, "{bad:?}");
+    assert!(
+        bad[0].contains("child.rs") && bad[0].contains("RoomError"),
+        "{bad:?}"
+    );
+    assert!(bad[1].contains("mod.rs: defines an error"), "{bad:?}");
+}

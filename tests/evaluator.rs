@@ -24,7 +24,7 @@ fn a_row_writes_the_evaluators_metrics_by_name_in_schema_order() {
     let cases = expand(&study, None).unwrap();
     let r = resolve_case(&study, &cases[1]).unwrap();
     let res = evaluate_resolved(&mut Evaluator::new(), &study, 1, &r, false, Deadline::NONE);
-    assert_eq!(res.status, CaseStatus::Ok, "{}", res.reason);
+    assert_eq!(res.status(), CaseStatus::Ok, "{}", res.reason);
     let expected: Vec<f64> = metric_columns(&study)
         .iter()
         .map(|c| res.metrics.value(c))

@@ -34,7 +34,7 @@
 //! Clarabel's does — no exact one-solve certificate.
 
 use super::conic::Params;
-use crate::dynamics::cholesky;
+use crate::linalg;
 
 /// Relative tolerance of the stationarity check: `|∇f(u)_j| ≤ CERT_TOL · a_j`, with `a_j` the
 /// sum of the magnitudes of the terms of `∇f(u)_j` (the componentwise backward-error scale).
@@ -73,11 +73,11 @@ impl InteriorQp {
             h[j * n + j] += p.w[j] + p.rate_w[j];
             u[j] = p.q * cj.dot(p.tau) + p.rate_w[j] * p.u_prev[j];
         }
-        let tol = cholesky::relative_tolerance(h, n);
-        if cholesky::factor(h, n, tol).is_err() {
+        let tol = linalg::relative_tolerance(h, n);
+        if linalg::factor(h, n, tol).is_err() {
             return false;
         }
-        cholesky::solve(h, n, u);
+        linalg::solve(h, n, u);
         stationary(p, u)
     }
 }

@@ -118,7 +118,7 @@ pub fn run_worlds(w: &Worlds, out: &Path) -> anyhow::Result<()> {
         "sampling": info.sampling,
         "params": info.params,
         "metrics": summary,
-        "status": row.status.as_str(),
+        "status": row.end.status().as_str(),
         "reason": row.reason,
     });
     // The one writer (issue 39): atomic and link-safe, like every other output.

@@ -13,7 +13,7 @@
 //! from USM-40/41 and the other axes get USM-34 with a zero reference
 //! ([`DynamicController::transport_control`]).
 
-use super::{check_nonneg, ControlError};
+use super::error::{check_nonneg, ControlError};
 use crate::spatial::Vec6;
 use nalgebra::Matrix6;
 use serde::{Deserialize, Serialize};

@@ -24,7 +24,7 @@
 //! The last segment (and any segment still waiting for a timed successor) extends as a line
 //! beyond its end.
 
-use super::{check_finite, check_nonneg, check_pos, ControlError};
+use super::error::{check_finite, check_nonneg, check_pos, ControlError};
 use crate::spatial::wrap_angle;
 use crate::spatial::Vec3;
 use serde::{Deserialize, Serialize};

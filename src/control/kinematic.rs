@@ -36,9 +36,10 @@
 //! regularisation and counted ([`PinvWorkspace::regularised`]); if that also fails (non-finite
 //! input) the contribution is zero and counted ([`PinvWorkspace::failed`]).
 
-use super::{check_nonneg, orientation_error, ControlError};
-use crate::dynamics::cholesky;
+use super::error::{check_nonneg, ControlError};
+use super::orientation_error;
 use crate::kinematics::BasePose;
+use crate::linalg;
 use crate::spatial::{stack, Mat3, Se3, Vec3, Vec6};
 use faer::{Mat, MatRef};
 use nalgebra::{Rotation3, UnitQuaternion};
@@ -136,7 +137,7 @@ impl PinvWorkspace {
             }
         };
         build(&mut self.a, 0.0);
-        if cholesky::factor(&mut self.a, task_dim, 0.0).is_ok() {
+        if linalg::factor(&mut self.a, task_dim, 0.0).is_ok() {
             return true;
         }
         build(&mut self.a, 0.0);
@@ -144,7 +145,7 @@ impl PinvWorkspace {
             .map(|r| self.a[r * task_dim + r].abs())
             .fold(0.0, f64::max);
         build(&mut self.a, 1e-12 * scale.max(1.0));
-        if cholesky::factor(&mut self.a, task_dim, 0.0).is_ok() {
+        if linalg::factor(&mut self.a, task_dim, 0.0).is_ok() {
             self.regularised += 1;
             true
         } else {
@@ -183,7 +184,7 @@ impl PinvWorkspace {
             return Ok(());
         }
         self.y[..task_dim].copy_from_slice(rhs);
-        cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
+        linalg::solve(&self.a, task_dim, &mut self.y[..task_dim]);
         for (c, o) in out.iter_mut().enumerate() {
             let mut acc = 0.0;
             for r in 0..task_dim {
@@ -216,7 +217,7 @@ impl PinvWorkspace {
             for r in 0..task_dim {
                 self.y[r] = j[(r, c)];
             }
-            cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
+            linalg::solve(&self.a, task_dim, &mut self.y[..task_dim]);
             for r in 0..task_dim {
                 out[(c, r)] = weight(u, c) * self.y[r];
             }
@@ -250,7 +251,7 @@ impl PinvWorkspace {
             for r in 0..task_dim {
                 self.y[r] = j[(r, b)];
             }
-            cholesky::solve(&self.a, task_dim, &mut self.y[..task_dim]);
+            linalg::solve(&self.a, task_dim, &mut self.y[..task_dim]);
             for a in 0..n {
                 let wa = weight(u, a);
                 if wa == 0.0 {

@@ -26,6 +26,7 @@
 //! the yaw of its x axis about the inertial +z axis, `ψ = atan2(R₁₀, R₀₀)`.
 
 pub mod dynamic;
+mod error;
 pub mod guidance;
 pub mod kinematic;
 pub mod quintic;
@@ -39,9 +40,10 @@ pub mod work;
 
 use crate::spatial::{quat_error_vec, Vec3};
 use nalgebra::UnitQuaternion;
-use thiserror::Error;
 
 pub use dynamic::{DynamicController, DynamicGains, DynamicOutput};
+pub(crate) use error::check_nonneg;
+pub use error::ControlError;
 pub use guidance::{LosGuidance, LosOutput, PathSpec, SegmentSpec};
 pub use kinematic::{
     base_position_jacobian, damped_weighted_pinv, ee_pose, ee_pose_error, InertialTask,
@@ -57,54 +59,6 @@ pub use transport::{
     TransportMeasurement, TransportMethod, TransportOutput, YawRateSource,
 };
 pub use work::{WorkController, WorkGains, WorkOutput, WorkTarget};
-
-/// Invalid control settings or inputs: the key path of the offending value and what is wrong
-/// (e.g. `path.segments[2]: zero length`).
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("{key}: {message}")]
-pub struct ControlError {
-    /// Key path, e.g. `transport.k_psi`.
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl ControlError {
-    /// A new error at `key`.
-    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            key: key.into(),
-            message: message.into(),
-        }
-    }
-}
-
-/// Check that `x` is finite; the error names `key`.
-pub(crate) fn check_finite(key: &str, x: f64) -> Result<(), ControlError> {
-    if x.is_finite() {
-        Ok(())
-    } else {
-        Err(ControlError::new(key, format!("must be finite, got {x}")))
-    }
-}
-
-/// Check that `x` is finite and `>= 0`.
-pub(crate) fn check_nonneg(key: &str, x: f64) -> Result<(), ControlError> {
-    check_finite(key, x)?;
-    if x < 0.0 {
-        return Err(ControlError::new(key, format!("must be >= 0, got {x}")));
-    }
-    Ok(())
-}
-
-/// Check that `x` is finite and `> 0`.
-pub(crate) fn check_pos(key: &str, x: f64) -> Result<(), ControlError> {
-    check_finite(key, x)?;
-    if x <= 0.0 {
-        return Err(ControlError::new(key, format!("must be > 0, got {x}")));
-    }
-    Ok(())
-}
 
 /// Orientation error `ε̃` of the end-effector task (docs/model.md §5, USM-42): the vector part of the
 /// error quaternion `q⁻¹ ⊗ q_d` (sign chosen with a non-negative scalar part), i.e. the rotation

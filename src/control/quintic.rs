@@ -8,7 +8,7 @@
 //! their end points (the paper's straight-line end-effector path), so a vector reference is one
 //! [`Quintic`] per component.
 
-use super::{check_finite, check_pos, ControlError};
+use super::error::{check_finite, check_pos, ControlError};
 
 /// A scalar quintic reference from `from` to `to` over `duration` seconds, starting at `t = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -18,8 +18,8 @@
 //! `V_e,d = [R_Ie^T ṗ; R_Ie^T E(φ, θ, ψ) [φ̇; θ̇; ψ̇]]` in the measured `F_e` (USM-42), with
 //! `E` the ZYX angle-rate matrix ([`zyx_rate_matrix`]).
 
+use super::error::{check_finite, ControlError};
 use super::quintic::Quintic;
-use super::{check_finite, ControlError};
 use crate::spatial::{Mat3, Vec3, Vec6};
 use nalgebra::UnitQuaternion;
 use std::f64::consts::TAU;

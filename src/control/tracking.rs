@@ -12,8 +12,9 @@
 //! [`TrackingGains::feedforward`] the reference's base wrench (brought into `F_b` by `R̃`) is
 //! added to the dynamic control's `τ_c`.
 
+use super::error::{check_nonneg, ControlError};
+use super::orientation_error;
 use super::reference::Reference;
-use super::{check_nonneg, orientation_error, ControlError};
 use crate::kinematics::BasePose;
 use crate::spatial::{Vec3, Vec6};
 use serde::{Deserialize, Serialize};

@@ -81,9 +81,9 @@
 //!   `k_ψ(ψ − ψ_r) ≈ 0.44 rad` while USM-41's `k_6d` term reacts to the head's resulting yaw
 //!   rate; ω_n = 1 rad/s halves it. We keep the servo and report it.
 
+use super::error::{check_finite, check_nonneg, check_pos, ControlError};
 use super::guidance::{LosGuidance, LosOutput, PathSpec};
 use super::kinematic::SecondaryTasks;
-use super::{check_finite, check_nonneg, check_pos, ControlError};
 use crate::kinematics::{BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{ang, lin, Vec3, Vec6};

@@ -26,11 +26,11 @@
 //! joint rate references `q̇_r`; the joint angle references `q_r` are their time integral, kept
 //! in the controller and clamped to the joint limits.
 
+use super::error::{check_nonneg, ControlError};
 use super::kinematic::{
     base_position_jacobian, ee_pose, ee_pose_error, JointLimitSettings, JointLimitTask,
     SecondaryTasks, Srmtp, TaskInverse,
 };
-use super::{check_nonneg, ControlError};
 use crate::kinematics::{ee_jacobian, BasePose, KinWorkspace};
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};

@@ -14,6 +14,7 @@
 //! Frames and names as in [`super::workspace`]; `s_i = [0; axis_k]` is joint `k = i − 1`'s
 //! unit twist in body `i`'s frame. Nothing here allocates.
 
+use super::error::{check_finite, DynError};
 use super::passes::{
     backward_pass, body_forces, composites, forward_pass, inertia_to_parent, needs_orientation,
     orientation_pass,
@@ -23,7 +24,7 @@ use super::structure::{
     joint_component, twist_to_child, wrench_to_parent,
 };
 use super::workspace::DynWorkspace;
-use super::{check_finite, DynError, DynOptions};
+use super::DynOptions;
 use crate::kinematics::{forward_kinematics, BasePose};
 use crate::model::Vehicle;
 use crate::spatial::{Mat6, Vec6};

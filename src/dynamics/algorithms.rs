@@ -17,14 +17,15 @@
 //! [`Simulator`](super::Simulator) and [`inspect_dynamics`](super::inspect_dynamics) check
 //! lengths of user input and return errors instead.
 
-use super::cholesky;
+use super::error::{check_finite, DynError};
 use super::passes::{
     backward_pass, body_current, body_forces, crba, forward_pass, needs_orientation,
     orientation_pass, relative_twist,
 };
 use super::workspace::DynWorkspace;
-use super::{check_finite, DynError, DynOptions};
+use super::DynOptions;
 use crate::kinematics::{forward_kinematics, BasePose};
+use crate::linalg;
 use crate::model::Vehicle;
 use crate::spatial::Vec6;
 use nalgebra::{Matrix6, Vector6};
@@ -128,8 +129,8 @@ pub fn solve_forward(ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), DynError>
         ws.rhs[r] = t - ws.bias[r];
     }
     // M must be numerically non-singular: pivots below n·ε·max|M_jj| are an error.
-    let tol = cholesky::relative_tolerance(&ws.chol, nv);
-    cholesky::factor(&mut ws.chol, nv, tol).map_err(|f| {
+    let tol = linalg::relative_tolerance(&ws.chol, nv);
+    linalg::factor(&mut ws.chol, nv, tol).map_err(|f| {
         DynError::new(
             "mass_matrix",
             format!(
@@ -138,7 +139,7 @@ pub fn solve_forward(ws: &mut DynWorkspace, tau: &[f64]) -> Result<(), DynError>
             ),
         )
     })?;
-    cholesky::solve(&ws.chol, nv, &mut ws.rhs);
+    linalg::solve(&ws.chol, nv, &mut ws.rhs);
     ws.zeta_dot.copy_from_slice(&ws.rhs);
     check_finite("base_acceleration", &ws.zeta_dot[..6])?;
     check_finite("joint_accelerations", &ws.zeta_dot[6..])

@@ -2,7 +2,8 @@
 //! [`ServoModel`], the [`ThrusterModel`], the time [`Integrator`] and the [`SimConfig`] that
 //! bundles them with the [`DynOptions`], each default beside its field and a `validate()`.
 
-use super::{DynOptions, SimError};
+use super::error::SimError;
+use super::DynOptions;
 
 /// Joint servo model (docs/model.md §4 joint actuation).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,8 +2,9 @@
 //! as a serialisable report (not a hot path: it allocates).
 
 use super::algorithms::{dynamics_terms, solve_forward};
+use super::error::{check_finite, DynError};
 use super::workspace::DynWorkspace;
-use super::{check_finite, DynError, DynOptions, SimState};
+use super::{DynOptions, SimState};
 use crate::model::Vehicle;
 use nalgebra::DMatrix;
 use serde::Serialize;

@@ -13,7 +13,7 @@
 //!
 //! Every buffer lives in [`Dopri5`], sized once: stepping allocates nothing.
 
-use super::DynError;
+use super::error::DynError;
 
 /// Iteration cap of [`Dopri5::span`]: trial steps (accepted or rejected) over one span. The
 /// step-size floor alone (1e-12 of the span) would allow 1e12 steps; a run needing more than

@@ -22,8 +22,8 @@
 //! - [`algorithms`]: composite-rigid-body mass matrix ([`mass_matrix`]), recursive
 //!   Newton–Euler bias forces ([`bias`]) and inverse dynamics, forward and hybrid dynamics,
 //!   energy and momentum;
-//! - `cholesky`: the one dense Cholesky factorisation of the crate (forward dynamics and the
-//!   kinematic-control pseudoinverse);
+//! - `error`: [`DynError`] (a dynamics algorithm's numerical failure), [`SimError`] (with the
+//!   simulation time) and the finiteness check;
 //! - [`config`]: the servo and thruster models and the [`SimConfig`] (defaults, `validate()`);
 //! - [`sim`]: the servo laws, the flat Lie-group state and the [`Simulator`];
 //!   `thruster_lag`: the thruster lag and rate limit in closed form;
@@ -38,8 +38,8 @@
 
 pub mod aba;
 pub mod algorithms;
-pub(crate) mod cholesky;
 pub mod config;
+mod error;
 pub mod hydro;
 pub mod hydrostatics;
 pub mod inspect;
@@ -61,12 +61,11 @@ pub use algorithms::{
     spatial_momentum,
 };
 pub use config::{Integrator, ServoModel, SimConfig, ThrusterModel};
+pub use error::{DynError, SimError};
 pub use inspect::{inspect_dynamics, DynamicsReport};
 pub use integrator::StepStats;
 pub use sim::{ActuatorCommand, SimState, Simulator};
 pub use workspace::DynWorkspace;
-
-use thiserror::Error;
 
 /// Which physical effects enter the dynamics (docs/model.md §4).
 ///
@@ -113,65 +112,5 @@ impl DynOptions {
 impl Default for DynOptions {
     fn default() -> Self {
         Self::full()
-    }
-}
-
-/// A numerical failure of a dynamics algorithm (no simulation time attached): a singular
-/// mass matrix or a non-finite quantity, named by `quantity` (e.g. `mass_matrix`,
-/// `bias[3]`), or a slice of the wrong length.
-#[derive(Clone, Debug, Error, PartialEq)]
-#[error("{quantity} {message}")]
-pub struct DynError {
-    /// The offending quantity, e.g. `mass_matrix` or `joint_accelerations[2]`.
-    pub quantity: String,
-    /// What is wrong with it.
-    pub message: String,
-}
-
-impl DynError {
-    /// A new error about `quantity`.
-    pub fn new(quantity: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            quantity: quantity.into(),
-            message: message.into(),
-        }
-    }
-
-    /// Attach the simulation time `t` [s].
-    pub fn at(self, time: f64) -> SimError {
-        SimError {
-            time,
-            quantity: self.quantity,
-            message: self.message,
-        }
-    }
-}
-
-/// A simulation failure: at simulation time `time` [s], `quantity` (e.g. `joint_rates[3]`)
-/// is wrong (`message`, e.g. "is NaN"). Configuration errors found before the run starts
-/// carry `time = 0`. The simulator never panics and never continues with a NaN.
-#[derive(Clone, Debug, Error, PartialEq)]
-#[error("{quantity} {message} at t = {time:.6} s")]
-pub struct SimError {
-    /// Simulation time [s] at which the problem was detected.
-    pub time: f64,
-    /// The offending quantity, e.g. `joint_rates[3]`, `mass_matrix`, `config.servo.omega_n`.
-    pub quantity: String,
-    /// What is wrong with it.
-    pub message: String,
-}
-
-/// `Err` naming the first non-finite entry of `x` as `name[i]`.
-pub(crate) fn check_finite(name: &str, x: &[f64]) -> Result<(), DynError> {
-    match x.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(DynError::new(
-            format!("{name}[{i}]"),
-            if x[i].is_nan() {
-                "is NaN"
-            } else {
-                "is infinite"
-            },
-        )),
     }
 }

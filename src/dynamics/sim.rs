@@ -49,9 +49,10 @@
 use super::aba::{aba_after_position, hybrid_terms, solve_hybrid_on};
 use super::algorithms::{kinetic_energy, spatial_momentum};
 use super::config::{config_err, Integrator, ServoModel, SimConfig, ThrusterModel};
+use super::error::{check_finite, DynError, SimError};
 use super::integrator::{rk4_step, Dopri5, Quadrature, StepStats, Tolerance};
 use super::thruster_lag::ThrusterDyn;
-use super::{check_finite, DynError, DynWorkspace, SimError};
+use super::DynWorkspace;
 use crate::kinematics::{thruster_column, BasePose};
 use crate::model::Vehicle;
 use crate::spatial::{Vec3, Vec6};

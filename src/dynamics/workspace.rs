@@ -81,7 +81,7 @@ pub struct DynWorkspace {
     pub(super) comp_twist: Vec<Vec6>,
     /// Thrust wrench of each body in `F_b` (the simulator's O(n + m) generalised thrust).
     pub(super) thrust_body: Vec<Vec6>,
-    /// Cholesky factor scratch, column-major lower triangle (`cholesky::factor`).
+    /// Cholesky factor scratch, column-major lower triangle (`crate::linalg::factor`).
     pub(super) chol: Vec<f64>,
     /// Right-hand-side scratch (6+n).
     pub(super) rhs: Vec<f64>,

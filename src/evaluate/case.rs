@@ -13,7 +13,7 @@ use super::metrics::{
     TCM_COLUMNS,
 };
 use super::static_table::{authority_spec, static_spec, STATIC_TABLE};
-use super::status::{missed_criterion, CaseStatus};
+use super::status::{CaseEnd, CaseStatus, Disqualification, PANIC, UNDER_ACTUATED};
 use crate::input::keypath::{set, Seg, SetError};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
@@ -94,9 +94,10 @@ pub struct CaseInput<'a> {
 pub struct CaseResult {
     /// Named metrics: design columns, static columns, run metrics, in that order.
     pub metrics: Metrics,
-    /// How the case ended.
-    pub status: CaseStatus,
-    /// Why it was not `ok` (for `unsuccessful`: `criterion: detail`); empty when `ok`.
+    /// How the case ended, with its data ([`CaseEnd::status`] is the `status` column).
+    pub end: CaseEnd,
+    /// Why it was not `ok`, for people (for `unsuccessful`: `criterion: detail`); empty when
+    /// `ok`. Nothing reads meaning back out of it: that is [`CaseResult::end`].
     pub reason: String,
     /// The closed loop's trajectory (when asked for and the run produced one).
     pub trajectory: Option<Table>,
@@ -106,31 +107,37 @@ impl CaseResult {
     fn new() -> Self {
         CaseResult {
             metrics: Metrics::new(),
-            status: CaseStatus::Ok,
+            end: CaseEnd::Ok,
             reason: String::new(),
             trajectory: None,
         }
     }
 
-    fn end(&mut self, status: CaseStatus, reason: impl Into<String>) {
-        self.status = status;
+    /// End the case with `end` for `reason` (the text for people).
+    pub fn finish(&mut self, end: CaseEnd, reason: impl Into<String>) {
+        self.end = end;
         self.reason = reason.into();
+    }
+
+    /// The `status` column of the case.
+    pub fn status(&self) -> CaseStatus {
+        self.end.status()
     }
 
     /// Whether every phase ran and every `[success]` criterion was met.
     pub fn success(&self) -> bool {
-        self.status == CaseStatus::Ok
+        self.end == CaseEnd::Ok
     }
 
     /// The criterion the case missed (`no_failure` for a failed case), see
-    /// [`missed_criterion`].
-    pub fn criterion(&self) -> Option<&str> {
-        missed_criterion(self.status, &self.reason)
+    /// [`CaseEnd::criterion`].
+    pub fn criterion(&self) -> Option<&'static str> {
+        self.end.criterion()
     }
 
     /// Why the case failed or could not be set up (`None` for `ok` and `unsuccessful`).
     pub fn failure(&self) -> Option<&str> {
-        matches!(self.status, CaseStatus::Failed | CaseStatus::Skipped).then_some(&*self.reason)
+        matches!(self.status(), CaseStatus::Failed | CaseStatus::Skipped).then_some(&*self.reason)
     }
 }
 
@@ -159,7 +166,12 @@ impl Evaluator {
                 .map(|s| s.to_string())
                 .or_else(|| p.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown panic".into());
-            out.end(CaseStatus::Failed, format!("panic: {msg}"));
+            out.finish(
+                CaseEnd::Panic {
+                    message: msg.clone(),
+                },
+                format!("{PANIC}{msg}"),
+            );
             out.trajectory = None;
             self.cache = None;
         }
@@ -176,7 +188,7 @@ impl Evaluator {
                     edited = t;
                     (&edited.0, &edited.1)
                 }
-                Err(e) => return out.end(CaseStatus::Skipped, e.to_string()),
+                Err(e) => return out.finish(CaseEnd::Skipped, e.to_string()),
             }
         };
         let Some(v) = self.vehicle(input, design, out) else {
@@ -203,7 +215,7 @@ impl Evaluator {
             match parse_design_table(design, input.label) {
                 Ok(v) => self.cache = Some((key, v)),
                 Err(e) => {
-                    out.end(CaseStatus::Skipped, format!("invalid design: {e}"));
+                    out.finish(CaseEnd::Skipped, format!("invalid design: {e}"));
                     return None;
                 }
             }
@@ -265,14 +277,14 @@ fn static_phase(
     let spec = match static_spec(scenario, derive_seed(input.seed, 1)) {
         Ok(s) => s,
         Err(m) => {
-            out.end(CaseStatus::Skipped, m.to_string());
+            out.finish(CaseEnd::Skipped, m.to_string());
             return false;
         }
     };
     let auth = match authority_spec(scenario) {
         Ok(s) => s,
         Err(m) => {
-            out.end(CaseStatus::Skipped, m.to_string());
+            out.finish(CaseEnd::Skipped, m.to_string());
             return false;
         }
     };
@@ -290,17 +302,19 @@ fn static_phase(
             true
         }
         Err(e) => {
-            out.end(CaseStatus::Failed, static_failure(e));
+            let (end, reason) = static_failure(e);
+            out.finish(end, reason);
             false
         }
     }
 }
 
-/// The reason of a failed static phase: a sink's own message (the deadline), else the error.
-fn static_failure(e: StaticError) -> String {
+/// The ending and reason of a failed static phase: a sink's own message (the deadline, its
+/// only sink error here: a timeout), else the error.
+fn static_failure(e: StaticError) -> (CaseEnd, String) {
     match e {
-        StaticError::Sink(m) => m.to_string(),
-        e => e.to_string(),
+        StaticError::Sink(m) => (CaseEnd::Timeout, m.to_string()),
+        e => (CaseEnd::Error, e.to_string()),
     }
 }
 
@@ -316,7 +330,7 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     let log = input.trajectory || margin;
     let mut run = match crate::outcome::run_case(v, &sc, input.seed, log, stop) {
         Ok(r) => r,
-        Err(e) => return out.end(CaseStatus::Failed, e.to_string()),
+        Err(e) => return out.finish(CaseEnd::Error, e.to_string()),
     };
     if margin {
         let m = run_authority_margin(v, &sc, &run);
@@ -329,21 +343,26 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
         .trajectory
         .map(|t| crate::report::figures::trajectory_table(&t))
     {
-        Some(Err(e)) => return out.end(CaseStatus::Failed, e.to_string()),
+        Some(Err(e)) => return out.finish(CaseEnd::Error, e.to_string()),
         t => t.and_then(Result::ok),
     };
     if let Some(f) = run.failure {
-        out.end(CaseStatus::Failed, f);
-    } else if let Some(axes) = under_actuated(out) {
-        out.end(
-            CaseStatus::Unsuccessful,
+        let end = if f.timeout {
+            CaseEnd::Timeout
+        } else {
+            CaseEnd::Diverged { at: f.at }
+        };
+        out.finish(end, f.reason);
+    } else if let Some((mask, axes)) = under_actuated(out) {
+        out.finish(
+            CaseEnd::Disqualified(Disqualification::UnderActuated { axes: mask }),
             format!(
-                "under_actuated: no authority over the commanded {axes} anywhere in the sampled \
-                 joint space (static analysis); not ranked whatever its run did"
+                "{UNDER_ACTUATED}: no authority over the commanded {axes} anywhere in the \
+                 sampled joint space (static analysis); not ranked whatever its run did"
             ),
         );
     } else if let Some(m) = run.missed {
-        out.end(CaseStatus::Unsuccessful, m);
+        out.finish(CaseEnd::missed(m.criterion), m.to_string());
     }
     out.metrics.extend(run.metrics);
     out.trajectory = trajectory;
@@ -355,10 +374,10 @@ pub const AUTHORITY_MARGIN: &str = "authority_margin";
 /// Configurations of a run's log at which its authority margin is measured (evenly spaced).
 const MARGIN_CONFIGS: usize = 15;
 
-/// The commanded axes a static analysis found unattainable everywhere (its
-/// `under_actuated_axes` bit mask, surge = 1 … yaw = 32), as words; `None` when it found
-/// none or did not run.
-fn under_actuated(out: &CaseResult) -> Option<String> {
+/// The commanded axes a static analysis found unattainable everywhere: its
+/// `under_actuated_axes` bit mask (surge = 1 … yaw = 32) and the axes as words; `None` when
+/// it found none or did not run.
+fn under_actuated(out: &CaseResult) -> Option<(u32, String)> {
     if out.metrics.get("under_actuated") != Some(1.0) {
         return None;
     }
@@ -368,11 +387,14 @@ fn under_actuated(out: &CaseResult) -> Option<String> {
         .filter(|k| mask & (1 << k) != 0)
         .map(|k| names[k])
         .collect();
-    Some(if axes.is_empty() {
-        "axes".into()
-    } else {
-        axes.join(", ")
-    })
+    Some((
+        mask,
+        if axes.is_empty() {
+            "axes".into()
+        } else {
+            axes.join(", ")
+        },
+    ))
 }
 
 /// `authority_margin` of a run (docs/model.md §6): the smallest ratio, over the commanded axes

@@ -43,7 +43,7 @@ fn input<'a>(
 fn a_static_case_has_its_design_and_tcm_metrics_by_name() {
     let (d, s) = (design(), static_scenario(64));
     let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
-    assert_eq!(r.status, CaseStatus::Ok, "{}", r.reason);
+    assert_eq!(r.status(), CaseStatus::Ok, "{}", r.reason);
     assert!(r.success() && r.criterion().is_none() && r.failure().is_none());
     assert_eq!(
         r.metrics.len(),
@@ -71,7 +71,7 @@ fn a_static_case_has_its_authority_columns_and_bad_authority_keys_skip_it() {
     )
     .unwrap();
     let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
-    assert_eq!(r.status, CaseStatus::Ok, "{}", r.reason);
+    assert_eq!(r.status(), CaseStatus::Ok, "{}", r.reason);
     let m = |n: &str| r.metrics.value(n);
     assert!(m("authority_roll_pos").is_nan() && m("authority_surge_pos") > 0.0);
     assert_eq!(m("under_actuated"), 0.0);
@@ -96,7 +96,7 @@ fn a_static_case_has_its_authority_columns_and_bad_authority_keys_skip_it() {
         ))
         .unwrap();
         let r = Evaluator::new().evaluate(&input(&d, &s, &[], Deadline::NONE));
-        assert_eq!(r.status, CaseStatus::Skipped, "{bad}");
+        assert_eq!(r.status(), CaseStatus::Skipped, "{bad}");
         let key = bad.split(' ').next().unwrap();
         assert!(r.reason.contains(key), "{bad}: {}", r.reason);
     }
@@ -107,7 +107,7 @@ fn an_invalid_design_is_skipped_and_a_bad_override_too() {
     let bad: toml::Table = toml::from_str("preset = \"no-such-preset\"\n").unwrap();
     let s = static_scenario(8);
     let r = Evaluator::new().evaluate(&input(&bad, &s, &[], Deadline::NONE));
-    assert_eq!(r.status, CaseStatus::Skipped);
+    assert_eq!(r.status(), CaseStatus::Skipped);
     assert!(r.reason.starts_with("invalid design: "), "{}", r.reason);
     assert!(r.metrics.is_empty());
     assert_eq!(r.failure(), Some(r.reason.as_str()));
@@ -119,7 +119,7 @@ fn an_invalid_design_is_skipped_and_a_bad_override_too() {
         shown: "design.preset[3]".into(),
     }];
     let r = Evaluator::new().evaluate(&input(&d, &s, &o, Deadline::NONE));
-    assert_eq!(r.status, CaseStatus::Skipped);
+    assert_eq!(r.status(), CaseStatus::Skipped);
     assert!(r.reason.contains("design.preset[3]"), "{}", r.reason);
 }
 
@@ -136,7 +136,7 @@ fn overrides_change_the_case_and_key_the_design_cache() {
     }];
     // Same design hash, other design: the cache must not serve the nominal vehicle.
     let other = ev.evaluate(&input(&d, &s, &o, Deadline::NONE));
-    assert_eq!(other.status, CaseStatus::Ok, "{}", other.reason);
+    assert_eq!(other.status(), CaseStatus::Ok, "{}", other.reason);
     assert_ne!(
         other.metrics.get("design_thrusters"),
         nominal.metrics.get("design_thrusters")
@@ -148,7 +148,7 @@ fn overrides_change_the_case_and_key_the_design_cache() {
         shown: "static.samples".into(),
     }];
     let r = ev.evaluate(&input(&d, &s, &so, Deadline::NONE));
-    assert_ne!(r.status, CaseStatus::Ok, "0 samples must not pass");
+    assert_ne!(r.status(), CaseStatus::Ok, "0 samples must not pass");
 }
 
 #[test]
@@ -156,12 +156,13 @@ fn a_passed_deadline_stops_the_static_analysis_with_the_sweeps_message() {
     let (d, s) = (design(), static_scenario(20_000));
     let past = Deadline::at(Instant::now() - Duration::from_millis(1));
     let r = Evaluator::new().evaluate(&input(&d, &s, &[], past));
-    assert_eq!(r.status, CaseStatus::Failed);
+    assert_eq!(r.status(), CaseStatus::Failed);
     assert_eq!(
         r.reason,
         "timeout: the case's wall-clock budget ran out in the static analysis"
     );
     assert_eq!(r.criterion(), Some("no_failure"));
+    assert!(r.end.timed_out(), "{:?}", r.end);
     // The design columns computed before the deadline are kept.
     assert_eq!(r.metrics.len(), DESIGN_COLUMNS.len());
 }

@@ -6,8 +6,9 @@
 //! module `k` (between link `k-1` and link `k`) is body `2k-1`. Each module carries a yaw
 //! joint (z) at its rear face and a pitch joint (y) at its front face, like `usm-paper`.
 
+use super::error::ModelError;
 use super::presets::{face_joint, neutral_body, thruster};
-use super::{Fluid, Hydro, ModelError, Thruster, Vehicle};
+use super::{Fluid, Hydro, Thruster, Vehicle};
 use crate::spatial::{Se3, Vec3};
 use std::f64::consts::PI;
 use std::fmt;

@@ -7,6 +7,7 @@
 //! vehicle body with thrusters followed by thruster-less links (docs/model.md §8).
 
 pub mod design;
+mod error;
 pub mod generator;
 pub mod ledger;
 pub mod manoeuvring;
@@ -14,10 +15,11 @@ pub mod presets;
 pub mod urdf;
 pub mod world;
 
+pub use error::ModelError;
+
 use crate::spatial::{rigid_inertia, Mat3, Mat6, Se3, Vec3};
 use nalgebra::Vector6;
 use std::f64::consts::PI;
-use thiserror::Error;
 
 /// Default water density [kg/m³] (docs/model.md §2, ρ = 1026).
 pub const RHO_SEAWATER: f64 = 1026.0;
@@ -362,26 +364,6 @@ pub struct Vehicle {
     pub end_effector: Se3,
     /// The surrounding fluid.
     pub fluid: Fluid,
-}
-
-/// An invalid model: what is wrong and where (a key path such as `body[2].mass`).
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("{key}: {message}")]
-pub struct ModelError {
-    /// Key path of the offending value, e.g. `thruster[3].direction`.
-    pub key: String,
-    /// What is wrong with it.
-    pub message: String,
-}
-
-impl ModelError {
-    /// A new error at `key`.
-    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            key: key.into(),
-            message: message.into(),
-        }
-    }
 }
 
 fn finite_pos(key: String, v: f64) -> Result<(), ModelError> {

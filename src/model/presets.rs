@@ -1,6 +1,7 @@
 //! Named designs: `usm-paper` (docs/model.md §2, USM Table II) and `uvms-planar` (docs/model.md §8).
 
-use super::{Body, Fluid, Hydro, Joint, ModelError, Thruster, Vehicle};
+use super::error::ModelError;
+use super::{Body, Fluid, Hydro, Joint, Thruster, Vehicle};
 use crate::spatial::{Mat3, Se3, Vec3};
 use std::f64::consts::FRAC_PI_2;
 

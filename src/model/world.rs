@@ -5,7 +5,8 @@
 //!
 //! The nominal scales ([`ModelScales::default`]) change nothing, bit for bit.
 
-use super::{Hydro, ModelError, Vehicle};
+use super::error::ModelError;
+use super::{Hydro, Vehicle};
 use crate::spatial::{Mat3, Vec3};
 
 /// Scale factors applied to every body and thruster of a design (dimensionless).

@@ -8,4 +8,7 @@ mod run;
 pub mod run_summary;
 pub mod success;
 
-pub use run::{run_case, run_scenario, run_scenario_until, CaseRun, RunResult, FAULT_TIME_METRIC};
+pub use run::{
+    run_case, run_scenario, run_scenario_until, CaseRun, RunResult, RunStopped, FAULT_TIME_METRIC,
+    RUN_STOPPED,
+};

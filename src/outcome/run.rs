@@ -109,11 +109,26 @@ pub struct CaseRun {
     /// The trajectory, when asked for.
     pub trajectory: Option<Trajectory>,
     /// Why the run stopped early, if it did.
-    pub failure: Option<String>,
-    /// The first success criterion the run missed, as `criterion: detail`
-    /// ([`crate::scenario::success::Missed`]; `no_failure` for a run that stopped early); `None` when it met
-    /// them all.
-    pub missed: Option<String>,
+    pub failure: Option<RunStopped>,
+    /// The first success criterion the run missed (`no_failure` for a run that stopped
+    /// early); `None` when it met them all.
+    pub missed: Option<Missed>,
+}
+
+/// The text the reason of a run that stopped early (not at its deadline) starts with
+/// (`run stopped at t = … s: cause`).
+pub const RUN_STOPPED: &str = "run stopped at t = ";
+
+/// Why a case's run stopped early.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunStopped {
+    /// Simulation time it stopped at [s].
+    pub at: f64,
+    /// Whether the case's wall-clock budget ran out (else the run failed: non-finite state,
+    /// singular mass matrix, …).
+    pub timeout: bool,
+    /// The reason, one line (`timeout: …` or `run stopped at t = … s: cause`).
+    pub reason: String,
 }
 
 /// Run one sweep case. `seed` is accepted for scenarios with random elements (none yet: the
@@ -133,18 +148,24 @@ pub fn run_case(
         metrics: r.metrics,
         trajectory: if log { Some(r.trajectory) } else { None },
         failure: r.failure.map(|(t, c)| {
-            if c == TIMEOUT {
+            let timeout = c == TIMEOUT;
+            let reason = if timeout {
                 format!(
                     "{TIMEOUT}: the case's wall-clock budget ran out at t = {} s",
                     crate::input::located::fmt_fixed(t, 3)
                 )
             } else {
                 format!(
-                    "run stopped at t = {} s: {c}",
+                    "{RUN_STOPPED}{} s: {c}",
                     crate::input::located::fmt_fixed(t, 3)
                 )
+            };
+            RunStopped {
+                at: t,
+                timeout,
+                reason,
             }
         }),
-        missed: r.missed.map(|m| m.to_string()),
+        missed: r.missed,
     })
 }

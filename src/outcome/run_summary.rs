@@ -14,8 +14,9 @@ use crate::scenario::recorder::AllocationCounts;
 use crate::scenario::success::Missed;
 use crate::spatial::wrap_angle;
 
-/// Named metrics in the order they are added.
-type Metrics = Vec<(String, f64)>;
+/// A run's metrics as (name, value) pairs in order, before the evaluator files them into its one
+/// `crate::evaluate::Metrics` row (named apart from it: this is not the row type).
+type RunValues = Vec<(String, f64)>;
 
 /// The metrics of every mode, in the order [`run_summary`] adds them (documented at
 /// [`common_metrics`]). Each name list below is the one declaration of its metrics: the code
@@ -143,7 +144,7 @@ pub fn is_run_metric(mode: Mode, name: &str) -> bool {
 }
 
 /// Append `values` under the declared `names` (same length by construction).
-fn add_all<const N: usize>(out: &mut Metrics, names: &[&str; N], values: [f64; N]) {
+fn add_all<const N: usize>(out: &mut RunValues, names: &[&str; N], values: [f64; N]) {
     out.extend(names.iter().zip(values).map(|(n, x)| (n.to_string(), x)));
 }
 
@@ -175,7 +176,7 @@ pub fn run_summary(
     counts: &AllocationCounts,
     energy: &EnergyMetrics,
 ) -> Vec<(String, f64)> {
-    let mut out = Metrics::new();
+    let mut out = RunValues::new();
     common_metrics(&mut out, file, run, traj, counts, energy);
     match file.scenario.mode {
         Mode::Transport => transport_metrics(&mut out, file, traj, energy),
@@ -229,7 +230,7 @@ pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Opt
 ///   along each base axis at a control tick (base frame, USM-33): the required wrench of
 ///   `authority_margin`.
 fn common_metrics(
-    out: &mut Metrics,
+    out: &mut RunValues,
     file: &ScenarioFile,
     run: RunFacts,
     traj: &Trajectory,
@@ -327,7 +328,7 @@ fn segment_runs(seg: &[f64]) -> Vec<(usize, usize)> {
 /// `[mission] tracking_weight`, J/m per m·s); the attitude and depth of the run
 /// ([`attitude_metrics`]).
 fn transport_metrics(
-    out: &mut Metrics,
+    out: &mut RunValues,
     file: &ScenarioFile,
     traj: &Trajectory,
     energy: &EnergyMetrics,
@@ -457,7 +458,7 @@ fn attitude_metrics(traj: &Trajectory) -> [f64; 3] {
 /// ([`roll_metrics`]), and how much the singularity-robust damping of `J_e^#` acted:
 /// `ee_damped_fraction` of the logged samples with λ > 0 and its largest value
 /// `ee_damping_max`.
-fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
+fn work_metrics(out: &mut RunValues, spec: &MetricsSpec, traj: &Trajectory) {
     let t = channel(traj, Channel::T);
     let ep = channel(traj, Channel::EePositionError);
     let ea = channel(traj, Channel::EeOrientationError);
@@ -493,7 +494,7 @@ fn work_metrics(out: &mut Metrics, spec: &MetricsSpec, traj: &Trajectory) {
 /// `ee_roll_max_settled_deg` and `ee_roll_std_deg`, its largest |deviation| and its standard
 /// deviation after the pose has settled (`settled` [s] from the start: the later of the
 /// position and orientation settling times; NaN when the pose never settles).
-fn roll_metrics(out: &mut Metrics, traj: &Trajectory, settled: f64) {
+fn roll_metrics(out: &mut RunValues, traj: &Trajectory, settled: f64) {
     let t = channel(traj, Channel::T);
     let er = channel(traj, Channel::EePose(Pose::Roll));
     let sr = channel(traj, Channel::Setpoint(Pose::Roll));

@@ -2,9 +2,9 @@
 //! (transport mode) and Fig. 9 (work mode), from a trajectory table. Columns are looked up
 //! by [`Channel`] (`t`, `ee_y`, `u_0`, … as named by [`Channel::name`]), no physics.
 
+use super::error::Result;
 use super::plot::{Colour, Figure, Panel, Series};
 use super::table::Table;
-use super::Result;
 use crate::scenario::channels::{Channel, Pose, Trajectory, Twist};
 use crate::scenario::config::Mode;
 

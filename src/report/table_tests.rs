@@ -1,9 +1,10 @@
 //! Tests of the tables, their CSV / Parquet files and the CSV float format.
 
 use super::*;
+use crate::report::error::ReportError;
 use crate::report::{
     read_csv, read_csv_typed, read_parquet, write_csv, write_csv_streamed, write_parquet,
-    CsvAppender, ReportError,
+    CsvAppender,
 };
 use std::io::Write;
 

@@ -51,11 +51,10 @@ use super::manifest::{
 };
 use super::outdir;
 use super::records::{
-    axis_text, compact, raw_schema, CaseStatus, Row, StatusCounts, HASH, PARTIAL_FILE,
+    axis_text, compact, raw_schema, CaseEnd, Row, StatusCounts, HASH, PARTIAL_FILE,
     PARTIAL_STUDY_FILE, STUDY_COPY,
 };
 use super::robust::{write_tables_with, RobustInfo};
-use super::runner::TIMEOUT;
 use super::schema::Study;
 use super::tune::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
@@ -502,8 +501,8 @@ fn stream_cases(
                 Msg::Row(row) => {
                     st.plan_hashes.insert(row.hash.clone());
                     st.progress.ran += 1;
-                    st.counts.add(row.status);
-                    if row.status == CaseStatus::Failed && row.reason.starts_with(TIMEOUT) {
+                    st.counts.add(row.end.status());
+                    if row.end.timed_out() {
                         st.timeouts += 1;
                     }
                     if write_error.is_none() {
@@ -554,7 +553,7 @@ fn process(
         Ok(r) => w.evaluate(study, case, &r, false, run.tuner).0,
         Err(reason) => {
             let mut row = Row::new(case.id, hash, case.values.clone());
-            row.end(CaseStatus::Skipped, &reason.to_string());
+            row.end(CaseEnd::Skipped, &reason.to_string());
             row
         }
     };

@@ -19,10 +19,10 @@
 
 use super::cases::Resolved;
 use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::records::{missed_criterion, CaseStatus, DESIGN_THRUSTERS};
+use super::records::DESIGN_THRUSTERS;
 use super::schema::Study;
 use super::worlds::{criterion_index, evaluate_phases, WorldTimeout};
-use crate::evaluate::{Deadline, Evaluator, Metrics, Phases, TIMEOUT};
+use crate::evaluate::{Deadline, Evaluator, Metrics, Phases};
 use crate::report::{fmt_short, MarkdownTable, Table};
 use crate::scenario::success::Criterion;
 use rayon::prelude::*;
@@ -88,12 +88,10 @@ pub fn score_faults(
             rf.scenario.insert("fault".into(), toml::Value::Table(spec));
             let res = evaluate_phases(evaluator, &rf, id, phases, false, deadline);
             FaultRun {
-                ok: res.status == CaseStatus::Ok,
+                ok: res.success(),
                 objective: res.metrics.value(&objective),
-                missed: missed_criterion(res.status, &res.reason)
-                    .and_then(Criterion::parse)
-                    .map_or(f64::NAN, criterion_index),
-                timeout: res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT),
+                missed: res.end.missed_criterion().map_or(f64::NAN, criterion_index),
+                timeout: res.end.timed_out(),
             }
         })
         .collect();

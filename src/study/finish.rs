@@ -7,7 +7,7 @@ use super::cases::{resolve_case, CaseError};
 use super::doe::expand;
 use super::error::{Notes, StudyError};
 use super::manifest::{read_manifest, Manifest};
-use super::records::{final_table, CaseStatus, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::rerank::Rerank;
 use super::schema::Study;
 use super::selection::Selection;
@@ -102,7 +102,7 @@ fn rerun_extremes(
             .filter(|s| s.is_finite() && *s > 0.0)
             .map(std::time::Duration::from_secs_f64);
         let res = evaluate_resolved(&mut ev, study, case.id, &r, true, Deadline::after(budget));
-        if res.status == CaseStatus::Failed && res.reason.starts_with(crate::evaluate::TIMEOUT) {
+        if res.end.timed_out() {
             return Err(RerunError::Timeout(res.reason));
         }
         if let Some(t) = res.trajectory {

@@ -17,7 +17,7 @@ pub use crate::evaluate::metrics::{
     AUTHORITY_COLUMNS, DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION,
     TCM_STRAIGHT_SIGMA_MIN,
 };
-pub use crate::evaluate::{missed_criterion, CaseStatus};
+pub use crate::evaluate::{CaseEnd, CaseStatus};
 
 /// Cases by status.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -225,9 +225,9 @@ pub struct Row {
     pub id: usize,
     /// Case hash.
     pub hash: String,
-    /// How the case ended.
-    pub status: CaseStatus,
-    /// Why it failed or was skipped (single line).
+    /// How the case ended ([`CaseEnd::status`] is its `status` cell).
+    pub end: CaseEnd,
+    /// Why it failed or was skipped (single line, for people).
     pub reason: String,
     /// Axis values.
     pub axes: Vec<toml::Value>,
@@ -242,7 +242,7 @@ impl Row {
         Row {
             id,
             hash,
-            status: CaseStatus::Ok,
+            end: CaseEnd::Ok,
             reason: String::new(),
             axes,
             metrics: Metrics::new(),
@@ -254,16 +254,16 @@ impl Row {
         Row {
             id,
             hash,
-            status: r.status,
+            end: r.end,
             reason: reason_cell(&r.reason),
             axes,
             metrics: r.metrics,
         }
     }
 
-    /// Mark the row as ended with `status` for `reason` (made one line).
-    pub fn end(&mut self, status: CaseStatus, reason: &str) {
-        self.status = status;
+    /// Mark the row as ended with `end` for `reason` (made one line).
+    pub fn end(&mut self, end: CaseEnd, reason: &str) {
+        self.end = end;
         self.reason = reason_cell(reason);
     }
 
@@ -288,7 +288,7 @@ impl Row {
         let mut v: Vec<Value<'a>> = vec![
             Value::I64(self.id as i64),
             Value::Str(&self.hash),
-            Value::Str(self.status.as_str()),
+            Value::Str(self.end.status().as_str()),
             Value::Str(&self.reason),
         ];
         for ((a, x), t) in study.axes.iter().zip(&self.axes).zip(texts) {

@@ -16,12 +16,12 @@ use std::path::Path;
 use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::error::StudyError;
 use super::records::{
-    final_table, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, REASON, STATUS,
+    final_table, CaseEnd, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, REASON,
+    STATUS,
 };
 use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
 use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
-use crate::evaluate::disqualified;
 use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::success::Criterion;
@@ -385,7 +385,11 @@ pub fn paired(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<Paired
             matches!(
                 CaseStatus::parse(s),
                 Some(CaseStatus::Ok | CaseStatus::Unsuccessful)
-            ) && !reason.is_some_and(|x| disqualified(&x[r]))
+            ) && !reason.is_some_and(|x| {
+                CaseStatus::parse(s)
+                    .and_then(|s| CaseEnd::read(s, &x[r]))
+                    .is_some_and(|e| e.disqualified())
+            })
         })
         .collect();
     // Eligibility by confidence, not by the proportion (issue 36 item 6): the one-sided Wilson

@@ -135,9 +135,6 @@ pub fn check_case(vehicle: &Vehicle, scenario: &toml::Table) -> Result<(), KeyEr
     crate::scenario::check_table(vehicle, scenario)
 }
 
-/// The reason of a case stopped by its wall-clock budget starts with this word.
-pub const TIMEOUT: &str = crate::evaluate::TIMEOUT;
-
 /// Every scenario-side key with its default for `mode` (see the module docs for the shape):
 /// `crate::scenario::default_table` for the dynamic modes.
 pub fn default_table(mode: StudyMode) -> Result<toml::Table, SettingsError> {

@@ -17,7 +17,7 @@ use std::path::Path;
 use super::faults::{fault_table, FAULT_PREFIX};
 use super::manifest::Manifest;
 use super::plots::{axis_plots, extreme_names, heatmaps, pareto_plot, timeseries_plot};
-use super::records::{missed_criterion, CaseStatus, CASE_ID, REASON, STATUS};
+use super::records::{CaseEnd, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
 use super::summary_robust::Robust;
@@ -136,7 +136,8 @@ fn left_out(table: &Table) -> Vec<(usize, CaseStatus, Option<&str>)> {
         .filter_map(|i| {
             let s = CaseStatus::parse(status.get(i)?)?;
             let r = reasons.get(i).map_or("", String::as_str);
-            (s != CaseStatus::Ok).then(|| (i, s, missed_criterion(s, r)))
+            let k = CaseEnd::read(s, r).and_then(|e| e.criterion());
+            (s != CaseStatus::Ok).then_some((i, s, k))
         })
         .collect()
 }
@@ -170,10 +171,7 @@ fn left_out_text(c: &Ctx) -> String {
 /// The reason of a left-out case without the criterion an unsuccessful case's reason starts
 /// with (the table shows it in its own column).
 fn detail(s: CaseStatus, reason: &str) -> &str {
-    match (s, reason.split_once(": ")) {
-        (CaseStatus::Unsuccessful, Some((_, d))) => d,
-        _ => reason,
-    }
+    crate::evaluate::reason_detail(s, reason)
 }
 
 /// Title, description, counts and the objective.

@@ -17,9 +17,7 @@ use super::records::Row;
 use super::schema::Study;
 use super::tune::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
-use crate::evaluate::{
-    disqualified, out_of_reach, CaseResult, CaseStatus, Deadline, Evaluator, Phases,
-};
+use crate::evaluate::{out_of_reach, CaseEnd, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
 use crate::report::Table;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
@@ -79,8 +77,8 @@ impl Worker {
         let robust =
             study.uncertainty.is_some() || !study.validate.is_empty() || study.faults.is_some();
         if !robust
-            || matches!(res.status, CaseStatus::Failed | CaseStatus::Skipped)
-            || disqualified(&res.reason)
+            || matches!(res.status(), CaseStatus::Failed | CaseStatus::Skipped)
+            || res.end.disqualified()
         {
             return;
         }
@@ -100,8 +98,7 @@ impl Worker {
         )
         .and_then(|()| score_faults(study, id, r, deadline, &mut res.metrics))
         {
-            res.status = CaseStatus::Failed;
-            res.reason = e.to_string();
+            res.finish(CaseEnd::Timeout, e.to_string());
         }
     }
 
@@ -149,7 +146,7 @@ impl Worker {
             }
             Err(e) => {
                 let mut failed = Row::new(case.id, r.hash.clone(), case.values.clone());
-                failed.end(CaseStatus::Failed, &e.to_string());
+                failed.end(CaseEnd::Error, &e.to_string());
                 (failed, None)
             }
         }

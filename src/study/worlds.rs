@@ -13,7 +13,6 @@
 use super::cases::apply_overrides as apply;
 use super::cases::Resolved;
 use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::records::{missed_criterion, CaseStatus};
 use super::schema::Study;
 use super::schema::World;
 use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
@@ -74,7 +73,7 @@ fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -
 
 /// Whether a run stopped at the case's wall-clock budget.
 fn timed_out(res: &CaseResult) -> bool {
-    res.status == CaseStatus::Failed && res.reason.starts_with(TIMEOUT)
+    res.end.timed_out()
 }
 
 /// The value of `metric` over worlds that is worst for it.
@@ -156,11 +155,9 @@ pub(super) fn run_world(
         Ok(rw) => {
             let res = run(evaluator, &rw, id, deadline);
             let timeout = timed_out(&res);
-            let missed = missed_criterion(res.status, &res.reason)
-                .and_then(Criterion::parse)
-                .map_or(f64::NAN, criterion_index);
+            let missed = res.end.missed_criterion().map_or(f64::NAN, criterion_index);
             WorldRun {
-                ok: res.status == CaseStatus::Ok,
+                ok: res.success(),
                 metrics: res.metrics,
                 missed,
                 timeout,
@@ -288,7 +285,7 @@ fn score_variants(
                 if timed_out(&res) {
                     return Err(WorldTimeout { world: usize::MAX });
                 }
-                (res.status == CaseStatus::Ok, res.metrics.value(&objective))
+                (res.success(), res.metrics.value(&objective))
             }
             Err(_) => (false, f64::NAN),
         };

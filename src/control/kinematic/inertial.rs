@@ -16,7 +16,7 @@
 //! is level, as in the paper's planar system). Heading errors are wrapped into `(−π, π]`.
 
 use super::ee_pose;
-use crate::control::{check_nonneg, ControlError};
+use crate::control::error::{check_nonneg, ControlError};
 use crate::kinematics::{ee_jacobian, BasePose, KinWorkspace};
 use crate::spatial::{heading, heading_gradient, wrap_angle};
 use faer::{Mat, MatRef};

@@ -23,7 +23,7 @@
 //! evaluation one forward-kinematics pass into a private workspace — `T(q)` and `J_e` depend on
 //! the joint angles only, so the base pose does not enter. Allocation-free per call.
 
-use super::super::{check_nonneg, check_pos, ControlError};
+use crate::control::error::{check_nonneg, check_pos, ControlError};
 use crate::kinematics::{ee_jacobian, forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{commanded_sigma, CommandedDofs};
 use crate::model::Vehicle;

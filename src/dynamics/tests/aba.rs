@@ -78,7 +78,7 @@ fn aba_equals_crba_cholesky_on_every_preset() {
                     &mut back,
                 );
                 let mut d: Vec<f64> = tau.iter().zip(&back).map(|(t, b)| t - b).collect();
-                crate::dynamics::cholesky::solve(&ws_ref.chol, nv, &mut d);
+                crate::linalg::solve(&ws_ref.chol, nv, &mut d);
                 let refined: Vec<f64> = x_chol.iter().zip(&d).map(|(x, d)| x + d).collect();
                 assert_close(&name, &ws.zeta_dot, &refined);
             }

@@ -5,9 +5,10 @@
 use super::error::{DesignError, DesignErrorKind, DesignFault};
 use super::schema::{BodyRef, BodySpec, DesignFile, FrameSpec, HydroSpec, JointSpec, ThrusterSpec};
 use crate::input::document::Document;
+use crate::model::error::ModelError;
 use crate::model::generator::{BodyProfile, GeneratorSpec, ThrusterRule};
 use crate::model::presets;
-use crate::model::{Body, Fluid, HullDrag, Hydro, Joint, ModelError, Thruster, Vehicle};
+use crate::model::{Body, Fluid, HullDrag, Hydro, Joint, Thruster, Vehicle};
 use crate::spatial::{rot_axis_angle, Mat3, Mat6, Se3, Vec3};
 use std::path::Path;
 

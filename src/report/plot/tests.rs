@@ -1,7 +1,7 @@
 //! Tests of the SVG figures.
 
 use super::*;
-use crate::report::ReportError;
+use crate::report::error::ReportError;
 
 /// Checks that start and end tags balance (a small well-formedness check).
 fn assert_well_formed(svg: &str) {

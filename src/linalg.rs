@@ -1,3 +1,6 @@
+//! The linear-algebra room, below `spatial` and above `dynamics`: the crate's one dense
+//! Cholesky factorisation.
+//!
 //! The dense Cholesky factorisation `A = L Lᵀ` and its solve, as one named algorithm shared
 //! by forward dynamics (`M ζ̇ = τ − h`, USM-19) and the damped pseudoinverse of kinematic
 //! control (`(J U Jᵀ + λ² I) y = r`, USM-31) — Pinocchio's `cholesky.hpp` habit: one
