@@ -1,145 +1,20 @@
 //! Two public vehicle descriptions nobody here wrote (tests/fixtures/urdf/README.md): the UUV
 //! Simulator RexROV 2 (UUV plugin blocks) and a BlueROV2 (gz-sim Hydrodynamics and Thruster
 //! systems). `design import` succeeds; `inspect`'s totals (mass, volume, T(q) singular values
-//! and rank) equal a reading of the file written here independently of the importer (its own
-//! XML walk, no usm-study code); each runs a short `simulate` and a small `tcm`.
+//! and rank, and the attainable wrench and authority under the thrust box) equal a reading of
+//! the file written here independently of the importer (`urdf_reading/mod.rs`: its own XML
+//! walk and a vertex enumeration of the LPs, no usm-study code); each runs a short `simulate`
+//! and a small `tcm`.
 
 mod common;
+#[path = "urdf_reading/mod.rs"]
+mod reading;
 
 use common::{json, run, stderr};
-use nalgebra::{DMatrix, Matrix3, Vector3};
+use nalgebra::DMatrix;
 use std::path::Path;
 
 const DIR: &str = "tests/fixtures/urdf";
-
-fn floats(s: &str) -> Vec<f64> {
-    s.split_whitespace().map(|t| t.parse().unwrap()).collect()
-}
-
-fn rpy(v: &[f64]) -> Matrix3<f64> {
-    let (r, p, y) = (v[0], v[1], v[2]);
-    let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, r.cos(), -r.sin(), 0.0, r.sin(), r.cos());
-    let ry = Matrix3::new(p.cos(), 0.0, p.sin(), 0.0, 1.0, 0.0, -p.sin(), 0.0, p.cos());
-    let rz = Matrix3::new(y.cos(), -y.sin(), 0.0, y.sin(), y.cos(), 0.0, 0.0, 0.0, 1.0);
-    rz * ry * rx
-}
-
-/// What the file says, read directly: total mass, displaced volume, fluid density and the
-/// thruster matrix at rest (thrusters on the root link: column `[d; p × d]`).
-struct Reading {
-    mass: f64,
-    volume: f64,
-    rho: f64,
-    t: DMatrix<f64>,
-}
-
-fn read(name: &str) -> Reading {
-    let text = std::fs::read_to_string(Path::new(DIR).join(name)).unwrap();
-    let doc = roxmltree::Document::parse(&text).unwrap();
-    let txt = |n: roxmltree::Node| n.text().unwrap().trim().to_string();
-    let robot = doc.root_element();
-    let links: Vec<_> = robot
-        .children()
-        .filter(|c| c.has_tag_name("link"))
-        .collect();
-    let mass: f64 = links
-        .iter()
-        .filter_map(|l| el(l, "inertial"))
-        .map(|i| {
-            el(&i, "mass")
-                .unwrap()
-                .attribute("value")
-                .unwrap()
-                .parse::<f64>()
-                .unwrap()
-        })
-        .sum();
-    let plugins: Vec<_> = robot
-        .descendants()
-        .filter(|c| c.has_tag_name("plugin"))
-        .collect();
-    let uuv = plugins.iter().find(|p| {
-        p.attribute("filename")
-            .unwrap()
-            .contains("underwater_object")
-    });
-    let (rho, volume) = match uuv {
-        // UUV Simulator: the plugin's fluid density and the volume of its link blocks.
-        Some(p) => {
-            let rho: f64 = txt(el(p, "fluid_density").unwrap()).parse().unwrap();
-            let v: f64 = p
-                .children()
-                .filter(|c| c.has_tag_name("link"))
-                .map(|l| txt(el(&l, "volume").unwrap()).parse::<f64>().unwrap())
-                .sum();
-            (rho, v)
-        }
-        // gz-sim: the Buoyancy system's collision volumes; a body without any (the camera on
-        // its tilt joint) is neutral, m/ρ; ρ from the thrusters' fluid_density.
-        None => {
-            let rho: f64 = plugins
-                .iter()
-                .find_map(|p| el(p, "fluid_density"))
-                .map(|n| txt(n).parse().unwrap())
-                .unwrap();
-            let mut v = 0.0;
-            for l in &links {
-                for c in l.children().filter(|c| c.has_tag_name("collision")) {
-                    let g = el(&el(&c, "geometry").unwrap(), "box")
-                        .map(|b| floats(b.attribute("size").unwrap()).iter().product::<f64>())
-                        .or_else(|| {
-                            el(&el(&c, "geometry").unwrap(), "cylinder").map(|y| {
-                                let r: f64 = y.attribute("radius").unwrap().parse().unwrap();
-                                let h: f64 = y.attribute("length").unwrap().parse().unwrap();
-                                std::f64::consts::PI * r * r * h
-                            })
-                        });
-                    v += g.unwrap_or(0.0);
-                }
-            }
-            let camera = links
-                .iter()
-                .find(|l| l.attribute("name") == Some("bluerov2/camera"));
-            let m: f64 = el(&el(camera.unwrap(), "inertial").unwrap(), "mass")
-                .unwrap()
-                .attribute("value")
-                .unwrap()
-                .parse()
-                .unwrap();
-            (rho, v + m / rho)
-        }
-    };
-    // Thruster joints in the order of their plugins.
-    let joint_names: Vec<String> = plugins
-        .iter()
-        .filter(|p| p.attribute("filename").unwrap().contains("thruster"))
-        .filter_map(|p| el(p, "jointName").or_else(|| el(p, "joint_name")).map(txt))
-        .collect();
-    let mut cols = Vec::new();
-    for jn in &joint_names {
-        let j = robot
-            .children()
-            .find(|c| c.has_tag_name("joint") && c.attribute("name") == Some(jn.as_str()))
-            .unwrap();
-        let o = el(&j, "origin").unwrap();
-        let p = Vector3::from_vec(floats(o.attribute("xyz").unwrap()));
-        let a = Vector3::from_vec(floats(el(&j, "axis").unwrap().attribute("xyz").unwrap()));
-        let d = rpy(&floats(o.attribute("rpy").unwrap())) * a.normalize();
-        let m = p.cross(&d);
-        cols.extend([d.x, d.y, d.z, m.x, m.y, m.z]);
-    }
-    let t = DMatrix::from_column_slice(6, joint_names.len(), &cols);
-    Reading {
-        mass,
-        volume,
-        rho,
-        t,
-    }
-}
-
-fn el<'a, 'i>(n: &roxmltree::Node<'a, 'i>, tag: &str) -> Option<roxmltree::Node<'a, 'i>> {
-    n.children().find(|c| c.has_tag_name(tag))
-}
 
 fn sorted_singular_values(m: &DMatrix<f64>) -> Vec<f64> {
     let mut s: Vec<f64> = m
@@ -153,13 +28,55 @@ fn sorted_singular_values(m: &DMatrix<f64>) -> Vec<f64> {
     s
 }
 
-fn check(name: &str, expect_rank: usize) {
+/// How a fixture is imported and read.
+struct Fixture<'a> {
+    name: &'a str,
+    /// T(q) rank the independent reading must find.
+    rank: usize,
+    /// `--thrust-limit` given to the import (neither file has finite limits): the box of the
+    /// independent LPs. `None`: the project's default, 40 N.
+    thrust_limit: Option<f64>,
+    /// `--fix-joint` joints.
+    fixed: &'a [&'a str],
+    /// Links of bodies the file gives no volume (neutral at import, m/ρ).
+    neutral: &'a [&'a str],
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+/// `inspect`'s attainable values (`positive`/`negative` arrays of `node`) against the
+/// independent LPs, to 1e-6 of the thrust limit.
+fn compare_attainable(what: &str, node: &serde_json::Value, ours: &[(usize, f64, f64)], lim: f64) {
+    for &(axis, pos, neg) in ours {
+        let p = node["positive"][axis].as_f64().unwrap();
+        let n = node["negative"][axis].as_f64().unwrap();
+        assert!(
+            close(p, pos, 1e-6 * lim) && close(n, neg, 1e-6 * lim),
+            "{what} axis {axis}: inspect +{p} / -{n}, independent +{pos} / -{neg}"
+        );
+    }
+}
+
+fn check(f: &Fixture) -> tempfile::TempDir {
+    let name = f.name;
     let d = tempfile::tempdir().unwrap();
     let design = d.path().join("design.toml");
     let urdf = format!("{DIR}/{name}");
-    let o = run(&["design", "import", &urdf, "--out", design.to_str().unwrap()]);
+    let mut args = vec!["design".to_string(), "import".into(), urdf.clone()];
+    args.extend(["--out".into(), design.display().to_string()]);
+    if let Some(l) = f.thrust_limit {
+        args.extend(["--thrust-limit".into(), l.to_string()]);
+    }
+    for j in f.fixed {
+        args.extend(["--fix-joint".into(), j.to_string()]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = run(&args);
     assert!(o.status.success(), "{name}: {}", stderr(&o));
-    let r = read(name);
+    let text = std::fs::read_to_string(&urdf).unwrap();
+    let r = reading::read(&text, f.neutral);
     let j = json(&["inspect", design.to_str().unwrap(), "--format", "json"]);
     let mass = j["total_mass"].as_f64().unwrap();
     assert!(
@@ -184,12 +101,33 @@ fn check(name: &str, expect_rank: usize) {
         );
     }
     let rank = b.iter().filter(|s| **s > 1e-6 * b[0]).count();
-    assert_eq!(rank, expect_rank, "{name}: independent rank");
+    assert_eq!(rank, f.rank, "{name}: independent rank");
     assert_eq!(
         j["tcm_rank"].as_u64().unwrap() as usize,
         rank,
         "{name}: inspect rank"
     );
+    // Attainable authority under the thrust box: the pure base wrench along each axis
+    // (`T u = ±α e_k`), and transport's commanded axes about the centre of mass (roll free).
+    let lim = f.thrust_limit.unwrap_or(40.0);
+    let c = &j["authority"]["reference_point"];
+    for k in 0..3 {
+        let x = c[k].as_f64().unwrap();
+        assert!(
+            close(x, r.com[k], 1e-9),
+            "{name}: CoM[{k}] {x} vs {}",
+            r.com[k]
+        );
+    }
+    let pure = reading::attainable(&r.t, &[0, 1, 2, 3, 4, 5], lim);
+    compare_attainable(name, &j["tcm_scaled"]["attainable"], &pure, lim);
+    let about_com = reading::attainable(&reading::about(&r.t, &r.com), &[0, 1, 2, 4, 5], lim);
+    compare_attainable(name, &j["authority"]["attainable"], &about_com, lim);
+    assert!(
+        j["authority"]["attainable"]["positive"][3].is_null(),
+        "{name}: roll is free"
+    );
+    eprintln!("{name}: pure wrench (axis, +, -) {pure:?}; about the CoM {about_com:?}");
     // A short closed loop and a small tcm on the imported design.
     let sim = d.path().join("sim");
     let set = format!("scenario.design=\"{}\"", design.display());
@@ -217,19 +155,81 @@ fn check(name: &str, expect_rank: usize) {
         tcm.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{name} tcm: {}", stderr(&o));
+    d
 }
 
 #[test]
 fn rexrov2_imports_and_matches_an_independent_reading() {
     // 1862.87 kg hull + 39 sensor and propeller links; 1.83826 m³; six thrusters, full rank.
-    check("rexrov2.urdf", 6);
+    check(&Fixture {
+        name: "rexrov2.urdf",
+        rank: 6,
+        // The RexROV 2 repository's thruster_manager.yaml: max_thrust 1540 N.
+        thrust_limit: Some(1540.0),
+        fixed: &[],
+        neutral: &[],
+    });
 }
 
 #[test]
 fn bluerov2_imports_and_matches_an_independent_reading() {
     // Six thrusters: four vectored horizontal, two vertical on the lateral axis, so pitch
     // has no authority: rank 5.
-    check("bluerov2.urdf", 5);
+    check(&Fixture {
+        name: "bluerov2.urdf",
+        rank: 5,
+        thrust_limit: None,
+        fixed: &[],
+        neutral: &["bluerov2/camera"],
+    });
+}
+
+/// The gripper's two finger joints, held fixed so the chain does not branch.
+const FINGERS: [&str; 2] = ["oberon7/finger_left_joint", "oberon7/finger_right_joint"];
+
+#[test]
+fn rexrov_oberon7_imports_and_matches_an_independent_reading() {
+    // UUV Simulator's vehicle-manipulator: the RexROV (8 thrusters, full rank) with the
+    // Oberon 7 arm (six revolute joints, UUV cylinder hydrodynamic model per arm link).
+    let d = check(&Fixture {
+        name: "rexrov_oberon7.urdf",
+        rank: 6,
+        // uuv_thruster_manager's config/rexrov/thruster_manager.yaml: max_thrust 2000 N.
+        thrust_limit: Some(2000.0),
+        fixed: &FINGERS,
+        // The gripper (end effector, fingers, tips) has no UUV block: neutral at import.
+        neutral: &[
+            "oberon7/end_effector",
+            "oberon7/finger_left",
+            "oberon7/finger_tip_left",
+            "oberon7/finger_right",
+            "oberon7/finger_tip_right",
+        ],
+    });
+    let j = json(&[
+        "inspect",
+        d.path().join("design.toml").to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    // Root body + the six arm bodies (azimuth … wrist); the chain's 12 DOF.
+    assert_eq!(j["ee_jacobian"][0].as_array().unwrap().len(), 12, "{j}");
+}
+
+#[test]
+fn a_branching_gripper_is_refused_unless_its_fingers_are_fixed() {
+    let o = run(&["design", "import", &format!("{DIR}/rexrov_oberon7.urdf")]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("branching tree"), "{}", stderr(&o));
+    let o = run(&[
+        "design",
+        "import",
+        &format!("{DIR}/rexrov_oberon7.urdf"),
+        "--fix-joint",
+        "oberon7/no_such_joint",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no_such_joint"), "{}", stderr(&o));
 }
 
 #[test]
@@ -279,4 +279,121 @@ fn a_malformed_urdf_exits_2_naming_the_element_and_its_line() {
             stderr(&o)
         );
     }
+}
+
+#[test]
+fn a_design_file_can_point_at_a_urdf_relative_to_itself() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("robots")).unwrap();
+    let good = std::fs::read_to_string(format!("{DIR}/bluerov2.urdf")).unwrap();
+    std::fs::write(d.path().join("robots/robot.urdf"), &good).unwrap();
+    let bad = good.replace(
+        "name=\"tilt\" type=\"revolute\"",
+        "name=\"tilt\" type=\"hinge\"",
+    );
+    std::fs::write(d.path().join("robots/bad.urdf"), &bad).unwrap();
+    let design = common::write(
+        d.path(),
+        "design.toml",
+        "name = \"mine\"\nurdf = \"robots/robot.urdf\"\nthrust_limit = 55.0\n",
+    );
+    // The same design as the import with the same options (only the name differs).
+    let shown = run(&["design", "show", design.to_str().unwrap()]);
+    assert!(shown.status.success(), "{}", stderr(&shown));
+    let shown = String::from_utf8(shown.stdout).unwrap();
+    let imported = run(&[
+        "design",
+        "import",
+        &format!("{DIR}/bluerov2.urdf"),
+        "--thrust-limit",
+        "55",
+    ]);
+    let imported = String::from_utf8(imported.stdout).unwrap();
+    let body = |s: &str| -> String {
+        s.lines()
+            .filter(|l| {
+                !l.starts_with('#')
+                    && !l.starts_with("name = \"mine\"")
+                    && !l.starts_with("name = \"bluerov2\"")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(body(&shown), body(&imported));
+    assert!(
+        shown.contains("name = \"mine\"") && shown.contains("u_max = 55.0"),
+        "{shown}"
+    );
+    let j = json(&["inspect", design.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(j["design"], "mine");
+    // Located errors: the design file's key and line, or the URDF's element and line.
+    let cases = [
+        (
+            "urdf = \"robots/missing.urdf\"\n",
+            "e0.toml:1:1: urdf: no URDF file".to_string(),
+        ),
+        (
+            "# a comment\nurdf = \"robots/bad.urdf\"\n",
+            format!(
+                "robots/bad.urdf:{}: <joint name=\"tilt\">: unknown joint type `hinge` (the URDF named by `urdf` at ",
+                bad.lines().position(|l| l.contains("name=\"tilt\"")).unwrap() + 1
+            ),
+        ),
+        (
+            "preset = \"usm-paper\"\nthrust_limit = 5.0\n",
+            "e2.toml:2:1: thrust_limit: only with `urdf`".to_string(),
+        ),
+        (
+            "urdf = \"robots/robot.urdf\"\n[fluid]\nrho = 1000.0\n",
+            "fluid: not allowed with `urdf`".to_string(),
+        ),
+        (
+            "urdf = \"robots/robot.urdf\"\nfixed_joints = [\"nope\"]\n",
+            "no joint of that name".to_string(),
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        let p = common::write(d.path(), &format!("e{k}.toml"), text);
+        let o = run(&["inspect", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(want.as_str()),
+            "want `{want}` in {}",
+            stderr(&o)
+        );
+    }
+}
+
+#[test]
+fn the_uvms_study_sweeps_the_arm_mount_of_a_urdf_design() {
+    // studies/uvms_urdf.toml: a pointer-form design, its arm's first joint moved by a sweep
+    // axis; the file's own mount (x = 1.3 m) holds station and reaches the work point, the
+    // aftmost (x = 0.7 m) cannot reach it within the tolerance.
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("uvms");
+    let o = common::sweep(Path::new("studies/uvms_urdf.toml"), &out, &[]);
+    assert!(o.status.code().is_some(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    let mut rows = text.lines();
+    let head: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (x, y, st) = (
+        col("design.joint[0].position[0]"),
+        col("design.joint[0].position[1]"),
+        col("status"),
+    );
+    let status = |xv: &str, yv: &str| -> String {
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|r| {
+                r[x].parse::<f64>().unwrap() == xv.parse::<f64>().unwrap()
+                    && r[y].parse::<f64>().unwrap() == yv.parse::<f64>().unwrap()
+            })
+            .map(|r| r[st].to_string())
+            .unwrap()
+    };
+    assert_eq!(text.lines().count(), 16, "15 cases");
+    assert_eq!(status("1.3", "-0.5"), "ok");
+    assert_eq!(status("0.7", "-0.5"), "unsuccessful");
 }

@@ -37,6 +37,10 @@ pub enum DesignCommand {
         /// (default 40, marked inferred).
         #[arg(long)]
         thrust_limit: Option<f64>,
+        /// Hold this revolute joint at zero and merge its child into the parent's body (e.g.
+        /// a gripper's fingers, which would make the tree branch); repeat for more.
+        #[arg(long = "fix-joint", value_name = "JOINT")]
+        fix_joint: Vec<String>,
     },
     /// Export a design (preset or file) as URDF with UUV Simulator plugin blocks, or as MuJoCo
     /// MJCF (docs/urdf.md).
@@ -80,6 +84,7 @@ pub fn run(cmd: &DesignCommand) -> anyhow::Result<ExitCode> {
             urdf,
             out,
             thrust_limit,
+            fix_joint,
         } => {
             if let Some(l) = thrust_limit {
                 anyhow::ensure!(
@@ -89,6 +94,7 @@ pub fn run(cmd: &DesignCommand) -> anyhow::Result<ExitCode> {
             }
             let opts = ImportOptions {
                 thrust_limit: *thrust_limit,
+                fixed_joints: fix_joint.clone(),
             };
             let imp = load_urdf(urdf, &opts)?;
             let text = imported_to_toml(&imp, &urdf.display().to_string());

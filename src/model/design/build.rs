@@ -127,6 +127,7 @@ pub(super) fn build(file: &DesignFile, ctx: &Ctx) -> Result<Vehicle, DesignError
     let explicit_key = if file.body.is_some() { "body" } else { "joint" };
     let forms: Vec<&str> = [
         ("preset", file.preset.is_some()),
+        ("urdf", file.urdf.is_some()),
         (explicit_key, explicit),
         ("generator", file.generator.is_some()),
     ]
@@ -134,8 +135,8 @@ pub(super) fn build(file: &DesignFile, ctx: &Ctx) -> Result<Vehicle, DesignError
     .filter(|(_, present)| *present)
     .map(|(k, _)| *k)
     .collect();
-    let usage = "a design uses exactly one of `preset = \"NAME\"`, explicit [[body]]/[[joint]] \
-                 lists or a [generator] table";
+    let usage = "a design uses exactly one of `preset = \"NAME\"`, `urdf = \"ROBOT.urdf\"`, \
+                 explicit [[body]]/[[joint]] lists or a [generator] table";
     if forms.len() > 1 {
         return Err(ctx.schema(
             forms[1],
@@ -150,10 +151,19 @@ pub(super) fn build(file: &DesignFile, ctx: &Ctx) -> Result<Vehicle, DesignError
             .unwrap_or("design")
             .to_string()
     };
+    for (key, present) in [
+        ("thrust_limit", file.thrust_limit.is_some()),
+        ("fixed_joints", file.fixed_joints.is_some()),
+    ] {
+        if present && file.urdf.is_none() {
+            return Err(ctx.schema(key, "only with `urdf` (an import option)"));
+        }
+    }
     let name = file.name.clone().unwrap_or_else(default_name);
     let v = match forms.first() {
         None => return Err(ctx.schema("", format!("no design found: {usage}"))),
         Some(&"preset") => build_preset(file, ctx)?,
+        Some(&"urdf") => build_urdf(file, ctx)?,
         Some(&"generator") => build_generator(file, ctx, &name)?,
         Some(_) => build_explicit(file, ctx, &name)?,
     };
@@ -163,6 +173,74 @@ pub(super) fn build(file: &DesignFile, ctx: &Ctx) -> Result<Vehicle, DesignError
         None
     };
     v.validate().map_err(|e| ctx.model_error(e, fallback))?;
+    Ok(v)
+}
+
+/// The pointer form `urdf = "robot.urdf"` (docs/urdf.md "A design file that points at a
+/// URDF"): the path is relative to the design file; `thrust_limit` [N] and `fixed_joints` are
+/// the import's options (`design import --thrust-limit`, `--fix-joint`). An error in the URDF
+/// keeps the URDF's file, line and element and names the design file's `urdf` line.
+fn build_urdf(file: &DesignFile, ctx: &Ctx) -> Result<Vehicle, DesignError> {
+    for (key, present) in [
+        ("fluid", file.fluid.is_some()),
+        ("thruster", file.thruster.is_some()),
+        ("base", file.base.is_some()),
+        ("end_effector", file.end_effector.is_some()),
+    ] {
+        if present {
+            return Err(ctx.schema(
+                key,
+                "not allowed with `urdf`: a URDF design takes only `name`, `thrust_limit` and \
+                 `fixed_joints`; import it with `usm-study design import` to edit it",
+            ));
+        }
+    }
+    let rel = file.urdf.as_deref().unwrap_or_default();
+    let dir = Path::new(ctx.doc.origin())
+        .parent()
+        .unwrap_or_else(|| Path::new(""));
+    let path = dir.join(rel);
+    if !path.is_file() {
+        return Err(ctx.invalid(
+            "urdf",
+            format!(
+                "no URDF file {} (the path is relative to the design file)",
+                path.display()
+            ),
+        ));
+    }
+    if let Some(l) = file.thrust_limit {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(ctx.invalid("thrust_limit", format!("must be finite and > 0, got {l}")));
+        }
+    }
+    let opts = crate::model::urdf::ImportOptions {
+        thrust_limit: file.thrust_limit,
+        fixed_joints: file.fixed_joints.clone().unwrap_or_default(),
+    };
+    let at = ctx.doc.location("urdf");
+    let mut v = crate::model::urdf::load_urdf(&path, &opts)
+        .map(|i| i.vehicle)
+        .map_err(|e| DesignError {
+            at: crate::input::located::Location {
+                origin: e.file.clone(),
+                line: (e.line > 0).then_some(e.line),
+                column: None,
+                key: e.element.clone(),
+            },
+            error: DesignFault {
+                kind: DesignErrorKind::Invalid,
+                message: format!(
+                    "{} (the URDF named by `urdf` at {}{})",
+                    e.message,
+                    at.origin,
+                    at.line.map_or(String::new(), |l| format!(":{l}"))
+                ),
+            },
+        })?;
+    if let Some(n) = &file.name {
+        v.name = n.clone();
+    }
     Ok(v)
 }
 

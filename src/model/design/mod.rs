@@ -2,7 +2,7 @@
 //! thruster lists, or by a `[generator]` table (docs/model.md §2).
 //!
 //! # Forms
-//! A design file uses exactly one of three forms:
+//! A design file uses exactly one of four forms:
 //!
 //! 1. **Preset**: `preset = "usm-paper"` (a name in [`PRESETS`]), optionally with `name`.
 //! 2. **Explicit lists**: `[[body]]`, `[[joint]]`, `[[thruster]]`, optional `[fluid]`,
@@ -13,6 +13,9 @@
 //!    `thruster_rule = "none"` to make that obvious). `[fluid]`, `[base]` and
 //!    `[end_effector]` may be given too; the generated bodies stay neutrally buoyant in the
 //!    given fluid (their volume is recomputed as `m/ρ`).
+//! 4. **URDF pointer**: `urdf = "robot.urdf"` (relative to the design file), optionally with
+//!    `name`, `thrust_limit` [N] and `fixed_joints` (the import options of `design import`);
+//!    the URDF is imported (docs/urdf.md) and its errors keep the URDF's file and line.
 //!
 //! # Units and frames
 //! SI units everywhere (m, kg, s, N, kg·m²); angles are in degrees only in keys ending in
@@ -97,7 +100,14 @@ pub fn load_design_table(arg: &str) -> Result<toml::Table, DesignError> {
     let (text, origin) = if is_urdf(arg) {
         (design_to_toml(&load_urdf_design(arg)?), arg.to_string())
     } else if Path::new(arg).is_file() {
-        (read_file(arg)?, arg.to_string())
+        let text = read_file(arg)?;
+        if points_at_urdf(&text) {
+            // The pointer form: its explicit form, so that sweep keys such as
+            // `joint[0].position` exist to be overridden.
+            (design_to_toml(&parse_design(&text, arg)?), arg.to_string())
+        } else {
+            (text, arg.to_string())
+        }
     } else if PRESETS.contains(&arg) {
         let v = presets::preset(arg).map_err(|e| not_found(arg, e.message))?;
         (design_to_toml(&v), format!("preset {arg}"))
@@ -142,6 +152,12 @@ pub fn parse_design_value(value: &toml::Value, origin: &str) -> Result<Vehicle, 
             format!("a design must be a table, got a {}", other.type_str()),
         )),
     }
+}
+
+/// Whether a design file's text uses the pointer form `urdf = "…"` (top-level key).
+fn points_at_urdf(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("urdf"))
 }
 
 /// Whether `arg` is an existing `.urdf` file: a design given as a URDF (docs/urdf.md).

@@ -11,6 +11,10 @@ use std::fmt;
 pub(super) struct DesignFile {
     pub(super) name: Option<String>,
     pub(super) preset: Option<String>,
+    /// The pointer form: a URDF path relative to the design file, with two import options.
+    pub(super) urdf: Option<String>,
+    pub(super) thrust_limit: Option<f64>,
+    pub(super) fixed_joints: Option<Vec<String>>,
     pub(super) fluid: Option<FluidSpec>,
     pub(super) body: Option<Vec<BodySpec>>,
     pub(super) joint: Option<Vec<JointSpec>>,

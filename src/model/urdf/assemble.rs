@@ -21,6 +21,9 @@ pub struct ImportOptions {
     /// Symmetric thrust limit [N] for thrusters whose plugin gives no finite limit
     /// (default [`DEFAULT_THRUST_LIMIT`], marked inferred).
     pub thrust_limit: Option<f64>,
+    /// Revolute joints held at zero and merged like fixed joints (e.g. a gripper's fingers,
+    /// which would make the tree branch); each must name a revolute joint of the file.
+    pub fixed_joints: Vec<String>,
 }
 
 /// One body being gathered from its links.
@@ -50,6 +53,8 @@ struct Walk<'a> {
     /// Child joints of each link.
     kids: Vec<Vec<usize>>,
     seen: Vec<bool>,
+    /// [`ImportOptions::fixed_joints`].
+    frozen: &'a [String],
     /// `(spec index, body, position, direction, joint name)`.
     thrusters: Vec<(usize, usize, Vec3, Vec3, String)>,
     ledger: Vec<Inferred>,
@@ -99,7 +104,9 @@ impl Walk<'_> {
                 let tc = t.compose(&j.origin);
                 let fixed = match (j.kind, j.limits) {
                     (JointKind::Fixed, _) => true,
-                    (JointKind::Revolute, Some((lo, hi))) => lo == hi,
+                    (JointKind::Revolute, Some((lo, hi))) => {
+                        lo == hi || self.frozen.contains(&j.name)
+                    }
                     _ => false,
                 };
                 if fixed {
@@ -333,6 +340,30 @@ pub(super) fn assemble(
 ) -> Result<(Vehicle, Vec<Inferred>), UrdfError> {
     let (links, kids, root) = tree_shape(origin, tree)?;
     let mut ledger = Vec::new();
+    for name in &opts.fixed_joints {
+        match tree.joints.iter().find(|j| &j.name == name) {
+            Some(j) if j.kind == JointKind::Revolute => ledger.push(Inferred::new(
+                format!("joint {name}"),
+                "held at 0 and merged into its parent's body (import option fixed_joints / --fix-joint)",
+            )),
+            Some(j) => {
+                return Err(at(
+                    origin,
+                    j.line,
+                    jlabel(j),
+                    "named as a fixed joint by the import options, but it is not revolute",
+                ))
+            }
+            None => {
+                return Err(at(
+                    origin,
+                    1,
+                    "<robot>".into(),
+                    format!("the import options name joint `{name}` to hold fixed, but the file has no joint of that name"),
+                ))
+            }
+        }
+    }
     let rho = match (plugins.rho, plugins.thruster_rho) {
         (Some(r), _) => r,
         (None, Some(r)) => {
@@ -355,6 +386,7 @@ pub(super) fn assemble(
         links,
         kids,
         seen: vec![false; tree.links.len()],
+        frozen: &opts.fixed_joints,
         thrusters: Vec::new(),
         ledger,
     };

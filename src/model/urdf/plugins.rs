@@ -136,21 +136,56 @@ fn uuv_link(origin: &str, l: Node, p: &mut Plugins) -> Result<(), UrdfError> {
     }
     if let Some(m) = child(l, "hydrodynamic_model") {
         let kind = child(m, "type").map(text).unwrap_or("fossen");
-        if kind != "fossen" {
+        if kind != "fossen" && kind != "cylinder" {
             return Err(err_at(
                 origin,
                 m,
-                format!("hydrodynamic model type `{kind}` is not supported (only `fossen`)"),
+                format!(
+                    "hydrodynamic model type `{kind}` is not supported (only `fossen` and \
+                     `cylinder`)"
+                ),
             ));
         }
-        if let Some(a) = child(m, "added_mass") {
-            h.added_mass = Some(flip_ned(&mat6_of(origin, a)?));
+        // UUV's file convention first (HMCylinder starts from HMFossen's matrices).
+        let given = |tag: &'static str| child(m, tag).map(|n| mat6_of(origin, n)).transpose();
+        let (mut a, d, mut q) = (
+            given("added_mass")?,
+            given("linear_damping")?,
+            given("quadratic_damping")?,
+        );
+        if kind == "cylinder" {
+            let rho = match p.rho {
+                Some(r) => r,
+                None => {
+                    h.notes.push(format!(
+                        "{name}: cylinder model without <fluid_density>: UUV Simulator's \
+                         default 1028 kg/m³"
+                    ));
+                    1028.0
+                }
+            };
+            let (ma, dq) = uuv_cylinder(origin, l, m, rho, &mut h.notes)?;
+            let (a0, q0) = (
+                a.get_or_insert_with(Mat6::zeros),
+                q.get_or_insert_with(Mat6::zeros),
+            );
+            for i in 0..6 {
+                if ma[i] != 0.0 {
+                    a0[(i, i)] = ma[i];
+                }
+                if dq[i] != 0.0 {
+                    q0[(i, i)] = dq[i];
+                }
+            }
         }
-        if let Some(d) = child(m, "linear_damping") {
-            h.linear = Some(-flip_ned(&mat6_of(origin, d)?));
+        if let Some(a) = a {
+            h.added_mass = Some(flip_ned(&a));
         }
-        if let Some(d) = child(m, "quadratic_damping") {
-            let q = -flip_ned(&mat6_of(origin, d)?);
+        if let Some(d) = d {
+            h.linear = Some(-flip_ned(&d));
+        }
+        if let Some(q) = q {
+            let q = -flip_ned(&q);
             if (0..6).any(|i| (0..6).any(|j| i != j && q[(i, j)] != 0.0)) {
                 h.notes.push(format!(
                     "{name}: off-diagonal quadratic damping kept (UUV Simulator itself uses \
@@ -167,6 +202,105 @@ fn uuv_link(origin: &str, l: Node, p: &mut Plugins) -> Result<(), UrdfError> {
     }
     p.hydro.insert(name.to_string(), h);
     Ok(())
+}
+
+/// UUV Simulator's `cylinder` hydrodynamic model (`HMCylinder`, uuv_gazebo_plugins
+/// HydrodynamicModel.cc), in UUV's file convention: the diagonal added mass (positive) and
+/// quadratic damping (negative) it sets. Radius and length are `<radius>`/`<length>` of the
+/// model, else — as UUV does — the smallest and the largest extent of the link block's `<box>`
+/// (`width` x, `length` y, `height` z; the smallest extent itself, not half of it, is UUV's
+/// radius); the axis is `<axis>` `i`/`j`/`k`, else the direction of the largest extent. With
+/// `L/(2r)` the dimension ratio, `C_d` of the circular face 0.91/0.85/0.87/0.99 for ratios
+/// ≤ 1, 2, 4, 7 (0 beyond 7, as UUV leaves it) and of the side 0.63/0.68/0.74/0.82/0.98 for
+/// ≤ 1, 2, 5, 10, above: along the axis `A = ρπr²` (UUV's expression, kg/m), across it
+/// `ρπr²L`, about the two transverse axes `ρπr²L³/12`, about the axis 0; quadratic damping
+/// `−½ρ C_d πr²` along the axis and `−½ρ C_d r L` across it.
+fn uuv_cylinder(
+    origin: &str,
+    l: Node,
+    m: Node,
+    rho: f64,
+    notes: &mut Vec<String>,
+) -> Result<([f64; 6], [f64; 6]), UrdfError> {
+    let name = l.attribute("name").unwrap_or("");
+    let num = |n: Node, tag: &'static str| child(n, tag).map(|c| f64_of(origin, c)).transpose();
+    let extents = match child(l, "box") {
+        Some(b) => match (num(b, "width")?, num(b, "length")?, num(b, "height")?) {
+            (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+            _ => None,
+        },
+        None => None,
+    };
+    let (r, len) = match (num(m, "radius")?, num(m, "length")?, extents) {
+        (Some(r), Some(len), _) => (r, len),
+        (r, len, Some(e)) => (
+            r.unwrap_or(e[0].min(e[1]).min(e[2])),
+            len.unwrap_or(e[0].max(e[1]).max(e[2])),
+        ),
+        _ => {
+            return Err(err_at(
+                origin,
+                m,
+                "cylinder model needs <radius> and <length>, or a <box> in its <link> block \
+                 (UUV Simulator would fall back to Gazebo's bounding box, which a URDF does \
+                 not carry)",
+            ))
+        }
+    };
+    if !(r > 0.0 && len > 0.0 && r.is_finite() && len.is_finite()) {
+        return Err(err_at(origin, m, "cylinder radius and length must be > 0"));
+    }
+    let axis = match child(m, "axis").map(text) {
+        Some("i") => 0,
+        Some("j") => 1,
+        Some("k") => 2,
+        Some(other) => {
+            return Err(err_at(
+                origin,
+                m,
+                format!("cylinder <axis> must be i, j or k, got `{other}`"),
+            ))
+        }
+        None => match extents {
+            Some(e) if e[0] >= e[1].max(e[2]) => 0,
+            Some(e) if e[1] >= e[2] => 1,
+            Some(_) => 2,
+            None => 0,
+        },
+    };
+    let ratio = len / (2.0 * r);
+    let cd_circ = match ratio {
+        x if x <= 1.0 => 0.91,
+        x if x <= 2.0 => 0.85,
+        x if x <= 4.0 => 0.87,
+        x if x <= 7.0 => 0.99,
+        _ => 0.0,
+    };
+    let cd_len = match ratio {
+        x if x <= 1.0 => 0.63,
+        x if x <= 2.0 => 0.68,
+        x if x <= 5.0 => 0.74,
+        x if x <= 10.0 => 0.82,
+        _ => 0.98,
+    };
+    let pi = std::f64::consts::PI;
+    let ma_len = rho * pi * r * r * len;
+    let ma_circ = rho * pi * r * r;
+    let ma_torque = rho * pi * r * r * len.powi(3) / 12.0;
+    let d_circ = -0.5 * cd_circ * pi * r * r * rho;
+    let d_len = -0.5 * cd_len * r * len * rho;
+    let (mut ma, mut dq) = ([0.0; 6], [0.0; 6]);
+    for k in 0..3 {
+        ma[k] = if k == axis { ma_circ } else { ma_len };
+        dq[k] = if k == axis { d_circ } else { d_len };
+        ma[3 + k] = if k == axis { 0.0 } else { ma_torque };
+    }
+    notes.push(format!(
+        "{name}: UUV Simulator cylinder model (HMCylinder) evaluated as UUV does: r = {r} m, \
+         L = {len} m, axis {}, added mass along the axis ρπr² (UUV's expression), none about it",
+        ["i", "j", "k"][axis]
+    ));
+    Ok((ma, dq))
 }
 
 const FORCES: [char; 6] = ['x', 'y', 'z', 'k', 'm', 'n'];

@@ -280,6 +280,88 @@ fn fixed_links_merge_with_the_parallel_axis_theorem() {
     assert!((b.inertia - Mat3::from_diagonal(&Vec3::new(2.0, 1.0, 2.0))).norm() < 1e-14);
 }
 
+#[test]
+fn a_branching_tree_imports_with_the_branch_held_fixed() {
+    let text = GOOD.replace(
+        "</robot>",
+        r#"  <link name="c"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="q2" type="revolute"><parent link="a"/><child link="c"/><limit lower="-1" upper="1"/></joint>
+</robot>"#,
+    );
+    let opts = ImportOptions {
+        fixed_joints: vec!["q2".into()],
+        ..ImportOptions::default()
+    };
+    let i = import_urdf(&text, "f.urdf", &opts).unwrap();
+    assert_eq!((i.vehicle.bodies.len(), i.vehicle.joints.len()), (2, 1));
+    assert_eq!(i.vehicle.bodies[0].mass, 3.0);
+    assert!(i.inferred.iter().any(|x| x.key == "joint q2"));
+    let bad = ImportOptions {
+        fixed_joints: vec!["nope".into()],
+        ..ImportOptions::default()
+    };
+    let e = import_urdf(&text, "f.urdf", &bad).unwrap_err();
+    assert!(e.message.contains("`nope`"), "{e}");
+}
+
+#[test]
+fn uuv_cylinder_model_is_evaluated_as_uuv_simulator_does() {
+    // UUV's HMCylinder on a 0.1 × 0.6 × 0.2 box along i: r = 0.1 (the smallest extent), L = 0.6,
+    // L/(2r) = 3: C_d 0.87 (circular face), 0.74 (side).
+    let text = GOOD.replace(
+        "</robot>",
+        r#"  <gazebo><plugin filename="libuuv_underwater_object_ros_plugin.so" name="u">
+    <fluid_density>1000</fluid_density>
+    <link name="b"><volume>0.01</volume><box><width>0.1</width><length>0.6</length><height>0.2</height></box>
+      <hydrodynamic_model><type>cylinder</type><axis>i</axis></hydrodynamic_model></link>
+  </plugin></gazebo>
+</robot>"#,
+    );
+    let i = import_urdf(&text, "c.urdf", &ImportOptions::default()).unwrap();
+    let Hydro::Coefficients {
+        added_mass,
+        quadratic,
+        linear,
+    } = &i.vehicle.bodies[1].hydro
+    else {
+        panic!("coefficients expected");
+    };
+    let pi = std::f64::consts::PI;
+    let (rho, r, l) = (1000.0, 0.1, 0.6);
+    let want_a = [
+        rho * pi * r * r,
+        rho * pi * r * r * l,
+        rho * pi * r * r * l,
+        0.0,
+        rho * pi * r * r * l.powi(3) / 12.0,
+        rho * pi * r * r * l.powi(3) / 12.0,
+    ];
+    let want_q = [
+        0.5 * 0.87 * pi * r * r * rho,
+        0.5 * 0.74 * r * l * rho,
+        0.5 * 0.74 * r * l * rho,
+        0.0,
+        0.0,
+        0.0,
+    ];
+    for k in 0..6 {
+        assert!(
+            (added_mass[(k, k)] - want_a[k]).abs() < 1e-12,
+            "{added_mass}"
+        );
+        assert!((quadratic[(k, k)] - want_q[k]).abs() < 1e-12, "{quadratic}");
+    }
+    assert_eq!(
+        added_mass.norm_squared(),
+        want_a.iter().map(|x| x * x).sum::<f64>()
+    );
+    assert_eq!(linear.norm(), 0.0);
+    let e = err_of(&text.replace("<axis>i</axis>", "<axis>q</axis>"));
+    assert!(e.message.contains("must be i, j or k"), "{e}");
+    let e = err_of(&text.replace("<type>cylinder</type>", "<type>sphere</type>"));
+    assert!(e.message.contains("`sphere` is not supported"), "{e}");
+}
+
 /// Generated designs with random rotations, coefficient bodies, frames and thruster options.
 fn arb_design() -> impl Strategy<Value = Vehicle> {
     (
