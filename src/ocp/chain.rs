@@ -28,13 +28,15 @@
 //! Path costs beyond the quadratic effort ([`PathCosts`], docs/ocp.md §1): thruster energy,
 //! joint energy and the joint-limit barrier, analytic in `(q, q̇, u)`.
 //!
-//! Derivatives: the trait's central differences (ε = 1e-6 in tangent coordinates) — not yet
-//! analytic nor automatic (docs/ocp.md §5).
+//! Derivatives: the trait's central and second differences (ε = 1e-6, 1e-4 in tangent
+//! coordinates), evaluated by the structured differences of [`super::derivatives`] — the same
+//! numbers with the dynamics terms each perturbation leaves unchanged reused — not yet
+//! analytic nor automatic (docs/ocp.md §2, §5).
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
 use super::cost::PathCosts;
-use super::model::{ModelError, OcpModel};
+use super::model::{FdScratch, ModelError, OcpModel};
 use crate::dynamics::{dynamics_terms, solve_forward, DynOptions, DynWorkspace};
 use crate::kinematics::{forward_kinematics, generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
@@ -81,16 +83,18 @@ fn rotation_error(target: &Mat3, r: &Mat3) -> Vec3 {
 /// The chain's discrete dynamics and terminal constraint.
 #[derive(Clone, Debug)]
 pub struct ChainModel {
-    vehicle: Vehicle,
-    ws: DynWorkspace,
-    opts: DynOptions,
+    pub(super) vehicle: Vehicle,
+    pub(super) ws: DynWorkspace,
+    pub(super) opts: DynOptions,
     dt: f64,
     terminal: TerminalSpec,
     costs: Option<PathCosts>,
     tau: Vec<f64>,
     zeta: Vec<f64>,
     /// Thruster actuation: the generalised thrust map G(q), (6+n)×m (None: base wrench).
-    gmap: Option<faer::Mat<f64>>,
+    pub(super) gmap: Option<faer::Mat<f64>>,
+    /// Scratch of the structured differences ([`super::derivatives`]).
+    pub(super) fd: FdScratch,
 }
 
 impl ChainModel {
@@ -113,6 +117,7 @@ impl ChainModel {
             tau: vec![0.0; nv],
             zeta: vec![0.0; nv],
             gmap: None,
+            fd: FdScratch::default(),
         }
     }
 
@@ -259,38 +264,43 @@ fn se3_exp_parts(v: &Vec3, phi: &Vec3) -> (UnitQuaternion<f64>, Vec3) {
     (UnitQuaternion::from_scaled_axis(*phi), j * v)
 }
 
-impl OcpModel for ChainModel {
-    fn nq(&self) -> usize {
-        13 + 2 * self.n_joints()
-    }
-    fn nx(&self) -> usize {
-        12 + 2 * self.n_joints()
-    }
-    fn nu(&self) -> usize {
-        self.n_body_controls() + self.n_joints()
-    }
-    fn nc(&self) -> usize {
-        self.terminal.rows(self.n_joints())
-    }
-
-    fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+impl ChainModel {
+    /// Load the dynamics terms at state `x` into the workspace: `M(q)`, `h(q, ζ)` (USM-19,
+    /// [`dynamics_terms`]) and, with thruster actuation, `G(q)` ([`generalized_thrust_map`]).
+    pub(super) fn load_terms(&mut self, x: &[f64]) {
         let n = self.n_joints();
         let pose = Self::pose(x);
-        let q = &x[7..7 + n];
         self.zeta.copy_from_slice(&x[7 + n..13 + 2 * n]);
         dynamics_terms(
             &self.vehicle,
             &mut self.ws,
             &pose,
-            q,
+            &x[7..7 + n],
             &self.zeta,
             &self.opts,
         );
-        match self.gmap.as_mut() {
+        if let Some(g) = self.gmap.as_mut() {
+            // The kinematics of q are in ws.kin.
+            generalized_thrust_map(&self.vehicle, &self.ws.kin, g);
+        }
+    }
+
+    /// `out = f(x, u)` from the terms in the workspace (loaded for a state with the same
+    /// terms as `x`, [`ChainModel::load_terms`]): `τ = G u_T + [0; τ_q]` (or `τ = u`),
+    /// `ζ̇ = M⁻¹(τ − h)`, then the symplectic Euler update of the module documentation.
+    pub(super) fn finish_step(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let n = self.n_joints();
+        let pose = Self::pose(x);
+        let q = &x[7..7 + n];
+        self.zeta.copy_from_slice(&x[7 + n..13 + 2 * n]);
+        match self.gmap.as_ref() {
             None => self.tau.copy_from_slice(u),
             Some(g) => {
-                // τ = G(q) u_T + [0; τ_q] (the kinematics of q are in ws.kin).
-                generalized_thrust_map(&self.vehicle, &self.ws.kin, g);
                 let m = g.ncols();
                 for r in 0..6 + n {
                     let mut v = if r >= 6 { u[m + r - 6] } else { 0.0 };
@@ -319,6 +329,46 @@ impl OcpModel for ChainModel {
         }
         out[7 + n..13 + 2 * n].copy_from_slice(&self.zeta);
         Ok(())
+    }
+}
+
+impl OcpModel for ChainModel {
+    fn nq(&self) -> usize {
+        13 + 2 * self.n_joints()
+    }
+    fn nx(&self) -> usize {
+        12 + 2 * self.n_joints()
+    }
+    fn nu(&self) -> usize {
+        self.n_body_controls() + self.n_joints()
+    }
+    fn nc(&self) -> usize {
+        self.terminal.rows(self.n_joints())
+    }
+
+    fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
+        self.load_terms(x);
+        self.finish_step(x, u, out)
+    }
+
+    fn jacobians(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        a: &mut DMatrix<f64>,
+        b: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        self.structured_jacobians(x, u, a, b)
+    }
+
+    fn weighted_hessian(
+        &mut self,
+        x: &[f64],
+        u: &[f64],
+        w: &[f64],
+        h: &mut DMatrix<f64>,
+    ) -> Result<(), ModelError> {
+        self.structured_hessian(x, u, w, h)
     }
 
     fn retract(&self, x: &[f64], dx: &[f64], out: &mut [f64]) {

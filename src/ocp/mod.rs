@@ -10,6 +10,8 @@
 //!   parametric multiplier);
 //! - [`qp`]: the box-bounded QP (Mehrotra interior point over the Riccati solve);
 //! - [`sqp`]: the SQP with the filter line search, KKT residuals, status and log;
+//! - [`derivatives`]: the chain's central and second differences with the dynamics terms
+//!   each perturbation leaves unchanged reused (the same numbers, fewer evaluations);
 //! - [`cost`]: [`PathCosts`], thruster and joint energy (smoothed) and the joint-limit
 //!   barrier, analytic derivatives;
 //! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
@@ -17,6 +19,7 @@
 
 pub mod chain;
 pub mod cost;
+pub mod derivatives;
 pub mod model;
 pub mod problem;
 pub mod qp;
@@ -29,6 +32,8 @@ pub mod start;
 mod tests;
 #[cfg(test)]
 mod tests_costs;
+#[cfg(test)]
+mod tests_derivatives;
 
 pub use chain::{ChainModel, TerminalSpec};
 pub use cost::{CostBreakdown, PathCosts};

@@ -60,6 +60,41 @@ struct HessBuf {
     phi: Vec<f64>,
 }
 
+/// Scratch of the chain's structured differences (`ocp::derivatives`), sized on first use.
+#[derive(Clone, Debug, Default)]
+pub struct FdScratch {
+    pub(super) f0: Vec<f64>,
+    pub(super) xp: Vec<f64>,
+    pub(super) fp: Vec<f64>,
+    pub(super) fm: Vec<f64>,
+    pub(super) dp: Vec<f64>,
+    pub(super) dm: Vec<f64>,
+    pub(super) e: Vec<f64>,
+    pub(super) u: Vec<f64>,
+    pub(super) phi: Vec<f64>,
+    pub(super) bias: Vec<f64>,
+    pub(super) mass: Option<faer::Mat<f64>>,
+    pub(super) gmap: Option<faer::Mat<f64>>,
+}
+
+impl FdScratch {
+    pub(super) fn size(&mut self, nq: usize, nx: usize, nu: usize) {
+        for (v, n) in [
+            (&mut self.f0, nq),
+            (&mut self.xp, nq),
+            (&mut self.fp, nq),
+            (&mut self.fm, nq),
+            (&mut self.dp, nx),
+            (&mut self.dm, nx),
+            (&mut self.e, nx),
+            (&mut self.u, nu),
+            (&mut self.phi, nx + nu),
+        ] {
+            v.resize(n, 0.0);
+        }
+    }
+}
+
 /// Discrete dynamics on a manifold, with a terminal equality (see the module documentation).
 pub trait OcpModel {
     /// Size of the state's representation (e.g. 13 + 2n with a unit quaternion).
@@ -128,40 +163,7 @@ pub trait OcpModel {
         a: &mut DMatrix<f64>,
         b: &mut DMatrix<f64>,
     ) -> Result<(), ModelError> {
-        let (nq, nx, nu) = (self.nq(), self.nx(), self.nu());
-        let mut f0 = vec![0.0; nq];
-        self.step(x, u, &mut f0)?;
-        let (mut xp, mut fp, mut fm) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq]);
-        let (mut dp, mut dm) = (vec![0.0; nx], vec![0.0; nx]);
-        let mut e = vec![0.0; nx];
-        for i in 0..nx {
-            e[i] = FD_STEP;
-            self.retract(x, &e, &mut xp);
-            self.step(&xp, u, &mut fp)?;
-            e[i] = -FD_STEP;
-            self.retract(x, &e, &mut xp);
-            self.step(&xp, u, &mut fm)?;
-            e[i] = 0.0;
-            self.difference(&f0, &fp, &mut dp);
-            self.difference(&f0, &fm, &mut dm);
-            for r in 0..nx {
-                a[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
-            }
-        }
-        let mut up = u.to_vec();
-        for i in 0..nu {
-            up[i] = u[i] + FD_STEP;
-            self.step(x, &up, &mut fp)?;
-            up[i] = u[i] - FD_STEP;
-            self.step(x, &up, &mut fm)?;
-            up[i] = u[i];
-            self.difference(&f0, &fp, &mut dp);
-            self.difference(&f0, &fm, &mut dm);
-            for r in 0..nx {
-                b[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
-            }
-        }
-        Ok(())
+        central_jacobians(self, x, u, a, b)
     }
 
     /// `H = ∇²φ` ((nx+nu)², order `[δx, δu]`) of `φ(δx, δu) = wᵀ (f(x ⊕ δx, u + δu) ⊖ f(x, u))`
@@ -176,31 +178,7 @@ pub trait OcpModel {
         w: &[f64],
         h: &mut DMatrix<f64>,
     ) -> Result<(), ModelError> {
-        let (nq, nx, nu) = (self.nq(), self.nx(), self.nu());
-        let m = nx + nu;
-        let mut f0 = vec![0.0; nq];
-        self.step(x, u, &mut f0)?;
-        let mut buf = HessBuf {
-            e: vec![0.0; nx],
-            u: vec![0.0; nu],
-            xp: vec![0.0; nq],
-            fp: vec![0.0; nq],
-            d: vec![0.0; nx],
-            phi: vec![0.0; m],
-        };
-        for i in 0..m {
-            buf.phi[i] = weighted_step(self, x, u, w, &f0, &[i], &mut buf)?;
-        }
-        let e2 = HESS_STEP * HESS_STEP;
-        for i in 0..m {
-            for j in i..m {
-                let pij = weighted_step(self, x, u, w, &f0, &[i, j], &mut buf)?;
-                let v = (pij - buf.phi[i] - buf.phi[j]) / e2;
-                h[(i, j)] = v;
-                h[(j, i)] = v;
-            }
-        }
-        Ok(())
+        second_difference_hessian(self, x, u, w, h)
     }
 
     /// `H = ∇²ψ` (nx×nx) of `ψ(δ) = νᵀ c(x ⊕ δ)` at 0 (the terminal equality's curvature
@@ -256,6 +234,88 @@ pub trait OcpModel {
             }
         }
     }
+}
+
+/// `A = ∂f/∂x`, `B = ∂f/∂u` by central differences with step [`FD_STEP`] in tangent
+/// coordinates, `2(nx + nu) + 1` steps: the reference path of [`OcpModel::jacobians`].
+pub fn central_jacobians<M: OcpModel + ?Sized>(
+    m: &mut M,
+    x: &[f64],
+    u: &[f64],
+    a: &mut DMatrix<f64>,
+    b: &mut DMatrix<f64>,
+) -> Result<(), ModelError> {
+    let (nq, nx, nu) = (m.nq(), m.nx(), m.nu());
+    let mut f0 = vec![0.0; nq];
+    m.step(x, u, &mut f0)?;
+    let (mut xp, mut fp, mut fm) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq]);
+    let (mut dp, mut dm) = (vec![0.0; nx], vec![0.0; nx]);
+    let mut e = vec![0.0; nx];
+    for i in 0..nx {
+        e[i] = FD_STEP;
+        m.retract(x, &e, &mut xp);
+        m.step(&xp, u, &mut fp)?;
+        e[i] = -FD_STEP;
+        m.retract(x, &e, &mut xp);
+        m.step(&xp, u, &mut fm)?;
+        e[i] = 0.0;
+        m.difference(&f0, &fp, &mut dp);
+        m.difference(&f0, &fm, &mut dm);
+        for r in 0..nx {
+            a[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
+        }
+    }
+    let mut up = u.to_vec();
+    for i in 0..nu {
+        up[i] = u[i] + FD_STEP;
+        m.step(x, &up, &mut fp)?;
+        up[i] = u[i] - FD_STEP;
+        m.step(x, &up, &mut fm)?;
+        up[i] = u[i];
+        m.difference(&f0, &fp, &mut dp);
+        m.difference(&f0, &fm, &mut dm);
+        for r in 0..nx {
+            b[(r, i)] = (dp[r] - dm[r]) / (2.0 * FD_STEP);
+        }
+    }
+    Ok(())
+}
+
+/// `H = ∇²(wᵀ (f(x ⊕ δx, u + δu) ⊖ f(x, u)))` at 0 by forward second differences with step
+/// [`HESS_STEP`], `(nx+nu)(nx+nu+3)/2 + 1` steps: the reference path of
+/// [`OcpModel::weighted_hessian`].
+pub fn second_difference_hessian<M: OcpModel + ?Sized>(
+    model: &mut M,
+    x: &[f64],
+    u: &[f64],
+    w: &[f64],
+    h: &mut DMatrix<f64>,
+) -> Result<(), ModelError> {
+    let (nq, nx, nu) = (model.nq(), model.nx(), model.nu());
+    let m = nx + nu;
+    let mut f0 = vec![0.0; nq];
+    model.step(x, u, &mut f0)?;
+    let mut buf = HessBuf {
+        e: vec![0.0; nx],
+        u: vec![0.0; nu],
+        xp: vec![0.0; nq],
+        fp: vec![0.0; nq],
+        d: vec![0.0; nx],
+        phi: vec![0.0; m],
+    };
+    for i in 0..m {
+        buf.phi[i] = weighted_step(model, x, u, w, &f0, &[i], &mut buf)?;
+    }
+    let e2 = HESS_STEP * HESS_STEP;
+    for i in 0..m {
+        for j in i..m {
+            let pij = weighted_step(model, x, u, w, &f0, &[i, j], &mut buf)?;
+            let v = (pij - buf.phi[i] - buf.phi[j]) / e2;
+            h[(i, j)] = v;
+            h[(j, i)] = v;
+        }
+    }
+    Ok(())
 }
 
 /// A linear model `x_{k+1} = A x + B u + w` on ℝⁿ with the terminal equality `C x = c`
