@@ -15,8 +15,10 @@
 //! - [`cost`]: [`PathCosts`], thruster and joint energy (smoothed) and the joint-limit
 //!   barrier, analytic derivatives;
 //! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
+//! - [`bound`]: the bound of a design on a transport leg (issue 41), N−1 warm-started;
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
 
+pub mod bound;
 pub mod chain;
 pub mod cost;
 pub mod derivatives;
@@ -30,6 +32,8 @@ pub mod start;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_bound;
 #[cfg(test)]
 mod tests_costs;
 #[cfg(test)]

@@ -1,0 +1,34 @@
+//! The N−1 bound (issue 41): removing a thruster never lowers the optimal-control bound.
+
+use super::bound::intact_and_n_minus_one;
+use super::problem::parse_problem;
+use super::sqp::Status;
+
+#[test]
+fn n_minus_one_bound_is_never_below_the_intact_bound() {
+    // The shipped usm-paper problem shortened (as the thruster test of `tests.rs`), two
+    // starts: for the first and the last thruster, the N−1 optimum converges and the
+    // intact design's bound (own starts, and warm-started from the N−1 optimum) is not
+    // above it.
+    let text = std::fs::read_to_string("studies/ocp_usm_paper.toml")
+        .unwrap()
+        .replace("knots = 40", "knots = 6")
+        .replace("duration = 4.0", "duration = 1.5")
+        .replace("[0.0, 0.10, -0.05]", "[0.0, 0.02, -0.01]");
+    let path = std::path::Path::new("studies/ocp_usm_paper.toml");
+    let mut spec = parse_problem(&text, path).unwrap();
+    spec.starts = 2;
+    for j in [0, spec.vehicle.n_thrusters() - 1] {
+        let (intact, minus) = intact_and_n_minus_one(&spec, j);
+        assert_eq!(minus.status, Status::Converged, "N−1 of thruster {j}");
+        assert!(minus.kkt.iter().all(|r| *r <= 1e-6), "{:?}", minus.kkt);
+        assert!(intact.kkt[0] <= 1e-6, "intact primal {}", intact.kkt[0]);
+        assert!(
+            intact.objective <= minus.objective,
+            "thruster {j}: intact {} above N−1 {}",
+            intact.objective,
+            minus.objective
+        );
+        assert_eq!(minus.solution.us[0].len() + 1, intact.solution.us[0].len());
+    }
+}
