@@ -336,3 +336,73 @@ fn report_re_ranks_over_the_worlds_by_another_recorded_metric() {
     assert!(verdict(&out).starts_with("**Winner: #1"));
     assert_eq!(column(&out, "p_best"), vec![0.0, 1.0]);
 }
+
+/// Issue 42 item 3: a payload declared a condition is a circumstance, not a rival. The same
+/// 10 % efficiency margin under two payloads: one verdict per payload (the better efficiency
+/// wins under each), `p_best` among the designs of one payload (1 and 0 under each, not 1 of
+/// 4 across), labels without the payload; and a held-out variant the leader fails is one of the
+/// verdict's caveats.
+#[test]
+fn a_payload_declared_a_condition_gets_a_verdict_per_payload() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "cond.toml",
+        "[[axis]]\nname = \"mission.payload_mass\"\nvalues = [0.5, 1.0]\ncondition = true\n\n\
+         [[axis]]\nname = \"metrics.efficiency\"\nvalues = [0.5, 0.55]\n\n\
+         [[validate]]\nname = \"impossible\"\nset = { \"success.cross_track_bound\" = 1e-6 }\n",
+    );
+    let out = dir.path().join("cond");
+    ok(&sweep(&s, &out, &["--jobs", "2"]));
+    let md = summary(&out);
+    let v = verdict(&out);
+    assert!(
+        v.starts_with("**Verdict per condition** (2 conditions"),
+        "{v}"
+    );
+    for (payload, winner) in [("0.5", 1), ("1", 3)] {
+        let line =
+            format!("**Under `mission.payload_mass` = {payload}:** **Winner: #{winner} (0.55)**");
+        assert!(md.contains(&line), "no `{line}` in:\n{md}");
+    }
+    // Ranked within each payload: each condition has its best design.
+    assert_eq!(column(&out, "p_best"), vec![0.0, 1.0, 0.0, 1.0]);
+    assert!(md.contains("### Under `mission.payload_mass` = 0.5: ranking over 8 worlds"));
+    // The failing held-out variant reaches the caveats of each verdict.
+    let caveat = "- `impossible`: unsuccessful (`validate.impossible.success` = 0";
+    assert_eq!(md.matches(caveat).count(), 2, "{md}");
+    // The manifest records the condition, so `report` regenerates the same summary.
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["robust"]["conditions"][0], "mission.payload_mass");
+    ok(&run(&["report", arg(&out)]));
+    assert_eq!(summary(&out), md);
+}
+
+/// A condition axis needs a list of values (each value one condition), and a study with
+/// `[uncertainty]` (the verdict it splits): else exit 2 at the key.
+#[test]
+fn a_condition_axis_without_values_or_worlds_exits_2_at_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = study(
+        dir.path(),
+        "range.toml",
+        "[[axis]]\nname = \"mission.payload_mass\"\nrange = { start = 0.5, stop = 1.0, steps = 2 }\ncondition = true\n",
+    );
+    let o = run(&["sweep", arg(&s), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("axis[0].condition"), "{}", stderr(&o));
+    let plain = write(
+        dir.path(),
+        "plain.toml",
+        "[study]\nname = \"plain\"\n[design.generator]\nlinks = 5\n[static]\nsamples = 32\n\
+         [[axis]]\nname = \"design.links\"\nvalues = [4, 5]\ncondition = true\n",
+    );
+    let o = run(&["sweep", arg(&plain), "--dry-run"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("plain.toml:") && e.contains("axis[0].condition"),
+        "{e}"
+    );
+}

@@ -389,10 +389,15 @@ fn print_verdict(verb: &str, dir: &Path) {
     } else if let Some(best) = usm_study::study::finish::best_case_line(dir) {
         eprintln!("[{verb}] {best}");
     }
-    // The leader's caveats, as the box lists them.
+    // The leader's caveats, as the box lists them (each condition's verdict first, with
+    // condition axes).
     let opening = usm_study::study::summary_robust::summary_opening(&md).unwrap_or("");
-    for c in opening.lines().filter(|l| l.starts_with("- ")) {
-        eprintln!("[{verb}]   caveat: {}", plain(&c[2..]));
+    for l in opening.lines() {
+        if let Some(c) = l.strip_prefix("- ") {
+            eprintln!("[{verb}]   caveat: {}", plain(c));
+        } else if l.starts_with("**Under ") {
+            eprintln!("[{verb}] {}", plain(l));
+        }
     }
     eprintln!(
         "[{verb}] review: {}",

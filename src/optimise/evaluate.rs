@@ -58,6 +58,7 @@ impl<'a> CaseEvaluator<'a> {
                 },
                 numeric: true,
                 integer: p.integer,
+                condition: false,
             })
             .collect();
         let mut keys: Vec<&str> = Vec::new();
@@ -87,6 +88,7 @@ impl<'a> CaseEvaluator<'a> {
                 spec: AxisSpec::Values(Vec::new()),
                 numeric: false,
                 integer: false,
+                condition: false,
             });
         }
         CaseEvaluator {

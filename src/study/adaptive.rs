@@ -24,7 +24,9 @@ use super::cases::resolve_case;
 use super::doe::Case;
 use super::error::StudyError;
 use super::records::{CaseStatus, CASE_ID, REASON, STATUS};
-use super::robust::{paired, split_worlds, study_verdict, AdaptiveInfo, RobustInfo, StudyVerdict};
+use super::robust::{
+    condition_verdicts, paired, split_worlds, AdaptiveInfo, RobustInfo, StudyVerdict,
+};
 use super::schema::{Study, Uncertainty};
 use super::tune::{tuned_columns, CaseTuner};
 use super::worlds::{push_world_columns, run_world, set_world_summaries, WORLD_PREFIX};
@@ -130,14 +132,21 @@ pub fn run_rounds(
         let Some(worlds) = split_worlds(&mut t, info) else {
             break Stop::Decided;
         };
-        let (Some(sv), Some(pd)) = (study_verdict(&t, &worlds, info), paired(&t, &worlds, info))
-        else {
+        let (Some(svs), Some(pd)) = (
+            condition_verdicts(&t, &worlds, info),
+            paired(&t, &worlds, info),
+        ) else {
             break Stop::Decided;
         };
         met.clone_from(&pd.met);
         ran.clone_from(&pd.ran);
-        // The tie margin of the verdict: max(equivalence, tuning noise).
-        let rows = contention(&sv, delta.max(sv.noise));
+        // The tie margin of each verdict: max(equivalence, tuning noise); the designs in
+        // contention under any condition (one verdict without condition axes).
+        let mut rows: Vec<usize> = svs
+            .iter()
+            .flat_map(|(_, sv)| contention(sv, delta.max(sv.noise)))
+            .collect();
+        rows.sort_unstable();
         if rows.is_empty() {
             break Stop::Decided;
         }

@@ -23,6 +23,7 @@ pub(crate) struct AxisFile {
     values: Option<Vec<toml::Value>>,
     range: Option<RangeFile>,
     distribution: Option<DistFile>,
+    condition: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -282,12 +283,21 @@ fn validate_axis(
             .all(|x| matches!(x, toml::Value::Integer(_) | toml::Value::Float(_))),
         _ => true,
     };
+    let condition = a.condition.unwrap_or(false);
+    if condition && !matches!(spec, AxisSpec::Values(_)) {
+        return Err(doc.err(
+            &format!("axis[{i}].condition"),
+            "a condition axis needs `values = [...]`: each value is a condition the designs \
+             are ranked under, apart from the others",
+        ));
+    }
     Ok(Axis {
         name: a.name.clone(),
         target,
         spec,
         numeric,
         integer,
+        condition,
     })
 }
 

@@ -40,6 +40,7 @@ pub mod admit;
 pub mod axes;
 pub mod cases;
 pub mod catalogue;
+pub mod conditions;
 pub mod dictionary;
 pub mod directions;
 pub mod doe;

@@ -264,6 +264,17 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
     let mut study = study;
     study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
     study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
+    if let (Some(i), None) = (
+        study.axes.iter().position(|a| a.condition),
+        &study.uncertainty,
+    ) {
+        return Err(doc.err(
+            &format!("axis[{i}].condition"),
+            "a condition axis splits the verdict over uncertain worlds, which this study has \
+             not: add `[uncertainty]`, or drop `condition` (without worlds each case is \
+             reported on its own)",
+        ));
+    }
     study.faults = parse_faults(file.faults.as_ref(), study.mode.is_dynamic(), doc)?;
     if let Some(f) = &study.faults {
         // A fault that strikes after the run ends never strikes: every design would read

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use std::path::Path;
 
+use super::conditions::Condition;
 use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::error::StudyError;
 use super::records::{
@@ -74,6 +75,11 @@ pub struct RobustInfo {
     /// they stopped; absent without the key.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptive: Option<AdaptiveInfo>,
+    /// The condition axes (`condition = true`), in file order: designs are ranked and judged
+    /// only against designs under the same values of these ([`super::conditions`]); absent
+    /// without any.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub conditions: Vec<String>,
 }
 
 /// What `manifest.json` records of a study's adaptive worlds (docs/statistics.md § Adaptive
@@ -136,6 +142,12 @@ impl RobustInfo {
                 worlds_used: u.worlds,
                 stopped: String::new(),
             }),
+            conditions: study
+                .axes
+                .iter()
+                .filter(|a| a.condition)
+                .map(|a| a.name.clone())
+                .collect(),
         })
     }
 
@@ -429,18 +441,23 @@ pub fn add_rank_columns(table: &mut Table, worlds: &Table, info: &RobustInfo) {
     let Some(pd) = paired(table, worlds, info) else {
         return;
     };
-    let idx: Vec<usize> = (0..pd.eligible.len()).filter(|&c| pd.eligible[c]).collect();
-    let obj: Vec<Vec<f64>> = idx.iter().map(|&c| pd.obj[c].clone()).collect();
-    let ok: Vec<Vec<bool>> = idx.iter().map(|&c| pd.ok[c].clone()).collect();
-    let stats = rank_stats(&obj, &ok);
     let n = table.n_rows();
     let mut cols = vec![vec![f64::NAN; n]; 4];
-    for (s, &c) in stats.iter().zip(&idx) {
-        for (col, x) in cols
-            .iter_mut()
-            .zip([s.p_best, s.rank_p05, s.rank_p50, s.rank_p95])
-        {
-            col[c] = x;
+    // Ranks and p_best among the ranked designs under the same condition, never across them.
+    for cond in super::conditions::conditions(table, &info.conditions) {
+        let idx: Vec<usize> = (0..pd.eligible.len())
+            .filter(|&c| pd.eligible[c] && cond.rows[c])
+            .collect();
+        let obj: Vec<Vec<f64>> = idx.iter().map(|&c| pd.obj[c].clone()).collect();
+        let ok: Vec<Vec<bool>> = idx.iter().map(|&c| pd.ok[c].clone()).collect();
+        let stats = rank_stats(&obj, &ok);
+        for (s, &c) in stats.iter().zip(&idx) {
+            for (col, x) in cols
+                .iter_mut()
+                .zip([s.p_best, s.rank_p05, s.rank_p50, s.rank_p95])
+            {
+                col[c] = x;
+            }
         }
     }
     // The Wilson lower bound beside the point estimate, for every case that ran.
@@ -524,7 +541,23 @@ fn worlds_for_share(share: f64, info: &RobustInfo) -> Option<usize> {
 /// The paired verdict of `table` (rows) with `worlds` under `info`'s rule, the tuning noise
 /// (median `tune_noise` of the ranked cases) counted as a tie margin.
 pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option<StudyVerdict> {
-    let pd = paired(table, worlds, info)?;
+    study_verdict_in(table, worlds, info, None)
+}
+
+/// [`study_verdict`] among the rows `within[r]` only (one condition,
+/// [`super::conditions`]): the others are neither ranked, pending nor counted.
+pub fn study_verdict_in(
+    table: &Table,
+    worlds: &Table,
+    info: &RobustInfo,
+    within: Option<&[bool]>,
+) -> Option<StudyVerdict> {
+    let mut pd = paired(table, worlds, info)?;
+    if let Some(w) = within {
+        for r in (0..pd.ran.len()).filter(|&r| !w.get(r).copied().unwrap_or(false)) {
+            (pd.ran[r], pd.eligible[r]) = (false, false);
+        }
+    }
     let mut noise: Vec<f64> = table
         .f64(TUNE_NOISE)
         .map(|v| {
@@ -575,6 +608,22 @@ pub fn study_verdict(table: &Table, worlds: &Table, info: &RobustInfo) -> Option
         ranked: pd.eligible.iter().filter(|e| **e).count(),
         pending,
     })
+}
+
+/// The verdict of each condition of `table` ([`super::conditions::conditions`] of `info.conditions`), each among
+/// its own rows only; one verdict over every row for a study without condition axes.
+pub fn condition_verdicts(
+    table: &Table,
+    worlds: &Table,
+    info: &RobustInfo,
+) -> Option<Vec<(Condition, StudyVerdict)>> {
+    super::conditions::conditions(table, &info.conditions)
+        .into_iter()
+        .map(|c| {
+            let v = study_verdict_in(table, worlds, info, Some(&c.rows))?;
+            Some((c, v))
+        })
+        .collect()
 }
 
 /// Write compacted raw rows to the partial file of `out` and the final table to

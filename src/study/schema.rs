@@ -80,6 +80,10 @@ pub struct Axis {
     pub numeric: bool,
     /// Whether the target key holds an integer (continuous values are rounded).
     pub integer: bool,
+    /// Whether the axis is a condition (`condition = true`: a payload, a current, a mission
+    /// variant), not a design choice: designs are ranked against each other only under the
+    /// same values of every condition axis ([`super::conditions`]).
+    pub condition: bool,
 }
 
 /// The kind of design of experiments (`[doe] kind`; written as lower-case text in study files

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::conditions::Condition;
 use super::manifest::Manifest;
 use super::records::CASE_ID;
 use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
@@ -25,7 +26,8 @@ use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
 
 /// How the verdict line [`Robust::verdict_line`] writes opens.
-pub const VERDICT_OPENINGS: [&str; 4] = [
+pub const VERDICT_OPENINGS: [&str; 5] = [
+    super::conditions::PER_CONDITION,
     "**Winner:",
     "**Statistically tied:",
     "**Undecided:",
@@ -64,10 +66,13 @@ const TOP: usize = 12;
 pub struct Robust<'a> {
     table: &'a Table,
     info: &'a RobustInfo,
-    worlds: Table,
+    worlds: std::rc::Rc<Table>,
     verdict: StudyVerdict,
     ids: Vec<i64>,
     axes: Vec<&'a str>,
+    /// The condition this view judges (a child view of a study with condition axes,
+    /// [`Robust::views`]); `None` for the study as a whole.
+    condition: Option<Condition>,
 }
 
 impl<'a> Robust<'a> {
@@ -79,10 +84,11 @@ impl<'a> Robust<'a> {
         Some(Robust {
             table,
             info,
-            worlds,
+            worlds: std::rc::Rc::new(worlds),
             verdict,
             ids: table.i64(CASE_ID).ok()?.to_vec(),
             axes: m.axes.iter().map(|a| a.name.as_str()).collect(),
+            condition: None,
         })
     }
 
@@ -95,8 +101,12 @@ impl<'a> Robust<'a> {
         format!("#{} ({})", self.ids[r], axes.join(", "))
     }
 
-    /// The leader of the verdict (winner or first of the tie), if any design is ranked.
+    /// The leader of the verdict (winner or first of the tie), if any design is ranked; none
+    /// for a study with condition axes as a whole (each condition has its own).
     fn leader(&self) -> Option<usize> {
+        if self.across_conditions() {
+            return None;
+        }
         self.verdict.verdict.leader()
     }
 
@@ -111,6 +121,9 @@ impl<'a> Robust<'a> {
     /// The verdict line and the box under it ([`super::verdict_box`]): the leader's caveats
     /// and the top designs side by side.
     pub fn opening(&self) -> String {
+        if self.across_conditions() {
+            return self.opening_per_condition();
+        }
         let ranked = self.ranked_rows();
         let label = |r: usize| self.label(r);
         let inp = BoxInput {
@@ -127,7 +140,11 @@ impl<'a> Robust<'a> {
     /// `plots`.
     pub fn sections(&self, dir: &Path, plots: &Path, warnings: &mut Vec<String>) -> String {
         let mut md = String::new();
-        self.ranking_section(&mut md, plots, warnings);
+        if self.across_conditions() {
+            self.ranking_per_condition(&mut md, plots, warnings);
+        } else {
+            self.ranking_section(&mut md, plots, warnings);
+        }
         self.tuning_section(&mut md);
         if self.tuning_curves(dir, plots, warnings) {
             let _ = writeln!(md, "![tuning curves](plots/tuning_curves.svg)\n");
@@ -149,7 +166,7 @@ impl<'a> Robust<'a> {
         let p = self.col(P_BEST);
         let mean = self.col(&format!("{}_mean", self.info.objective()));
         let mut rows: Vec<usize> = (0..self.table.n_rows())
-            .filter(|&r| p[r].is_finite())
+            .filter(|&r| p[r].is_finite() && self.condition.as_ref().is_none_or(|c| c.rows[r]))
             .collect();
         rows.sort_by(|&a, &b| p[b].total_cmp(&p[a]).then(mean[a].total_cmp(&mean[b])));
         rows
@@ -173,7 +190,9 @@ impl<'a> Robust<'a> {
 
     /// "ranked designs" or "designs that ran" for the rows of [`Robust::scope`].
     fn scope_text(&self) -> &'static str {
-        if self.verdict.ranked > 0 {
+        if self.verdict.ranked > 0 && self.across_conditions() {
+            "ranked designs of every condition"
+        } else if self.verdict.ranked > 0 {
             "ranked designs"
         } else {
             "designs that ran (none is ranked)"
@@ -203,7 +222,11 @@ impl<'a> Robust<'a> {
                 format!("Every design met the same {} worlds", self.info.worlds),
             ),
         };
-        let _ = writeln!(md, "## Ranking over {worlds} uncertain worlds\n");
+        match &self.condition {
+            Some(c) => writeln!(md, "### Under {}: ranking over {worlds} worlds\n", c.label),
+            None => writeln!(md, "## Ranking over {worlds} uncertain worlds\n"),
+        }
+        .ok();
         let _ = writeln!(
             md,
             "{every} ({} sampling; common random numbers, so \
@@ -217,7 +240,8 @@ impl<'a> Robust<'a> {
             self.verdict.below_requirement,
             self.info.min_success_probability
         );
-        if let Ok(missed) = self.worlds.str(super::worlds::MISSED) {
+        // Counted over every design and world: once, not under each condition.
+        if let (Ok(missed), None) = (self.worlds.str(super::worlds::MISSED), &self.condition) {
             let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
             for m in missed.iter().filter(|m| !m.is_empty()) {
                 *counts.entry(m.as_str()).or_default() += 1;
@@ -268,36 +292,7 @@ impl<'a> Robust<'a> {
             t.row(cells_row);
         }
         let _ = writeln!(md, "{}", t.finish());
-        let (p05, p50, p95) = (
-            self.col(RANK_COLUMNS[0]),
-            self.col(RANK_COLUMNS[1]),
-            self.col(RANK_COLUMNS[2]),
-        );
-        let leader = self.leader();
-        let rank_rows: Vec<RankRow> = rows
-            .iter()
-            .take(TOP)
-            .map(|&r| RankRow {
-                label: self.label(r),
-                p05: p05[r],
-                p50: p50[r],
-                p95: p95[r],
-                highlight: Some(r) == leader,
-            })
-            .collect();
-        if !rank_rows.is_empty() && self.verdict.ranked > 0 {
-            let title = format!(
-                "Rank of each design by {o} over {} worlds (5–95 %)",
-                self.info.worlds
-            );
-            match rank_interval_svg(&title, &rank_rows, self.verdict.ranked) {
-                Ok(svg) => {
-                    write_plot(plots, "rank_intervals.svg", &svg, warnings);
-                    let _ = writeln!(md, "![rank intervals](plots/rank_intervals.svg)\n");
-                }
-                Err(e) => warnings.push(format!("rank_intervals.svg: {e}")),
-            }
-        }
+        self.rank_plot(&rows, md, plots, warnings);
     }
 
     /// Every design's best-so-far tuning curve (`tuning.csv`) relative to its final value, one
@@ -358,6 +353,12 @@ impl<'a> Robust<'a> {
             Verdict::Undecided { open, .. } => open.first().map_or(f64::NAN, |c| c.margin),
             Verdict::NoneEligible => f64::NAN,
         };
+        // A margin between designs under different conditions means nothing.
+        let top_margin = if self.across_conditions() {
+            f64::NAN
+        } else {
+            top_margin
+        };
         let _ = writeln!(
             md,
             "Median tuning noise (relative spread of the tuned `{}` across independent tuning \
@@ -365,7 +366,13 @@ impl<'a> Robust<'a> {
              leader and the closest design. A margin inside the tuning noise is a tie: a \
              winner is named only beyond both the noise and the equivalence margin.\n",
             self.info.objective(),
-            Self::pct(self.verdict.noise),
+            if self.verdict.noise_measured {
+                Self::pct(self.verdict.noise)
+            } else {
+                "not measured (`tune_noise` empty: one tuning start, or fewer than two reached a \
+                 feasible point)"
+                    .into()
+            },
             Self::pct(top_margin)
         );
         if let Ok(hits) = self.table.f64(TUNE_BOUND_HITS) {
@@ -646,3 +653,6 @@ pub const MIN_SENSITIVITY_WORLDS: usize = 10;
 
 #[path = "summary_robust_verdict.rs"]
 mod verdict_line;
+
+#[path = "summary_robust_conditions.rs"]
+mod per_condition;

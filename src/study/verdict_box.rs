@@ -115,6 +115,43 @@ pub fn caveats(inp: &BoxInput) -> Vec<String> {
     out
 }
 
+/// The held-out validation variants (`validate.<name>.success` columns) in which row `r` did
+/// not succeed, each as a caveat line with the criterion it missed when recorded.
+pub fn failed_variants(t: &Table, r: usize) -> Vec<String> {
+    let mut out = Vec::new();
+    for c in &t.columns {
+        let Some(name) = c
+            .name
+            .strip_prefix("validate.")
+            .and_then(|n| n.strip_suffix(".success"))
+        else {
+            continue;
+        };
+        let Some(ok) = column(t, &c.name) else {
+            continue;
+        };
+        if ok[r] == 1.0 {
+            continue;
+        }
+        let gap = column(t, &format!("validate.{name}.gap")).map_or(f64::NAN, |g| g[r]);
+        out.push(format!(
+            "`{name}`: {} (`validate.{name}.success` = {}{})",
+            if ok[r].is_nan() {
+                "did not run to an outcome"
+            } else {
+                "unsuccessful"
+            },
+            fmt_short(ok[r]),
+            if gap.is_finite() {
+                format!(", gap {:+.1} % from the nominal run", 100.0 * gap)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    out
+}
+
 /// The top [`TOP_N`] ranked designs side by side: one column per design, one row per box
 /// metric.
 pub fn top_table(inp: &BoxInput) -> Option<String> {
@@ -161,6 +198,19 @@ pub fn verdict_box(inp: &BoxInput) -> String {
                 (inp.label)(leader),
                 100.0 * noise
             );
+        }
+        let failed = failed_variants(inp.table, leader);
+        if !failed.is_empty() {
+            let _ = writeln!(
+                md,
+                "Held-out variants {} fails (`[[validate]]`, at its tuned values; not part of \
+                 the ranking):\n",
+                (inp.label)(leader)
+            );
+            for v in &failed {
+                let _ = writeln!(md, "- {v}");
+            }
+            md.push('\n');
         }
         if inp.ranked.len() < 4 {
             let _ = writeln!(
