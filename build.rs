@@ -1,6 +1,7 @@
 //! The build identity (issue 39 item 4): a hash of the crate's sources, `Cargo.toml` and
 //! `Cargo.lock`, exported as `USM_BUILD_ID`. Study hashes include it, so a journal written by a
-//! build with other sources is never resumed silently (`src/study/hash.rs`).
+//! build with other sources is never resumed silently (`src/study/hash.rs`). Also the
+//! compiler's `rustc --version` as `USM_RUSTC_VERSION`, recorded in `manifest.json`.
 
 use std::path::{Path, PathBuf};
 
@@ -45,6 +46,16 @@ fn main() {
         }
     }
     println!("cargo:rustc-env=USM_BUILD_ID={a:016x}{b:016x}");
+    // The compiler's version for the manifest (issue 42 item 6); empty when it cannot be asked.
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let version = std::process::Command::new(rustc)
+        .arg("--version")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default();
+    println!("cargo:rustc-env=USM_RUSTC_VERSION={version}");
     println!("cargo:rerun-if-changed=src");
     println!("cargo:rerun-if-changed=Cargo.toml");
     println!("cargo:rerun-if-changed=Cargo.lock");

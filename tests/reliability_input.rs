@@ -632,6 +632,19 @@ fn values_a_key_refuses_are_refused_at_load_with_file_line_and_key() {
             "values = ",
             "axis[0].values: the value 0.0 of `scenario.duration` is refused",
         ),
+        // Issue 42 item 6: a payload axis with a value of the wrong type or range.
+        (
+            "payload_axis_2kg",
+            "[[axis]]\nname = \"mission.payload_mass\"\nvalues = [2.0, \"2kg\"]\n".to_string(),
+            "values = ",
+            "axis[0].values: the value \"2kg\" of `mission.payload_mass` is refused: invalid type",
+        ),
+        (
+            "payload_axis_negative",
+            "[[axis]]\nname = \"mission.payload_mass\"\nvalues = [2.0, -1.0]\n".to_string(),
+            "values = ",
+            "axis[0].values: the value -1.0 of `mission.payload_mass` is refused: must be a finite number >= 0",
+        ),
         (
             "negative_payload",
             world(

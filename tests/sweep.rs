@@ -87,6 +87,24 @@ fn shards_merged_equal_unsharded() {
         read(&merged.join("cases.csv"))
     );
     assert!(merged.join("summary.md").is_file());
+    // Issue 42 item 6: the manifests name no path of this machine — the study and the shards
+    // relative to the output directory — and record the compiler, the CPU and the checkout.
+    let root = std::fs::canonicalize(d.path()).unwrap();
+    for dir in [&full, &merged] {
+        let text = String::from_utf8(read(&dir.join("manifest.json"))).unwrap();
+        assert!(!text.contains(root.to_str().unwrap()), "{text}");
+        assert!(!text.contains(d.path().to_str().unwrap()), "{text}");
+        let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(m["study_file"], "../study.toml");
+        assert!(m["rustc"].as_str().unwrap().starts_with("rustc "), "{text}");
+        assert!(m["cpu"].as_str().unwrap().contains("logical CPU"), "{text}");
+    }
+    let m: serde_json::Value =
+        serde_json::from_slice(&read(&merged.join("manifest.json"))).unwrap();
+    assert_eq!(
+        m["merged_from"],
+        serde_json::json!(["../s0", "../s1", "../s2"])
+    );
     // Regenerating the report works from the directory alone.
     std::fs::remove_file(merged.join("summary.md")).unwrap();
     let o = run(&["report", merged.to_str().unwrap()]);

@@ -406,3 +406,40 @@ fn a_condition_axis_without_values_or_worlds_exits_2_at_the_key() {
         "{e}"
     );
 }
+
+/// Issue 39 item 3: beyond 10 000 world values `manifest.json` lists none and names
+/// `worlds.csv`, which holds them; `report` reads them back from it and rewrites the same
+/// `worlds.csv` (5001 worlds × 2 parameters, 0.5 s runs).
+#[test]
+fn many_worlds_are_left_to_worlds_csv_not_listed_in_the_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "[study]\nname = \"many\"\nseed = 1\n\n[design]\npreset = \"usm-paper\"\n\n\
+        [scenario]\nmode = \"transport\"\nduration = 0.5\n\n[uncertainty]\nworlds = 5001\n\n\
+        [[uncertainty.param]]\nname = \"physics.current_speed\"\n\
+        distribution = { kind = \"uniform\", low = 0.0, high = 0.1 }\n\n\
+        [[uncertainty.param]]\nname = \"hydro.linear_damping_scale\"\n\
+        distribution = { kind = \"uniform\", low = 0.8, high = 1.2 }\n";
+    let path = write(dir.path(), "many.toml", text);
+    let out = dir.path().join("many");
+    let o = sweep(&path, &out, &["--jobs", "2"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let bytes = std::fs::read(out.join("manifest.json")).unwrap();
+    assert!(bytes.len() < 100_000, "manifest of {} bytes", bytes.len());
+    let m: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+    assert_eq!(m["robust"]["world_values_in"], "worlds.csv");
+    assert!(m["robust"]
+        .get("world_values")
+        .is_none_or(|v| v.as_array().is_some_and(|a| a.is_empty())));
+    let worlds = std::fs::read(out.join("worlds.csv")).unwrap();
+    let text = String::from_utf8(worlds.clone()).unwrap();
+    assert_eq!(text.lines().count(), 1 + 5001);
+    // Every world's values are in it (no NaN parameter), and `report` gives them back.
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert!(f[2].parse::<f64>().unwrap().is_finite(), "{line}");
+        assert!(f[3].parse::<f64>().unwrap().is_finite(), "{line}");
+    }
+    let o = run(&["report", arg(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read(out.join("worlds.csv")).unwrap(), worlds);
+}

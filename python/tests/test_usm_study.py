@@ -109,6 +109,14 @@ def test_simulate_many_of_64_equals_64_single_runs():
     assert one.equals(df)
 
 
+def test_the_readme_grid_succeeds_where_the_readme_says():
+    # README.md's simulate_many example as written (issue 42 item 6): 5 of the 6 rows meet every
+    # [success] criterion; k_psi 0.3 with a 1 m look-ahead ends 0.12 m off the path (bound 0.1 m).
+    grid = [{"control.k_psi": k, "control.look_ahead": d} for k in (0.3, 0.45, 0.6) for d in (1.0, 2.0)]
+    df = usm_study.simulate_many("transport-method2", grid, jobs=2)
+    assert df["ok"].to_list() == [False, True, True, True, True, True]
+
+
 def test_errors_raise_with_the_location(tmp_path):
     assert issubclass(usm_study.UsmStudyError, ValueError)
     bad = tmp_path / "bad.toml"

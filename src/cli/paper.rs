@@ -76,6 +76,11 @@ pub fn run(a: &PaperArgs) -> anyhow::Result<ExitCode> {
             t.ours.moment_integral_b,
             t.paper.moment_integral_b
         );
+        eprintln!(
+            "[paper antonelli] Table I differs (the 1998 code behind it had other cross-flow \
+             terms): every reading of case 3 and why, in results/antonelli/FINDINGS.md \
+             §\"Case 3 and Table I\""
+        );
         eprintln!("[paper antonelli] wrote {}", out.display());
         return Ok(ExitCode::SUCCESS);
     }

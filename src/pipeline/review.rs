@@ -137,13 +137,20 @@ fn remove_dead_temporaries(dir: &Path) {
 }
 
 /// Rebuilds and draws the designs of `ids` (cases sharing a design drawn once), from the
-/// study copy in `dir` or the original study file the manifest names.
+/// original study file the manifest names (relative to `dir`) while its text is still the
+/// copy's in `dir` — its relative paths (a `[design] file`) resolve only from there — else
+/// from the copy.
 fn drawings(dir: &Path, study_file: Option<&str>, ids: &[i64]) -> Result<Vec<Drawing>, String> {
     let copy = dir.join(STUDY_COPY);
-    let path = if copy.is_file() {
-        copy
-    } else {
-        PathBuf::from(study_file.ok_or("no study.toml in the directory")?)
+    let original = study_file.map(|f| dir.join(f));
+    let same = |p: &PathBuf| {
+        let read = |p: &Path| std::fs::read(p).ok();
+        read(p).is_some_and(|t| Some(t) == read(&copy))
+    };
+    let path = match original {
+        Some(p) if !copy.is_file() || same(&p) => p,
+        _ if copy.is_file() => copy,
+        _ => return Err("no study.toml in the directory".into()),
     };
     let study = load_study(&path).map_err(|e| e.to_string())?;
     let all = expand(&study, None)?;

@@ -47,7 +47,8 @@ use super::finish::finish_report;
 use super::journal;
 use super::lock;
 use super::manifest::{
-    git_commit, now_rfc3339, read_manifest, write_manifest, AxisInfo, Counts, Manifest,
+    cpu_model, git_commit, git_dirty, now_rfc3339, read_manifest, relative_path, rustc_version,
+    write_manifest, AxisInfo, Counts, Manifest,
 };
 use super::outdir;
 use super::records::{
@@ -233,7 +234,7 @@ pub fn run_sweep(
     outcome.set_counts(StatusCounts::of_table(&table)?);
     let elapsed = t0.elapsed().as_secs_f64();
     outcome.elapsed_s = elapsed;
-    let mut manifest = sweep_manifest(study, &schema, start_time, elapsed, jobs);
+    let mut manifest = sweep_manifest(study, &out, &schema, start_time, elapsed, jobs);
     manifest.robust = robust;
     manifest.case_timeout_s = opts.case_timeout.map(|d| d.as_secs_f64());
     manifest.shard = opts.shard.map(|(i, n)| [i, n]);
@@ -563,6 +564,7 @@ fn process(
 /// The manifest of a finished sweep, without its shard, throughput and counts.
 fn sweep_manifest(
     study: &Study,
+    out: &Path,
     schema: &[(String, ColumnKind)],
     start_time: String,
     elapsed: f64,
@@ -573,12 +575,12 @@ fn sweep_manifest(
         tool_version: env!("CARGO_PKG_VERSION").into(),
         build_id: Some(super::hash::BUILD_ID.into()),
         git_commit: git_commit(),
+        git_dirty: git_dirty(),
+        rustc: rustc_version(),
+        cpu: cpu_model(),
         study_name: study.name.clone(),
         description: study.description.clone(),
-        study_file: std::fs::canonicalize(&study.path)
-            .unwrap_or_else(|_| study.path.clone())
-            .display()
-            .to_string(),
+        study_file: relative_path(&study.path, out),
         study_hash: study.hash.clone(),
         seed: study.seed,
         mode: study.mode,

@@ -82,11 +82,24 @@ pub struct Manifest {
     pub build_id: Option<String>,
     /// `git rev-parse HEAD` of the working directory, when available.
     pub git_commit: Option<String>,
+    /// Whether that checkout had uncommitted changes to tracked files (`git status
+    /// --porcelain --untracked-files=no` not empty) when the run started; absent outside git.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub git_dirty: Option<bool>,
+    /// `rustc --version` of the compiler that built this binary (recorded by `build.rs`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rustc: Option<String>,
+    /// The CPU model of the machine that ran it (`model name` of `/proc/cpuinfo`, else the
+    /// architecture), and its logical CPU count: the context of every time in the manifest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu: Option<String>,
     /// Study name.
     pub study_name: String,
     /// Description.
     pub description: String,
-    /// Study file (absolute when known).
+    /// Study file, relative to the output directory that holds this manifest (e.g.
+    /// `../../studies/thrusters.toml`; [`study_path`] resolves it), so that a results folder
+    /// names no path of the machine that ran it. Older manifests: absolute.
     pub study_file: String,
     /// Study hash.
     pub study_hash: String,
@@ -194,8 +207,89 @@ pub fn git_commit() -> Option<String> {
     (out.status.success() && s.len() >= 7).then_some(s)
 }
 
-/// Write `manifest.json` into `dir`.
+/// Whether the working directory's git checkout has uncommitted changes to tracked files;
+/// `None` outside a checkout or without git.
+pub fn git_dirty() -> Option<bool> {
+    let out = std::process::Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=no"])
+        .stderr(std::process::Stdio::null())
+        .output()
+        .ok()?;
+    out.status.success().then(|| !out.stdout.is_empty())
+}
+
+/// `rustc --version` of the build (`build.rs`).
+pub fn rustc_version() -> Option<String> {
+    let v = env!("USM_RUSTC_VERSION");
+    (!v.is_empty()).then(|| v.to_string())
+}
+
+/// The CPU model and logical CPU count of this machine, e.g. `AMD EPYC 7B13 (2 logical CPUs)`.
+pub fn cpu_model() -> Option<String> {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines().find_map(|l| {
+                l.strip_prefix("model name")?
+                    .split_once(':')
+                    .map(|(_, v)| v.trim().to_string())
+            })
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let n = std::thread::available_parallelism().map_or(1, |n| n.get());
+    Some(format!("{model} ({n} logical CPUs)"))
+}
+
+/// `path` relative to the directory `base` (both made absolute and resolved first), e.g.
+/// `../../studies/a.toml`; `path` as given when either cannot be resolved.
+pub fn relative_path(path: &Path, base: &Path) -> String {
+    let (Ok(p), Ok(b)) = (std::fs::canonicalize(path), std::fs::canonicalize(base)) else {
+        return path.display().to_string();
+    };
+    let (pc, bc): (Vec<_>, Vec<_>) = (p.components().collect(), b.components().collect());
+    let common = pc.iter().zip(&bc).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return p.display().to_string();
+    }
+    let mut rel = std::path::PathBuf::new();
+    for _ in common..bc.len() {
+        rel.push("..");
+    }
+    for c in &pc[common..] {
+        rel.push(c);
+    }
+    rel.to_string_lossy().replace('\\', "/")
+}
+
+/// The study file a manifest of output directory `dir` names: its `study_file` resolved
+/// against `dir` (an absolute one, of an older manifest, as it is).
+pub fn study_path(dir: &Path, m: &Manifest) -> std::path::PathBuf {
+    dir.join(&m.study_file)
+}
+
+/// Most world parameter values (worlds × parameters) `manifest.json` lists; beyond it they
+/// are left to `worlds.csv` (issue 39 item 3: 130 000 Saltelli worlds × 24 parameters made a
+/// 75 MB manifest). 10 000 numbers are ≈ 250 kB of JSON.
+pub const MAX_LISTED_WORLD_VALUES: usize = 10_000;
+
+/// Write `manifest.json` into `dir` (worlds' values beyond [`MAX_LISTED_WORLD_VALUES`] left
+/// to `worlds.csv`; [`read_manifest`] reads them back).
 pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), StudyError> {
+    let listed = m
+        .robust
+        .as_ref()
+        .map_or(0, |r| r.world_values.iter().map(Vec::len).sum::<usize>());
+    let mut short;
+    let m = if listed > MAX_LISTED_WORLD_VALUES {
+        short = m.clone();
+        if let Some(r) = short.robust.as_mut() {
+            r.world_values.clear();
+            r.world_values_in = Some(super::robust::WORLDS_CSV.to_string());
+        }
+        &short
+    } else {
+        m
+    };
     let text = serde_json::to_string_pretty(m).map_err(|e| StudyError::Other(e.to_string()))?;
     let p = dir.join(MANIFEST_FILE);
     crate::report::atomic_write(&p, (text + "\n").as_bytes()).map_err(StudyError::from)
@@ -211,5 +305,49 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, StudyError> {
             dir.display()
         ))
     })?;
-    serde_json::from_str(&text).map_err(|e| StudyError::Input(format!("{}: {e}", p.display())))
+    let mut m: Manifest = serde_json::from_str(&text)
+        .map_err(|e| StudyError::Input(format!("{}: {e}", p.display())))?;
+    if let Some(r) = m.robust.as_mut() {
+        if let Some(file) = r.world_values_in.take() {
+            r.world_values = world_values_from(&dir.join(&file), r)?;
+        }
+    }
+    Ok(m)
+}
+
+/// The worlds' parameter values of `info` read back from `worlds.csv` at `path` (one row per
+/// case and world: every row of world k carries its values); a world no row names (met by no
+/// case) gets NaN values.
+fn world_values_from(
+    path: &Path,
+    info: &super::robust::RobustInfo,
+) -> Result<Vec<Vec<f64>>, StudyError> {
+    let bad = |e: String| {
+        StudyError::Input(format!(
+            "{}: {e} (manifest.json leaves the worlds' values to it)",
+            path.display()
+        ))
+    };
+    let t = crate::report::read_csv(path).map_err(|e| bad(e.to_string()))?;
+    let worlds = t.i64("world").map_err(|e| bad(e.to_string()))?;
+    let cols = info
+        .params
+        .iter()
+        .map(|p| t.f64(&p.name).map_err(|e| bad(e.to_string())))
+        .collect::<Result<Vec<_>, _>>()?;
+    let n = worlds
+        .iter()
+        .map(|&k| k.max(0) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut out = vec![vec![f64::NAN; cols.len()]; n];
+    for (r, &k) in worlds.iter().enumerate() {
+        let Ok(k) = usize::try_from(k) else {
+            return Err(bad(format!("row {}: world {k} is negative", r + 2)));
+        };
+        for (j, c) in cols.iter().enumerate() {
+            out[k][j] = c[r];
+        }
+    }
+    Ok(out)
 }

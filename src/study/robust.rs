@@ -60,7 +60,14 @@ pub struct RobustInfo {
     /// The uncertain parameters.
     pub params: Vec<ParamInfo>,
     /// Each world's parameter values (numbers; a `choice` of text by its index), by world.
+    /// Beyond [`super::manifest::MAX_LISTED_WORLD_VALUES`] numbers `manifest.json` leaves them
+    /// out and names the file that holds them (`world_values_in`, issue 39 item 3).
+    #[serde(default)]
     pub world_values: Vec<Vec<f64>>,
+    /// The file of the output directory holding the worlds' values when `manifest.json` does
+    /// not list them (`worlds.csv`); absent when they are listed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world_values_in: Option<String>,
     /// Metrics summarised over worlds; the first is the ranking objective.
     pub metrics: Vec<String>,
     /// Least success probability of a ranked case.
@@ -130,6 +137,7 @@ impl RobustInfo {
                 })
                 .collect(),
             world_values,
+            world_values_in: None,
             metrics: u.metrics.clone(),
             min_success_probability: u.min_success_probability,
             confidence: u.confidence,

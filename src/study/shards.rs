@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 
 use super::error::{Notes, StudyError};
 use super::finish::finish_report;
-use super::manifest::{now_rfc3339, read_manifest, write_manifest, Counts, Manifest};
+use super::manifest::{
+    now_rfc3339, read_manifest, relative_path, study_path, write_manifest, Counts, Manifest,
+};
 use super::outdir;
 use super::parse::load_study;
 use super::records::{compact, StatusCounts, PARTIAL_FILE, STUDY_COPY};
@@ -47,7 +49,7 @@ pub fn merge(
         .iter()
         .map(|d| read_manifest(d))
         .collect::<Result<_, _>>()?;
-    let m0 = &manifests[0];
+    let m0 = &with_every_world(&manifests);
     let canonical = |d: &Path| std::fs::canonicalize(d).ok();
     if let Some(o) = canonical(out) {
         if let Some(d) = dirs.iter().find(|d| canonical(d).as_ref() == Some(&o)) {
@@ -89,7 +91,9 @@ pub fn merge(
     m.start_time = start_time;
     m.end_time = now_rfc3339();
     m.shard = None;
-    m.merged_from = dirs.iter().map(|d| d.display().to_string()).collect();
+    // Paths relative to the merged output, as a sweep records them (issue 42 item 6).
+    m.merged_from = dirs.iter().map(|d| relative_path(d, out)).collect();
+    m.study_file = relative_path(&study_path(first_dir, m0), out);
     m.cases = Counts {
         planned: m0.cases.planned,
         in_output: table.n_rows(),
@@ -110,7 +114,7 @@ pub fn merge(
         ));
     }
     // The study itself (for reruns of the best/worst case), when it is still where it was.
-    let study = load_study(Path::new(&m.study_file))
+    let study = load_study(&study_path(out, &m))
         .ok()
         .filter(|s| s.hash == m.study_hash);
     warnings.extend(finish_report(out, &table, &m, study.as_ref(), tuning));
@@ -186,6 +190,30 @@ fn check_shard_set(
         "merge: {}; pass --partial to merge what is there",
         problems.join("; ")
     )))
+}
+
+/// The first manifest with the worlds' values the others know and it does not: a manifest
+/// that leaves them to its shard's `worlds.csv` knows only the worlds its cases met (NaN for
+/// the rest); the shards' worlds are the same draws, so their union is the study's.
+fn with_every_world(manifests: &[Manifest]) -> Manifest {
+    let mut m0 = manifests[0].clone();
+    if let Some(r0) = m0.robust.as_mut() {
+        for r in manifests[1..].iter().filter_map(|m| m.robust.as_ref()) {
+            if r.world_values.len() > r0.world_values.len() {
+                let width = r0.params.len();
+                r0.world_values
+                    .resize(r.world_values.len(), vec![f64::NAN; width]);
+            }
+            for (w0, w) in r0.world_values.iter_mut().zip(&r.world_values) {
+                for (x0, x) in w0.iter_mut().zip(w) {
+                    if x0.is_nan() {
+                        *x0 = *x;
+                    }
+                }
+            }
+        }
+    }
+    m0
 }
 
 /// Every shard must come from the first one's study and have its columns.
