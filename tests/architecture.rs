@@ -629,6 +629,36 @@ fn the_library_has_no_command_line_layer() {
     }
 }
 
+/// The rooms of the physics: `report` imports none of them (issue 37 item 5; its module docs
+/// say it knows nothing of the physics — geometry from `spatial` is drawing, not physics).
+const PHYSICS_ROOMS: &[&str] = &[
+    "model",
+    "kinematics",
+    "dynamics",
+    "allocation",
+    "control",
+    "scenario",
+    "outcome",
+    "statics",
+    "evaluate",
+];
+
+#[test]
+fn the_report_room_imports_no_physics() {
+    let (edges, _) = dependency_graph(&root().join("src/lib.rs"));
+    let report = root().join("src/report");
+    let mut seen = 0;
+    for p in edges.keys().filter(|p| p.starts_with(&report)) {
+        seen += 1;
+        let toks = tokens(&strip(&std::fs::read_to_string(p).unwrap()));
+        for w in toks.windows(3) {
+            let physics = w[0] == "crate" && w[1] == "::" && PHYSICS_ROOMS.contains(&w[2].as_str());
+            assert!(!physics, "{} imports crate::{}", p.display(), w[2]);
+        }
+    }
+    assert!(seen > 10, "the walk found {seen} report files");
+}
+
 /// Longest non-test function we accept, in lines.
 const MAX_FN_LINES: usize = 120;
 

@@ -17,8 +17,8 @@ use super::status::{CaseEnd, CaseStatus, Disqualification, PANIC, UNDER_ACTUATED
 use crate::input::keypath::{set, Seg, SetError};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
-use crate::report::Table;
 use crate::sampling::derive_seed;
+use crate::scenario::channels::Trajectory;
 use crate::statics::{analyse, authority_analysis, SinkError, StaticError};
 
 /// Which phases a case runs besides building its design.
@@ -99,8 +99,9 @@ pub struct CaseResult {
     /// Why it was not `ok`, for people (for `unsuccessful`: `criterion: detail`); empty when
     /// `ok`. Nothing reads meaning back out of it: that is [`CaseResult::end`].
     pub reason: String,
-    /// The closed loop's trajectory (when asked for and the run produced one).
-    pub trajectory: Option<Table>,
+    /// The closed loop's trajectory, typed (when asked for and the run produced one);
+    /// [`super::trajectory_table`] makes it a table for the files that hold it.
+    pub trajectory: Option<Trajectory>,
 }
 
 impl CaseResult {
@@ -339,13 +340,7 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     if !input.trajectory {
         run.trajectory = None;
     }
-    let trajectory = match run
-        .trajectory
-        .map(|t| crate::report::figures::trajectory_table(&t))
-    {
-        Some(Err(e)) => return out.finish(CaseEnd::Error, e.to_string()),
-        t => t.and_then(Result::ok),
-    };
+    let trajectory = run.trajectory;
     if let Some(f) = run.failure {
         let end = if f.timeout {
             CaseEnd::Timeout

@@ -18,6 +18,7 @@ pub mod deadline;
 pub mod metrics;
 pub mod static_table;
 pub mod status;
+pub mod trajectory;
 
 pub use case::{
     out_of_reach, CaseInput, CaseResult, Evaluator, Override, OverrideError, Overrides, Phases,
@@ -28,3 +29,4 @@ pub use metrics::{Metrics, AUTHORITY_COLUMNS, DESIGN_COLUMNS, N1_LOSS_COLUMNS, T
 pub use status::{
     reason_detail, CaseEnd, CaseStatus, Disqualification, UnknownStatus, PANIC, UNDER_ACTUATED,
 };
+pub use trajectory::trajectory_table;

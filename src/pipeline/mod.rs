@@ -23,6 +23,7 @@ pub mod optimise;
 mod optimise_plots;
 pub mod review;
 mod review_top;
+pub mod run_figure;
 pub mod shapes;
 pub mod simulate;
 pub mod tcm;

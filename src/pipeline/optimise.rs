@@ -12,6 +12,7 @@ use serde_json::json;
 
 use super::error::PipelineError;
 use super::optimise_plots::{parameter_figure, progress_figure};
+use super::run_figure::run_figure;
 use crate::control::transport::yaw_joint_mask;
 use crate::evaluate::static_table::STATIC_TABLE;
 use crate::model::design::parse_design_table;
@@ -19,7 +20,6 @@ use crate::optimise::evaluate::CaseEvaluator;
 use crate::optimise::history::{history_table, Record};
 use crate::optimise::score::mean_of;
 use crate::optimise::{Outcome, Problem};
-use crate::report::figures::run_figure;
 use crate::report::{
     atomic_write, file_stem_safe, fmt_num, write_csv, write_parquet, Figure, MarkdownTable, Panel,
 };
@@ -349,9 +349,10 @@ fn runs_figure(
             .filter(|(_, y)| **y)
             .map(|(i, _)| i)
             .collect();
-        let Some(table) = run.trajectory.filter(|t| t.n_rows() > 0) else {
+        let Some(traj) = run.trajectory.filter(|t| !t.is_empty()) else {
             return Ok(None);
         };
+        let table = crate::evaluate::trajectory_table(&traj)?;
         figs.push(run_figure(&table, mode, &yaw, label)?);
     }
     let best = figs.pop().unwrap_or_else(|| Figure::new(""));

@@ -7,11 +7,12 @@ use std::path::Path;
 use serde_json::json;
 
 use super::error::PipelineError;
+use super::run_figure::run_figure;
 use crate::allocation::Method;
 use crate::control::transport::yaw_joint_mask;
+use crate::evaluate::trajectory_table;
 use crate::model::Vehicle;
 use crate::outcome::RunResult;
-use crate::report::figures::{run_figure, trajectory_table};
 use crate::report::{atomic_write, write_csv, write_parquet_with};
 
 /// Sets `allocation.method` in a scenario table (the `--allocation` override, and the paper's

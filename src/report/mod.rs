@@ -26,8 +26,6 @@ pub mod column_kind;
 pub mod csv_append;
 pub mod drawing;
 pub mod error;
-/// SVG figures.
-pub mod figures;
 pub mod html;
 pub mod markdown;
 pub mod number;

@@ -551,7 +551,7 @@ fn process(
         return Msg::NotRun;
     }
     let row = match resolved {
-        Ok(r) => w.evaluate(study, case, &r, false, run.tuner).0,
+        Ok(r) => w.evaluate(study, case, &r, run.tuner),
         Err(reason) => {
             let mut row = Row::new(case.id, hash, case.values.clone());
             row.end(CaseEnd::Skipped, &reason.to_string());

@@ -14,7 +14,7 @@ use super::selection::Selection;
 use super::summary::write_report;
 use super::tune::{case_tuner, tuned_columns, TuneError, TuningHook};
 use super::worker::evaluate_resolved;
-use crate::evaluate::{Deadline, Evaluator};
+use crate::evaluate::{trajectory_table, Deadline, Evaluator};
 use crate::report::{read_csv_typed, write_csv, ReportError, Table};
 
 /// Why the best or worst case could not be rerun (a warning of the report, not fatal).
@@ -106,7 +106,7 @@ fn rerun_extremes(
             return Err(RerunError::Timeout(res.reason));
         }
         if let Some(t) = res.trajectory {
-            write_csv(&t, &out.join(which.trajectory_file()))?;
+            write_csv(&trajectory_table(&t)?, &out.join(which.trajectory_file()))?;
         }
         Ok(())
     };

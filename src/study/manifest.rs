@@ -215,7 +215,7 @@ pub fn git_dirty() -> Option<bool> {
         .stderr(std::process::Stdio::null())
         .output()
         .ok()?;
-    out.status.success().then(|| !out.stdout.is_empty())
+    out.status.success().then_some(!out.stdout.is_empty())
 }
 
 /// `rustc --version` of the build (`build.rs`).

@@ -18,7 +18,6 @@ use super::schema::Study;
 use super::tune::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
 use crate::evaluate::{out_of_reach, CaseEnd, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
-use crate::report::Table;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
 /// by the design hash, so consecutive cases of one design build it once) and the budget.
@@ -102,17 +101,17 @@ impl Worker {
         }
     }
 
-    /// Evaluate a resolved case; returns the row and (with `log`) the trajectory. With a
-    /// `tuner`, the case is tuned first and scored at its tuned values (a tuning that cannot
-    /// run makes the case `failed` with a reason starting `tune:`).
+    /// Evaluate a resolved case into its row (no trajectory is logged: the report's best and
+    /// worst reruns log theirs, `finish::rerun_extremes`). With a `tuner`, the case is tuned
+    /// first and scored at its tuned values (a tuning that cannot run makes the case `failed`
+    /// with a reason starting `tune:`).
     pub fn evaluate(
         &mut self,
         study: &Study,
         case: &Case,
         r: &Resolved,
-        log: bool,
         tuner: Option<&dyn CaseTuner>,
-    ) -> (Row, Option<Table>) {
+    ) -> Row {
         let deadline = Deadline::after(self.budget);
         let row =
             |res: CaseResult| Row::from_result(case.id, r.hash.clone(), case.values.clone(), res);
@@ -120,14 +119,12 @@ impl Worker {
         // changes its reach; one untuned evaluation records its static columns and the miss.
         let unreachable = out_of_reach(&r.design, &r.scenario, &study.name);
         let Some(t) = tuner.filter(|_| !unreachable) else {
-            let mut res = evaluate_resolved(&mut self.evaluator, study, case.id, r, log, deadline);
-            if unreachable {
-                let traj = res.trajectory.take();
-                return (row(res), traj);
+            let mut res =
+                evaluate_resolved(&mut self.evaluator, study, case.id, r, false, deadline);
+            if !unreachable {
+                self.robust(study, case.id, r, deadline, &mut res);
             }
-            self.robust(study, case.id, r, deadline, &mut res);
-            let traj = res.trajectory.take();
-            return (row(res), traj);
+            return row(res);
         };
         match t.tune(study, case, r, deadline) {
             Ok(tuned) => {
@@ -136,18 +133,17 @@ impl Worker {
                     study,
                     case.id,
                     &tuned.resolved,
-                    log,
+                    false,
                     deadline,
                 );
                 tuned.record(study, &mut res.metrics);
                 self.robust(study, case.id, &tuned.resolved, deadline, &mut res);
-                let traj = res.trajectory.take();
-                (row(res), traj)
+                row(res)
             }
             Err(e) => {
                 let mut failed = Row::new(case.id, r.hash.clone(), case.values.clone());
                 failed.end(CaseEnd::Error, &e.to_string());
-                (failed, None)
+                failed
             }
         }
     }

@@ -1,22 +1,12 @@
 //! The paper-style figures of one closed-loop run, laid out like the USM paper's Fig. 8
 //! (transport mode) and Fig. 9 (work mode), from a trajectory table. Columns are looked up
-//! by [`Channel`] (`t`, `ee_y`, `u_0`, … as named by [`Channel::name`]), no physics.
+//! by [`Channel`] (`t`, `ee_y`, `u_0`, … as named by [`Channel::name`]), no physics. It lives
+//! with the pipelines that draw it (issue 37 item 5: `report` knows nothing of the physics).
 
-use super::error::Result;
-use super::plot::{Colour, Figure, Panel, Series};
-use super::table::Table;
-use crate::scenario::channels::{Channel, Pose, Trajectory, Twist};
+use crate::report::plot::{Colour, Figure, Panel, Series};
+use crate::report::{Result, Table};
+use crate::scenario::channels::{Channel, Pose, Twist};
 use crate::scenario::config::Mode;
-
-/// A table of a run's trajectory: one f64 column per channel, named by [`Channel::name`], in
-/// the trajectory's column order.
-pub fn trajectory_table(traj: &Trajectory) -> Result<Table> {
-    let mut t = Table::new();
-    for (c, x) in traj.iter() {
-        t.push(c.name(), x.to_vec())?;
-    }
-    Ok(t)
-}
 
 fn col(t: &Table, c: Channel) -> Result<Vec<f64>> {
     t.f64(&c.name()).map(|x| x.to_vec())
