@@ -228,6 +228,43 @@ fn simulate_draws_the_body_along_the_run_deterministically() {
     assert_eq!(snapshot_times(&anim, "top").len(), 60);
     // One opacity animation per frame and view, plus one per frame for the clock.
     assert_eq!(anim.matches("<animate ").count(), 3 * 60);
+    // Issue 42 item 5: without SMIL only the first frame shows (one per view, one clock) …
+    assert_eq!(anim.matches("opacity=\"1\"").count(), 3, "first frames");
+    assert_eq!(
+        anim.matches("opacity=\"0\"").count(),
+        3 * 59,
+        "hidden frames"
+    );
+    // … the thrust dots are not blown up by the camera's zoom (radius × zoom = 1.2 or 1.6 px) …
+    let zoom: f64 = anim
+        .split("scale(")
+        .nth(1)
+        .unwrap()
+        .split(')')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    for r in anim
+        .split("<circle ")
+        .skip(1)
+        .filter_map(|c| c.split("r=\"").nth(1))
+    {
+        let r: f64 = r.split('"').next().unwrap().parse().unwrap();
+        assert!(
+            (r * zoom - 1.2).abs() < 0.01 || (r * zoom - 1.6).abs() < 0.01,
+            "r {r} at zoom {zoom}"
+        );
+    }
+    // … and in the overlaid picture every arrow comes after every outline.
+    let last_body = shapes.rfind("class=\"body\"").unwrap();
+    let first_arrow = shapes.find("class=\"thruster\"").unwrap();
+    let (top_end, _) = shapes.split_at(shapes.find("id=\"view-side\"").unwrap());
+    assert!(top_end.rfind("class=\"body\"").unwrap() < top_end.find("class=\"thruster\"").unwrap());
+    assert!(
+        first_arrow < last_body,
+        "the side view follows the top view"
+    );
     // --no-plots leaves them out.
     let o = run(&[
         "simulate",

@@ -5,9 +5,14 @@
 //! Structure (for tests and the HTML report): each view is a `<g class="view" id="view-top|side">`
 //! with the same `data-scale`/`data-x0`/`data-y0` transform attributes as the design drawing
 //! ([`super::ViewTransform`]); each snapshot is a `<g class="snap" data-t="…">` holding its
-//! body outlines (`polygon.body`) and thrust arrows (`g.thruster`). In the animation each
-//! snapshot group carries one discrete `<animate>` of its opacity, so that exactly one is
-//! visible at a time; the document needs no script.
+//! body outlines (`polygon.body`) and, in the animation, its thrust arrows (`g.thruster`); the
+//! overlaid picture draws the arrows after every outline, in `<g class="thrust" data-t="…">`,
+//! so that no later outline hides a thrust. In the animation each snapshot group carries one
+//! discrete `<animate>` of its opacity, so that exactly one is visible at a time; the document
+//! needs no script, and a viewer without SMIL shows the first frame alone (every frame but the
+//! first has opacity 0 until animated; the still sequence is the overlaid picture,
+//! `shapes.svg`). The thrust dots inside the animation's zoomed camera are drawn at 1/zoom of
+//! their radius, so the zoom does not blow them up over the arrows.
 
 use std::fmt::Write as _;
 
@@ -166,8 +171,31 @@ fn trace(s: &mut Svg, class: &str, view: View, t: &ViewTransform, ps: &[Vec3]) {
     }
 }
 
+/// What of a snapshot a group draws, and how: [`Layer::Bodies`] and [`Layer::Arrows`] apart
+/// (the overlaid picture draws every body first, so no later outline hides an earlier thrust
+/// arrow), [`Layer::Both`] in one group (an animation frame).
+#[derive(Clone, Copy, PartialEq)]
+enum Layer {
+    Bodies,
+    Arrows,
+    Both,
+}
+
+/// How a snapshot group is drawn: its layer; `dot`, the scale of the thrust dots' radii (1 on
+/// the page; 1/zoom inside the animation's camera, whose zoom would blow them up over the
+/// arrows); `opacity`, the group's opacity without SMIL (the animation shows its first frame
+/// alone where SMIL is not supported; `None` = visible).
+#[derive(Clone, Copy)]
+struct Style {
+    layer: Layer,
+    dot: f64,
+    opacity: Option<&'static str>,
+}
+
 /// One snapshot in one view: outlines stroked in the snapshot's colour, thrust arrows in the
-/// accent colour. `extra` is written first inside the group (the animation's `<animate>`).
+/// accent colour (as `style` says). `extra` is written first inside the group (the
+/// animation's `<animate>`). The arrows' group is `g.thrust` when drawn apart, else the
+/// snapshot's `g.snap` holds both.
 fn snapshot(
     s: &mut Svg,
     view: View,
@@ -175,75 +203,91 @@ fn snapshot(
     snap: &Snapshot,
     colour: &str,
     extra: &[(&str, Attr)],
+    style: Style,
 ) {
-    s.open(
-        "g",
-        &[
-            ("class", "snap".into()),
-            ("data-t", Attr::Text(format!("{:.3}", snap.t))),
-            ("stroke", colour.into()),
-        ],
-    );
+    let class = if style.layer == Layer::Arrows {
+        "thrust"
+    } else {
+        "snap"
+    };
+    let mut attrs = vec![
+        ("class", class.into()),
+        ("data-t", Attr::Text(format!("{:.3}", snap.t))),
+        ("stroke", colour.into()),
+    ];
+    if let Some(o) = style.opacity {
+        attrs.push(("opacity", o.into()));
+    }
+    s.open("g", &attrs);
     if !extra.is_empty() {
         s.empty("animate", extra);
     }
-    for c in &snap.scene.cylinders {
-        let pts = points(
-            t,
-            cylinder_outline(view, &c.pose, c.length, c.radius).into_iter(),
-        );
-        s.empty(
-            "polygon",
-            &[
-                ("class", "body".into()),
-                ("data-body", c.name.as_str().into()),
-                ("points", pts.into()),
-            ],
-        );
-    }
-    for a in &snap.scene.arrows {
-        let p1 = t.to_svg(view.project(&a.start));
-        let p2 = t.to_svg(view.project(&(a.start + a.direction * a.length)));
-        s.open(
-            "g",
-            &[
-                ("class", "thruster".into()),
-                ("data-thruster", a.name.as_str().into()),
-                ("data-length-m", a.length.into()),
-            ],
-        );
-        if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
-            // No thrust (or seen end-on): the thruster as a dot.
+    if style.layer != Layer::Arrows {
+        for c in &snap.scene.cylinders {
+            let pts = points(
+                t,
+                cylinder_outline(view, &c.pose, c.length, c.radius).into_iter(),
+            );
             s.empty(
-                "circle",
+                "polygon",
                 &[
-                    ("cx", p1[0].into()),
-                    ("cy", p1[1].into()),
-                    ("r", 1.2.into()),
+                    ("class", "body".into()),
+                    ("data-body", c.name.as_str().into()),
+                    ("points", pts.into()),
                 ],
             );
-            s.close("g");
-            continue;
         }
-        s.empty(
-            "line",
-            &[
-                ("x1", p1[0].into()),
-                ("y1", p1[1].into()),
-                ("x2", p2[0].into()),
-                ("y2", p2[1].into()),
-            ],
-        );
+    }
+    if style.layer != Layer::Bodies {
+        for a in &snap.scene.arrows {
+            arrow(s, view, t, a, style.dot);
+        }
+    }
+    s.close("g");
+}
+
+/// One thrust arrow (`g.thruster`): a line from the thruster with a dot at its tip, or a dot
+/// alone when it is shorter than 2 px (no thrust, or seen end-on); dots of radius × `dot`.
+fn arrow(s: &mut Svg, view: View, t: &ViewTransform, a: &super::scene::Arrow, dot: f64) {
+    let p1 = t.to_svg(view.project(&a.start));
+    let p2 = t.to_svg(view.project(&(a.start + a.direction * a.length)));
+    s.open(
+        "g",
+        &[
+            ("class", "thruster".into()),
+            ("data-thruster", a.name.as_str().into()),
+            ("data-length-m", a.length.into()),
+        ],
+    );
+    if (p2[0] - p1[0]).hypot(p2[1] - p1[1]) < 2.0 {
         s.empty(
             "circle",
             &[
-                ("cx", p2[0].into()),
-                ("cy", p2[1].into()),
-                ("r", 1.6.into()),
+                ("cx", p1[0].into()),
+                ("cy", p1[1].into()),
+                ("r", (1.2 * dot).into()),
             ],
         );
         s.close("g");
+        return;
     }
+    s.empty(
+        "line",
+        &[
+            ("x1", p1[0].into()),
+            ("y1", p1[1].into()),
+            ("x2", p2[0].into()),
+            ("y2", p2[1].into()),
+        ],
+    );
+    s.empty(
+        "circle",
+        &[
+            ("cx", p2[0].into()),
+            ("cy", p2[1].into()),
+            ("r", (1.6 * dot).into()),
+        ],
+    );
     s.close("g");
 }
 
@@ -371,15 +415,17 @@ pub fn render_shapes_svg(d: &RunDrawing) -> String {
         open_view(&mut s, view, &ts[k], boxes[k], Vec::new());
         trace(&mut s, "base", view, &ts[k], &d.base_trace);
         trace(&mut s, "ee", view, &ts[k], &d.ee_trace);
-        for (i, snap) in d.snapshots.iter().enumerate() {
-            snapshot(
-                &mut s,
-                view,
-                &ts[k],
-                snap,
-                &time_colour(i as f64 / n as f64),
-                &[],
-            );
+        // Every outline first, then every arrow: a later outline never hides a thrust.
+        for layer in [Layer::Bodies, Layer::Arrows] {
+            let style = Style {
+                layer,
+                dot: 1.0,
+                opacity: None,
+            };
+            for (i, snap) in d.snapshots.iter().enumerate() {
+                let colour = time_colour(i as f64 / n as f64);
+                snapshot(&mut s, view, &ts[k], snap, &colour, &[], style);
+            }
         }
         if view == View::Top {
             for (i, snap) in d.snapshots.iter().enumerate() {
@@ -439,14 +485,13 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
                 ("dur", dur.clone().into()),
                 ("repeatCount", "indefinite".into()),
             ];
-            snapshot(
-                &mut s,
-                view,
-                &ts[k],
-                snap,
-                &time_colour(i as f64 / (n.max(2) - 1) as f64),
-                &anim,
-            );
+            let style = Style {
+                layer: Layer::Both,
+                dot: 1.0 / zoom,
+                opacity: Some(if i == 0 { "1" } else { "0" }),
+            };
+            let colour = time_colour(i as f64 / (n.max(2) - 1) as f64);
+            snapshot(&mut s, view, &ts[k], snap, &colour, &anim, style);
         }
         s.close("g");
         s.close("svg");
@@ -476,7 +521,8 @@ pub fn render_animation_svg(d: &RunDrawing, duration: f64) -> String {
             ];
             if view == View::Top {
                 // The clock: one text per frame, shown with its frame.
-                s.open("g", &[("class", "clock".into())]);
+                let still = if i == 0 { "1" } else { "0" };
+                s.open("g", &[("class", "clock".into()), ("opacity", still.into())]);
                 s.empty("animate", &anim);
                 s.text(
                     &[
