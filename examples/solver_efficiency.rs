@@ -34,10 +34,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use usm_study::evaluate::{out_of_reach, Deadline};
+use usm_study::optimise::case_tuner::Tuner;
 use usm_study::optimise::evaluate::CaseEvaluator;
 use usm_study::optimise::history::Record;
 use usm_study::optimise::problem::{Method, SolverSettings};
-use usm_study::optimise::tune::Tuner;
 use usm_study::optimise::{minimise, Options, Spec};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;

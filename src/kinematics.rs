@@ -320,14 +320,6 @@ pub fn centre_of_mass(v: &Vehicle, ws: &KinWorkspace) -> Vec3 {
     }
 }
 
-/// Pose of every body in the inertial frame, `g_Ii = g_Ib g_bi`.
-pub fn inertial_body_poses(base: &BasePose, ws: &KinWorkspace, out: &mut [Se3]) {
-    let g_ib = base.to_se3();
-    for (o, g) in out.iter_mut().zip(&ws.g_b) {
-        *o = g_ib.compose(g);
-    }
-}
-
 /// Reach [m]: `|p_be|`, the distance from the base frame's origin to the end-effector frame's
 /// origin at the straight configuration `q = 0` (docs/model.md §6 "Missions"; for a chain whose
 /// links are collinear at `q = 0`, the largest over joint space).

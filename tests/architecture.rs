@@ -659,6 +659,65 @@ fn the_report_room_imports_no_physics() {
     assert!(seen > 10, "the walk found {seen} report files");
 }
 
+/// Every `.rs` file under `dir` (recursively), sorted.
+fn rs_files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Issue 37 item 5: no `pub fn` of the library that nothing calls — its name appears nowhere
+/// but its definition in the library, the tests, benchmarks, examples and Python bindings
+/// (a lower bound: a name shared with another item counts as used).
+#[test]
+fn no_public_function_that_nothing_calls() {
+    let r = root();
+    let mut words: BTreeMap<String, usize> = BTreeMap::new();
+    let mut defs: Vec<(PathBuf, String)> = Vec::new();
+    for dir in ["src", "tests", "benches", "examples", "python/src"] {
+        for p in rs_files_under(&r.join(dir)) {
+            let toks = tokens(&strip(&std::fs::read_to_string(&p).unwrap()));
+            for (i, t) in toks.iter().enumerate() {
+                *words.entry(t.clone()).or_default() += 1;
+                let public_fn = t == "fn"
+                    && i >= 1
+                    && (toks[i - 1] == "pub"
+                        || (toks[i - 1] == ")" && i >= 4 && toks[i - 4] == "pub"));
+                if dir == "src" && public_fn {
+                    if let Some(name) = toks.get(i + 1) {
+                        defs.push((p.clone(), name.clone()));
+                    }
+                }
+            }
+        }
+    }
+    let unused: Vec<String> = defs
+        .iter()
+        .filter(|(_, n)| words.get(n).copied().unwrap_or(0) <= 1)
+        .map(|(p, n)| format!("{}: {n}", p.strip_prefix(&r).unwrap_or(p).display()))
+        .collect();
+    assert!(defs.len() > 500, "found {} public functions", defs.len());
+    assert!(
+        unused.is_empty(),
+        "public functions nothing calls:\n{}",
+        unused.join("\n")
+    );
+}
+
 /// Longest non-test function we accept, in lines.
 const MAX_FN_LINES: usize = 120;
 

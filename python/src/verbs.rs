@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use usm_study::metrics::singularity::DEFAULT_RANK_REL_TOL;
 use usm_study::model::design::{design_to_toml, load_design};
-use usm_study::optimise::tune::{Tuner, HOOK as TUNING};
+use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
 use usm_study::optimise::{load_problem, run as run_problem, Options};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles};

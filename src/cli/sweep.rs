@@ -12,7 +12,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
-use usm_study::optimise::tune::{Tuner, HOOK as TUNING};
+use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
 use usm_study::pipeline::review::write_review;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;

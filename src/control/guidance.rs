@@ -192,23 +192,6 @@ impl LosGuidance {
         self.look_ahead
     }
 
-    /// Change the look-ahead distance Δ [m] (ignored unless finite and > 0).
-    pub fn set_look_ahead(&mut self, delta: f64) {
-        if delta.is_finite() && delta > 0.0 {
-            self.look_ahead = delta;
-        }
-    }
-
-    /// Number of segments.
-    pub fn n_segments(&self) -> usize {
-        self.segments.len()
-    }
-
-    /// Index of the active segment.
-    pub fn active_segment(&self) -> usize {
-        self.active
-    }
-
     /// Make segment 0 active again.
     pub fn reset(&mut self) {
         self.active = 0;

@@ -516,11 +516,6 @@ impl TransportController {
         self.secondary = Some(Box::new(tasks));
     }
 
-    /// The secondary offset δ [rad] of the joint references (zeros without secondary tasks).
-    pub fn secondary_offset(&self) -> &[f64] {
-        &self.offset
-    }
-
     /// Advance δ over `dt` [s] at the current references and add it to them (see
     /// [`TransportController::set_secondary`]). Allocation-free.
     fn apply_secondary(&mut self, dt: f64) {

@@ -269,11 +269,6 @@ impl Simulator {
         self.time
     }
 
-    /// Set the simulation time [s].
-    pub fn set_time(&mut self, t: f64) {
-        self.time = t;
-    }
-
     /// Actual thrust per thruster [N] at the last step boundary evaluated (RK4: the start
     /// of the last step; Dormand–Prince: the end of the last span, under its command): the
     /// saturated thrust state.

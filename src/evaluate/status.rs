@@ -6,7 +6,7 @@ use std::str::FromStr;
 
 use super::deadline::TIMEOUT;
 use crate::outcome::RUN_STOPPED;
-use crate::scenario::success::Criterion;
+use crate::scenario::criteria::Criterion;
 
 /// How a case ended (the `status` column: `ok`, `unsuccessful`, `failed`, `skipped`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

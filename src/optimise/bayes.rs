@@ -141,11 +141,6 @@ impl Gp {
         let v = (1.0 + NUGGET - k.iter().map(|a| a * a).sum::<f64>()).max(0.0);
         (self.mean + self.sd * mu, self.sd * v.sqrt())
     }
-
-    /// The length scale chosen.
-    pub fn length_scale(&self) -> f64 {
-        self.ell
-    }
 }
 
 /// Standard normal density and distribution function.

@@ -23,8 +23,9 @@
 //! [`run`] for a problem file, or [`minimise`] for any [`search::Evaluator`].
 
 pub mod bayes;
+pub mod case_tuner;
 pub mod cmaes;
-pub mod engine;
+pub mod driver;
 pub mod evaluate;
 pub mod history;
 pub mod problem;
@@ -32,8 +33,7 @@ pub mod score;
 pub mod search;
 pub mod solver;
 pub mod space;
-pub mod tune;
 mod tune_seeds;
 
-pub use engine::{minimise, run, OptimiseError, Options, Outcome};
+pub use driver::{minimise, run, OptimiseError, Options, Outcome};
 pub use problem::{load_problem, parse_problem, Problem, Spec};

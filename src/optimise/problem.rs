@@ -455,7 +455,7 @@ fn parse_param(
         }
     };
     // A `[tune]` parameter without `start` starts every case from the case's own value clamped
-    // to the bounds (`optimise::tune`), so the base file's value is clamped here too; an
+    // to the bounds (`optimise::case_tuner`), so the base file's value is clamped here too; an
     // explicit `start` (or a problem file's current value) must lie in the bounds.
     let start = if at.starts_with("tune.") && from == "name" && start.is_finite() {
         start.clamp(p.lower, p.upper)

@@ -4,11 +4,11 @@
 //! ([`run_scenario`], [`run_case`]). The pure kernels these use live below the control laws in
 //! [`crate::metrics`].
 
-mod run;
+mod case_run;
+pub mod judge;
 pub mod run_summary;
-pub mod success;
 
-pub use run::{
+pub use case_run::{
     run_case, run_scenario, run_scenario_until, CaseRun, RunResult, RunStopped, FAULT_TIME_METRIC,
     RUN_STOPPED,
 };

@@ -4,14 +4,14 @@
 //! singularity and allocation metrics, then the transport tracking or the work regulation
 //! metrics; [`add_success`] appends the verdict on the scenario's success criteria.
 
-use super::success::{judge, success_margin};
+use super::judge::{judge, success_margin};
 use crate::metrics::trajectory::{
     integrate, segment_tracking, settling_time, singularity_exposure, EnergyMetrics,
 };
 use crate::scenario::channels::{Channel, Pose, Trajectory};
 use crate::scenario::config::{MetricsSpec, Mode, ModeGains, ScenarioFile};
+use crate::scenario::criteria::Missed;
 use crate::scenario::recorder::AllocationCounts;
-use crate::scenario::success::Missed;
 use crate::spatial::wrap_angle;
 
 /// A run's metrics as (name, value) pairs in order, before the evaluator files them into its one
@@ -189,7 +189,7 @@ pub fn run_summary(
 pub const SUCCESS_MARGIN: &str = "success_margin";
 
 /// Judge the run by its `metrics` against `file`'s `[success]` criteria
-/// ([`super::success::judge`]) and append `success_margin` and `success` (1 = every criterion
+/// ([`super::judge::judge`]) and append `success_margin` and `success` (1 = every criterion
 /// met, 0 = not); returns the first criterion missed.
 pub fn add_success(metrics: &mut Vec<(String, f64)>, file: &ScenarioFile) -> Option<Missed> {
     let margin = success_margin(&file.success, &file.mission, file.scenario.mode, metrics);

@@ -1,6 +1,6 @@
 //! The body along a run: `shapes.svg` (the body at regular times over the path, coloured by
 //! time, with the base and end-effector traces) and `animation.svg` (the body moving along
-//! the run, SMIL, self-contained), drawn by [`crate::report::drawing::run`] from the logged
+//! the run, SMIL, self-contained), drawn by [`crate::report::drawing::run_drawing`] from the logged
 //! base pose (inertial frame, ZYX Euler angles) and joint angles.
 
 use std::path::Path;
@@ -13,7 +13,9 @@ use crate::kinematics::BasePose;
 use crate::model::Vehicle;
 use crate::outcome::RunResult;
 use crate::report::atomic_write;
-use crate::report::drawing::run::{render_animation_svg, render_shapes_svg, RunDrawing, Snapshot};
+use crate::report::drawing::run_drawing::{
+    render_animation_svg, render_shapes_svg, RunDrawing, Snapshot,
+};
 use crate::report::drawing::Arrow;
 use crate::scenario::channels::{Channel, Pose};
 use crate::spatial::Vec3;

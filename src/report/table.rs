@@ -190,11 +190,6 @@ impl Table {
         self.columns.first().map_or(0, |c| c.data.len())
     }
 
-    /// Number of columns.
-    pub fn n_cols(&self) -> usize {
-        self.columns.len()
-    }
-
     /// Appends a column. Errors if the name is taken or the length differs from the table's row
     /// count (the first column sets the row count).
     pub fn push(&mut self, name: impl Into<String>, data: impl Into<ColumnData>) -> Result<()> {

@@ -31,7 +31,7 @@
 //! [thrusters]                 # thruster dynamics
 //! [physics]                   # which effects, current, integrator (rk4 | dopri5), rtol, atol
 //! [metrics]                   # thresholds, power model
-//! [success]                   # what counts as a successful run (scenario::success)
+//! [success]                   # what counts as a successful run (scenario::criteria)
 //! [mission]                   # payload, reach, convergence deadline (config::MissionSpec)
 //! [fault]                     # optional: one thruster fault (scenario::fault)
 //! ```
@@ -42,7 +42,7 @@ mod metrics;
 mod mission;
 mod physics;
 
-use super::success::SuccessSpec;
+use super::criteria::SuccessSpec;
 pub use super::target::{ReferenceSpec, SetpointSpec, ViaSpec};
 use crate::allocation::{AllocSettings, Method, RateSettings};
 use crate::control::dynamic::DynamicGains;

@@ -29,26 +29,26 @@
 //!   work-mode defaults.
 
 pub mod channels;
+pub mod closed_loop;
 pub mod config;
 mod controller;
+pub mod criteria;
 mod error;
 pub mod fault;
 mod nominal;
 #[cfg(test)]
 mod nominal_tests;
 pub(crate) mod recorder;
-pub mod run;
 mod setup;
-pub mod success;
 pub mod target;
 pub mod tracked;
 mod watch;
 
 pub use channels::{check_log_size, Channel, Trajectory, MAX_LOG_BYTES};
+pub use closed_loop::{run_loop, LoopRun, Stop, INTERRUPTED, TIMEOUT};
 pub use config::{Mode, ScenarioFile};
 pub use error::ScenarioError;
 pub use recorder::{AllocationCounts, Timing};
-pub use run::{run_loop, LoopRun, Stop, INTERRUPTED, TIMEOUT};
 pub use tracked::{compare_with_reference, TrackingComparison};
 
 use crate::input::document::{deserialize_table, Document};
@@ -84,7 +84,7 @@ segments = [
 method = "qp"
 
 [success]
-# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# A successful run (scenario::criteria): completes, thrusters at a limit at most 5 % of the time,
 # ends within 0.1 m of the path, and each segment converges (|e_y| < metrics.band and staying)
 # within 60 s of becoming active; stays upright and at the path's depth over the whole run (base
 # |roll| and |pitch| within 30 deg, base and head within 1 m of the depth they started at).
@@ -174,7 +174,7 @@ method = "pinv"
 lambda = 0.1
 
 [success]
-# A successful run (scenario::success): completes, thrusters at a limit at most 5 % of the time,
+# A successful run (scenario::criteria): completes, thrusters at a limit at most 5 % of the time,
 # final end-effector errors within 2 cm and 2 deg (roll excluded).
 max_saturation_fraction = 0.05
 position_tolerance = 0.02

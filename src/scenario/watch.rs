@@ -1,6 +1,6 @@
 //! The failure watch of a closed-loop run (`[success] stop_on_failure`, docs/study-format.md
 //! "Stopping a failed run"): after every control period, whether the criterion the run's
-//! verdict (`outcome::success::judge`) would name is already certain to be missed, whatever the
+//! verdict (`outcome::judge::judge`) would name is already certain to be missed, whatever the
 //! rest of the run does.
 //!
 //! The verdict names the first criterion missed in a fixed order (the mission's reach,
@@ -27,7 +27,7 @@
 
 use super::channels::{Channel, Pose, Trajectory};
 use super::config::{Mode, ScenarioFile};
-use super::success::Criterion;
+use super::criteria::Criterion;
 use crate::kinematics::straight_reach;
 use crate::metrics::trajectory::EnergyIntegrator;
 use crate::model::Vehicle;

@@ -28,7 +28,7 @@ use super::robust::{
     condition_verdicts, paired, split_worlds, AdaptiveInfo, RobustInfo, StudyVerdict,
 };
 use super::schema::{Study, Uncertainty};
-use super::tune::{tuned_columns, CaseTuner};
+use super::tuning_hook::{tuned_columns, CaseTuner};
 use super::worlds::{push_world_columns, run_world, set_world_summaries, WORLD_PREFIX};
 use crate::evaluate::{Deadline, Evaluator, Metrics};
 use crate::report::{Column, ColumnData, Table};

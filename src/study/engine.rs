@@ -17,7 +17,7 @@
 //! - `.usm-study.lock`: held while the sweep runs ([`super::outdir`]): one run per directory.
 //!
 //! With `[tune]`, every case is first tuned, then scored at its tuned values
-//! ([`super::tune`]).
+//! ([`super::tuning_hook`]).
 //!
 //! Every case has a wall-clock budget (`case_timeout`), checked cooperatively inside the
 //! simulation loop (see [`super::worker`]): a case past it is recorded `failed` with a reason
@@ -57,7 +57,7 @@ use super::records::{
 };
 use super::robust::{write_tables_with, RobustInfo};
 use super::schema::Study;
-use super::tune::{case_tuner, CaseTuner, TuningHook};
+use super::tuning_hook::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
 

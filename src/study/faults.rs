@@ -24,7 +24,7 @@ use super::schema::Study;
 use super::worlds::{criterion_index, evaluate_phases, WorldTimeout};
 use crate::evaluate::{Deadline, Evaluator, Metrics, Phases};
 use crate::report::{fmt_short, MarkdownTable, Table};
-use crate::scenario::success::Criterion;
+use crate::scenario::criteria::Criterion;
 use rayon::prelude::*;
 
 /// Prefix of the per-thruster fault columns (`fault.t<j>.<what>`).

@@ -12,7 +12,7 @@ use super::rerank::Rerank;
 use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
-use super::tune::{case_tuner, tuned_columns, TuneError, TuningHook};
+use super::tuning_hook::{case_tuner, tuned_columns, TuneError, TuningHook};
 use super::worker::evaluate_resolved;
 use crate::evaluate::{trajectory_table, Deadline, Evaluator};
 use crate::report::{read_csv_typed, write_csv, ReportError, Table};

@@ -65,7 +65,7 @@ pub mod selection;
 pub mod shards;
 pub mod summary;
 pub mod summary_robust;
-pub mod tune;
+pub mod tuning_hook;
 pub mod uncertainty;
 pub mod verdict_box;
 pub mod worker;

@@ -25,7 +25,7 @@ use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
 use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
-use crate::scenario::success::Criterion;
+use crate::scenario::criteria::Criterion;
 use crate::stats::confidence::{wilson_lower, wilson_worlds_needed, worlds_at_share};
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
 

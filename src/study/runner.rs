@@ -16,7 +16,7 @@ use std::str::FromStr;
 use crate::input::document::deserialize_table;
 use crate::input::located::KeyError;
 use crate::model::Vehicle;
-use crate::scenario::success::SuccessSpec;
+use crate::scenario::criteria::SuccessSpec;
 use crate::scenario::Mode as ScenarioMode;
 
 /// Why the scenario side's defaults or a method's gains could not be produced.

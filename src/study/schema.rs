@@ -230,7 +230,7 @@ pub struct Study {
     /// SHA-256 of the study text, the base design and the tool version (hex).
     pub hash: String,
     /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`); validated
-    /// by the tuner wired into the sweep (`crate::optimise::tune::Tuner::new`) before any
+    /// by the tuner wired into the sweep (`crate::optimise::case_tuner::Tuner::new`) before any
     /// case runs.
     pub tune: Option<toml::Table>,
     /// The `[uncertainty]` section: worlds every case meets (issue 22).

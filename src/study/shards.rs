@@ -19,7 +19,7 @@ use super::outdir;
 use super::parse::load_study;
 use super::records::{compact, StatusCounts, PARTIAL_FILE, STUDY_COPY};
 use super::robust::write_tables;
-use super::tune::TuningHook;
+use super::tuning_hook::TuningHook;
 use crate::report::{read_csv_typed, Table};
 
 /// Options of [`merge`].

@@ -15,7 +15,7 @@ use super::doe::Case;
 use super::faults::score_faults;
 use super::records::Row;
 use super::schema::Study;
-use super::tune::CaseTuner;
+use super::tuning_hook::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
 use crate::evaluate::{out_of_reach, CaseEnd, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
 

@@ -16,7 +16,7 @@ use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::schema::Study;
 use super::schema::World;
 use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
-use crate::scenario::success::Criterion;
+use crate::scenario::criteria::Criterion;
 use crate::stats::describe::describe;
 use rayon::prelude::*;
 

@@ -21,7 +21,7 @@ mod camera;
 mod labels;
 mod page;
 mod render;
-pub mod run;
+pub mod run_drawing;
 mod scene;
 pub mod svg;
 pub mod views;

@@ -1,7 +1,7 @@
 //! `[mission]`: what a design must do beyond following the path or holding the setpoint —
 //! carry a payload at the end effector, reach a distance, converge by a deadline (docs/model.md
 //! §6 "Missions"). A design that cannot meet a requirement is unsuccessful with the
-//! requirement named (`mission.reach`, `mission.deadline`; `outcome::success::judge`).
+//! requirement named (`mission.reach`, `mission.deadline`; `outcome::judge::judge`).
 //!
 //! ```toml
 //! [mission]

@@ -1,13 +1,13 @@
 //! One closed-loop run and its outcome: the loop of [`crate::scenario::run_loop`], then the
 //! run's summary metrics ([`super::run_summary`]) and its `[success]` judgement
-//! ([`super::success`]).
+//! ([`super::judge`]).
 
 use super::run_summary::{add_success, run_summary, RunFacts};
 use crate::kinematics::straight_reach;
 use crate::model::Vehicle;
 use crate::scenario::channels::Trajectory;
 use crate::scenario::config::{Mode, ScenarioFile};
-use crate::scenario::success::Missed;
+use crate::scenario::criteria::Missed;
 use crate::scenario::{
     parse_table, run_loop, AllocationCounts, ScenarioError, Source, Stop, Timing, TIMEOUT,
 };

@@ -1,6 +1,6 @@
 //! `[success]`: what a closed-loop run must achieve to count as a success (docs/model.md §6
 //! "Success"), the criteria and the verdict on a run ([`Missed`]: the first criterion it
-//! missed), as judged by `outcome::success::judge`.
+//! missed), as judged by `outcome::judge::judge`.
 //!
 //! ```toml
 //! [success]
@@ -273,7 +273,7 @@ impl fmt::Display for Missed {
 
 #[cfg(test)]
 mod tests {
-    use crate::scenario::success::{Criterion, SuccessSpec};
+    use crate::scenario::criteria::{Criterion, SuccessSpec};
 
     #[test]
     fn ids_round_trip_and_validation_names_the_key() {

@@ -3,7 +3,7 @@
 
 use crate::input::located::{fmt_exact as num, fmt_fixed as fixed};
 use crate::scenario::config::{MissionSpec, Mode};
-use crate::scenario::success::{Criterion, Missed, SuccessSpec};
+use crate::scenario::criteria::{Criterion, Missed, SuccessSpec};
 
 /// Judge a run of `mode` by its summary `metrics` (see [`super::run_summary`]) against
 /// `spec` and the `mission`'s requirements: `None` when it met every criterion, else the
@@ -317,9 +317,9 @@ fn judge_deadline(deadline: f64, get: &dyn Fn(&str) -> f64) -> Option<Missed> {
 
 #[cfg(test)]
 mod tests {
-    use crate::outcome::success::{judge, success_margin};
+    use crate::outcome::judge::{judge, success_margin};
     use crate::scenario::config::{MissionSpec, Mode};
-    use crate::scenario::success::{Criterion, SuccessSpec};
+    use crate::scenario::criteria::{Criterion, SuccessSpec};
 
     /// Issue 39: a reason printed a limit of 1e308 as 309 digits and 1e-300 as `0.0000`.
     #[test]

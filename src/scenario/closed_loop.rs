@@ -12,10 +12,10 @@
 use super::channels::Trajectory;
 use super::config::ScenarioFile;
 use super::controller::Measurement;
+use super::criteria::Criterion;
 use super::error::ScenarioError;
 use super::recorder::{timed, AllocationCounts, Recorder, Timing};
 use super::setup::ClosedLoop;
-use super::success::Criterion;
 use super::watch::FailureWatch;
 use crate::dynamics::ActuatorCommand;
 use crate::kinematics::{forward_kinematics, thruster_matrix, BasePose};

@@ -1,5 +1,5 @@
 //! The per-case tuning hook of a sweep (`[tune]`, `docs/study-format.md`). The tuner itself
-//! lives with the optimiser (`crate::optimise::tune`); the sweep engine only knows this
+//! lives with the optimiser (`crate::optimise::case_tuner`); the sweep engine only knows this
 //! interface, handed in by the caller ([`TuningHook`] in `SweepOptions::tuning` and to
 //! [`super::finish::finish_report`]), so `study` never imports `optimise`.
 //!
