@@ -46,6 +46,7 @@ pub mod directions;
 pub mod doe;
 pub mod engine;
 pub mod error;
+pub mod families;
 pub mod fault_spec;
 pub mod faults;
 pub mod finish;
@@ -68,6 +69,7 @@ pub mod summary_robust;
 pub mod tune;
 pub mod uncertainty;
 pub mod verdict_box;
+pub mod verdict_firm;
 pub mod worker;
 pub mod worlds;
 

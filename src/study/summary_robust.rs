@@ -73,6 +73,9 @@ pub struct Robust<'a> {
     /// The condition this view judges (a child view of a study with condition axes,
     /// [`Robust::views`]); `None` for the study as a whole.
     condition: Option<Condition>,
+    /// The "how firm" paragraph of the box ([`super::verdict_firm`]; empty in a condition's
+    /// view: the study states it once).
+    firm: String,
 }
 
 impl<'a> Robust<'a> {
@@ -81,7 +84,9 @@ impl<'a> Robust<'a> {
         let info = m.robust.as_ref()?;
         let worlds = read_csv(&dir.join(WORLDS_CSV)).ok()?;
         let verdict = study_verdict(table, &worlds, info)?;
+        let firm = super::verdict_firm::how_firm(dir, m.seed, info, &verdict);
         Some(Robust {
+            firm,
             table,
             info,
             worlds: std::rc::Rc::new(worlds),
@@ -131,9 +136,12 @@ impl<'a> Robust<'a> {
             ranked: &ranked,
             objective: self.info.objective(),
             label: &label,
+            axes: &self.axes,
+            within: None,
+            min_success: self.info.min_success_probability,
         };
         let (line, boxed) = (self.verdict_line(), verdict_box(&inp));
-        format!("{line}\n\n{boxed}{VERDICT_END}")
+        format!("{line}\n\n{}{boxed}{VERDICT_END}", self.firm)
     }
 
     /// The ranking, tuning-adequacy, sensitivity and validation sections; plots into
