@@ -57,6 +57,7 @@ pub mod manifest;
 pub mod outdir;
 pub mod parse;
 pub mod plots;
+pub mod plots_ranked;
 pub mod records;
 pub mod rerank;
 pub mod robust;

@@ -324,7 +324,16 @@ impl<'a> Robust<'a> {
             "tuning run",
             "best so far / final",
         );
-        for (k, (x, y)) in curves.values().enumerate() {
+        // Not-ranked designs in grey under the ranked ones in blue.
+        let p = self.col(P_BEST);
+        let ranked: std::collections::BTreeSet<i64> = (0..self.ids.len())
+            .filter(|&r| p[r].is_finite())
+            .map(|r| self.ids[r])
+            .collect();
+        let mut order: Vec<(&i64, &(Vec<f64>, Vec<f64>))> = curves.iter().collect();
+        order.sort_by_key(|(c, _)| ranked.contains(c));
+        let mut named = [false; 2];
+        for (c, (x, y)) in order {
             let last = y
                 .iter()
                 .rev()
@@ -332,10 +341,21 @@ impl<'a> Robust<'a> {
                 .find(|v| v.is_finite())
                 .unwrap_or(f64::NAN);
             let rel: Vec<f64> = y.iter().map(|v| v / last).collect();
-            panel.series.push(
-                Series::new(if k == 0 { "one design each" } else { "" }, x.clone(), rel)
-                    .colour(Colour::Palette(0)),
-            );
+            let k = usize::from(ranked.contains(c));
+            let name = match (named[k], k) {
+                (true, _) => "",
+                (false, 1) => "ranked designs (one line each)",
+                (false, _) => "not ranked (one line each)",
+            };
+            named[k] = true;
+            let colour = if k == 1 {
+                Colour::Palette(0)
+            } else {
+                Colour::Grey
+            };
+            panel
+                .series
+                .push(Series::new(name, x.clone(), rel).colour(colour));
         }
         let mut fig = Figure::new("Per-design tuning: best so far");
         fig.panels.push(panel);
