@@ -533,6 +533,7 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::records::STATUS;
 
     #[test]
     fn metrics_spanning_decades_get_a_log_axis() {

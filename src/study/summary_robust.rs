@@ -330,8 +330,8 @@ impl<'a> Robust<'a> {
             .filter(|&r| p[r].is_finite())
             .map(|r| self.ids[r])
             .collect();
-        let mut order: Vec<(&i64, &(Vec<f64>, Vec<f64>))> = curves.iter().collect();
-        order.sort_by_key(|(c, _)| ranked.contains(c));
+        let mut order: Vec<_> = curves.iter().collect();
+        order.sort_by_key(|(c, _)| ranked.contains(*c));
         let mut named = [false; 2];
         for (c, (x, y)) in order {
             let last = y
