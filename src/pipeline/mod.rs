@@ -22,6 +22,8 @@ pub mod inspect;
 pub mod optimise;
 mod optimise_plots;
 pub mod review;
+mod review_designs;
+mod review_page;
 mod review_top;
 pub mod run_figure;
 pub mod shapes;

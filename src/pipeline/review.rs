@@ -1,6 +1,6 @@
 //! `report.html`: the design-review page of a sweep (or any study) output directory — one
-//! self-contained HTML file (inline CSS and SVG; no scripts, fonts, links or requests) that a
-//! reviewer opens in a browser or prints.
+//! self-contained HTML file (inline CSS, SVG and one inline script that sorts and filters the
+//! tables; no fonts, external links or requests) that a reviewer opens in a browser or prints.
 //!
 //! Built only from the files already in the directory, so `usm-study report DIR` can rebuild
 //! it: `manifest.json` (study description and parameters), `summary.md` (its tables, with case
@@ -18,7 +18,10 @@ use std::path::{Path, PathBuf};
 
 use super::draw::draw_design;
 use super::error::PipelineError;
-use super::review_top::{pareto_html, verdict_html, Drawing, TOP_STYLE};
+use super::review_designs::{designs_html, rank_marks, DesignInputs};
+use super::review_page::{figure_files, fold, plots_section, units_in_headers, with_toc};
+use super::review_page::{PAGE_STYLE, SCRIPT};
+use super::review_top::{pareto_html, top_ids, verdict_html, Drawing, TOP_STYLE};
 use crate::model::design::parse_design_table;
 use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
 use crate::report::{atomic_write, read_csv, read_parquet, Table};
@@ -199,24 +202,6 @@ fn read_cases(dir: &Path) -> Option<Table> {
     Some(t)
 }
 
-/// The SVG figures of `dir`: `plots/*.svg` then `*.svg`, each sorted by name.
-fn figure_files(dir: &Path) -> Vec<PathBuf> {
-    let list = |d: &Path| -> Vec<PathBuf> {
-        let mut v: Vec<PathBuf> = std::fs::read_dir(d)
-            .map(|rd| {
-                rd.filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "svg") && p.is_file())
-                    .collect()
-            })
-            .unwrap_or_default();
-        v.sort();
-        v
-    };
-    let mut out = list(&dir.join("plots"));
-    out.extend(list(dir));
-    out
-}
-
 /// Inline style sheet: readable on screen and on paper; unsuccessful cases in red.
 const STYLE: &str = "body{font-family:'DejaVu Sans',Arial,Helvetica,sans-serif;margin:24px auto;\
 max-width:1280px;padding:0 16px;color:#111;line-height:1.4}h1{font-size:26px}h2{font-size:21px;\
@@ -260,12 +245,13 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
     // What the page needs of the case table: the named cases' details, the counts and whether
     // success was judged; the table itself is dropped before the page is built (a 100 000-case
     // table is tens of MB).
-    let (infos, counts, has_success) = match read_cases(dir) {
+    let table = read_cases(dir);
+    let (infos, counts, has_success) = match &table {
         Some(t) => {
             let wanted: BTreeSet<i64> = named.iter().copied().collect();
             let axes: Vec<&str> = axes.iter().map(String::as_str).collect();
-            let infos = case_infos(&t, &axes, |id| wanted.contains(&id));
-            let bad = unsuccessful_rows(&t).iter().filter(|b| **b).count();
+            let infos = case_infos(t, &axes, |id| wanted.contains(&id));
+            let bad = unsuccessful_rows(t).iter().filter(|b| **b).count();
             (
                 infos,
                 Some((t.n_rows(), bad)),
@@ -274,6 +260,14 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
         }
         None => (BTreeMap::new(), None, false),
     };
+    let robust = m.and_then(|m| m.get("robust")).filter(|r| r.is_object());
+    let min_success = robust
+        .and_then(|r| r["min_success_probability"].as_f64())
+        .unwrap_or(f64::NAN);
+    let marks = table
+        .as_ref()
+        .map(|t| rank_marks(t, &named, min_success))
+        .unwrap_or_default();
     let study_file = m.and_then(|m| m["study_file"].as_str());
     let drawn = if named.is_empty() {
         Vec::new()
@@ -283,6 +277,26 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
             Vec::new()
         })
     };
+    let top = summary
+        .as_deref()
+        .and_then(summary_opening)
+        .map(top_ids)
+        .unwrap_or_default();
+    let objective = robust
+        .and_then(|r| r["metrics"][0].as_str())
+        .unwrap_or("mission_cost");
+    let name = |id: i64| infos.get(&id).map(|i| i.name.clone()).unwrap_or_default();
+    let design_html = table.as_ref().and_then(|t| {
+        designs_html(&DesignInputs {
+            dir,
+            table: t,
+            ids: &top,
+            objective,
+            drawings: &drawn,
+            name: &name,
+        })
+    });
+    drop(table);
     let figures = figure_files(dir);
     let page = Page {
         dir,
@@ -293,6 +307,8 @@ pub fn write_review(dir: &Path) -> Result<ReviewOutcome, PipelineError> {
         infos: &infos,
         summary: summary.as_deref(),
         drawings: &drawn,
+        marks: &marks,
+        design_html: design_html.as_deref(),
     };
     let html = page.render(&figures, &mut warnings);
     let path = dir.join(REPORT_HTML);
@@ -318,6 +334,10 @@ struct Page<'a> {
     infos: &'a BTreeMap<i64, CaseInfo>,
     summary: Option<&'a str>,
     drawings: &'a [Drawing],
+    /// Each named case's rank mark (empty: the study ranks nothing over worlds).
+    marks: &'a BTreeMap<i64, (bool, String)>,
+    /// The per-design sections of the leader and its competitors.
+    design_html: Option<&'a str>,
 }
 
 impl Page<'_> {
@@ -338,6 +358,7 @@ impl Page<'_> {
             anchor: self.anchor(id),
             unsuccessful: info.is_some_and(|i| i.unsuccessful),
             name: info.map(|i| i.name.clone()).filter(|n| !n.is_empty()),
+            mark: self.marks.get(&id).cloned(),
         })
     }
 
@@ -362,7 +383,7 @@ impl Page<'_> {
             h,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
              <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-             <title>Design review: {t}</title>\n<style>{STYLE}{TOP_STYLE}</style>\n</head>\n<body>\n\
+             <title>Design review: {t}</title>\n<style>{STYLE}{TOP_STYLE}{PAGE_STYLE}</style>\n</head>\n<body>\n\
              <h1>Design review: <code>{t}</code></h1>",
             t = escape(&title)
         );
@@ -370,22 +391,27 @@ impl Page<'_> {
         if let Some(p) = pareto_html(figures) {
             h.push_str(&p);
         }
+        if let Some(d) = self.design_html {
+            h.push_str(d);
+        }
         self.success_section(&mut h);
         self.tables_section(&mut h);
         self.designs_section(&mut h);
-        plots_section(&mut h, figures, warnings);
+        plots_section(&mut h, figures, !self.marks.is_empty(), warnings);
         self.study_section(&mut h);
         self.ledger_section(&mut h);
         self.manifest_section(&mut h);
+        h.push_str(SCRIPT);
         h.push_str("</body>\n</html>\n");
-        h
+        with_toc(&h)
     }
 
     /// The answer first: the verdict box of `summary.md` (verdict line, caveats, top three
     /// side by side with their drawings), when the study has one.
     fn verdict_section(&self, h: &mut String) {
         if let Some(block) = self.summary.and_then(summary_opening) {
-            h.push_str(&verdict_html(block, self.drawings, &|id| self.link(id)));
+            let block = units_in_headers(block);
+            h.push_str(&verdict_html(&block, self.drawings, &|id| self.link(id)));
         }
     }
 
@@ -398,7 +424,7 @@ impl Page<'_> {
         h.push_str(
             "<section id=\"ledger\">\n<h2>Assumption ledger</h2>\n<p>Model parameters that \
              are inferred rather than taken from a source, with the range the uncertain worlds \
-             use (docs/assumptions.md).</p>\n<table class=\"r-kv\">\n<tr><th>parameter</th>\
+             use (docs/assumptions.md).</p>\n<div class=\"r-scroll\"><table class=\"r-kv\">\n<tr><th>parameter</th>\
              <th>value</th><th>source</th><th>key</th><th>range</th></tr>\n",
         );
         for r in rows {
@@ -427,7 +453,7 @@ impl Page<'_> {
                 escape(&range)
             );
         }
-        h.push_str("</table>\n</section>\n");
+        h.push_str("</table></div>\n</section>\n");
     }
 
     /// Description, parameters and counts from the manifest.
@@ -469,26 +495,34 @@ impl Page<'_> {
         h.push_str("</section>\n");
     }
 
-    /// Every field of the manifest.
+    /// The run's record: a link to `manifest.json` (not its raw JSON) and the fields a reader
+    /// of a printed page needs to place the run.
     fn manifest_section(&self, h: &mut String) {
-        let Some(obj) = self.manifest.and_then(|m| m.as_object()) else {
+        let Some(m) = self.manifest else {
             return;
         };
-        h.push_str("<section id=\"manifest\">\n<h2>Run parameters (manifest.json)</h2>\n");
-        h.push_str("<table class=\"r-kv\">\n");
-        for (k, v) in obj
-            .iter()
-            .filter(|(k, _)| !matches!(k.as_str(), "columns" | "axes"))
-        {
-            let text = json_text(v);
+        h.push_str(
+            "<section id=\"manifest\">\n<h2>Run record</h2>\n<p>Every parameter of the run is in \
+             <a href=\"manifest.json\">manifest.json</a> (appendix, not printed here).</p>\n\
+             <div class=\"r-scroll\"><table class=\"r-kv\">\n",
+        );
+        for k in [
+            "tool_version",
+            "git_commit",
+            "study_hash",
+            "seed",
+            "start_time",
+            "elapsed_s",
+            "jobs",
+        ] {
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td></tr>",
                 escape(k),
-                escape(&text)
+                escape(&json_text(&m[k]))
             );
         }
-        h.push_str("</table>\n</section>\n");
+        h.push_str("</table></div>\n</section>\n");
     }
 
     /// What success means here, and how many cases met it.
@@ -555,11 +589,16 @@ impl Page<'_> {
                 escape(&ids.join(", ")),
                 escape(&info(&first).name),
                 if bad.is_empty() {
-                    String::new()
+                    self.marks
+                        .get(&first)
+                        .map_or(String::new(), |m| format!(" — {}", escape(&m.1)))
                 } else {
                     format!(
-                        " — <span class=\"r-badword\">unsuccessful</span>: {}",
-                        escape(&bad.join("; "))
+                        " — <span class=\"r-badword\">unsuccessful</span>: {}{}",
+                        escape(&bad.join("; ")),
+                        self.marks
+                            .get(&first)
+                            .map_or(String::new(), |m| format!(" ({})", escape(&m.1)))
                     )
                 }
             );
@@ -577,7 +616,13 @@ impl Page<'_> {
                     Some(block) => md.replacen(block, "", 1),
                     None => md.to_string(),
                 };
-                h.push_str(&markdown_to_html(&rest, 1, &|id| self.link(id)));
+                let html = markdown_to_html(&units_in_headers(&rest), 1, &|id| self.link(id));
+                let folded = [
+                    "best-case-by-each-metric",
+                    "single-thruster-faults",
+                    "cases-left-out",
+                ];
+                h.push_str(&fold(&html, &folded));
             }
             None => h.push_str(
                 "<h2>Tables</h2>\n<p class=\"r-note\">No summary.md in this directory.</p>\n",
@@ -599,36 +644,6 @@ fn json_text(v: &serde_json::Value) -> String {
             .join(", "),
         other => other.to_string(),
     }
-}
-
-/// Every figure, inline.
-fn plots_section(h: &mut String, figures: &[PathBuf], warnings: &mut Vec<String>) {
-    // The Pareto plot is at the top of the page already.
-    let figures: Vec<&PathBuf> = figures
-        .iter()
-        .filter(|p| p.file_name().is_none_or(|n| n != "pareto.svg"))
-        .collect();
-    h.push_str("<section id=\"plots\">\n<h2>Plots</h2>\n");
-    if figures.is_empty() {
-        h.push_str("<p class=\"r-note\">No plots in this directory.</p>\n");
-    }
-    for (k, p) in figures.iter().enumerate() {
-        let name = p
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        match std::fs::read_to_string(p) {
-            Ok(svg) => {
-                let _ = writeln!(
-                    h,
-                    "<figure class=\"r-plot\" id=\"plot-{k}\">{}<figcaption>{}</figcaption></figure>",
-                    inline_svg(&svg, &format!("p{k}-")),
-                    escape(&name)
-                );
-            }
-            Err(e) => warnings.push(format!("{}: {e}", p.display())),
-        }
-    }
-    h.push_str("</section>\n");
 }
 
 #[cfg(test)]

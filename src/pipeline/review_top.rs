@@ -61,10 +61,14 @@ pub(super) fn verdict_html(
     if !shown.is_empty() {
         h.push_str("<div class=\"r-top\">\n");
         for (rank, id, d) in shown.iter() {
-            let name = link(*id).and_then(|l| l.name).unwrap_or_default();
+            let l = link(*id);
+            let name = l.as_ref().and_then(|l| l.name.clone()).unwrap_or_default();
+            let mark = l
+                .and_then(|l| l.mark)
+                .map_or(String::new(), |m| format!(" — {}", escape(&m.1)));
             let _ = writeln!(
                 h,
-                "<figure>{}<figcaption><strong>{}. #{id}</strong> {}</figcaption></figure>",
+                "<figure>{}<figcaption><strong>{}. #{id}</strong> {}{mark}</figcaption></figure>",
                 inline_svg(&d.svg, &format!("v{id}-")),
                 *rank + 1,
                 escape(&name)
@@ -85,8 +89,10 @@ pub(super) fn pareto_html(figures: &[PathBuf]) -> Option<String> {
     let svg = std::fs::read_to_string(p).ok()?;
     Some(format!(
         "<section id=\"pareto\">\n<h2>Trade-off</h2>\n<figure class=\"r-plot\">{}\
-         <figcaption>pareto.svg — the Pareto front of the study's two trade-off metrics \
-         (successful cases)</figcaption></figure>\n</section>\n",
+         <figcaption>pareto.svg — the Pareto front of the study's two trade-off metrics over \
+         the cases successful in the nominal world: ranked designs in blue, not-ranked ones in \
+         grey (labelled \"not ranked\" on the front), unsuccessful ones in red; axes clipped to \
+         the ranked designs, points beyond drawn at the edge</figcaption></figure>\n</section>\n",
         inline_svg(&svg, "top-")
     ))
 }

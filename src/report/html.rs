@@ -22,6 +22,9 @@ pub struct CaseLink {
     pub unsuccessful: bool,
     /// A short design name shown after the number (e.g. `paper / 5 / 0.06`).
     pub name: Option<String>,
+    /// Whether the design is ranked, and the short text shown after the name (`ranked`, or
+    /// why not: `not ranked: success 0.19 …`); `None`: the study ranks nothing.
+    pub mark: Option<(bool, String)>,
 }
 
 /// Inline Markdown: `` `code` ``, `**bold**`, links, images `![alt](src)`, and (when `link` is given) case references `#N`
@@ -70,10 +73,14 @@ fn inline(text: &str, link: Option<&dyn Fn(i64) -> Option<CaseLink>>) -> (String
             let digits: String = rest[1..].chars().take_while(char::is_ascii_digit).collect();
             if let Some(r) = digits.parse::<i64>().ok().and_then(link) {
                 bad |= r.unsuccessful;
-                let label = match &r.name {
+                let mut label = match &r.name {
                     Some(n) => format!("#{digits} <span class=\"r-name\">{}</span>", escape(n)),
                     None => format!("#{digits}"),
                 };
+                if let Some((ranked, text)) = &r.mark {
+                    let class = if *ranked { "r-ranked" } else { "r-unranked" };
+                    let _ = write!(label, " <span class=\"{class}\">{}</span>", escape(text));
+                }
                 match &r.anchor {
                     Some(a) => {
                         let _ = write!(out, "<a href=\"#{}\">{label}</a>", escape(a));
@@ -303,6 +310,7 @@ mod tests {
             anchor: Some(format!("case-{id}")),
             unsuccessful: id == 3,
             name: Some("paper / 5".into()),
+            mark: None,
         })
     }
 

@@ -15,12 +15,14 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use super::records::{Extreme, CASE_ID, STATUS};
+pub use super::plots_ranked::unsuccessful_rows;
+use super::plots_ranked::{clip_to_ranked, ranked_mask, split_series, unsuccessful_series};
+use super::records::{Extreme, CASE_ID};
 use super::selection::{levels, mean, thin, Front, Selection};
 use crate::report::file_stem_safe;
 use crate::report::{
-    fmt_short, heatmap, read_csv, scatter_labelled, Colour, ColourScale, ColumnData, ColumnKind,
-    Figure, LabelledPoint, Panel, PanelKind, Scale, Series, Table,
+    fmt_short, heatmap, read_csv, scatter_labelled, ColourScale, ColumnData, ColumnKind, Figure,
+    LabelledPoint, Panel, PanelKind, Scale, Series, Table,
 };
 
 /// Units of metric and design columns, by name or by name suffix (docs/model.md §6 and the design
@@ -129,45 +131,6 @@ pub fn case_name(table: &Table, axes: &[&str], row: usize) -> String {
         .join("/")
 }
 
-/// Whether each row is unsuccessful: its `status` is not `ok`, or its `success` column (when
-/// the table has one: bool, 0/1 or `true`/`yes`) says no.
-pub fn unsuccessful_rows(table: &Table) -> Vec<bool> {
-    let status = table.str(STATUS).ok();
-    let success = table.column("success").map(|c| &c.data);
-    (0..table.n_rows())
-        .map(|r| {
-            let failed = status.is_some_and(|s| s[r] != "ok");
-            let missed = success.is_some_and(|d| match d {
-                ColumnData::Bool(v) => !v[r],
-                ColumnData::F64(v) => !(v[r] != 0.0 && v[r].is_finite()),
-                ColumnData::I64(v) => v[r] == 0,
-                ColumnData::Str(v) => !matches!(
-                    v[r].trim().to_ascii_lowercase().as_str(),
-                    "true" | "1" | "yes" | "ok"
-                ),
-            });
-            failed || missed
-        })
-        .collect()
-}
-
-/// The unsuccessful rows with finite `xs` and `ys`, as a red series (`None` when there are
-/// none).
-fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Option<Series> {
-    let rows: Vec<usize> = (0..bad.len())
-        .filter(|&r| bad[r] && xs[r].is_finite() && ys[r].is_finite())
-        .collect();
-    (!rows.is_empty()).then(|| {
-        Series::new(
-            "unsuccessful cases",
-            rows.iter().map(|&r| xs[r]).collect(),
-            rows.iter().map(|&r| ys[r]).collect(),
-        )
-        .colour(Colour::Alert)
-        .kind(PanelKind::Scatter)
-    })
-}
-
 /// The scale of axis `a` over its levels `lv`: the level names for a text axis, integers for
 /// whole-numbered axes.
 fn axis_scale(table: &Table, a: &str, lv: &[(String, f64, Vec<usize>)]) -> Scale {
@@ -191,6 +154,8 @@ pub(crate) fn pareto_plot(
     warnings: &mut Vec<String>,
 ) {
     let ids = table.i64(CASE_ID).unwrap_or(&[]);
+    let mask = ranked_mask(table);
+    let unranked = |r: usize| mask.as_ref().is_some_and(|m| !m[r]);
     let mut shown: Vec<usize> = thin(&(0..f.rows.len()).collect::<Vec<_>>());
     shown.extend(f.front.iter().copied());
     shown.sort_unstable();
@@ -208,9 +173,10 @@ pub(crate) fn pareto_plot(
                 x: f.xs[r],
                 y: f.ys[r],
                 label: format!(
-                    "#{} {}",
+                    "#{} {}{}",
                     ids.get(r).copied().unwrap_or(r as i64),
-                    case_name(table, axes, r)
+                    case_name(table, axes, r),
+                    if unranked(r) { " (not ranked)" } else { "" }
                 ),
             }
         })
@@ -240,6 +206,13 @@ pub(crate) fn pareto_plot(
         if let Some(s) = unsuccessful_series(&unsuccessful_rows(table), f.xs, f.ys) {
             p.series.push(s);
         }
+        if let Some(m) = &mask {
+            let rows: Vec<usize> = shown.iter().map(|&k| f.rows[k]).collect();
+            p.series.splice(0..1, split_series(&rows, f.xs, f.ys, m));
+            let r: Vec<usize> = f.rows.iter().copied().filter(|&r| m[r]).collect();
+            let (x, y): (Vec<f64>, Vec<f64>) = r.iter().map(|&r| (f.xs[r], f.ys[r])).unzip();
+            clip_to_ranked(p, &x, &y, true);
+        }
         fig.write_svg(&plots.join("pareto.svg"))
     });
     if let Err(e) = result {
@@ -258,6 +231,7 @@ pub(crate) fn axis_plots(
 ) {
     let all: Vec<usize> = (0..table.n_rows()).collect();
     let bad = unsuccessful_rows(table);
+    let mask = ranked_mask(table);
     for a in axes {
         // Levels over every case, so that a text axis has the same categories in every plot.
         let lv = levels(table, a, &all);
@@ -292,9 +266,20 @@ pub(crate) fn axis_plots(
                 .with_series(s);
             p.x_scale = x_scale.clone();
             p.y_scale = value_scale(yv, &all);
+            if let Some(m) = &mask {
+                p.series = split_series(&plotted, &xv, yv, m);
+            }
             match unsuccessful_series(&bad, &xv, yv) {
                 Some(u) => p.series.push(u),
-                None => p.legend = false,
+                None => p.legend = mask.is_some(),
+            }
+            if let Some(m) = &mask {
+                let (x, y): (Vec<f64>, Vec<f64>) = ok_rows
+                    .iter()
+                    .filter(|&&r| m[r])
+                    .map(|&r| (xv[r], yv[r]))
+                    .unzip();
+                clip_to_ranked(&mut p, &x, &y, false);
             }
             fig.panels.push(p);
         }
@@ -322,19 +307,37 @@ pub(crate) fn heatmaps(
     let Ok(z) = table.f64(objective) else {
         return;
     };
+    // Over the ranked designs by default (a study ranking over worlds), the others counted.
+    let ranked: Option<Vec<usize>> =
+        ranked_mask(table).map(|m| rows.0.iter().copied().filter(|&r| m[r]).collect());
+    let (rows, what) = match &ranked {
+        Some(r) => (
+            (r.as_slice(), rows.1),
+            format!(
+                "the {} ranked designs ({} successful not ranked and {} unsuccessful left out)",
+                r.len(),
+                rows.0.len() - r.len(),
+                rows.1.len() - rows.0.len()
+            ),
+        ),
+        None => (rows, "the successful cases".to_string()),
+    };
     for i in 0..axes.len() {
         for j in i + 1..axes.len() {
             let grid = |r: &[usize]| (levels(table, axes[i], r), levels(table, axes[j], r));
             let (ok_a, ok_b) = grid(rows.0);
             let (la, lb, over) = if ok_a.len() >= 2 && ok_b.len() >= 2 {
-                (ok_a, ok_b, "the successful cases".to_string())
+                (ok_a, ok_b, what.clone())
             } else {
                 let (a, b) = grid(rows.1);
                 let n = rows.0.len();
                 (
                     a,
                     b,
-                    format!("all {} cases that ran ({n} successful)", rows.1.len()),
+                    format!(
+                        "all {} cases that ran ({n} ranked or successful)",
+                        rows.1.len()
+                    ),
                 )
             };
             // Fewer than two values of an axis among the cases that ran: no grid to draw
@@ -387,7 +390,12 @@ pub(crate) fn extreme_names(table: &Table, sel: &Selection) -> [String; 2] {
         (Some((o, _)), Some(r)) => {
             let v = table.f64(o).map_or(f64::NAN, |v| v[r]);
             let id = ids.get(r).copied().unwrap_or(r as i64);
-            format!("{}: case #{id}, {o} = {}", e.label(), fmt_short(v))
+            let rk = match ranked_mask(table) {
+                Some(m) if m[r] => " (ranked)",
+                Some(_) => " (not ranked)",
+                None => "",
+            };
+            format!("{}: case #{id}{rk}, {o} = {}", e.label(), fmt_short(v))
         }
         _ => format!("{} case", e.label()),
     };
@@ -525,6 +533,7 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::records::STATUS;
 
     #[test]
     fn metrics_spanning_decades_get_a_log_axis() {

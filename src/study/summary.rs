@@ -2,7 +2,7 @@
 //! generated from the final case table and the manifest only (so `usm-study report DIR` can
 //! regenerate them).
 //!
-//! `summary.md`: counts, the best case by each metric, the main effects of each axis (mean of
+//! `summary.md`: counts, the best case by each metric, the main effects of each axis (median of
 //! the key metrics per axis value; numeric axes with many values binned), the Pareto-optimal
 //! cases of the trade-off (energy vs singularity exposure by default), the cases left out.
 //!
@@ -19,7 +19,7 @@ use super::manifest::Manifest;
 use super::plots::{axis_plots, extreme_names, heatmaps, pareto_plot, timeseries_plot};
 use super::records::{CaseEnd, CaseStatus, CASE_ID, REASON, STATUS};
 use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
-use super::selection::{cell_text, levels, mean, ok_rows, Front, Selection, SUCCESS};
+use super::selection::{cell_text, levels, ok_rows, Front, Selection, SUCCESS};
 use super::summary_robust::Robust;
 use crate::outcome::run_summary::SUCCESS_MARGIN;
 use crate::report::{fmt_short, MarkdownTable, Table};
@@ -347,8 +347,23 @@ fn best_section(c: &Ctx, md: &mut String) {
     md.push_str(&t.finish());
 }
 
-/// Main effects: per axis value, how many cases ran and how many succeeded, and the mean
-/// of each key metric over the successful ones.
+/// The median of `v` over `rows` (finite values; NaN without any): effect tables use medians,
+/// so that a few cost blow-ups of unsuccessful or fragile designs do not make the column.
+fn median(v: &[f64], rows: &[usize]) -> f64 {
+    let mut x: Vec<f64> = rows
+        .iter()
+        .map(|&r| v[r])
+        .filter(|x| x.is_finite())
+        .collect();
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    x.sort_by(f64::total_cmp);
+    crate::stats::describe::quantile_sorted(&x, 0.5)
+}
+
+/// Main effects: per axis value, how many cases ran, succeeded and (over worlds) are ranked,
+/// and the median of each key metric over the successful ones and over all that ran.
 fn effects_section(c: &Ctx, md: &mut String) {
     if c.axes.is_empty() || c.ok_rows.is_empty() {
         return;
@@ -356,11 +371,13 @@ fn effects_section(c: &Ctx, md: &mut String) {
     let _ = writeln!(
         md,
         "\n## Effect of each axis\n\nPer axis value: the cases that ran (`ok` or \
-         `unsuccessful`), how many of them succeeded and their success rate, the mean \
-         `success_margin` of all that ran (signed distance to the success bounds: < 0 missed, \
-         by that fraction of the bound), and the mean of each key metric over the successful \
-         ones (`ok`) beside its mean over all that ran (`all`): unsuccessful cases are \
-         information in a sensitivity study.\n"
+         `unsuccessful`), how many of them succeeded (and, in a study over worlds, how many are \
+         ranked) and their success rate, the **median** `success_margin` of all that ran (signed \
+         distance to the success bounds: < 0 missed, by that fraction of the bound), and the \
+         **median** of each key metric over the successful ones (`ok`) beside its median over \
+         all that ran (`all`): medians, not means, so that the cost blow-ups of a few failing \
+         designs do not decide a column; unsuccessful cases are information in a sensitivity \
+         study.\n"
     );
     let ran = c.ran_rows();
     let margin = c.table.f64(SUCCESS_MARGIN).ok();
@@ -391,12 +408,16 @@ fn effects_section(c: &Ctx, md: &mut String) {
             .into_iter()
             .map(String::from)
             .collect();
+        let ranked = super::plots_ranked::ranked_mask(c.table);
+        if ranked.is_some() {
+            header.insert(3, "ranked".into());
+        }
         if margin.is_some() {
-            header.push(format!("`{SUCCESS_MARGIN}` (all)"));
+            header.push(format!("`{SUCCESS_MARGIN}` median (all)"));
         }
         for k in &keys {
-            header.push(format!("`{k}` (ok)"));
-            header.push(format!("`{k}` (all)"));
+            header.push(format!("`{k}` median (ok)"));
+            header.push(format!("`{k}` median (all)"));
         }
         let mut t = MarkdownTable::new(header);
         for (label, _, rows) in levels(c.table, a, &ran) {
@@ -414,13 +435,16 @@ fn effects_section(c: &Ctx, md: &mut String) {
                     100.0 * ok.len() as f64 / rows.len().max(1) as f64
                 ),
             ];
+            if let Some(m) = &ranked {
+                row.insert(3, rows.iter().filter(|&&r| m[r]).count().to_string());
+            }
             if let Some(m) = margin {
-                row.push(fmt_short(mean(m, &rows)));
+                row.push(fmt_short(median(m, &rows)));
             }
             for k in &keys {
                 let col = c.table.f64(k).ok();
-                row.push(fmt_short(col.map_or(f64::NAN, |v| mean(v, &ok))));
-                row.push(fmt_short(col.map_or(f64::NAN, |v| mean(v, &rows))));
+                row.push(fmt_short(col.map_or(f64::NAN, |v| median(v, &ok))));
+                row.push(fmt_short(col.map_or(f64::NAN, |v| median(v, &rows))));
             }
             t.row(row);
         }

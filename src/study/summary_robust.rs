@@ -73,6 +73,9 @@ pub struct Robust<'a> {
     /// The condition this view judges (a child view of a study with condition axes,
     /// [`Robust::views`]); `None` for the study as a whole.
     condition: Option<Condition>,
+    /// The "how firm" paragraph of the box ([`super::verdict_firm`]; empty in a condition's
+    /// view: the study states it once).
+    firm: String,
 }
 
 impl<'a> Robust<'a> {
@@ -81,7 +84,9 @@ impl<'a> Robust<'a> {
         let info = m.robust.as_ref()?;
         let worlds = read_csv(&dir.join(WORLDS_CSV)).ok()?;
         let verdict = study_verdict(table, &worlds, info)?;
+        let firm = super::verdict_firm::how_firm(dir, m.seed, info, &verdict);
         Some(Robust {
+            firm,
             table,
             info,
             worlds: std::rc::Rc::new(worlds),
@@ -131,9 +136,12 @@ impl<'a> Robust<'a> {
             ranked: &ranked,
             objective: self.info.objective(),
             label: &label,
+            axes: &self.axes,
+            within: None,
+            min_success: self.info.min_success_probability,
         };
         let (line, boxed) = (self.verdict_line(), verdict_box(&inp));
-        format!("{line}\n\n{boxed}{VERDICT_END}")
+        format!("{line}\n\n{}{boxed}{VERDICT_END}", self.firm)
     }
 
     /// The ranking, tuning-adequacy, sensitivity and validation sections; plots into
@@ -316,7 +324,16 @@ impl<'a> Robust<'a> {
             "tuning run",
             "best so far / final",
         );
-        for (k, (x, y)) in curves.values().enumerate() {
+        // Not-ranked designs in grey under the ranked ones in blue.
+        let p = self.col(P_BEST);
+        let ranked: std::collections::BTreeSet<i64> = (0..self.ids.len())
+            .filter(|&r| p[r].is_finite())
+            .map(|r| self.ids[r])
+            .collect();
+        let mut order: Vec<_> = curves.iter().collect();
+        order.sort_by_key(|(c, _)| ranked.contains(*c));
+        let mut named = [false; 2];
+        for (c, (x, y)) in order {
             let last = y
                 .iter()
                 .rev()
@@ -324,10 +341,21 @@ impl<'a> Robust<'a> {
                 .find(|v| v.is_finite())
                 .unwrap_or(f64::NAN);
             let rel: Vec<f64> = y.iter().map(|v| v / last).collect();
-            panel.series.push(
-                Series::new(if k == 0 { "one design each" } else { "" }, x.clone(), rel)
-                    .colour(Colour::Palette(0)),
-            );
+            let k = usize::from(ranked.contains(c));
+            let name = match (named[k], k) {
+                (true, _) => "",
+                (false, 1) => "ranked designs (one line each)",
+                (false, _) => "not ranked (one line each)",
+            };
+            named[k] = true;
+            let colour = if k == 1 {
+                Colour::Palette(0)
+            } else {
+                Colour::Grey
+            };
+            panel
+                .series
+                .push(Series::new(name, x.clone(), rel).colour(colour));
         }
         let mut fig = Figure::new("Per-design tuning: best so far");
         fig.panels.push(panel);

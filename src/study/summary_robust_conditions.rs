@@ -43,6 +43,7 @@ impl<'a> Robust<'a> {
                     .filter(|a| !conds.iter().any(|c| c == a))
                     .collect(),
                 condition: Some(c),
+                firm: String::new(),
             })
             .collect()
     }
@@ -65,6 +66,7 @@ impl<'a> Robust<'a> {
             views.len(),
             axes.join(", ")
         );
+        md.push_str(&self.firm);
         for v in &views {
             let ranked = v.ranked_rows();
             let label = |r: usize| v.label(r);
@@ -73,6 +75,9 @@ impl<'a> Robust<'a> {
                 ranked: &ranked,
                 objective: v.info.objective(),
                 label: &label,
+                axes: &v.axes,
+                within: v.condition.as_ref().map(|c| c.rows.as_slice()),
+                min_success: v.info.min_success_probability,
             };
             let c = v.condition.as_ref().map_or("", |c| c.label.as_str());
             let _ = write!(

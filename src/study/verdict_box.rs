@@ -7,6 +7,7 @@
 use std::fmt::Write as _;
 
 use super::directions::larger_is_better;
+use super::families::{families, families_note, family_name, minor_axes};
 use crate::report::{fmt_short, MarkdownTable, Table};
 use crate::stats::describe::quantile_sorted;
 
@@ -44,6 +45,12 @@ pub struct BoxInput<'a> {
     pub objective: &'a str,
     /// A row's label (`#45 (ends, 4, 0.06)`).
     pub label: &'a dyn Fn(usize) -> String,
+    /// The study's axes (the families of [`super::families`] are over them).
+    pub axes: &'a [&'a str],
+    /// The rows this box judges (a condition's; `None`: every row).
+    pub within: Option<&'a [bool]>,
+    /// The success probability a design needs (its lower confidence bound) to be ranked.
+    pub min_success: f64,
 }
 
 /// The column `name` as numbers (`None` when the table lacks it or it is not numeric).
@@ -152,28 +159,171 @@ pub fn failed_variants(t: &Table, r: usize) -> Vec<String> {
     out
 }
 
-/// The top [`TOP_N`] ranked designs side by side: one column per design, one row per box
-/// metric.
+/// The top [`TOP_N`] families of ranked designs ([`super::families`]) side by side: one
+/// column per family (its best-ranked member's values, the range of its minor axes and its
+/// members in the header), one row per box metric, and the family's `p_best` (the sum over its
+/// members). Without a minor axis every family is one design.
 pub fn top_table(inp: &BoxInput) -> Option<String> {
     if inp.ranked.is_empty() {
         return None;
     }
-    let top: Vec<usize> = inp.ranked.iter().copied().take(TOP_N).collect();
+    let minor = minor_axes(inp.table, inp.axes, inp.ranked, inp.objective);
+    let fams = families(inp.table, inp.axes, inp.ranked, &minor);
+    let top: Vec<&Vec<usize>> = fams.iter().take(TOP_N).collect();
     let mut header = vec!["metric".to_string()];
-    header.extend(
-        top.iter()
-            .enumerate()
-            .map(|(i, &r)| format!("{}. {}", i + 1, (inp.label)(r))),
-    );
+    header.extend(top.iter().enumerate().map(|(i, f)| {
+        if f.len() == 1 {
+            format!("{}. {}", i + 1, (inp.label)(f[0]))
+        } else {
+            let ids: Vec<String> = f.iter().map(|&r| (inp.label)(r)).collect();
+            let ids: Vec<&str> = ids.iter().filter_map(|l| l.split(' ').next()).collect();
+            format!(
+                "{}. family ({}): {}",
+                i + 1,
+                family_name(inp.table, inp.axes, f),
+                ids.join(", ")
+            )
+        }
+    }));
     let mut t = MarkdownTable::new(header);
+    let p_best = column(inp.table, "p_best");
     for m in box_metrics(inp) {
         let col = column(inp.table, &m)?;
         let mut row = vec![format!("`{m}`")];
-        row.extend(top.iter().map(|&r| fmt_short(col[r])));
+        row.extend(top.iter().map(|f| fmt_short(col[f[0]])));
         t.row(row);
+        if m == inp.objective && top.iter().any(|f| f.len() > 1) {
+            let mut row = vec![format!("`{m}` range in the family")];
+            row.extend(top.iter().map(|f| {
+                let v: Vec<f64> = f.iter().map(|&r| col[r]).collect();
+                let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                format!("{} … {}", fmt_short(lo), fmt_short(hi))
+            }));
+            t.row(row);
+        }
+        if m == "p_best" && top.iter().any(|f| f.len() > 1) {
+            let mut row = vec!["family `p_best` (sum over its members)".to_string()];
+            row.extend(top.iter().map(|f| {
+                let s: f64 = f
+                    .iter()
+                    .filter_map(|&r| p_best.as_ref().map(|p| p[r]))
+                    .sum();
+                fmt_short(s)
+            }));
+            t.row(row);
+        }
     }
-    Some(t.finish())
+    let mut md = t.finish();
+    if let Some(note) = families_note(&minor, inp.objective) {
+        md.push('\n');
+        md.push_str(&note);
+        md.push('\n');
+    }
+    Some(md)
 }
+
+/// Why ranked row `r` is ranked or unranked row `r` is not: its success probability over the
+/// worlds with its lower confidence bound against the requirement, or the nominal criterion
+/// it missed.
+pub fn rank_reason(t: &Table, r: usize, min_success: f64) -> String {
+    let at = |c: &str| column(t, c).map_or(f64::NAN, |v| v[r]);
+    let (p, lo, met) = (
+        at("success_probability"),
+        at("success_probability_lower"),
+        at("worlds_met"),
+    );
+    if p.is_finite() {
+        let worlds = if met.is_finite() {
+            format!("success in {} of {} worlds, ", (p * met).round(), met)
+        } else {
+            String::new()
+        };
+        return format!(
+            "{worlds}success probability {} (95 % lower bound {} {} {})",
+            fmt_short(p),
+            fmt_short(lo),
+            if lo >= min_success { "≥" } else { "<" },
+            fmt_short(min_success)
+        );
+    }
+    let missed = t
+        .str("missed")
+        .ok()
+        .or_else(|| t.str(super::records::REASON).ok())
+        .map(|c| c[r].clone())
+        .filter(|s| !s.is_empty());
+    match missed {
+        Some(m) => format!("unsuccessful in the nominal world ({m}), so never met the worlds"),
+        None => "did not run in the worlds".into(),
+    }
+}
+
+/// The nominal-best design (the best objective among the cases successful in the nominal
+/// world, within the box's rows) named beside the leader when it differs, with the reason:
+/// the same family, behind over the worlds, or not ranked and why.
+pub fn nominal_best_line(inp: &BoxInput) -> Option<String> {
+    let &leader = inp.ranked.first()?;
+    let obj = column(inp.table, inp.objective)?;
+    let bad = super::plots::unsuccessful_rows(inp.table);
+    let larger = larger_is_better(inp.objective);
+    let best = (0..inp.table.n_rows())
+        .filter(|&r| !bad[r] && obj[r].is_finite() && inp.within.is_none_or(|w| w[r]))
+        .min_by(|&a, &b| {
+            let o = obj[a].total_cmp(&obj[b]);
+            if larger {
+                o.reverse()
+            } else {
+                o
+            }
+        })?;
+    let o = inp.objective;
+    if best == leader {
+        return Some(format!(
+            "The leader is also the best design in the nominal world (`{o}` = {}).",
+            fmt_short(obj[best])
+        ));
+    }
+    let head = format!(
+        "**Best in the nominal world: {}** (`{o}` = {} against the leader's {}), **robust-best \
+         (the verdict): {}** — ",
+        (inp.label)(best),
+        fmt_short(obj[best]),
+        fmt_short(obj[leader]),
+        (inp.label)(leader)
+    );
+    let minor = minor_axes(inp.table, inp.axes, inp.ranked, o);
+    let fams = families(inp.table, inp.axes, inp.ranked, &minor);
+    let why = if fams
+        .iter()
+        .any(|f| f.contains(&best) && f.contains(&leader))
+    {
+        "the same family: they differ only in a minor axis, so this is one layout.".to_string()
+    } else if inp.ranked.contains(&best) {
+        let mean = column(inp.table, &format!("{o}_mean"));
+        let m = |r: usize| mean.as_ref().map_or(f64::NAN, |v| v[r]);
+        format!(
+            "ranked, but behind over the worlds (mean `{o}` {} against {}): cheaper in the \
+             nominal world is not cheaper where the worlds vary.",
+            fmt_short(m(best)),
+            fmt_short(m(leader))
+        )
+    } else {
+        format!(
+            "**not ranked**: {}; a design must succeed reliably over the worlds before its \
+             cost counts.",
+            rank_reason(inp.table, best, inp.min_success)
+        )
+    };
+    Some(head + &why)
+}
+
+/// What `p_best` and "tied" mean, for the line under the box's table.
+pub const P_BEST_NOTE: &str = "`p_best`: the fraction of the paired worlds in which the design \
+has the best objective of all ranked designs (a family's: the sum over its members). *Tied*: \
+the leader does not beat the design at 95 % confidence over the paired worlds and the margin is \
+inside max(equivalence margin, tuning noise) — the study cannot tell them apart, which is not a \
+claim that they are equal.";
 
 /// The box below the verdict line: caveats, then the top designs side by side.
 pub fn verdict_box(inp: &BoxInput) -> String {
@@ -233,15 +383,18 @@ pub fn verdict_box(inp: &BoxInput) -> String {
             md.push('\n');
         }
     }
-    if let Some(t) = top_table(inp) {
-        let _ = writeln!(
-            md,
-            "Top {} side by side (ranked by the probability of being best, then the mean \
-             objective):\n\n{t}",
-            inp.ranked.len().min(TOP_N)
-        );
+    if let Some(line) = nominal_best_line(inp) {
+        let _ = writeln!(md, "{line}\n");
     }
-    md
+    // The top layouts first (what a reader looks for), then the leader's caveats.
+    match top_table(inp) {
+        Some(t) => format!(
+            "Top {} layouts side by side (ranked by the probability of being best, then the \
+             mean objective):\n\n{t}\n{P_BEST_NOTE}\n\n{md}",
+            inp.ranked.len().min(TOP_N)
+        ),
+        None => md,
+    }
 }
 
 #[cfg(test)]
@@ -277,6 +430,9 @@ mod tests {
             ranked: &[0, 1, 2, 3, 4],
             objective: "mission_cost",
             label: &label,
+            axes: &[],
+            within: None,
+            min_success: 0.9,
         };
         let c = caveats(&inp);
         assert_eq!(c.len(), 1, "{c:?}");
@@ -309,6 +465,9 @@ mod tests {
             ranked: &[0, 1, 2, 3, 4],
             objective: "mission_cost",
             label: &label,
+            axes: &[],
+            within: None,
+            min_success: 0.9,
         };
         assert!(verdict_box(&inp).contains("fewer than two of the independent tuning starts of #0"));
         let inp = BoxInput {
@@ -317,5 +476,60 @@ mod tests {
         };
         let b = verdict_box(&inp);
         assert!(b.contains("#2 did not settle") && b.contains("50 %"), "{b}");
+    }
+
+    #[test]
+    fn the_box_shows_families_and_names_a_nominal_best_that_is_not_ranked() {
+        let mut t = Table::new();
+        let rule = ["a", "a", "b", "b", "c"].map(String::from).to_vec();
+        t.push("rule", ColumnData::Str(rule)).unwrap();
+        t.push("off", ColumnData::F64(vec![0.1, 0.2, 0.1, 0.2, 0.1]))
+            .unwrap();
+        let cost = vec![10.0, 10.01, 12.0, 12.02, 5.0];
+        t.push("mission_cost", ColumnData::F64(cost)).unwrap();
+        t.push(
+            "mission_cost_mean",
+            ColumnData::F64(vec![11.0, 11.1, 13.0, 13.1, 9.0]),
+        )
+        .unwrap();
+        let p = vec![0.6, 0.3, 0.1, 0.0, f64::NAN];
+        t.push("p_best", ColumnData::F64(p)).unwrap();
+        t.push(
+            "success_probability",
+            ColumnData::F64(vec![1.0, 1.0, 1.0, 1.0, 0.5]),
+        )
+        .unwrap();
+        t.push(
+            "success_probability_lower",
+            ColumnData::F64(vec![0.9, 0.9, 0.9, 0.9, 0.3]),
+        )
+        .unwrap();
+        let label = |r: usize| format!("#{r}");
+        let inp = BoxInput {
+            table: &t,
+            ranked: &[0, 1, 2, 3],
+            objective: "mission_cost",
+            label: &label,
+            axes: &["rule", "off"],
+            within: None,
+            min_success: 0.9,
+        };
+        let top = top_table(&inp).unwrap();
+        assert!(
+            top.contains(
+                "| metric | 1. family (a, 0.1–0.2): #0, #1 | 2. family (b, 0.1–0.2): #2, #3 |"
+            ),
+            "{top}"
+        );
+        assert!(
+            top.contains("| family `p_best` (sum over its members) | 0.9 | 0.1 |"),
+            "{top}"
+        );
+        let line = nominal_best_line(&inp).unwrap();
+        assert!(
+            line.contains("Best in the nominal world: #4") && line.contains("**not ranked**"),
+            "{line}"
+        );
+        assert!(line.contains("95 % lower bound 0.3 < 0.9"), "{line}");
     }
 }
