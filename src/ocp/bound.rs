@@ -169,7 +169,6 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
             tolerance: spec.qp.0,
             max_iterations: spec.qp.1,
         },
-        ..SqpSettings::default()
     };
     let base = warm.map_or_else(|| vec![vec![0.0; nu]; spec.knots], |w| w.1.clone());
     let mut sols: Vec<OcpSolution> = Vec::with_capacity(spec.starts);

@@ -389,50 +389,15 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             bounds[i] = v;
         }
     }
-    let joint_limit = (
-        f.bounds.joint_angle.unwrap_or(f64::INFINITY),
-        f.bounds.barrier.unwrap_or(1e-3),
-    );
-    if joint_limit.0 <= 0.0 {
-        return Err(doc.err("bounds.joint_angle", "must be positive [rad]"));
-    }
-    if joint_limit.1 <= 0.0 {
-        return Err(doc.err("bounds.barrier", "must be positive"));
-    }
-    if joint_angles.iter().any(|q| q.abs() >= joint_limit.0) {
-        return Err(doc.err(
-            "bounds.joint_angle",
-            "the initial joint angles must be strictly inside the limit",
-        ));
-    }
+    let joint_limit = check_joint_limit(&doc, &f.bounds, &joint_angles)?;
     let sv = &f.solver;
     let (hessian, gauss_newton_above, warm_start) = check_solver(&doc, sv, path)?;
-    let feedback = match sv.rollout.as_deref() {
-        None | Some("linear") => false,
-        Some("feedback") => true,
-        Some(other) => {
-            return Err(doc.err(
-                "solver.rollout",
-                format!("`{other}` is not one of \"linear\", \"feedback\""),
-            ))
-        }
-    };
-    let cruise_start = match sv.initial_guess.as_deref() {
-        None | Some("rest") => false,
-        Some("cruise") if f.terminal.base_displacement.is_some() && warm_start.is_none() => true,
-        Some("cruise") => {
-            return Err(doc.err(
-                "solver.initial_guess",
-                "\"cruise\" needs terminal.base_displacement and no solver.warm_start",
-            ))
-        }
-        Some(other) => {
-            return Err(doc.err(
-                "solver.initial_guess",
-                format!("`{other}` is not one of \"rest\", \"cruise\""),
-            ))
-        }
-    };
+    let (feedback, cruise_start) = check_strategy(
+        &doc,
+        sv,
+        f.terminal.base_displacement.is_some(),
+        warm_start.is_some(),
+    )?;
     Ok(ProblemSpec {
         origin,
         vehicle,
@@ -466,6 +431,69 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         seed: sv.seed,
         perturbation: sv.perturbation,
     })
+}
+
+/// The joint-limit keys (`bounds.joint_angle`, `barrier`), validated against the initial
+/// joint angles: (limit, barrier weight).
+fn check_joint_limit(
+    doc: &Document,
+    b: &Bounds,
+    joint_angles: &[f64],
+) -> Result<(f64, f64), InputError> {
+    let joint_limit = (
+        b.joint_angle.unwrap_or(f64::INFINITY),
+        b.barrier.unwrap_or(1e-3),
+    );
+    if joint_limit.0 <= 0.0 {
+        return Err(doc.err("bounds.joint_angle", "must be positive [rad]"));
+    }
+    if joint_limit.1 <= 0.0 {
+        return Err(doc.err("bounds.barrier", "must be positive"));
+    }
+    if joint_angles.iter().any(|q| q.abs() >= joint_limit.0) {
+        return Err(doc.err(
+            "bounds.joint_angle",
+            "the initial joint angles must be strictly inside the limit",
+        ));
+    }
+    Ok(joint_limit)
+}
+
+/// The solver's strategy keys: `rollout` ("feedback" → true) and `initial_guess` ("cruise"
+/// → true; needs a base target and no warm start). Returns (feedback, cruise start).
+fn check_strategy(
+    doc: &Document,
+    sv: &Solver,
+    base_target: bool,
+    warm: bool,
+) -> Result<(bool, bool), InputError> {
+    let feedback = match sv.rollout.as_deref() {
+        None | Some("linear") => false,
+        Some("feedback") => true,
+        Some(other) => {
+            return Err(doc.err(
+                "solver.rollout",
+                format!("`{other}` is not one of \"linear\", \"feedback\""),
+            ))
+        }
+    };
+    let cruise_start = match sv.initial_guess.as_deref() {
+        None | Some("rest") => false,
+        Some("cruise") if base_target && !warm => true,
+        Some("cruise") => {
+            return Err(doc.err(
+                "solver.initial_guess",
+                "\"cruise\" needs terminal.base_displacement and no solver.warm_start",
+            ))
+        }
+        Some(other) => {
+            return Err(doc.err(
+                "solver.initial_guess",
+                format!("`{other}` is not one of \"rest\", \"cruise\""),
+            ))
+        }
+    };
+    Ok((feedback, cruise_start))
 }
 
 /// Whether `actuation` asks for thrusters (validated against the design's thrusters).

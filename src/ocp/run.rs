@@ -156,7 +156,6 @@ pub fn solve_spec(spec: &ProblemSpec) -> Result<OcpRun, InputError> {
             tolerance: spec.qp.0,
             max_iterations: spec.qp.1,
         },
-        ..SqpSettings::default()
     };
     let (warm_xs, warm_us) = match &spec.warm_start {
         Some(p) => {

@@ -34,34 +34,15 @@
 use super::model::OcpModel;
 use super::qp::{solve_box_qp, QpSettings, QpSolution};
 use super::riccati::LqError;
-use super::sqp_eval::{evaluate, feedback_rollout, kkt_residuals, Eval};
-use nalgebra::{DMatrix, DVector};
+use super::sqp_eval::{evaluate, feedback_rollout, kkt_residuals, strictly_inside, Eval};
+use nalgebra::DVector;
 use serde::Serialize;
 use std::time::Instant;
 
 /// Margin of the filter's acceptance tests (γ_θ = γ_φ).
 const GAMMA: f64 = 1e-5;
 
-/// The problem data besides the model.
-#[derive(Clone, Debug)]
-pub struct OcpProblem {
-    /// Number of intervals N (states x_0 … x_N).
-    pub knots: usize,
-    /// Initial state (representation, nq).
-    pub x0: Vec<f64>,
-    /// Reference state of the state cost (nq).
-    pub x_ref: Vec<f64>,
-    /// Stage state weight `Q` (nx×nx, symmetric positive semidefinite).
-    pub q: DMatrix<f64>,
-    /// Stage control weight `R` (nu×nu, symmetric positive definite).
-    pub r: DMatrix<f64>,
-    /// Terminal state weight `Q_N` (nx×nx).
-    pub q_n: DMatrix<f64>,
-    /// Lower control bounds (nu; `-inf` for none).
-    pub u_lo: Vec<f64>,
-    /// Upper control bounds (nu; `inf` for none).
-    pub u_hi: Vec<f64>,
-}
+pub use super::sqp_eval::OcpProblem;
 
 /// The Hessian of the SQP's subproblems.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -284,6 +265,26 @@ struct Filter {
     theta_first: Option<f64>,
 }
 
+/// The states of `st` rolled out from `x_0` with its controls (single-shooting start).
+fn roll_out_start<M: OcpModel>(
+    model: &mut M,
+    prob: &OcpProblem,
+    st: &mut SolveState,
+) -> Result<(), super::model::ModelError> {
+    let n = prob.knots;
+    let mut x = vec![prob.x0.clone(); n + 1];
+    for k in 0..n {
+        let (a, b) = x.split_at_mut(k + 1);
+        let r = model.step(&a[k], &st.us[k], &mut b[0]);
+        if r.is_err() {
+            st.xs = x;
+            return r;
+        }
+    }
+    st.xs = x;
+    Ok(())
+}
+
 /// The SQP iteration on `st` (states rolled out first when empty).
 fn iterate<M: OcpModel>(
     model: &mut M,
@@ -291,17 +292,11 @@ fn iterate<M: OcpModel>(
     set: &SqpSettings,
     st: &mut SolveState,
 ) -> End {
-    let (n, nu) = (prob.knots, model.nu());
+    let nu = model.nu();
     if st.xs.is_empty() {
-        let mut x = vec![prob.x0.clone(); n + 1];
-        for k in 0..n {
-            let (a, b) = x.split_at_mut(k + 1);
-            if let Err(e) = model.step(&a[k], &st.us[k], &mut b[0]) {
-                st.xs = x;
-                return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]);
-            }
+        if let Err(e) = roll_out_start(model, prob, st) {
+            return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]);
         }
-        st.xs = x;
     }
     st.xs[0].copy_from_slice(&prob.x0);
     let mut filter = Filter::default();
@@ -329,9 +324,7 @@ fn iterate<M: OcpModel>(
                 .collect()
         };
         let (lo, hi) = (bound(&prob.u_lo), bound(&prob.u_hi));
-        // Levenberg damping of the state increments (docs/ocp.md §3, eq. (P1)): ρ_p I on
-        // every Q_k and Q_N; on a failed line search ρ_p grows ×10 and the QP is solved
-        // again at the same point (the derivatives kept, the matrices restored).
+        // Levenberg damping (P1): a failed line search retries the QP with ρ_p ×10.
         let pristine = (set.proximal > 0.0).then(|| (ev.stages.clone(), ev.term.q_mat.clone()));
         let mut rho_p = st.proximal;
         let (qp, mut row, kkt, step) = loop {
@@ -622,14 +615,4 @@ fn line_search<M: OcpModel>(
         alpha *= 0.5;
     }
     None
-}
-
-/// `v` moved strictly inside `[lo, hi]` (by 1e-3 of the width, or 1e-3 from a one-sided bound).
-pub(super) fn strictly_inside(v: f64, lo: f64, hi: f64) -> f64 {
-    let margin = if lo.is_finite() && hi.is_finite() {
-        1e-3 * (hi - lo)
-    } else {
-        1e-3
-    };
-    v.max(lo + margin).min(hi - margin)
 }

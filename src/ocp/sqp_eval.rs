@@ -8,9 +8,29 @@ use super::cost::add_path_cost;
 use super::model::{ModelError, OcpModel};
 use super::qp::{residuals, QpSolution};
 use super::riccati::{LqStage, LqTerminal};
-use super::sqp::{strictly_inside, OcpProblem};
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
+
+/// The problem data besides the model.
+#[derive(Clone, Debug)]
+pub struct OcpProblem {
+    /// Number of intervals N (states x_0 … x_N).
+    pub knots: usize,
+    /// Initial state (representation, nq).
+    pub x0: Vec<f64>,
+    /// Reference state of the state cost (nq).
+    pub x_ref: Vec<f64>,
+    /// Stage state weight `Q` (nx×nx, symmetric positive semidefinite).
+    pub q: DMatrix<f64>,
+    /// Stage control weight `R` (nu×nu, symmetric positive definite).
+    pub r: DMatrix<f64>,
+    /// Terminal state weight `Q_N` (nx×nx).
+    pub q_n: DMatrix<f64>,
+    /// Lower control bounds (nu; `-inf` for none).
+    pub u_lo: Vec<f64>,
+    /// Upper control bounds (nu; `inf` for none).
+    pub u_hi: Vec<f64>,
+}
 
 /// Everything evaluated at one iterate.
 pub(super) struct Eval {
@@ -209,4 +229,14 @@ pub(super) fn feedback_rollout<M: OcpModel>(
         }
     }
     Ok(())
+}
+
+/// `v` moved strictly inside `[lo, hi]` (by 1e-3 of the width, or 1e-3 from a one-sided bound).
+pub(super) fn strictly_inside(v: f64, lo: f64, hi: f64) -> f64 {
+    let margin = if lo.is_finite() && hi.is_finite() {
+        1e-3 * (hi - lo)
+    } else {
+        1e-3
+    };
+    v.max(lo + margin).min(hi - margin)
 }
