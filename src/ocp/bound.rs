@@ -16,6 +16,7 @@
 use super::chain::ChainModel;
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
+use super::qp::QpSettings;
 use super::run::build_model;
 use super::sqp::{solve, Hessian, OcpProblem, OcpSolution, SqpSettings, Status};
 use super::start::{perturbed_controls, Trajectory};
@@ -96,6 +97,10 @@ pub fn leg_problem(vehicle: &Vehicle, leg: &LegSpec) -> ProblemSpec {
         hessian: Hessian::Exact,
         gauss_newton_above: 1e-2,
         warm_start: None,
+        cruise_start: false,
+        proximal: 0.0,
+        feedback: false,
+        qp: (1e-10, 60),
         starts: leg.starts.max(1),
         seed: leg.seed,
         perturbation: leg.perturbation,
@@ -158,7 +163,12 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
         max_iterations: spec.max_iterations,
         hessian: spec.hessian,
         gauss_newton_above: spec.gauss_newton_above,
-        ..SqpSettings::default()
+        proximal: spec.proximal,
+        feedback: spec.feedback,
+        qp: QpSettings {
+            tolerance: spec.qp.0,
+            max_iterations: spec.qp.1,
+        },
     };
     let base = warm.map_or_else(|| vec![vec![0.0; nu]; spec.knots], |w| w.1.clone());
     let mut sols: Vec<OcpSolution> = Vec::with_capacity(spec.starts);

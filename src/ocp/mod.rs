@@ -14,6 +14,7 @@
 //!   each perturbation leaves unchanged reused (the same numbers, fewer evaluations);
 //! - [`cost`]: [`PathCosts`], thruster and joint energy (smoothed) and the joint-limit
 //!   barrier, analytic derivatives;
+//! - [`cruise`]: the cruise start of a transport leg (a start that already moves);
 //! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
 //! - [`bound`]: the bound of a design on a transport leg (issue 41), N−1 warm-started;
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
@@ -21,6 +22,7 @@
 pub mod bound;
 pub mod chain;
 pub mod cost;
+pub mod cruise;
 pub mod derivatives;
 pub mod model;
 pub mod problem;
@@ -28,6 +30,7 @@ pub mod qp;
 pub mod riccati;
 pub mod run;
 pub mod sqp;
+mod sqp_eval;
 pub mod start;
 
 #[cfg(test)]
@@ -36,6 +39,8 @@ mod tests;
 mod tests_bound;
 #[cfg(test)]
 mod tests_costs;
+#[cfg(test)]
+mod tests_cruise;
 #[cfg(test)]
 mod tests_derivatives;
 

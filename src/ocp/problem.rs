@@ -37,6 +37,11 @@
 //! hessian = "exact"          # or "gauss_newton" (objective only, no dynamics curvature)
 //! gauss_newton_above = 1e-2  # optional: Gauss–Newton while the primal infeasibility is above
 //! warm_start = "trajectory.csv"  # optional: an `ocp` trajectory (same design, actuation, knots)
+//! proximal = 1.0            # initial Levenberg weight on the state increments (0: off; docs/ocp.md §3)
+//! rollout = "linear"        # or "feedback": trial points rolled out with the QP's gains (docs/ocp.md §3)
+//! qp_tolerance = 1e-10       # the QP interior point's stopping tolerance (absolute)
+//! qp_iterations = 60         # its most Newton iterations
+//! initial_guess = "rest"     # or "cruise": the base moving along base_displacement (docs/ocp.md §4)
 //! starts = 1                 # multi-start: start 0 as given, the others perturbed
 //! seed = 0                   # of the perturbations (ChaCha8 per start)
 //! perturbation = 0.1         # uniform ± this × the bound (or × 1 where unbounded)
@@ -176,6 +181,16 @@ struct Solver {
     gauss_newton_above: Option<f64>,
     #[serde(default)]
     warm_start: Option<String>,
+    #[serde(default)]
+    initial_guess: Option<String>,
+    #[serde(default)]
+    proximal: f64,
+    #[serde(default)]
+    rollout: Option<String>,
+    #[serde(default = "qp_tol")]
+    qp_tolerance: f64,
+    #[serde(default = "qp_iters")]
+    qp_iterations: i64,
     #[serde(default = "one_start")]
     starts: i64,
     #[serde(default)]
@@ -192,11 +207,24 @@ impl Default for Solver {
             hessian: None,
             gauss_newton_above: None,
             warm_start: None,
+            initial_guess: None,
+            proximal: 0.0,
+            rollout: None,
+            qp_tolerance: qp_tol(),
+            qp_iterations: qp_iters(),
             starts: 1,
             seed: 0,
             perturbation: perturbation(),
         }
     }
+}
+
+fn qp_tol() -> f64 {
+    1e-10
+}
+
+fn qp_iters() -> i64 {
+    60
 }
 
 fn one_start() -> i64 {
@@ -267,6 +295,15 @@ pub struct ProblemSpec {
     pub gauss_newton_above: f64,
     /// Warm start: the trajectory file (resolved against the problem file's directory).
     pub warm_start: Option<std::path::PathBuf>,
+    /// Start 0 without a warm start: the cruise start of `ocp::cruise` (docs/ocp.md §4,
+    /// eq. (C1)–(C3)) instead of zero controls rolled out.
+    pub cruise_start: bool,
+    /// Initial Levenberg weight of the SQP (docs/ocp.md §3, eq. (P1); 0: off).
+    pub proximal: f64,
+    /// Line-search trial points by the feedback rollout (docs/ocp.md §3, eq. (P2)).
+    pub feedback: bool,
+    /// The QP interior point's tolerance and most iterations (docs/ocp.md §3).
+    pub qp: (f64, usize),
     /// Number of starts (multi-start), the perturbations' seed and amplitude.
     pub starts: usize,
     /// Seed of the perturbed starts.
@@ -352,24 +389,15 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             bounds[i] = v;
         }
     }
-    let joint_limit = (
-        f.bounds.joint_angle.unwrap_or(f64::INFINITY),
-        f.bounds.barrier.unwrap_or(1e-3),
-    );
-    if joint_limit.0 <= 0.0 {
-        return Err(doc.err("bounds.joint_angle", "must be positive [rad]"));
-    }
-    if joint_limit.1 <= 0.0 {
-        return Err(doc.err("bounds.barrier", "must be positive"));
-    }
-    if joint_angles.iter().any(|q| q.abs() >= joint_limit.0) {
-        return Err(doc.err(
-            "bounds.joint_angle",
-            "the initial joint angles must be strictly inside the limit",
-        ));
-    }
+    let joint_limit = check_joint_limit(&doc, &f.bounds, &joint_angles)?;
     let sv = &f.solver;
     let (hessian, gauss_newton_above, warm_start) = check_solver(&doc, sv, path)?;
+    let (feedback, cruise_start) = check_strategy(
+        &doc,
+        sv,
+        f.terminal.base_displacement.is_some(),
+        warm_start.is_some(),
+    )?;
     Ok(ProblemSpec {
         origin,
         vehicle,
@@ -395,10 +423,77 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         hessian,
         gauss_newton_above,
         warm_start,
+        cruise_start,
+        proximal: sv.proximal,
+        feedback,
+        qp: (sv.qp_tolerance, sv.qp_iterations as usize),
         starts: sv.starts as usize,
         seed: sv.seed,
         perturbation: sv.perturbation,
     })
+}
+
+/// The joint-limit keys (`bounds.joint_angle`, `barrier`), validated against the initial
+/// joint angles: (limit, barrier weight).
+fn check_joint_limit(
+    doc: &Document,
+    b: &Bounds,
+    joint_angles: &[f64],
+) -> Result<(f64, f64), InputError> {
+    let joint_limit = (
+        b.joint_angle.unwrap_or(f64::INFINITY),
+        b.barrier.unwrap_or(1e-3),
+    );
+    if joint_limit.0 <= 0.0 {
+        return Err(doc.err("bounds.joint_angle", "must be positive [rad]"));
+    }
+    if joint_limit.1 <= 0.0 {
+        return Err(doc.err("bounds.barrier", "must be positive"));
+    }
+    if joint_angles.iter().any(|q| q.abs() >= joint_limit.0) {
+        return Err(doc.err(
+            "bounds.joint_angle",
+            "the initial joint angles must be strictly inside the limit",
+        ));
+    }
+    Ok(joint_limit)
+}
+
+/// The solver's strategy keys: `rollout` ("feedback" → true) and `initial_guess` ("cruise"
+/// → true; needs a base target and no warm start). Returns (feedback, cruise start).
+fn check_strategy(
+    doc: &Document,
+    sv: &Solver,
+    base_target: bool,
+    warm: bool,
+) -> Result<(bool, bool), InputError> {
+    let feedback = match sv.rollout.as_deref() {
+        None | Some("linear") => false,
+        Some("feedback") => true,
+        Some(other) => {
+            return Err(doc.err(
+                "solver.rollout",
+                format!("`{other}` is not one of \"linear\", \"feedback\""),
+            ))
+        }
+    };
+    let cruise_start = match sv.initial_guess.as_deref() {
+        None | Some("rest") => false,
+        Some("cruise") if base_target && !warm => true,
+        Some("cruise") => {
+            return Err(doc.err(
+                "solver.initial_guess",
+                "\"cruise\" needs terminal.base_displacement and no solver.warm_start",
+            ))
+        }
+        Some(other) => {
+            return Err(doc.err(
+                "solver.initial_guess",
+                format!("`{other}` is not one of \"rest\", \"cruise\""),
+            ))
+        }
+    };
+    Ok((feedback, cruise_start))
 }
 
 /// Whether `actuation` asks for thrusters (validated against the design's thrusters).
@@ -492,6 +587,15 @@ fn check_solver(
 ) -> Result<(Hessian, f64, Option<std::path::PathBuf>), InputError> {
     if sv.starts < 1 || sv.starts > 1000 {
         return Err(doc.err("solver.starts", "must be between 1 and 1000"));
+    }
+    if sv.qp_tolerance <= 0.0 {
+        return Err(doc.err("solver.qp_tolerance", "must be positive"));
+    }
+    if sv.qp_iterations < 1 {
+        return Err(doc.err("solver.qp_iterations", "must be at least 1"));
+    }
+    if sv.proximal < 0.0 {
+        return Err(doc.err("solver.proximal", "must be at least 0 (0: off)"));
     }
     if sv.perturbation < 0.0 {
         return Err(doc.err("solver.perturbation", "must be at least 0"));

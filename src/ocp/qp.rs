@@ -18,7 +18,7 @@
 use super::riccati::{
     solve_lq, solve_lq_into, LqError, LqSolution, LqStage, LqTerminal, LqWorkspace,
 };
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// Settings of the interior point.
 #[derive(Clone, Copy, Debug)]
@@ -54,6 +54,9 @@ pub struct QpSolution {
     pub z_lo: Vec<DVector<f64>>,
     /// Multipliers of the upper bounds.
     pub z_hi: Vec<DVector<f64>>,
+    /// The feedback gains `K_k` (nu×nx) of the last Riccati factorisation, barrier
+    /// diagonal included (docs/ocp.md §3, eq. (P2)); empty without bounds.
+    pub gains: Vec<DMatrix<f64>>,
     /// Newton iterations (Riccati factorisations) used.
     pub iterations: usize,
     /// Whether the tolerance was met (else the last iterate).
@@ -92,6 +95,7 @@ pub fn solve_box_qp(
             nu: s.nu,
             z_lo: zeros.clone(),
             z_hi: zeros,
+            gains: Vec::new(),
             iterations: 1,
             converged: true,
             least_squares: s.least_squares,
@@ -178,6 +182,7 @@ pub fn solve_box_qp(
         nu: nuv,
         z_lo,
         z_hi,
+        gains: lq.feedback_gains().to_vec(),
         iterations,
         converged,
         least_squares,

@@ -133,6 +133,12 @@ pub struct LqWorkspace {
 }
 
 impl LqWorkspace {
+    /// The feedback gains `K_k` of the last solve (`δu_k = K_k δx_k + k_k + K^ν_k ν`):
+    /// the trial rollout of the SQP's line search (docs/ocp.md §3, eq. (P2)).
+    pub fn feedback_gains(&self) -> &[DMatrix<f64>] {
+        &self.kfb
+    }
+
     /// Storage for N stages of sizes nx, nu and nc terminal rows.
     pub fn new(n: usize, nx: usize, nu: usize, nc: usize) -> Self {
         Self {

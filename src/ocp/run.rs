@@ -7,8 +7,10 @@
 
 use super::chain::{ChainModel, TerminalSpec};
 use super::cost::PathCosts;
+use super::cruise::cruise_start;
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
+use super::qp::QpSettings;
 use super::sqp::{solve, OcpProblem, OcpSolution, SqpSettings, Status};
 pub use super::start::trajectory_columns;
 use super::start::{perturbed_controls, read_warm_start};
@@ -148,11 +150,26 @@ pub fn solve_spec(spec: &ProblemSpec) -> Result<OcpRun, InputError> {
         max_iterations: spec.max_iterations,
         hessian: spec.hessian,
         gauss_newton_above: spec.gauss_newton_above,
-        ..SqpSettings::default()
+        proximal: spec.proximal,
+        feedback: spec.feedback,
+        qp: QpSettings {
+            tolerance: spec.qp.0,
+            max_iterations: spec.qp.1,
+        },
     };
     let (warm_xs, warm_us) = match &spec.warm_start {
         Some(p) => {
             let (xs, us) = read_warm_start(p, &model, spec.knots)?;
+            (Some(xs), us)
+        }
+        None if spec.cruise_start => {
+            let d = spec.base_displacement.unwrap_or_default();
+            let (lo, hi) = (&prob.u_lo, &prob.u_hi);
+            let cruise = cruise_start(&mut model, &prob.x0, spec.knots, d, lo, hi);
+            let (xs, us) = cruise.map_err(|e| InputError {
+                at: crate::input::located::Location::origin(&spec.origin),
+                error: format!("solver.initial_guess: the cruise start failed: {}", e.0),
+            })?;
             (Some(xs), us)
         }
         None => (None, vec![vec![0.0; nu]; spec.knots]),
@@ -259,7 +276,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     }
     atomic_write(&dir.join("trajectory.csv"), csv.as_bytes())?;
     let mut it = String::from(
-        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size,regularisation,terminal_penalty\n",
+        "iteration,objective,primal,stationarity,complementarity,step,qp_iterations,filter_size,regularisation,terminal_penalty,proximal\n",
     );
     for r in &sol.log {
         let cells = [
@@ -273,6 +290,7 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
             r.filter_size.to_string(),
             format_f64(r.regularisation),
             format_f64(r.terminal_penalty),
+            format_f64(r.proximal),
         ];
         it.push_str(&cells.join(","));
         it.push('\n');

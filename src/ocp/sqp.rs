@@ -31,37 +31,18 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
-use super::cost::add_path_cost;
-use super::model::{ModelError, OcpModel};
-use super::qp::{residuals, solve_box_qp, QpSettings, QpSolution};
-use super::riccati::{LqError, LqStage, LqTerminal};
-use nalgebra::{DMatrix, DVector};
+use super::model::OcpModel;
+use super::qp::{solve_box_qp, QpSettings, QpSolution};
+use super::riccati::LqError;
+use super::sqp_eval::{evaluate, feedback_rollout, kkt_residuals, strictly_inside, Eval};
+use nalgebra::DVector;
 use serde::Serialize;
 use std::time::Instant;
 
 /// Margin of the filter's acceptance tests (γ_θ = γ_φ).
 const GAMMA: f64 = 1e-5;
 
-/// The problem data besides the model.
-#[derive(Clone, Debug)]
-pub struct OcpProblem {
-    /// Number of intervals N (states x_0 … x_N).
-    pub knots: usize,
-    /// Initial state (representation, nq).
-    pub x0: Vec<f64>,
-    /// Reference state of the state cost (nq).
-    pub x_ref: Vec<f64>,
-    /// Stage state weight `Q` (nx×nx, symmetric positive semidefinite).
-    pub q: DMatrix<f64>,
-    /// Stage control weight `R` (nu×nu, symmetric positive definite).
-    pub r: DMatrix<f64>,
-    /// Terminal state weight `Q_N` (nx×nx).
-    pub q_n: DMatrix<f64>,
-    /// Lower control bounds (nu; `-inf` for none).
-    pub u_lo: Vec<f64>,
-    /// Upper control bounds (nu; `inf` for none).
-    pub u_hi: Vec<f64>,
-}
+pub use super::sqp_eval::OcpProblem;
 
 /// The Hessian of the SQP's subproblems.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -89,6 +70,12 @@ pub struct SqpSettings {
     pub tolerance: f64,
     /// Most SQP iterations.
     pub max_iterations: usize,
+    /// Initial Levenberg weight ρ_p of the state increments (docs/ocp.md §3, eq. (P1));
+    /// 0: off (the plain SQP step).
+    pub proximal: f64,
+    /// Trial points of the line search by the feedback rollout of eq. (P2) (dynamically
+    /// feasible: only the terminal residual remains) instead of `x_k ⊕ αδx_k`, `u_k + αδu_k`.
+    pub feedback: bool,
     /// Settings of the QP interior point.
     pub qp: QpSettings,
 }
@@ -100,6 +87,8 @@ impl Default for SqpSettings {
             gauss_newton_above: f64::INFINITY,
             tolerance: 1e-6,
             max_iterations: 200,
+            proximal: 0.0,
+            feedback: false,
             qp: QpSettings::default(),
         }
     }
@@ -144,6 +133,8 @@ pub struct IterLog {
     pub regularisation: f64,
     /// Terminal penalty ρ (ρ CᵀC added to `Q_N`; 0: none).
     pub terminal_penalty: f64,
+    /// Levenberg weight ρ_p on the state increments of this QP (eq. (P1); 0: none).
+    pub proximal: f64,
 }
 
 /// Wall-clock time by phase [s].
@@ -186,19 +177,6 @@ pub struct OcpSolution {
     pub timing: Timing,
 }
 
-/// Everything evaluated at one iterate.
-struct Eval {
-    stages: Vec<LqStage>,
-    term: LqTerminal,
-    objective: f64,
-    /// Σ‖d_k‖₁ + ‖c‖₁.
-    infeas1: f64,
-    /// max ‖d_k‖∞, ‖c‖∞.
-    infeas_max: f64,
-    /// Time spent on the Lagrangian Hessians [s].
-    hessian_time: f64,
-}
-
 /// Solve `prob` on `model` from the initial guess `us` (controls; pushed strictly inside
 /// the bounds) and `xs` (states; `None`: rolled out from `x0` with `us`).
 pub fn solve<M: OcpModel>(
@@ -224,6 +202,7 @@ pub fn solve<M: OcpModel>(
         iterations: 0,
         mult: None,
         reg: Reg::default(),
+        proximal: set.proximal,
     };
     let end = iterate(model, prob, set, &mut st);
     st.timing.total = t0.elapsed().as_secs_f64();
@@ -253,6 +232,8 @@ struct SolveState {
     mult: Option<(Vec<DVector<f64>>, DVector<f64>)>,
     /// Last convexification that made every factorisation positive definite.
     reg: Reg,
+    /// Levenberg weight ρ_p for the next QP (eq. (P1)).
+    proximal: f64,
 }
 
 /// How the iteration ended.
@@ -284,6 +265,26 @@ struct Filter {
     theta_first: Option<f64>,
 }
 
+/// The states of `st` rolled out from `x_0` with its controls (single-shooting start).
+fn roll_out_start<M: OcpModel>(
+    model: &mut M,
+    prob: &OcpProblem,
+    st: &mut SolveState,
+) -> Result<(), super::model::ModelError> {
+    let n = prob.knots;
+    let mut x = vec![prob.x0.clone(); n + 1];
+    for k in 0..n {
+        let (a, b) = x.split_at_mut(k + 1);
+        let r = model.step(&a[k], &st.us[k], &mut b[0]);
+        if r.is_err() {
+            st.xs = x;
+            return r;
+        }
+    }
+    st.xs = x;
+    Ok(())
+}
+
 /// The SQP iteration on `st` (states rolled out first when empty).
 fn iterate<M: OcpModel>(
     model: &mut M,
@@ -291,17 +292,11 @@ fn iterate<M: OcpModel>(
     set: &SqpSettings,
     st: &mut SolveState,
 ) -> End {
-    let (n, nu) = (prob.knots, model.nu());
+    let nu = model.nu();
     if st.xs.is_empty() {
-        let mut x = vec![prob.x0.clone(); n + 1];
-        for k in 0..n {
-            let (a, b) = x.split_at_mut(k + 1);
-            if let Err(e) = model.step(&a[k], &st.us[k], &mut b[0]) {
-                st.xs = x;
-                return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]);
-            }
+        if let Err(e) = roll_out_start(model, prob, st) {
+            return End::new(Status::Diverged, e.0, None, [f64::NAN; 3]);
         }
-        st.xs = x;
     }
     st.xs[0].copy_from_slice(&prob.x0);
     let mut filter = Filter::default();
@@ -329,48 +324,68 @@ fn iterate<M: OcpModel>(
                 .collect()
         };
         let (lo, hi) = (bound(&prob.u_lo), bound(&prob.u_hi));
-        let tq = Instant::now();
-        let warm = z_warm.as_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
-        let (qp, reg) = regularised_qp(&mut ev, &lo, &hi, warm, set, st.reg);
-        st.reg = reg;
-        st.timing.qp += tq.elapsed().as_secs_f64();
-        let qp = match qp {
-            Ok(q) => q,
-            Err(e) => {
-                let status = match e {
-                    LqError::Unreachable { .. } => Status::Infeasible,
-                    LqError::NotConvex(_) => Status::Diverged,
-                };
-                let kkt = [ev.infeas_max, f64::NAN, f64::NAN];
-                return End::new(status, e.to_string(), Some(ev), kkt);
+        // Levenberg damping (P1): a failed line search retries the QP with ρ_p ×10.
+        let pristine = (set.proximal > 0.0).then(|| (ev.stages.clone(), ev.term.q_mat.clone()));
+        let mut rho_p = st.proximal;
+        let (qp, mut row, kkt, step) = loop {
+            if rho_p > 0.0 {
+                shift_states(&mut ev, rho_p);
+            }
+            let tq = Instant::now();
+            let warm = z_warm.as_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
+            let (qp, reg) = regularised_qp(&mut ev, &lo, &hi, warm, set, st.reg);
+            st.reg = reg;
+            st.timing.qp += tq.elapsed().as_secs_f64();
+            let qp = match qp {
+                Ok(q) => q,
+                Err(e) => {
+                    let status = match e {
+                        LqError::Unreachable { .. } => Status::Infeasible,
+                        LqError::NotConvex(_) => Status::Diverged,
+                    };
+                    let kkt = [ev.infeas_max, f64::NAN, f64::NAN];
+                    return End::new(status, e.to_string(), Some(ev), kkt);
+                }
+            };
+            let kkt = kkt_residuals(prob, &ev, &qp, &st.us, model.nx());
+            let row = IterLog {
+                iteration: it,
+                objective: ev.objective,
+                primal: ev.infeas_max,
+                stationarity: kkt[1],
+                complementarity: kkt[2],
+                step: 0.0,
+                qp_iterations: qp.iterations,
+                filter_size: filter.entries.len(),
+                regularisation: reg.delta,
+                terminal_penalty: reg.rho,
+                proximal: rho_p,
+            };
+            if kkt.iter().all(|r| *r <= set.tolerance) {
+                st.log.push(row);
+                let msg = format!("KKT residuals at most {:e}", set.tolerance);
+                return End::new(Status::Converged, msg, Some(ev), kkt);
+            }
+            if it >= set.max_iterations {
+                st.log.push(row);
+                let msg = format!("{} iterations", set.max_iterations);
+                return End::new(Status::MaxIterations, msg, Some(ev), kkt);
+            }
+            let tl = Instant::now();
+            let step = line_search(model, prob, st, &ev, &qp, &mut filter, set.feedback);
+            st.timing.line_search += tl.elapsed().as_secs_f64();
+            match &pristine {
+                Some((stages, q_n)) if step.is_none() && rho_p < MAX_PROXIMAL => {
+                    rho_p = (rho_p * 10.0).max(set.proximal);
+                    for (s, p) in ev.stages.iter_mut().zip(stages) {
+                        s.q_mat.copy_from(&p.q_mat);
+                        s.r_mat.copy_from(&p.r_mat);
+                    }
+                    ev.term.q_mat.copy_from(q_n);
+                }
+                _ => break (qp, row, kkt, step),
             }
         };
-        let kkt = kkt_residuals(prob, &ev, &qp, &st.us, model.nx());
-        let mut row = IterLog {
-            iteration: it,
-            objective: ev.objective,
-            primal: ev.infeas_max,
-            stationarity: kkt[1],
-            complementarity: kkt[2],
-            step: 0.0,
-            qp_iterations: qp.iterations,
-            filter_size: filter.entries.len(),
-            regularisation: reg.delta,
-            terminal_penalty: reg.rho,
-        };
-        if kkt.iter().all(|r| *r <= set.tolerance) {
-            st.log.push(row);
-            let msg = format!("KKT residuals at most {:e}", set.tolerance);
-            return End::new(Status::Converged, msg, Some(ev), kkt);
-        }
-        if it >= set.max_iterations {
-            st.log.push(row);
-            let msg = format!("{} iterations", set.max_iterations);
-            return End::new(Status::MaxIterations, msg, Some(ev), kkt);
-        }
-        let tl = Instant::now();
-        let step = line_search(model, prob, st, &ev, &qp, &mut filter);
-        st.timing.line_search += tl.elapsed().as_secs_f64();
         let Some((alpha, xt, ut)) = step else {
             st.log.push(row);
             if qp.least_squares {
@@ -380,6 +395,7 @@ fn iterate<M: OcpModel>(
             let msg = "the filter line search found no acceptable step".to_string();
             return End::new(Status::Stalled, msg, Some(ev), kkt);
         };
+        st.proximal = adapt_proximal(rho_p, alpha, set.proximal);
         row.step = alpha;
         st.log.push(row);
         st.xs = xt;
@@ -460,6 +476,41 @@ fn regularised_qp(
     }
 }
 
+/// Largest Levenberg weight ρ_p tried before the line search is declared stalled.
+const MAX_PROXIMAL: f64 = 1e10;
+
+/// Add `rho` to the diagonals of the state blocks `Q_k` (k ≥ 1; δx_0 = 0) and of `Q_N`:
+/// the Levenberg term `ρ_p Σ_k ‖δx_k‖²/2` of eq. (P1).
+fn shift_states(ev: &mut Eval, rho: f64) {
+    for s in ev.stages.iter_mut().skip(1) {
+        for i in 0..s.q_mat.nrows() {
+            s.q_mat[(i, i)] += rho;
+        }
+    }
+    for i in 0..ev.term.q_mat.nrows() {
+        ev.term.q_mat[(i, i)] += rho;
+    }
+}
+
+/// The Levenberg weight after a step of length `alpha` taken with `rho` (eq. (P1)): a full
+/// step divides it by 10 (to 0 below 1e-8 × the initial `rho0`: the plain SQP step, hence
+/// its local convergence, near the solution), a step shorter than 1/4 multiplies it by 4
+/// (at least 1e-3 × `rho0`), any other keeps it.
+fn adapt_proximal(rho: f64, alpha: f64, rho0: f64) -> f64 {
+    if alpha >= 1.0 {
+        let r = rho / 10.0;
+        if r < 1e-8 * rho0 {
+            0.0
+        } else {
+            r
+        }
+    } else if alpha < 0.25 {
+        (rho * 4.0).max(1e-3 * rho0)
+    } else {
+        rho
+    }
+}
+
 /// Add `d` to the diagonals of every stage's `Q_k`, `R_k` and of `Q_N`.
 fn shift_diagonal(ev: &mut Eval, d: f64) {
     for s in ev.stages.iter_mut() {
@@ -475,36 +526,6 @@ fn shift_diagonal(ev: &mut Eval, d: f64) {
     }
 }
 
-/// KKT residuals (primal, stationarity, complementarity) at the current iterate with the
-/// QP's multipliers.
-fn kkt_residuals(
-    prob: &OcpProblem,
-    ev: &Eval,
-    qp: &QpSolution,
-    us: &[Vec<f64>],
-    nx: usize,
-) -> [f64; 3] {
-    let n = prob.knots;
-    let nu = prob.u_lo.len();
-    let zx = vec![DVector::zeros(nx); n + 1];
-    let zu = vec![DVector::zeros(nu); n];
-    let (stat, _) = residuals(
-        &ev.stages, &ev.term, &zx, &zu, &qp.lam, &qp.nu, &qp.z_lo, &qp.z_hi,
-    );
-    let mut comp: f64 = 0.0;
-    for k in 0..n {
-        for i in 0..nu {
-            if prob.u_lo[i].is_finite() {
-                comp = comp.max((us[k][i] - prob.u_lo[i]) * qp.z_lo[k][i]);
-            }
-            if prob.u_hi[i].is_finite() {
-                comp = comp.max((prob.u_hi[i] - us[k][i]) * qp.z_hi[k][i]);
-            }
-        }
-    }
-    [ev.infeas_max, stat, comp]
-}
-
 /// Filter line search (Wächter & Biegler 2006, without restoration) along the QP step:
 /// the accepted step length and trial point, or `None` below α = 1e-10.
 #[allow(clippy::type_complexity)]
@@ -515,6 +536,7 @@ fn line_search<M: OcpModel>(
     ev: &Eval,
     qp: &QpSolution,
     filter: &mut Filter,
+    feedback: bool,
 ) -> Option<(f64, Vec<Vec<f64>>, Vec<Vec<f64>>)> {
     let (n, nu) = (prob.knots, model.nu());
     let mut slope = 0.0;
@@ -531,19 +553,44 @@ fn line_search<M: OcpModel>(
     });
     let (mut xt, mut ut) = (st.xs.clone(), st.us.clone());
     let mut dxk = vec![0.0; model.nx()];
+    let mut scratch = (
+        vec![0.0; model.nx()],
+        vec![0.0; model.nq()],
+        vec![0.0; model.nx()],
+    );
     while alpha >= 1e-10 {
-        for k in 0..=n {
-            if k > 0 {
-                for (d, v) in dxk.iter_mut().zip(qp.dx[k].iter()) {
-                    *d = alpha * v;
+        let trial = if feedback && !qp.gains.is_empty() {
+            let (xs, us) = (&st.xs, &st.us);
+            feedback_rollout(
+                model,
+                prob,
+                xs,
+                us,
+                qp,
+                alpha,
+                &mut xt,
+                &mut ut,
+                &mut scratch,
+            )
+        } else {
+            for k in 0..=n {
+                if k > 0 {
+                    for (d, v) in dxk.iter_mut().zip(qp.dx[k].iter()) {
+                        *d = alpha * v;
+                    }
+                    model.retract(&st.xs[k], &dxk, &mut xt[k]);
                 }
-                model.retract(&st.xs[k], &dxk, &mut xt[k]);
-            }
-            if k < n {
-                for i in 0..nu {
-                    ut[k][i] = st.us[k][i] + alpha * qp.du[k][i];
+                if k < n {
+                    for i in 0..nu {
+                        ut[k][i] = st.us[k][i] + alpha * qp.du[k][i];
+                    }
                 }
             }
+            Ok(())
+        };
+        if trial.is_err() {
+            alpha *= 0.5;
+            continue;
         }
         if let Ok(e) = evaluate(model, prob, &xt, &ut, None) {
             let (theta, j) = (e.infeas1, e.objective);
@@ -568,125 +615,4 @@ fn line_search<M: OcpModel>(
         alpha *= 0.5;
     }
     None
-}
-
-/// `v` moved strictly inside `[lo, hi]` (by 1e-3 of the width, or 1e-3 from a one-sided bound).
-fn strictly_inside(v: f64, lo: f64, hi: f64) -> f64 {
-    let margin = if lo.is_finite() && hi.is_finite() {
-        1e-3 * (hi - lo)
-    } else {
-        1e-3
-    };
-    v.max(lo + margin).min(hi - margin)
-}
-
-/// Multiplier estimates (λ_0 … λ_N, ν) weighting the dynamics' and terminal curvature.
-type Multipliers<'a> = (&'a [DVector<f64>], &'a DVector<f64>);
-
-/// Objective, defects and terminal residual at (xs, us); with `derivatives = Some(m)`, also
-/// the Jacobians and the QP data: the Gauss–Newton Hessian, plus the Lagrangian's curvature
-/// when `m` holds multipliers.
-fn evaluate<M: OcpModel>(
-    model: &mut M,
-    prob: &OcpProblem,
-    xs: &[Vec<f64>],
-    us: &[Vec<f64>],
-    derivatives: Option<Option<Multipliers>>,
-) -> Result<Eval, ModelError> {
-    let mut hessian_time = 0.0;
-    let mut hbuf = DMatrix::zeros(0, 0);
-    if let Some(Some(_)) = derivatives {
-        hbuf = DMatrix::zeros(model.nx() + model.nu(), model.nx() + model.nu());
-    }
-    let (n, nx, nu, nq, nc) = (prob.knots, model.nx(), model.nu(), model.nq(), model.nc());
-    let paths = model.has_path_costs();
-    let mut pbuf = (vec![0.0; nx + nu], DMatrix::zeros(nx + nu, nx + nu));
-    let mut stages = Vec::with_capacity(n);
-    let mut f = vec![0.0; nq];
-    let mut d = vec![0.0; nx];
-    let mut e = vec![0.0; nx];
-    let mut objective = 0.0;
-    let (mut infeas1, mut infeas_max) = (0.0, 0.0f64);
-    for k in 0..n {
-        let mut s = LqStage::zeros(nx, nu);
-        model.step(&xs[k], &us[k], &mut f)?;
-        if f.iter().any(|v| !v.is_finite()) {
-            return Err(ModelError(format!("non-finite state at knot {}", k + 1)));
-        }
-        model.difference(&xs[k + 1], &f, &mut d);
-        s.d.copy_from_slice(&d);
-        infeas1 += s.d.lp_norm(1);
-        infeas_max = infeas_max.max(s.d.amax());
-        model.difference(&prob.x_ref, &xs[k], &mut e);
-        let ev = DVector::from_column_slice(&e);
-        let uv = DVector::from_column_slice(&us[k]);
-        objective += ev.dot(&(&prob.q * &ev)) + uv.dot(&(&prob.r * &uv));
-        if paths {
-            objective += model.stage_cost(&xs[k], &us[k]);
-        }
-        if let Some(mult) = derivatives {
-            model.jacobians(&xs[k], &us[k], &mut s.a, &mut s.b)?;
-            s.q_mat = &prob.q * 2.0;
-            s.q_vec = &prob.q * &ev * 2.0;
-            s.r_mat = &prob.r * 2.0;
-            s.r_vec = &prob.r * &uv * 2.0;
-            if let Some((lam, _)) = mult {
-                let th = Instant::now();
-                model.weighted_hessian(&xs[k], &us[k], lam[k + 1].as_slice(), &mut hbuf)?;
-                s.q_mat += hbuf.view((0, 0), (nx, nx));
-                s.r_mat += hbuf.view((nx, nx), (nu, nu));
-                s.s_mat.copy_from(&hbuf.view((nx, 0), (nu, nx)));
-                hessian_time += th.elapsed().as_secs_f64();
-            }
-            if paths {
-                add_path_cost(model, &xs[k], &us[k], mult.is_some(), &mut s, &mut pbuf);
-            }
-        }
-        stages.push(s);
-    }
-    model.difference(&prob.x_ref, &xs[n], &mut e);
-    let ev = DVector::from_column_slice(&e);
-    objective += ev.dot(&(&prob.q_n * &ev));
-    let mut q_vec_n = &prob.q_n * &ev * 2.0;
-    let mut q_n = &prob.q_n * 2.0;
-    if paths {
-        objective += model.terminal_cost(&xs[n]);
-        if derivatives.is_some() {
-            let mut g = vec![0.0; nx];
-            let mut h = DMatrix::zeros(nx, nx);
-            model.terminal_cost_derivatives(&xs[n], &mut g, &mut h);
-            q_vec_n += DVector::from_vec(g);
-            q_n += h;
-        }
-    }
-    let mut c = vec![0.0; nc];
-    model.terminal(&xs[n], &mut c);
-    let c_vec = DVector::from_vec(c);
-    infeas1 += c_vec.lp_norm(1);
-    infeas_max = infeas_max.max(c_vec.amax());
-    let mut c_mat = DMatrix::zeros(nc, nx);
-    if let Some(mult) = derivatives {
-        model.terminal_jacobian(&xs[n], &mut c_mat);
-        if let Some((_, nu_mult)) = mult {
-            let mut h = DMatrix::zeros(nx, nx);
-            model.terminal_hessian(&xs[n], nu_mult.as_slice(), &mut h);
-            q_n += h;
-        }
-    }
-    if !objective.is_finite() || !infeas1.is_finite() {
-        return Err(ModelError("non-finite objective or residual".into()));
-    }
-    Ok(Eval {
-        stages,
-        term: LqTerminal {
-            q_mat: q_n,
-            q_vec: q_vec_n,
-            c_mat,
-            c_vec,
-        },
-        objective,
-        infeas1,
-        infeas_max,
-        hessian_time,
-    })
 }
