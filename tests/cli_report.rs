@@ -374,15 +374,7 @@ fn decode_png(bytes: &[u8]) -> (usize, usize, Vec<[u8; 4]>) {
 
 /// Runs headless Chromium on `page` with `args`; returns its standard output and error.
 fn chromium(page: &Path, args: &[&str]) -> (String, String) {
-    let bin = ["chromium", "chromium-browser"]
-        .into_iter()
-        .find(|b| {
-            std::process::Command::new(b)
-                .arg("--version")
-                .output()
-                .is_ok()
-        })
-        .expect("USM_BROWSER_TEST is set but neither chromium nor chromium-browser runs");
+    let bin = common::chromium_bin();
     let url = format!("file://{}", page.canonicalize().unwrap().display());
     let o = std::process::Command::new(bin)
         .args([

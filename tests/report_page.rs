@@ -7,6 +7,8 @@
 //! `.ci/run` with `USM_BROWSER_TEST=1 cargo test --release --test report_page -- --ignored`: with
 //! the variable set a missing browser fails the test instead of skipping it.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 /// The committed page.
@@ -24,15 +26,7 @@ fn require_browser() {
 
 /// Runs headless Chromium (the flags that work in CI) on `page` with `args`; its stdout.
 fn chromium(page: &Path, args: &[&str]) -> String {
-    let bin = ["chromium", "chromium-browser"]
-        .into_iter()
-        .find(|b| {
-            std::process::Command::new(b)
-                .arg("--version")
-                .output()
-                .is_ok()
-        })
-        .expect("USM_BROWSER_TEST is set but neither chromium nor chromium-browser runs");
+    let bin = common::chromium_bin();
     let profile = tempfile::tempdir().unwrap();
     let url = format!("file://{}", page.canonicalize().unwrap().display());
     let o = std::process::Command::new(bin)

@@ -32,3 +32,34 @@ fn n_minus_one_bound_is_never_below_the_intact_bound() {
         assert_eq!(minus.solution.us[0].len() + 1, intact.solution.us[0].len());
     }
 }
+
+/// The bound's leg (`leg_problem`, what issue 41's `[ocp]` in studies will solve) and the
+/// shipped reproducer `studies/ocp_transport.toml` pose the same problem: 10 m along +x in
+/// 20 s on 20 knots, the 0.05 m/s cross current, thrusters and ±20 N·m joint torques, the
+/// base level and at rest with the joints straight at T, the same thruster-energy and effort
+/// weights (the leg adds joint energy, docs/ocp.md §6).
+#[test]
+fn the_bound_leg_is_the_shipped_transport_problem() {
+    use super::bound::{leg_problem, LegSpec};
+    let path = std::path::Path::new("studies/ocp_transport.toml");
+    let file = parse_problem(&std::fs::read_to_string(path).unwrap(), path).unwrap();
+    let leg = LegSpec {
+        current: [0.0, 0.05, 0.0],
+        ..LegSpec::default()
+    };
+    let spec = leg_problem(&file.vehicle, &leg);
+    assert_eq!(spec.vehicle.name, file.vehicle.name);
+    assert_eq!(
+        (spec.hydrodynamics, spec.thrusters),
+        (file.hydrodynamics, file.thrusters)
+    );
+    assert_eq!((spec.duration, spec.knots), (file.duration, file.knots));
+    assert_eq!(spec.current, file.current);
+    assert_eq!(spec.base_displacement, file.base_displacement);
+    assert_eq!(spec.base_rpy, file.base_rpy);
+    assert_eq!(spec.terminal_joints, file.terminal_joints);
+    assert_eq!(spec.zero_velocity, file.zero_velocity);
+    assert_eq!(spec.bounds[2], file.bounds[2]);
+    assert_eq!(spec.effort, file.effort);
+    assert_eq!(spec.energy[0], file.energy[0], "thruster energy weight");
+}

@@ -124,3 +124,12 @@ pub fn optimise_study_with(
     let o = usm_study::optimise::run(&p, &opts).unwrap();
     (p, o)
 }
+
+/// The headless-browser binary of the browser tests (`chromium` or `chromium-browser`);
+/// panics when neither runs (the tests call it only with `USM_BROWSER_TEST` set).
+pub fn chromium_bin() -> &'static str {
+    ["chromium", "chromium-browser"]
+        .into_iter()
+        .find(|b| Command::new(b).arg("--version").output().is_ok())
+        .expect("USM_BROWSER_TEST is set but neither chromium nor chromium-browser runs")
+}
