@@ -329,7 +329,7 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
     // from its logged joint angles; tuning and world runs do not.
     let margin = input.phases.static_analysis;
     let log = input.trajectory || margin;
-    let mut run = match crate::outcome::run_case(v, &sc, input.seed, log, stop) {
+    let run = match crate::outcome::run_case(v, &sc, input.seed, log, stop) {
         Ok(r) => r,
         Err(e) => return out.finish(CaseEnd::Error, e.to_string()),
     };
@@ -337,10 +337,7 @@ fn closed_loop(v: &Vehicle, scenario: &toml::Table, input: &CaseInput<'_>, out: 
         let m = run_authority_margin(v, &sc, &run);
         out.metrics.push(AUTHORITY_MARGIN, m);
     }
-    if !input.trajectory {
-        run.trajectory = None;
-    }
-    let trajectory = run.trajectory;
+    let trajectory = run.trajectory.filter(|_| input.trajectory);
     if let Some(f) = run.failure {
         let end = if f.timeout {
             CaseEnd::Timeout
