@@ -13,12 +13,12 @@
 use std::path::Path;
 use std::time::Instant;
 
+use usm_study::batch::tuning_hook::{CaseTuner, Tuned};
 use usm_study::evaluate::{out_of_reach, Deadline};
 use usm_study::optimise::case_tuner::Tuner;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::parse_study;
-use usm_study::study::tuning_hook::{CaseTuner, Tuned};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()

@@ -22,6 +22,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+use usm_study::batch::tuning_hook::CaseTuner;
 use usm_study::evaluate::Deadline;
 use usm_study::optimise::case_tuner::Tuner;
 use usm_study::optimise::evaluate::CaseEvaluator;
@@ -29,7 +30,6 @@ use usm_study::optimise::search::Evaluator;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::parse_study;
-use usm_study::study::tuning_hook::CaseTuner;
 
 const STUDY: &str = "studies/thrusters.toml";
 

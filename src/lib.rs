@@ -10,7 +10,7 @@
 //! each importing only rooms below it: data flows from [`model`] through [`kinematics`] to the
 //! dynamics, the control laws and the scenario loop, a run's [`outcome`] is judged above it, and
 //! results flow out to reports ([`report`]) through the static analysis ([`statics`]), the
-//! sweep ([`study`]), the optimiser ([`optimise`]) and the output pipelines ([`pipeline`]); the
+//! study ([`study`]: what to run), its running ([`batch`]) and what it says ([`review`]), the optimiser ([`optimise`]) and the output pipelines ([`pipeline`]); the
 //! paper reproductions ([`paper`]) sit on top. Decisions under uncertainty (quantiles over
 //! worlds, Sobol indices, paired rankings and the winner-or-tie verdict) rest on the pure
 //! kernels of [`stats`]. The command-line interface is the binary's own
@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod allocation;
+pub mod batch;
 pub mod control;
 pub mod dynamics;
 pub mod evaluate;
@@ -33,6 +34,7 @@ pub mod outcome;
 pub mod paper;
 pub mod pipeline;
 pub mod report;
+pub mod review;
 pub mod sampling;
 pub mod scenario;
 pub mod spatial;

@@ -4,15 +4,15 @@
 
 use std::path::Path;
 
+use usm_study::batch::records::{
+    metric_columns, Row, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS,
+};
+use usm_study::batch::worker::evaluate_resolved;
+use usm_study::batch::{run_sweep, SweepOptions};
 use usm_study::evaluate::{CaseStatus, Deadline, Evaluator};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::parse_study;
-use usm_study::study::records::{
-    metric_columns, Row, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS,
-};
-use usm_study::study::worker::evaluate_resolved;
-use usm_study::study::{run_sweep, SweepOptions};
 
 const STATIC: &str = "[study]\nname = \"e\"\nseed = 3\n[design]\npreset = \"usm-paper\"\n\
 [scenario]\nmode = \"static\"\n[static]\nsamples = 32\n\
@@ -72,9 +72,10 @@ fn a_tuned_study_without_a_tuner_is_refused_before_anything_runs() {
 }
 
 #[test]
-fn study_does_not_import_optimise() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/study");
-    for entry in std::fs::read_dir(&root).unwrap() {
+fn study_and_batch_do_not_import_optimise() {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dirs = ["src/study", "src/batch", "src/review"].map(|d| base.join(d));
+    for entry in dirs.iter().flat_map(|d| std::fs::read_dir(d).unwrap()) {
         let p = entry.unwrap().path();
         let text = std::fs::read_to_string(&p).unwrap();
         for (i, line) in text.lines().enumerate() {

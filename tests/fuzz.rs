@@ -71,7 +71,7 @@ fn journal_schema() -> &'static [(String, usm_study::report::ColumnKind)] {
             Path::new("studies/thrusters.toml"),
         )
         .unwrap();
-        usm_study::study::records::raw_schema(&study)
+        usm_study::batch::records::raw_schema(&study)
     })
 }
 
@@ -392,7 +392,7 @@ fn exercise(kind: Kind, text: &str) {
                 let p = d.path().join("cases.partial.csv");
                 std::fs::write(&p, text).unwrap();
                 let schema = journal_schema();
-                if usm_study::study::journal::repair(&p, schema).is_ok() {
+                if usm_study::batch::journal::repair(&p, schema).is_ok() {
                     let _ = usm_study::report::read_csv_typed(&p, schema);
                 }
             });

@@ -112,7 +112,7 @@ fn one_run_per_output_directory_and_another_study_needs_force() {
     let me = format!(
         "pid={}\nhost={}\nsince=now\n",
         std::process::id(),
-        usm_study::study::outdir::host_name()
+        usm_study::batch::outdir::host_name()
     );
     std::fs::write(out.join(".usm-study.lock"), &me).unwrap();
     let o = sweep(&s, &out, &[]);
@@ -645,7 +645,7 @@ fn report_refuses_a_folder_that_is_not_a_finished_output_or_is_locked() {
     let me = format!(
         "pid={}\nhost={}\nsince=now\n",
         std::process::id(),
-        usm_study::study::outdir::host_name()
+        usm_study::batch::outdir::host_name()
     );
     std::fs::write(out.join(".usm-study.lock"), me).unwrap();
     let o = run(&["report", out.to_str().unwrap()]);
@@ -816,7 +816,7 @@ fn optimise_holds_the_lock_and_refuses_a_sweeps_output() {
     let me = format!(
         "pid={}\nhost={}\nsince=now\n",
         std::process::id(),
-        usm_study::study::outdir::host_name()
+        usm_study::batch::outdir::host_name()
     );
     std::fs::write(busy.join(".usm-study.lock"), me).unwrap();
     let o = run(&[

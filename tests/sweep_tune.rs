@@ -397,9 +397,9 @@ fn control_method_selects_its_table_iii_gains_unless_the_file_sets_them() {
 /// the sweeps' `cases.csv` (the key is not hashed), while racing runs fewer worlds.
 #[test]
 fn racing_the_tuning_worlds_finds_what_the_full_evaluation_finds_in_fewer_runs() {
+    use usm_study::batch::tuning_hook::CaseTuner;
     use usm_study::evaluate::Deadline;
     use usm_study::optimise::case_tuner::Tuner;
-    use usm_study::study::tuning_hook::CaseTuner;
     let dir = tempfile::tempdir().unwrap();
     let on = tuned_in_two_worlds()
         .replace("[tune]\nworlds = 2\n", "[tune]\nworlds = 3\n")

@@ -6,6 +6,7 @@ use std::time::Duration;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use usm_study::batch::{outdir, run_sweep, SweepOptions};
 use usm_study::metrics::singularity::DEFAULT_RANK_REL_TOL;
 use usm_study::model::design::{design_to_toml, load_design};
 use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
@@ -17,7 +18,7 @@ use usm_study::pipeline::tcm::{run_tcm, TcmConfig};
 use usm_study::sampling::Sampling;
 use usm_study::scenario::Mode;
 use usm_study::statics::StaticSpec;
-use usm_study::study::{load_study, outdir, run_sweep, SweepOptions};
+use usm_study::study::load_study;
 
 use crate::convert::{err, msg, Failure};
 use crate::run::{base_table, prepare};

@@ -12,12 +12,12 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use usm_study::batch::outdir;
 use usm_study::optimise::history::{Record, JOURNAL_FILE};
 use usm_study::optimise::{load_problem, run, Options};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles, BEST_FILE};
 use usm_study::report::fmt_num;
-use usm_study::study::outdir;
 
 /// Arguments of `optimise`.
 #[derive(Debug, Args)]

@@ -8,15 +8,15 @@
 use std::path::Path;
 
 use anyhow::Context;
+use usm_study::batch::records::CASE_ID;
+use usm_study::batch::robust::{split_worlds, RobustInfo, WORLDS_CSV};
+use usm_study::batch::worker::Worker;
+use usm_study::batch::worlds::SUCCESS_PROBABILITY;
 use usm_study::report::{file_stem_safe, write_csv, ColumnData, Table};
 use usm_study::scenario::Source;
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::parse::parse_study_table;
-use usm_study::study::records::CASE_ID;
-use usm_study::study::robust::{split_worlds, RobustInfo, WORLDS_CSV};
-use usm_study::study::worker::Worker;
-use usm_study::study::worlds::SUCCESS_PROBABILITY;
 
 /// The file of the summaries over the worlds.
 pub const UNCERTAINTY_JSON: &str = "uncertainty.json";

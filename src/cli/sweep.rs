@@ -12,17 +12,17 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
+use usm_study::batch::engine::output_dir;
+use usm_study::batch::outdir;
+use usm_study::batch::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
+use usm_study::batch::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
+use usm_study::batch::{merge, run_sweep, SweepOptions};
 use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
 use usm_study::pipeline::review::write_review;
+use usm_study::review::{report_ranked, Reported, Rerank};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
-use usm_study::study::engine::output_dir;
-use usm_study::study::outdir;
-use usm_study::study::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
-use usm_study::study::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
-use usm_study::study::{
-    load_study_at, merge, report_ranked, run_sweep, Reported, Rerank, StudyError, SweepOptions,
-};
+use usm_study::study::{load_study_at, StudyError};
 
 /// Arguments of `sweep`.
 #[derive(Debug, Args)]
@@ -190,7 +190,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
         j => j,
     };
-    usm_study::study::worlds::check_world_budget(&study, a.case_timeout, threads)?;
+    usm_study::study::admit::check_world_budget(&study, a.case_timeout, threads)?;
     let shard = match &a.shard {
         None => None,
         Some(ShardArg::Fixed(i, n)) => Some((*i, *n)),
@@ -384,14 +384,14 @@ fn print_verdict(verb: &str, dir: &Path) {
         return;
     };
     let plain = |s: &str| s.replace("**", "").replace('`', "");
-    if let Some(v) = usm_study::study::summary_robust::summary_verdict(&md) {
+    if let Some(v) = usm_study::review::summary_robust::summary_verdict(&md) {
         eprintln!("[{verb}] {}", plain(v));
-    } else if let Some(best) = usm_study::study::finish::best_case_line(dir) {
+    } else if let Some(best) = usm_study::review::finish::best_case_line(dir) {
         eprintln!("[{verb}] {best}");
     }
     // The leader's caveats, as the box lists them (each condition's verdict first, with
     // condition axes).
-    let opening = usm_study::study::summary_robust::summary_opening(&md).unwrap_or("");
+    let opening = usm_study::review::summary_robust::summary_opening(&md).unwrap_or("");
     for l in opening.lines() {
         if let Some(c) = l.strip_prefix("- ") {
             eprintln!("[{verb}]   caveat: {}", plain(c));
@@ -474,7 +474,7 @@ pub fn run_report(a: &ReportArgs) -> anyhow::Result<ExitCode> {
         };
         bail!("{} is not a study output: {hint}", a.dir.display());
     }
-    if let Some([i, n]) = usm_study::study::manifest::read_manifest(dir)
+    if let Some([i, n]) = usm_study::batch::manifest::read_manifest(dir)
         .ok()
         .and_then(|m| m.shard)
     {

@@ -23,6 +23,7 @@ use super::tune_seeds::{
     WorldsOf, SEEDS_STREAM,
 };
 use super::{minimise, Options, Problem, Spec};
+use crate::batch::tuning_hook::{CaseTuner, TuneError, Tuned, TuningHook};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
 use crate::input::document::Document;
 use crate::input::keypath::get;
@@ -31,7 +32,6 @@ use crate::study::cases::Resolved;
 use crate::study::doe::Case;
 use crate::study::error::InputError;
 use crate::study::schema::{Study, Target, Uncertainty, WorldSampling};
-use crate::study::tuning_hook::{CaseTuner, TuneError, Tuned, TuningHook};
 use rayon::prelude::*;
 
 /// The hook wiring this tuner into sweeps, merges and reports.
@@ -635,7 +635,7 @@ mod tests {
         assert_eq!(problem(&study, 5).spec.variants, p.spec.variants);
         // The tuned case is scored in the nominal world: resolved at a point, it equals the
         // nominal-tuning study's case at that point (not tuning world w0).
-        use crate::study::tuning_hook::CaseTuner;
+        use crate::batch::tuning_hook::CaseTuner;
         let x: Vec<f64> = p.spec.space.params.iter().map(|q| q.start).collect();
         let at = |s: &crate::study::schema::Study| {
             let r = crate::study::cases::resolve_case(s, &cases[5]).unwrap();

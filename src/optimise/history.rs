@@ -251,7 +251,7 @@ pub fn history_table(
         ColumnData::Str(
             records
                 .iter()
-                .map(|r| crate::study::records::reason_cell(r.failure.as_deref().unwrap_or("")))
+                .map(|r| crate::batch::records::reason_cell(r.failure.as_deref().unwrap_or("")))
                 .collect(),
         ),
     ));

@@ -13,6 +13,7 @@ use serde_json::json;
 use super::error::PipelineError;
 use super::optimise_plots::{parameter_figure, progress_figure};
 use super::run_figure::run_figure;
+use crate::batch::manifest::{git_commit, now_rfc3339};
 use crate::control::transport::yaw_joint_mask;
 use crate::evaluate::static_table::STATIC_TABLE;
 use crate::model::design::parse_design_table;
@@ -25,7 +26,6 @@ use crate::report::{
 };
 use crate::scenario::Mode;
 use crate::study::cases::Resolved;
-use crate::study::manifest::{git_commit, now_rfc3339};
 use crate::study::runner::StudyMode;
 
 /// The history table's file stem in an output directory.

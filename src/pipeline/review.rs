@@ -22,16 +22,16 @@ use super::review_designs::{designs_html, rank_marks, DesignInputs};
 use super::review_page::{figure_files, fold, plots_section, units_in_headers, with_toc};
 use super::review_page::{PAGE_STYLE, SCRIPT};
 use super::review_top::{pareto_html, top_ids, verdict_html, Drawing, TOP_STYLE};
+use crate::batch::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
 use crate::model::design::parse_design_table;
 use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
 use crate::report::{atomic_write, read_csv, read_parquet, Table};
+use crate::review::plots::{case_name, unsuccessful_rows};
+use crate::review::summary_robust::summary_opening;
 use crate::state::VehicleState;
 use crate::study::cases::resolve_case;
 use crate::study::doe::expand;
 use crate::study::parse::load_study;
-use crate::study::plots::{case_name, unsuccessful_rows};
-use crate::study::records::{CASES_CSV, CASES_PARQUET, CASE_ID, REASON, STUDY_COPY};
-use crate::study::summary_robust::summary_opening;
 
 /// The file name of the page.
 pub const REPORT_HTML: &str = "report.html";
@@ -649,8 +649,8 @@ fn json_text(v: &serde_json::Value) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::batch::records::STATUS;
     use crate::report::ColumnData;
-    use crate::study::records::STATUS;
 
     #[test]
     fn only_a_dead_writers_page_temporaries_are_removed() {

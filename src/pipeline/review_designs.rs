@@ -9,12 +9,12 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::review_top::Drawing;
+use crate::batch::records::CASE_ID;
 use crate::report::html::{escape, inline_svg};
 use crate::report::{fmt_short, read_csv, Table};
+use crate::review::plots::{metric_title, unsuccessful_rows};
+use crate::review::verdict_box::REVIEW_METRICS;
 use crate::stats::describe::quantile_sorted;
-use crate::study::plots::{metric_title, unsuccessful_rows};
-use crate::study::records::CASE_ID;
-use crate::study::verdict_box::REVIEW_METRICS;
 
 /// Each case's rank mark (ranked, or why not) for the cases `ids`; empty for a study that
 /// ranks nothing over worlds (no `p_best` column).

@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::report::html::{escape, inline_svg};
-use crate::study::plots::metric_title;
+use crate::review::plots::metric_title;
 
 /// Header cells that take the unit of the metric column before them (the summaries of one
 /// metric over the worlds: `mean`, `p05`, …).

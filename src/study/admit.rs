@@ -187,3 +187,70 @@ fn check(study: &Study, r: &Resolved) -> Result<(), KeyError> {
     sc.remove(crate::evaluate::static_table::STATIC_TABLE);
     super::runner::check_case(&v, &sc)
 }
+
+/// The least wall time one closed-loop control period takes on one core [s]: a lower bound
+/// (a transport period of the shipped designs takes about 25 µs on the reference machine), so
+/// [`check_world_budget`] refuses only what cannot fit.
+pub const MIN_PERIOD_S: f64 = 1e-6;
+
+/// Refuse, at load, a study whose runs per case — the nominal run, every world of
+/// `[uncertainty]` (a Saltelli design's `N × (k + 2)`) and every `[[validate]]` variant —
+/// cannot finish within the case's wall-clock budget `budget_s` (`--case-timeout`; 0 = none)
+/// on `threads` threads even at [`MIN_PERIOD_S`] per control period: every case would time
+/// out. The error names `uncertainty.worlds` at its line.
+pub fn check_world_budget(
+    study: &Study,
+    budget_s: f64,
+    threads: usize,
+) -> Result<(), crate::input::located::InputError> {
+    let Some(u) = &study.uncertainty else {
+        return Ok(());
+    };
+    if budget_s.is_nan() || budget_s <= 0.0 || !study.mode.is_dynamic() {
+        return Ok(());
+    }
+    let sc = study.scenario_full.get("scenario");
+    let num = |k: &str| {
+        sc.and_then(|s| s.get(k))
+            .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+    };
+    let duration = num("duration").unwrap_or(0.0);
+    let dt = num("control_dt").unwrap_or(crate::scenario::config::DEFAULT_CONTROL_DT);
+    let periods = (duration / dt).ceil().max(1.0);
+    let runs = 1 + u.n_worlds() + study.validate.len();
+    let need = runs as f64 * periods * MIN_PERIOD_S / threads.max(1) as f64;
+    if need <= budget_s {
+        return Ok(());
+    }
+    let doc =
+        crate::input::document::Document::parse(&study.text, &study.path.display().to_string())
+            .unwrap_or_else(|_| {
+                crate::input::document::Document::unplaced(&study.path.display().to_string())
+            });
+    Err(doc.err(
+        "uncertainty.worlds",
+        format!(
+            "{runs} runs per case ({} worlds{}{}) of {periods} control periods need at least \
+             {} s per case on {threads} threads (at {MIN_PERIOD_S} s a period, a lower bound), \
+             more than the --case-timeout of {} s: every case would time out; draw fewer \
+             worlds or raise --case-timeout",
+            u.n_worlds(),
+            if matches!(u.sampling, super::schema::WorldSampling::Saltelli) {
+                format!(
+                    " = {} × ({} parameters + 2), Saltelli",
+                    u.worlds,
+                    u.params.len()
+                )
+            } else {
+                String::new()
+            },
+            if study.validate.is_empty() {
+                String::new()
+            } else {
+                format!(", {} validation variants", study.validate.len())
+            },
+            crate::input::located::fmt_exact(need),
+            crate::input::located::fmt_exact(budget_s),
+        ),
+    ))
+}

@@ -1,9 +1,9 @@
 //! The metric catalogue of a study: which metric names its cases report (design, static
 //! `T(q)`, run and tuning columns), and the located error for a name that is none of them.
 
-use super::records::{AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use super::runner::StudyMode;
 use super::schema::Study;
+use crate::evaluate::metrics::{AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use crate::evaluate::AUTHORITY_MARGIN;
 use crate::input::document::Document;
 use crate::input::keypath::did_you_mean;

@@ -2,7 +2,7 @@
 //! worlds), by magnitude (signed metrics), else smaller; and the names the report and the
 //! worlds share (`success`, `energy_per_metre`).
 
-use super::records::TCM_STRAIGHT_SIGMA_MIN;
+use crate::evaluate::metrics::TCM_STRAIGHT_SIGMA_MIN;
 
 /// Signed metrics whose best value is the one nearest zero: ranked, and put on a Pareto
 /// front, by |x| (the final cross-track error of transport, positive to the left).

@@ -1,5 +1,5 @@
 //! The `[faults]` section of a study file (issue 24): the single fault every thruster of every
-//! case gets in its fault reruns (`super::faults`), as a scenario `[fault]`
+//! case gets in its fault reruns (`crate::batch::faults`), as a scenario `[fault]`
 //! (`crate::scenario::fault`) for thruster `j`.
 //!
 //! ```toml

@@ -82,7 +82,7 @@ pub struct Axis {
     pub integer: bool,
     /// Whether the axis is a condition (`condition = true`: a payload, a current, a mission
     /// variant), not a design choice: designs are ranked against each other only under the
-    /// same values of every condition axis ([`super::conditions`]).
+    /// same values of every condition axis ([`crate::batch::conditions`]).
     pub condition: bool,
 }
 

@@ -65,8 +65,8 @@ fn default_metrics(study: &Study) -> Vec<String> {
     let run_metric = |m: &str| {
         super::catalogue::known_metric(m, study)
             && !study.tune_columns().iter().any(|c| c == m)
-            && !super::records::DESIGN_COLUMNS.contains(&m)
-            && !super::records::TCM_COLUMNS.contains(&m)
+            && !crate::evaluate::metrics::DESIGN_COLUMNS.contains(&m)
+            && !crate::evaluate::metrics::TCM_COLUMNS.contains(&m)
             && !crate::evaluate::AUTHORITY_COLUMNS.contains(&m)
     };
     let mut v: Vec<String> = Vec::new();

@@ -1,7 +1,7 @@
 //! The per-case tuning hook of a sweep (`[tune]`, `docs/study-format.md`). The tuner itself
 //! lives with the optimiser (`crate::optimise::case_tuner`); the sweep engine only knows this
 //! interface, handed in by the caller ([`TuningHook`] in `SweepOptions::tuning` and to
-//! [`super::finish::finish_report`]), so `study` never imports `optimise`.
+//! [`crate::review::finish::finish_report`]), so `study` never imports `optimise`.
 //!
 //! A tuned case's row carries the tuned values (`tuned.<param>`), the evaluations used
 //! (`tune_evaluations`) and whether the tuned point met every `[[tune.constraint]]`
@@ -9,14 +9,14 @@
 
 use std::fmt;
 
-use super::cases::Resolved;
-use super::doe::Case;
-use super::error::{InputError, StudyError};
-use super::schema::{
+use crate::evaluate::{Deadline, Metrics};
+use crate::study::cases::Resolved;
+use crate::study::doe::Case;
+use crate::study::error::{InputError, StudyError};
+use crate::study::schema::{
     Study, TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_CURVE_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE,
     TUNE_NOISE, TUNE_SUCCESS_SPREAD,
 };
-use crate::evaluate::{Deadline, Metrics};
 
 /// Why a case could not be tuned (its row is `failed` with reason `tune: …`).
 #[derive(Debug, thiserror::Error)]

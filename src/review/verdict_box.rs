@@ -6,10 +6,10 @@
 
 use std::fmt::Write as _;
 
-use super::directions::larger_is_better;
 use super::families::{families, families_note, family_name, minor_axes};
 use crate::report::{fmt_short, MarkdownTable, Table};
 use crate::stats::describe::quantile_sorted;
+use crate::study::directions::larger_is_better;
 
 /// The metrics a reviewer weighs beside the objective, in the order the box lists them; a
 /// study shows those its table has.
@@ -250,7 +250,7 @@ pub fn rank_reason(t: &Table, r: usize, min_success: f64) -> String {
     let missed = t
         .str("missed")
         .ok()
-        .or_else(|| t.str(super::records::REASON).ok())
+        .or_else(|| t.str(crate::batch::records::REASON).ok())
         .map(|c| c[r].clone())
         .filter(|s| !s.is_empty());
     match missed {

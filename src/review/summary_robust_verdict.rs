@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 
 use super::{Robust, TOP};
+use crate::batch::records::CASE_ID;
 use crate::stats::ranking::{Contender, Verdict};
-use crate::study::records::CASE_ID;
 
 impl Robust<'_> {
     /// The line the summary opens with: the verdict, then (with adaptive worlds) the rounds,
@@ -28,7 +28,7 @@ impl Robust<'_> {
     /// Whether row `r` ran in its worlds (its success probability is a number).
     fn ran(&self, r: usize) -> bool {
         self.table
-            .f64(crate::study::worlds::SUCCESS_PROBABILITY)
+            .f64(crate::batch::worlds::SUCCESS_PROBABILITY)
             .is_ok_and(|p| p[r].is_finite())
     }
 
@@ -86,7 +86,7 @@ impl Robust<'_> {
                           could rank or separate from the leader)"
                 .to_string(),
             _ => {
-                let open: Vec<String> = crate::study::adaptive::contention(&self.verdict, delta)
+                let open: Vec<String> = crate::batch::adaptive::contention(&self.verdict, delta)
                     .iter()
                     .take(TOP)
                     .map(|r| format!("#{}", self.ids[*r]))

@@ -8,13 +8,15 @@
 
 use std::collections::HashSet;
 
-pub use super::directions::{
+use crate::batch::manifest::Manifest;
+use crate::batch::records::{
+    CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION,
+};
+use crate::report::{fmt_short, pareto_front, ColumnData, ColumnKind, Table};
+pub use crate::study::directions::{
     is_identifier, larger_is_better, BY_MAGNITUDE, ENERGY_PER_METRE, SUCCESS, TRANSPORT_OBJECTIVE,
     WORLD_SUFFIXES,
 };
-use super::manifest::Manifest;
-use super::records::{CaseStatus, DESIGN_THRUSTERS, RAW_HEAD, STATUS, TCM_SINGULAR_FRACTION};
-use crate::report::{fmt_short, pareto_front, ColumnData, ColumnKind, Table};
 
 /// Relative difference below which two values of a metric tie in `Selection::best_row`
 /// (far above rounding, far below any difference a design review would act on).

@@ -9,7 +9,7 @@
 use crate::report::{fmt_short, ColumnData, Table};
 
 /// How the opening of `summary.md` starts for a study with condition axes (one of
-/// [`super::summary_robust::VERDICT_OPENINGS`]).
+/// [`crate::review::summary_robust::VERDICT_OPENINGS`]).
 pub const PER_CONDITION: &str = "**Verdict per condition";
 
 /// One condition of a study: the rows that share the values of every condition axis.

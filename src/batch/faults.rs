@@ -17,14 +17,14 @@
 //! thruster order, so the row does not depend on the thread count. A faulted run that fails
 //! is recorded (its `missed` criterion is `no_failure`) and the batch goes on.
 
-use super::cases::Resolved;
-use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use super::records::DESIGN_THRUSTERS;
-use super::schema::Study;
 use super::worlds::{criterion_index, evaluate_phases, WorldTimeout};
 use crate::evaluate::{Deadline, Evaluator, Metrics, Phases};
 use crate::report::{fmt_short, MarkdownTable, Table};
 use crate::scenario::criteria::Criterion;
+use crate::study::cases::Resolved;
+use crate::study::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use crate::study::schema::Study;
 use rayon::prelude::*;
 
 /// Prefix of the per-thruster fault columns (`fault.t<j>.<what>`).
@@ -44,7 +44,7 @@ pub fn fault_objective(study: &Study) -> String {
                 .as_ref()
                 .map(|u| u.objective().to_string())
         })
-        .unwrap_or_else(|| super::directions::TRANSPORT_OBJECTIVE.to_string())
+        .unwrap_or_else(|| crate::study::directions::TRANSPORT_OBJECTIVE.to_string())
 }
 
 /// One faulted run: success, objective, missed criterion index; whether it timed out.

@@ -14,15 +14,15 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::faults::{fault_table, FAULT_PREFIX};
-use super::manifest::Manifest;
 use super::plots::{axis_plots, extreme_names, heatmaps, pareto_plot, timeseries_plot};
-use super::records::{CaseEnd, CaseStatus, CASE_ID, REASON, STATUS};
-use super::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 use super::selection::{cell_text, levels, ok_rows, Front, Selection, SUCCESS};
 use super::summary_robust::Robust;
+use crate::batch::faults::{fault_table, FAULT_PREFIX};
+use crate::batch::manifest::Manifest;
+use crate::batch::records::{CaseEnd, CaseStatus, CASE_ID, REASON, STATUS};
 use crate::outcome::run_summary::SUCCESS_MARGIN;
 use crate::report::{fmt_short, MarkdownTable, Table};
+use crate::study::schema::{DoeKind, TUNED_PREFIX, TUNE_EVALUATIONS, TUNE_FEASIBLE};
 
 /// What every section of the summary reads.
 struct Ctx<'a> {
@@ -72,7 +72,7 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     let mut warnings = Vec::new();
     let plots = dir.join("plots");
     // The figures of an earlier report go first: this one writes its own again.
-    if let Err(e) = super::outdir::remove_owned_plots(dir) {
+    if let Err(e) = crate::batch::outdir::remove_owned_plots(dir) {
         warnings.push(e.to_string());
     }
     if let Err(e) = std::fs::create_dir_all(&plots) {

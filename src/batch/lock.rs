@@ -23,9 +23,9 @@ use std::sync::atomic::{AtomicBool, AtomicI32, AtomicPtr, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, SystemTime};
 
-use super::error::StudyError;
 use super::manifest::now_rfc3339;
 use crate::report::process_alive;
+use crate::study::error::StudyError;
 
 /// The lock file's name in an output directory.
 pub const LOCK_FILE: &str = ".usm-study.lock";

@@ -10,24 +10,26 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::conditions::Condition;
-use super::manifest::Manifest;
-use super::records::CASE_ID;
-use super::robust::{study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV};
-use super::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
 use super::selection::cell_text;
 use super::verdict_box::{verdict_box, BoxInput};
-use super::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
+use crate::batch::conditions::Condition;
+use crate::batch::manifest::Manifest;
+use crate::batch::records::CASE_ID;
+use crate::batch::robust::{
+    study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV,
+};
+use crate::batch::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
 use crate::report::plot::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
 use crate::report::{fmt_short, read_csv, MarkdownTable, Table};
 use crate::report::{Colour, Figure, Panel, Series};
 use crate::stats::ranking::Verdict;
 use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
+use crate::study::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
 
 /// How the verdict line [`Robust::verdict_line`] writes opens.
 pub const VERDICT_OPENINGS: [&str; 5] = [
-    super::conditions::PER_CONDITION,
+    crate::batch::conditions::PER_CONDITION,
     "**Winner:",
     "**Statistically tied:",
     "**Undecided:",
@@ -249,7 +251,10 @@ impl<'a> Robust<'a> {
             self.info.min_success_probability
         );
         // Counted over every design and world: once, not under each condition.
-        if let (Ok(missed), None) = (self.worlds.str(super::worlds::MISSED), &self.condition) {
+        if let (Ok(missed), None) = (
+            self.worlds.str(crate::batch::worlds::MISSED),
+            &self.condition,
+        ) {
             let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
             for m in missed.iter().filter(|m| !m.is_empty()) {
                 *counts.entry(m.as_str()).or_default() += 1;
@@ -306,7 +311,7 @@ impl<'a> Robust<'a> {
     /// Every design's best-so-far tuning curve (`tuning.csv`) relative to its final value, one
     /// faint line each: how many runs the tuning needed, and whether it had settled.
     fn tuning_curves(&self, dir: &Path, plots: &Path, warnings: &mut Vec<String>) -> bool {
-        let Ok(t) = read_csv(&dir.join(super::robust::TUNING_CSV)) else {
+        let Ok(t) = read_csv(&dir.join(crate::batch::robust::TUNING_CSV)) else {
             return false;
         };
         let (Ok(case), Ok(eval), Ok(best)) = (t.i64(CASE_ID), t.i64("evaluation"), t.f64("best"))

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::robust::{RobustInfo, StudyVerdict};
+use crate::batch::robust::{RobustInfo, StudyVerdict};
 use crate::report::fmt_short;
 
 /// The findings file a study's author may put beside its output.
@@ -31,7 +31,7 @@ pub fn findings_firm(text: &str) -> Option<String> {
 /// The `[tune]` settings of the study copy in `dir` that say how firm the tuning is: the
 /// independent tuning seeds and the worlds each candidate meets (`None` without `[tune]`).
 fn tuning(dir: &Path) -> Option<(i64, i64)> {
-    let text = std::fs::read_to_string(dir.join(super::records::STUDY_COPY)).ok()?;
+    let text = std::fs::read_to_string(dir.join(crate::batch::records::STUDY_COPY)).ok()?;
     let doc: toml::Table = toml::from_str(&text).ok()?;
     let t = doc.get("tune")?.as_table()?;
     let get = |k: &str| t.get(k).and_then(toml::Value::as_integer);

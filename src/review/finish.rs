@@ -3,19 +3,19 @@
 
 use std::path::Path;
 
-use super::cases::{resolve_case, CaseError};
-use super::doe::expand;
-use super::error::{Notes, StudyError};
-use super::manifest::{read_manifest, Manifest};
-use super::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
 use super::rerank::Rerank;
-use super::schema::Study;
 use super::selection::Selection;
 use super::summary::write_report;
-use super::tuning_hook::{case_tuner, tuned_columns, TuneError, TuningHook};
-use super::worker::evaluate_resolved;
+use crate::batch::manifest::{read_manifest, Manifest};
+use crate::batch::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use crate::batch::tuning_hook::{case_tuner, tuned_columns, TuneError, TuningHook};
+use crate::batch::worker::evaluate_resolved;
 use crate::evaluate::{trajectory_table, Deadline, Evaluator};
 use crate::report::{read_csv_typed, write_csv, ReportError, Table};
+use crate::study::cases::{resolve_case, CaseError};
+use crate::study::doe::expand;
+use crate::study::error::{Notes, StudyError};
+use crate::study::schema::Study;
 
 /// Why the best or worst case could not be rerun (a warning of the report, not fatal).
 #[derive(Debug, thiserror::Error)]
@@ -144,7 +144,7 @@ pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError
         let schema = m.schema()?;
         final_table(read_csv_typed(&dir.join(PARTIAL_FILE), &schema)?)?
     };
-    super::dictionary::integers_for_files(&mut table, false);
+    crate::study::dictionary::integers_for_files(&mut table, false);
     let notes = if rerank.is_empty() {
         Notes::new()
     } else {
@@ -163,7 +163,7 @@ pub fn report_ranked(dir: &Path, rerank: &Rerank) -> Result<Reported, StudyError
 pub fn best_case_line(dir: &Path) -> Option<String> {
     let m = read_manifest(dir).ok()?;
     let mut table = crate::report::read_parquet(&dir.join(CASES_PARQUET)).ok()?;
-    super::dictionary::integers_for_files(&mut table, false);
+    crate::study::dictionary::integers_for_files(&mut table, false);
     let sel = Selection::new(&table, &m);
     let o = sel.objective.as_deref()?;
     let row = sel.best_row(&table, o, false)?;

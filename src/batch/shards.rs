@@ -10,17 +10,17 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use super::error::{Notes, StudyError};
-use super::finish::finish_report;
 use super::manifest::{
     now_rfc3339, read_manifest, relative_path, study_path, write_manifest, Counts, Manifest,
 };
 use super::outdir;
-use super::parse::load_study;
 use super::records::{compact, StatusCounts, PARTIAL_FILE, STUDY_COPY};
 use super::robust::write_tables;
 use super::tuning_hook::TuningHook;
 use crate::report::{read_csv_typed, Table};
+use crate::review::finish::finish_report;
+use crate::study::error::{Notes, StudyError};
+use crate::study::parse::load_study;
 
 /// Options of [`merge`].
 #[derive(Clone, Copy, Debug, Default)]

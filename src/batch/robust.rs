@@ -14,20 +14,20 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 use super::conditions::Condition;
-use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::error::StudyError;
 use super::records::{
     final_table, CaseEnd, CaseStatus, CASES_CSV, CASES_PARQUET, CASE_ID, PARTIAL_FILE, REASON,
     STATUS,
 };
-use super::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
-use super::schema::{Uncertainty, WorldDist, WorldSampling};
 use super::worlds::{MISSED, SUCCESS_PROBABILITY, WORLD_PREFIX};
 use crate::report::{write_csv_streamed, write_parquet_with};
 use crate::report::{Column, ColumnData, Table};
 use crate::scenario::criteria::Criterion;
 use crate::stats::confidence::{wilson_lower, wilson_worlds_needed, worlds_at_share};
 use crate::stats::ranking::{rank_stats, verdict, Verdict, VerdictSettings};
+use crate::study::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use crate::study::error::StudyError;
+use crate::study::schema::{Study, TUNE_CURVE_PREFIX, TUNE_NOISE};
+use crate::study::schema::{Uncertainty, WorldDist, WorldSampling};
 
 /// The per-world table of a study output (long format: one row per case and world).
 pub const WORLDS_CSV: &str = "worlds.csv";
@@ -640,7 +640,7 @@ pub fn condition_verdicts(
 /// With uncertain worlds (`robust`), the per-world columns move to
 /// [`WORLDS_CSV`] and the ranking columns are added
 /// ([`add_rank_columns`]). `cases.parquet` carries the data dictionary of its columns
-/// (`axes` named as such) in its metadata ([`super::dictionary::parquet_metadata`]).
+/// (`axes` named as such) in its metadata ([`crate::study::dictionary::parquet_metadata`]).
 pub fn write_tables(
     raw: Table,
     out: &Path,
@@ -678,13 +678,13 @@ pub fn write_tables_with(
 }
 
 /// Write `table` to [`CASES_CSV`] and [`CASES_PARQUET`] in `out`: whole-number columns as
-/// integers ([`super::dictionary::integers_for_files`]; `table` is left as it was), the
+/// integers ([`crate::study::dictionary::integers_for_files`]; `table` is left as it was), the
 /// dictionary of the columns in the Parquet file's metadata.
 pub fn write_case_files(table: &mut Table, out: &Path, axes: &[&str]) -> Result<(), StudyError> {
-    super::dictionary::integers_for_files(table, true);
-    let meta = super::dictionary::parquet_metadata(table, axes);
+    crate::study::dictionary::integers_for_files(table, true);
+    let meta = crate::study::dictionary::parquet_metadata(table, axes);
     let written = write_csv_streamed(table, &out.join(CASES_CSV))
         .and_then(|()| write_parquet_with(table, &out.join(CASES_PARQUET), &meta));
-    super::dictionary::integers_for_files(table, false);
+    crate::study::dictionary::integers_for_files(table, false);
     Ok(written?)
 }

@@ -23,9 +23,9 @@ use std::io::BufRead;
 use std::path::{Component, Path, PathBuf};
 use std::time::SystemTime;
 
-use super::error::{Notes, StudyError};
 use super::manifest::MANIFEST_FILE;
 use super::records::{CASES_CSV, CASES_PARQUET, PARTIAL_FILE, PARTIAL_STUDY_FILE, STUDY_COPY};
+use crate::study::error::{Notes, StudyError};
 
 pub use super::lock::{host_name, lock, LockOwner, OutputLock, LOCK_FILE, RELEASED_FILE};
 

@@ -1,6 +1,6 @@
 //! One case in its uncertain worlds and validation variants (issue 22): after the nominal
 //! run (at the case's tuned values), the case meets every world of the study's
-//! `[uncertainty]` ([`super::uncertainty`], the same worlds for every case) and every
+//! `[uncertainty]` ([`crate::study::uncertainty`], the same worlds for every case) and every
 //! `[[validate]]` variant, and its row gains
 //!
 //! - per tracked metric `m`: `m_mean`, `m_std`, `m_p05`, `m_p95`, `m_worst` over the worlds
@@ -10,14 +10,14 @@
 //! - per variant `v`: `validate.<v>.<objective>`, `validate.<v>.success` and
 //!   `validate.<v>.gap` (relative change of the objective from the nominal run).
 
-use super::cases::apply_overrides as apply;
-use super::cases::Resolved;
-use super::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
-use super::schema::Study;
-use super::schema::World;
 use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
 use crate::scenario::criteria::Criterion;
 use crate::stats::describe::describe;
+use crate::study::cases::apply_overrides as apply;
+use crate::study::cases::Resolved;
+use crate::study::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
+use crate::study::schema::Study;
+use crate::study::schema::World;
 use rayon::prelude::*;
 
 /// Prefix of the per-world columns of a row (`world.<k>.<metric>`).
@@ -112,7 +112,7 @@ pub struct WorldTimeout {
 /// every world of an unchanged design), collected in world order so nothing depends on the
 /// thread count. A world whose overrides do not apply counts as unsuccessful with NaN metrics.
 pub(super) fn run_worlds(
-    u: &super::schema::Uncertainty,
+    u: &crate::study::schema::Uncertainty,
     worlds: &[World],
     id: usize,
     r: &Resolved,
@@ -129,7 +129,7 @@ pub(super) fn run_worlds(
 /// Case `r` in world `w` of `u` (see [`run_worlds`]).
 pub(super) fn run_world(
     evaluator: &mut Evaluator,
-    u: &super::schema::Uncertainty,
+    u: &crate::study::schema::Uncertainty,
     w: &World,
     id: usize,
     r: &Resolved,
@@ -182,7 +182,7 @@ impl WorldRun {
 /// The per-world columns of run `wr` in world `k` (`world.<k>.missed`, `world.<k>.<m>` per
 /// tracked metric, `world.<k>.success`), pushed in that order.
 pub(super) fn push_world_columns(
-    u: &super::schema::Uncertainty,
+    u: &crate::study::schema::Uncertainty,
     k: usize,
     wr: &WorldRun,
     metrics: &mut Metrics,
@@ -202,7 +202,7 @@ pub(super) fn push_world_columns(
 /// each handed to `set` by name. One function for the first worlds and for adaptive ones, so a
 /// case that met `n` worlds adaptively has the summaries of a study with `worlds = n`.
 pub(super) fn set_world_summaries(
-    u: &super::schema::Uncertainty,
+    u: &crate::study::schema::Uncertainty,
     values: &[Vec<f64>],
     successes: usize,
     mut set: impl FnMut(&str, f64),
@@ -272,7 +272,7 @@ fn score_variants(
         .uncertainty
         .as_ref()
         .map(|u| u.objective().to_string())
-        .unwrap_or_else(|| super::directions::TRANSPORT_OBJECTIVE.to_string());
+        .unwrap_or_else(|| crate::study::directions::TRANSPORT_OBJECTIVE.to_string());
     let nominal = metrics.value(&objective);
     for v in &study.validate {
         if deadline.passed() {
@@ -295,71 +295,4 @@ fn score_variants(
         metrics.set(&col("gap"), (x - nominal) / nominal.abs());
     }
     Ok(())
-}
-
-/// The least wall time one closed-loop control period takes on one core [s]: a lower bound
-/// (a transport period of the shipped designs takes about 25 µs on the reference machine), so
-/// [`check_world_budget`] refuses only what cannot fit.
-pub const MIN_PERIOD_S: f64 = 1e-6;
-
-/// Refuse, at load, a study whose runs per case — the nominal run, every world of
-/// `[uncertainty]` (a Saltelli design's `N × (k + 2)`) and every `[[validate]]` variant —
-/// cannot finish within the case's wall-clock budget `budget_s` (`--case-timeout`; 0 = none)
-/// on `threads` threads even at [`MIN_PERIOD_S`] per control period: every case would time
-/// out. The error names `uncertainty.worlds` at its line.
-pub fn check_world_budget(
-    study: &Study,
-    budget_s: f64,
-    threads: usize,
-) -> Result<(), crate::input::located::InputError> {
-    let Some(u) = &study.uncertainty else {
-        return Ok(());
-    };
-    if budget_s.is_nan() || budget_s <= 0.0 || !study.mode.is_dynamic() {
-        return Ok(());
-    }
-    let sc = study.scenario_full.get("scenario");
-    let num = |k: &str| {
-        sc.and_then(|s| s.get(k))
-            .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
-    };
-    let duration = num("duration").unwrap_or(0.0);
-    let dt = num("control_dt").unwrap_or(crate::scenario::config::DEFAULT_CONTROL_DT);
-    let periods = (duration / dt).ceil().max(1.0);
-    let runs = 1 + u.n_worlds() + study.validate.len();
-    let need = runs as f64 * periods * MIN_PERIOD_S / threads.max(1) as f64;
-    if need <= budget_s {
-        return Ok(());
-    }
-    let doc =
-        crate::input::document::Document::parse(&study.text, &study.path.display().to_string())
-            .unwrap_or_else(|_| {
-                crate::input::document::Document::unplaced(&study.path.display().to_string())
-            });
-    Err(doc.err(
-        "uncertainty.worlds",
-        format!(
-            "{runs} runs per case ({} worlds{}{}) of {periods} control periods need at least \
-             {} s per case on {threads} threads (at {MIN_PERIOD_S} s a period, a lower bound), \
-             more than the --case-timeout of {} s: every case would time out; draw fewer \
-             worlds or raise --case-timeout",
-            u.n_worlds(),
-            if matches!(u.sampling, super::schema::WorldSampling::Saltelli) {
-                format!(
-                    " = {} × ({} parameters + 2), Saltelli",
-                    u.worlds,
-                    u.params.len()
-                )
-            } else {
-                String::new()
-            },
-            if study.validate.is_empty() {
-                String::new()
-            } else {
-                format!(", {} validation variants", study.validate.len())
-            },
-            crate::input::located::fmt_exact(need),
-            crate::input::located::fmt_exact(budget_s),
-        ),
-    ))
 }

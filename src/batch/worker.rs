@@ -10,14 +10,14 @@
 
 use std::time::Duration;
 
-use super::cases::Resolved;
-use super::doe::Case;
 use super::faults::score_faults;
 use super::records::Row;
-use super::schema::Study;
 use super::tuning_hook::CaseTuner;
 use super::worlds::{evaluate_phases, score_worlds};
 use crate::evaluate::{out_of_reach, CaseEnd, CaseResult, CaseStatus, Deadline, Evaluator, Phases};
+use crate::study::cases::Resolved;
+use crate::study::doe::Case;
+use crate::study::schema::Study;
 
 /// Per-worker state of a sweep (one per rayon worker): the evaluator (its vehicle cache keyed
 /// by the design hash, so consecutive cases of one design build it once) and the budget.

@@ -17,8 +17,8 @@ use std::path::Path;
 
 pub use super::plots_ranked::unsuccessful_rows;
 use super::plots_ranked::{clip_to_ranked, ranked_mask, split_series, unsuccessful_series};
-use super::records::{Extreme, CASE_ID};
 use super::selection::{levels, mean, thin, Front, Selection};
+use crate::batch::records::{Extreme, CASE_ID};
 use crate::report::file_stem_safe;
 use crate::report::{
     fmt_short, heatmap, read_csv, scatter_labelled, ColourScale, ColumnData, ColumnKind, Figure,
@@ -54,11 +54,11 @@ const UNITS: [(&str, &str); 23] = [
 ];
 
 /// A column name as an axis title: the name as in the tables, with its unit in brackets from
-/// the data dictionary ([`super::dictionary::unit_of`]; design axes from their key's unit)
+/// the data dictionary ([`crate::study::dictionary::unit_of`]; design axes from their key's unit)
 /// when known (`mission_cost` → `mission_cost [J/m]`, `design.longitudinal_offset` →
 /// `design.longitudinal_offset [m]`).
 pub fn metric_title(name: &str) -> String {
-    let unit = super::dictionary::unit_of(name).or_else(|| {
+    let unit = crate::study::dictionary::unit_of(name).or_else(|| {
         // Suffix keys (`_energy`) match any name ending in them; whole names match exactly.
         UNITS
             .iter()
@@ -533,7 +533,7 @@ fn timeseries(trajs: &[(&str, Table)]) -> Figure {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::records::STATUS;
+    use crate::batch::records::STATUS;
 
     #[test]
     fn metrics_spanning_decades_get_a_log_axis() {

@@ -1,5 +1,5 @@
 //! The robust sections of a study with condition axes (issue 42 item 3; a child of
-//! `summary_robust`): one view per condition ([`super::super::conditions`]), each with its own
+//! `summary_robust`): one view per condition ([`crate::batch::conditions`]), each with its own
 //! verdict, box and ranking among the designs under that condition — never across them; and
 //! the rank-interval plot of a ranking (one per condition).
 
@@ -10,8 +10,8 @@ use super::{
     rank_interval_svg, verdict_box, write_plot, BoxInput, RankRow, Robust, RANK_COLUMNS, TOP,
     VERDICT_END,
 };
-use crate::study::conditions::PER_CONDITION;
-use crate::study::robust::condition_verdicts;
+use crate::batch::conditions::PER_CONDITION;
+use crate::batch::robust::condition_verdicts;
 
 impl<'a> Robust<'a> {
     /// Whether this is the whole study of one with condition axes (its verdict, leader and

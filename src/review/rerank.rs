@@ -1,6 +1,6 @@
 //! `usm-study report DIR --objective M --pareto A,B`: a finished study re-ranked without
 //! re-running any case. The objective and the Pareto pair replace the study's `objective` and
-//! `pareto` for the report (direction from [`super::directions`]) and are recorded in
+//! `pareto` for the report (direction from [`crate::study::directions`]) and are recorded in
 //! `manifest.json`, so that `summary.md`, the plots, `report.html` and later reports agree.
 //!
 //! With uncertain worlds the objective must be one of the metrics the worlds recorded
@@ -11,15 +11,15 @@
 
 use std::path::Path;
 
-use super::error::{Notes, StudyError};
-use super::manifest::{write_manifest, Manifest};
-use super::records::{Extreme, CASES_CSV, CASES_PARQUET};
-use super::robust::{
+use super::selection::Selection;
+use crate::batch::manifest::{write_manifest, Manifest};
+use crate::batch::records::{Extreme, CASES_CSV, CASES_PARQUET};
+use crate::batch::robust::{
     add_rank_columns, write_case_files, P_BEST, RANK_COLUMNS, SUCCESS_LOWER, WORLDS_CSV,
 };
-use super::selection::Selection;
 use crate::input::keypath::did_you_mean;
 use crate::report::{read_csv, Table};
+use crate::study::error::{Notes, StudyError};
 
 /// A re-ranking: the objective and the Pareto pair `[x, y]` to report by (`None`: as the
 /// study set them).

@@ -7,9 +7,9 @@
 
 use std::path::Path;
 
-use super::error::{Notes, StudyError};
 use super::records::{CaseStatus, HASH, SCENARIO_METRICS_COLUMN, STATUS};
 use crate::report::{atomic_write, ColumnKind};
+use crate::study::error::{Notes, StudyError};
 
 /// Split one CSV line (quotes as written by `CsvAppender`: `"…"` with `""` inside) into its
 /// fields; `None` for an unterminated quote.

@@ -40,10 +40,6 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use super::cases::{case_hash, resolve_case};
-use super::doe::{case_count, expand, Case};
-use super::error::StudyError;
-use super::finish::finish_report;
 use super::journal;
 use super::lock;
 use super::manifest::{
@@ -56,10 +52,14 @@ use super::records::{
     PARTIAL_STUDY_FILE, STUDY_COPY,
 };
 use super::robust::{write_tables_with, RobustInfo};
-use super::schema::Study;
 use super::tuning_hook::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
+use crate::review::finish::finish_report;
+use crate::study::cases::{case_hash, resolve_case};
+use crate::study::doe::{case_count, expand, Case};
+use crate::study::error::StudyError;
+use crate::study::schema::Study;
 
 /// Options of a sweep run.
 #[derive(Clone, Debug, Default)]
@@ -326,7 +326,7 @@ fn open_journal(
     out: &Path,
     schema: &[(String, ColumnKind)],
     resume: bool,
-    notes: &mut super::error::Notes,
+    notes: &mut crate::study::error::Notes,
 ) -> Result<(CsvAppender, DoneHashes), StudyError> {
     crate::report::atomic_write(&out.join(STUDY_COPY), study.text.as_bytes())?;
     let partial = out.join(PARTIAL_FILE);
@@ -348,7 +348,7 @@ fn journal_of_this_study(
     out: &Path,
     partial: &Path,
     study: &Study,
-    notes: &mut super::error::Notes,
+    notes: &mut crate::study::error::Notes,
 ) -> bool {
     if !partial.is_file() {
         return true;
@@ -360,7 +360,7 @@ fn journal_of_this_study(
                 "{} was written by another study text or another build of usm-study (build {} \
                  now): not resumed; every case runs afresh",
                 partial.display(),
-                &super::hash::BUILD_ID[..12]
+                &crate::study::hash::BUILD_ID[..12]
             ));
             false
         }
@@ -573,7 +573,7 @@ fn sweep_manifest(
     Manifest {
         tool: "usm-study".into(),
         tool_version: env!("CARGO_PKG_VERSION").into(),
-        build_id: Some(super::hash::BUILD_ID.into()),
+        build_id: Some(crate::study::hash::BUILD_ID.into()),
         git_commit: git_commit(),
         git_dirty: git_dirty(),
         rustc: rustc_version(),

@@ -20,19 +20,19 @@
 
 use rayon::prelude::*;
 
-use super::cases::resolve_case;
-use super::doe::Case;
-use super::error::StudyError;
 use super::records::{CaseStatus, CASE_ID, REASON, STATUS};
 use super::robust::{
     condition_verdicts, paired, split_worlds, AdaptiveInfo, RobustInfo, StudyVerdict,
 };
-use super::schema::{Study, Uncertainty};
 use super::tuning_hook::{tuned_columns, CaseTuner};
 use super::worlds::{push_world_columns, run_world, set_world_summaries, WORLD_PREFIX};
 use crate::evaluate::{Deadline, Evaluator, Metrics};
 use crate::report::{Column, ColumnData, Table};
 use crate::stats::ranking::Verdict;
+use crate::study::cases::resolve_case;
+use crate::study::doe::Case;
+use crate::study::error::StudyError;
+use crate::study::schema::{Study, Uncertainty};
 
 /// Column of a study with adaptive worlds: the worlds each case met.
 pub const WORLDS_MET: &str = "worlds_met";
@@ -292,7 +292,7 @@ fn resummarise(u: &Uncertainty, table: &mut Table, r: usize, n: usize) {
         .map(|m| (0..n).map(|k| cell(table, k, m)).collect())
         .collect();
     let successes = (0..n)
-        .filter(|&k| cell(table, k, super::directions::SUCCESS) == 1.0)
+        .filter(|&k| cell(table, k, crate::study::directions::SUCCESS) == 1.0)
         .count();
     set_world_summaries(u, &values, successes, |name, x| set_f64(table, name, r, x));
 }
@@ -332,8 +332,8 @@ fn set_str(table: &mut Table, name: &str, r: usize, s: &str) -> Result<(), Study
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::batch::robust::Pending;
     use crate::stats::ranking::Contender;
-    use crate::study::robust::Pending;
     use crate::study::schema::{UncertainParam, WorldDist, WorldSampling};
 
     fn contender(case: usize, margin: f64) -> Contender {

@@ -6,11 +6,11 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::error::StudyError;
 use super::records::StatusCounts;
-use super::runner::StudyMode;
-use super::schema::{DoeKind, ReportSettings};
 use crate::report::ColumnKind;
+use crate::study::error::StudyError;
+use crate::study::runner::StudyMode;
+use crate::study::schema::{DoeKind, ReportSettings};
 
 /// The manifest's file name in an output directory.
 pub const MANIFEST_FILE: &str = "manifest.json";
@@ -76,7 +76,7 @@ pub struct Manifest {
     pub tool: String,
     /// Tool version.
     pub tool_version: String,
-    /// The build's identity ([`super::hash::BUILD_ID`], a hash of the sources): part of the
+    /// The build's identity ([`crate::study::hash::BUILD_ID`], a hash of the sources): part of the
     /// study hash, so another build's journal is not resumed. Absent in older manifests.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub build_id: Option<String>,

@@ -4,7 +4,7 @@
 //! the region of the ranked designs with every point beyond it drawn at the edge in a series of
 //! its own ([`clip_to_ranked`]), so that one outlier does not squash the region that matters.
 
-use super::records::STATUS;
+use crate::batch::records::STATUS;
 use crate::report::{Colour, ColumnData, Panel, PanelKind, Series, Table};
 
 /// The legend name of the ranked designs.

@@ -8,10 +8,10 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::error::StudyError;
-use super::schema::Study;
 use crate::evaluate::{CaseResult, Metrics};
 use crate::report::{format_f64, Column, ColumnData, ColumnKind, Table, Value};
+use crate::study::error::StudyError;
+use crate::study::schema::Study;
 
 pub use crate::evaluate::metrics::{
     AUTHORITY_COLUMNS, DESIGN_COLUMNS, DESIGN_THRUSTERS, TCM_COLUMNS, TCM_SINGULAR_FRACTION,
@@ -60,7 +60,7 @@ impl StatusCounts {
 /// The raw rows, appended as cases finish, compacted at the end.
 pub const PARTIAL_FILE: &str = "cases.partial.csv";
 /// Beside the journal: the hash of the study that wrote it (which includes the build identity,
-/// [`super::hash::BUILD_ID`]). `--resume` reuses the journal only when it matches.
+/// [`crate::study::hash::BUILD_ID`]). `--resume` reuses the journal only when it matches.
 pub const PARTIAL_STUDY_FILE: &str = "cases.partial.study";
 /// The final table as CSV.
 pub const CASES_CSV: &str = "cases.csv";
