@@ -91,6 +91,7 @@ pub fn sweep<'py>(
             case_timeout: (case_timeout > 0.0).then(|| Duration::from_secs_f64(case_timeout)),
             force,
             tuning: Some(TUNING),
+            report: Some(usm_study::review::HOOK),
         };
         let o = run_sweep(&study, &opts, &mut |_| {}).map_err(|e| err(&e))?;
         let review = write_review(&o.out).map_err(|e| err(&e))?;

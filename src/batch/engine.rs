@@ -51,11 +51,11 @@ use super::records::{
     axis_text, compact, raw_schema, CaseEnd, Row, StatusCounts, HASH, PARTIAL_FILE,
     PARTIAL_STUDY_FILE, STUDY_COPY,
 };
+use super::report_hook::ReportHook;
 use super::robust::{write_tables_with, RobustInfo};
 use super::tuning_hook::{case_tuner, CaseTuner, TuningHook};
 use super::worker::Worker;
 use crate::report::{read_csv_typed, ColumnKind, CsvAppender};
-use crate::review::finish::finish_report;
 use crate::study::cases::{case_hash, resolve_case};
 use crate::study::doe::{case_count, expand, Case};
 use crate::study::error::StudyError;
@@ -82,6 +82,9 @@ pub struct SweepOptions {
     /// How cases of a study with `[tune]` are tuned (the optimiser's tuner, wired in by the
     /// caller); a study with `[tune]` and no hook is refused.
     pub tuning: Option<TuningHook>,
+    /// How the finished sweep writes `summary.md` and its plots (the review room's report,
+    /// wired in by the caller); `None` writes the tables and the manifest only.
+    pub report: Option<ReportHook>,
 }
 
 /// Progress of a sweep, reported after every finished case.
@@ -255,8 +258,11 @@ pub fn run_sweep(
     write_manifest(&out, &manifest)?;
     if opts.shard.is_none() {
         // Inside the sweep's pool, so the best/worst reruns respect --jobs.
-        let w = pool.install(|| finish_report(&out, &table, &manifest, Some(study), opts.tuning));
-        outcome.warnings.extend(w);
+        if let Some(report) = opts.report {
+            let w =
+                pool.install(|| report.write(&out, &table, &manifest, Some(study), opts.tuning));
+            outcome.warnings.extend(w);
+        }
         outdir::record_owned(&out, lock.created, &outdir::SWEEP_FILES)?;
         // Last: a kill before this leaves a journal that --resume completes from.
         std::fs::remove_file(&partial).map_err(|e| StudyError::io(&partial, e))?;

@@ -18,8 +18,9 @@
 //! is recorded (its `missed` criterion is `no_failure`) and the batch goes on.
 
 use super::records::DESIGN_THRUSTERS;
-use super::worlds::{criterion_index, evaluate_phases, WorldTimeout};
-use crate::evaluate::{Deadline, Evaluator, Metrics, Phases};
+use super::worlds::{criterion_index, evaluate_varied, WorldTimeout};
+use crate::evaluate::{Deadline, Evaluator, Metrics, Override, Phases};
+use crate::input::keypath::Seg;
 use crate::report::{fmt_short, MarkdownTable, Table};
 use crate::scenario::criteria::Criterion;
 use crate::study::cases::Resolved;
@@ -81,12 +82,16 @@ pub fn score_faults(
     let runs: Vec<FaultRun> = (0..n)
         .into_par_iter()
         .map_init(Evaluator::new, |evaluator, j| {
-            let mut rf = r.clone();
-            let Ok(toml::Value::Table(spec)) = toml::Value::try_from(fs.spec(j)) else {
+            let Ok(spec @ toml::Value::Table(_)) = toml::Value::try_from(fs.spec(j)) else {
                 return FaultRun::not_run();
             };
-            rf.scenario.insert("fault".into(), toml::Value::Table(spec));
-            let res = evaluate_phases(evaluator, &rf, id, phases, false, deadline);
+            // Thruster j's fault as the case's `[fault]` table (one override).
+            let fault = [Override::scenario(
+                vec![Seg::Key("fault".into())],
+                spec,
+                "fault",
+            )];
+            let res = evaluate_varied(evaluator, r, id, phases, false, deadline, &fault);
             FaultRun {
                 ok: res.success(),
                 objective: res.metrics.value(&objective),

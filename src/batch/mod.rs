@@ -6,7 +6,8 @@
 //!
 //! - [`records`]: rows (named metrics), columns of the raw and final tables.
 //! - [`tuning_hook`]: the per-case tuning hook (`[tune]`): the optimiser's tuner reaches the
-//!   sweep through it, handed in by the caller.
+//!   sweep through it, handed in by the caller; [`report_hook`]: the review room's report
+//!   (`summary.md`, plots) reaches a finished sweep or merge the same way.
 //! - [`worlds`], [`faults`], [`adaptive`]: one case in its worlds and validation variants, its
 //!   fault reruns, adaptive rounds of worlds.
 //! - [`worker`]: one resolved case → one row through the case evaluator ([`crate::evaluate`]).
@@ -23,6 +24,7 @@ pub mod lock;
 pub mod manifest;
 pub mod outdir;
 pub mod records;
+pub mod report_hook;
 pub mod robust;
 pub mod shards;
 pub mod tuning_hook;
@@ -31,4 +33,5 @@ pub mod worlds;
 
 pub use engine::{run_sweep, ProgressEvent, SweepOptions, SweepOutcome};
 pub use records::CaseStatus;
+pub use report_hook::ReportHook;
 pub use shards::merge;

@@ -15,10 +15,10 @@ use super::manifest::{
 };
 use super::outdir;
 use super::records::{compact, StatusCounts, PARTIAL_FILE, STUDY_COPY};
+use super::report_hook::ReportHook;
 use super::robust::write_tables;
 use super::tuning_hook::TuningHook;
 use crate::report::{read_csv_typed, Table};
-use crate::review::finish::finish_report;
 use crate::study::error::{Notes, StudyError};
 use crate::study::parse::load_study;
 
@@ -33,13 +33,14 @@ pub struct MergeOptions {
 
 /// Merge shard outputs into `out`: check they come from the same study and form one whole set
 /// of shards (unless `opts.partial`), concatenate their raw rows, sort by case id, deduplicate
-/// by hash, and write the final tables, manifest and report (the best/worst reruns of a study
-/// with `[tune]` at their tuned values through `tuning`).
+/// by hash, and write the final tables, manifest and, through `report`, the report (the
+/// best/worst reruns of a study with `[tune]` at their tuned values through `tuning`).
 pub fn merge(
     dirs: &[PathBuf],
     out: &Path,
     opts: MergeOptions,
     tuning: Option<TuningHook>,
+    report: Option<ReportHook>,
 ) -> Result<(Manifest, Notes), StudyError> {
     let start_time = now_rfc3339();
     let first_dir = dirs
@@ -117,7 +118,9 @@ pub fn merge(
     let study = load_study(&study_path(out, &m))
         .ok()
         .filter(|s| s.hash == m.study_hash);
-    warnings.extend(finish_report(out, &table, &m, study.as_ref(), tuning));
+    if let Some(report) = report {
+        warnings.extend(report.write(out, &table, &m, study.as_ref(), tuning));
+    }
     outdir::record_owned(out, lock.created, &outdir::SWEEP_FILES)?;
     // The merged rows are in cases.csv: no journal is left behind, unless the output is one
     // of the inputs (the journal is that shard's raw output).

@@ -10,11 +10,12 @@
 //! - per variant `v`: `validate.<v>.<objective>`, `validate.<v>.success` and
 //!   `validate.<v>.gap` (relative change of the objective from the nominal run).
 
-use crate::evaluate::{CaseInput, CaseResult, Deadline, Evaluator, Metrics, Phases, TIMEOUT};
+use crate::evaluate::{
+    CaseEnd, CaseInput, CaseResult, Deadline, Evaluator, Metrics, Overrides, Phases, TIMEOUT,
+};
 use crate::scenario::criteria::Criterion;
 use crate::stats::describe::describe;
-use crate::study::cases::apply_overrides as apply;
-use crate::study::cases::Resolved;
+use crate::study::cases::{overrides_of, Resolved};
 use crate::study::directions::{larger_is_better, BY_MAGNITUDE, SUCCESS};
 use crate::study::schema::Study;
 use crate::study::schema::World;
@@ -49,11 +50,25 @@ pub fn evaluate_phases(
     log: bool,
     deadline: Deadline,
 ) -> CaseResult {
+    evaluate_varied(evaluator, r, id, phases, log, deadline, &[])
+}
+
+/// [`evaluate_phases`] with `overrides` on top of `r`'s tables (a world, a validation variant,
+/// a fault): the evaluator applies them ([`crate::evaluate::overrides`]).
+pub fn evaluate_varied(
+    evaluator: &mut Evaluator,
+    r: &Resolved,
+    id: usize,
+    phases: Phases,
+    log: bool,
+    deadline: Deadline,
+    overrides: &Overrides,
+) -> CaseResult {
     evaluator.evaluate(&CaseInput {
         design: &r.design,
         design_hash: &r.design_hash,
         scenario: &r.scenario,
-        overrides: &[],
+        overrides,
         seed: r.seed,
         deadline,
         phases,
@@ -62,13 +77,19 @@ pub fn evaluate_phases(
     })
 }
 
-/// Run `r` (closed loop only) with `evaluator`.
-fn run(evaluator: &mut Evaluator, r: &Resolved, id: usize, deadline: Deadline) -> CaseResult {
+/// Run `r` (closed loop only) with `overrides` on top, with `evaluator`.
+fn run(
+    evaluator: &mut Evaluator,
+    r: &Resolved,
+    id: usize,
+    deadline: Deadline,
+    overrides: &Overrides,
+) -> CaseResult {
     let phases = Phases {
         static_analysis: false,
         closed_loop: true,
     };
-    evaluate_phases(evaluator, r, id, phases, false, deadline)
+    evaluate_varied(evaluator, r, id, phases, false, deadline, overrides)
 }
 
 /// Whether a run stopped at the case's wall-clock budget.
@@ -146,29 +167,23 @@ pub(super) fn run_world(
             timeout: true,
         };
     }
-    let overrides = u
-        .params
-        .iter()
-        .zip(&w.values)
-        .map(|(p, v)| (p.name.as_str(), &p.target, v));
-    match apply(r, overrides) {
-        Ok(rw) => {
-            let res = run(evaluator, &rw, id, deadline);
-            let timeout = timed_out(&res);
-            let missed = res.end.missed_criterion().map_or(f64::NAN, criterion_index);
-            WorldRun {
-                ok: res.success(),
-                metrics: res.metrics,
-                missed,
-                timeout,
-            }
-        }
-        Err(_) => WorldRun {
-            ok: false,
-            metrics: Metrics::new(),
-            missed: criterion_index(Criterion::NoFailure),
-            timeout: false,
-        },
+    let overrides = overrides_of(
+        u.params
+            .iter()
+            .zip(&w.values)
+            .map(|(p, v)| (p.name.as_str(), &p.target, v)),
+    );
+    let res = run(evaluator, r, id, deadline, &overrides);
+    // A world whose overrides do not apply counts as a failure to run (`no_failure`).
+    let missed = match res.end {
+        CaseEnd::NotApplicable => criterion_index(Criterion::NoFailure),
+        ref end => end.missed_criterion().map_or(f64::NAN, criterion_index),
+    };
+    WorldRun {
+        ok: res.success(),
+        timeout: timed_out(&res),
+        metrics: res.metrics,
+        missed,
     }
 }
 
@@ -278,17 +293,13 @@ fn score_variants(
         if deadline.passed() {
             return Err(WorldTimeout { world: usize::MAX });
         }
-        let overrides = v.set.iter().map(|(n, t, x)| (n.as_str(), t, x));
-        let (ok, x) = match apply(r, overrides) {
-            Ok(rv) => {
-                let res = run(evaluator, &rv, id, deadline);
-                if timed_out(&res) {
-                    return Err(WorldTimeout { world: usize::MAX });
-                }
-                (res.success(), res.metrics.value(&objective))
-            }
-            Err(_) => (false, f64::NAN),
-        };
+        let overrides = overrides_of(v.set.iter().map(|(n, t, x)| (n.as_str(), t, x)));
+        let res = run(evaluator, r, id, deadline, &overrides);
+        if timed_out(&res) {
+            return Err(WorldTimeout { world: usize::MAX });
+        }
+        // A variant whose overrides do not apply: unsuccessful, its objective NaN (no metrics).
+        let (ok, x) = (res.success(), res.metrics.value(&objective));
         let col = |m: &str| format!("{VALIDATE_PREFIX}{}.{m}", v.name);
         metrics.set(&col(&objective), x);
         metrics.set(&col(SUCCESS), f64::from(u8::from(ok)));

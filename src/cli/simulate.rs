@@ -9,7 +9,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use usm_study::allocation::Method;
-use usm_study::input::keypath::{parse_override, set};
+use usm_study::evaluate::{apply_overrides, Override};
+use usm_study::input::keypath::parse_override;
 use usm_study::outcome::{run_scenario_until, RunResult};
 use usm_study::paper::antonelli_outputs::{run_antonelli_preset as run_preset, AntonelliPreset};
 use usm_study::pipeline::create_dir;
@@ -57,9 +58,13 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<ExitCode> {
     if let Some(f) = &a.reference {
         super::simulate_reference::follow(&mut table, f)?;
     }
+    // `--set` takes the one road for variation (typed overrides, as sweeps and optimisers
+    // vary a case); the scenario file holds its design, so each edits the file's table.
     for s in &a.set {
         let (path, value) = parse_override(s)?;
-        set(&mut table, &path.0, value, s).map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
+        let o = [Override::scenario(path.0, value, s.as_str())];
+        apply_overrides(&mut toml::Table::new(), &mut table, &o)
+            .map_err(|e| anyhow::anyhow!("--set {s}: {e}"))?;
     }
     // `[uncertainty]` is the study layer's: the nominal run below, then the worlds.
     let uncertainty = match table.remove("uncertainty") {

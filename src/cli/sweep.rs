@@ -19,7 +19,7 @@ use usm_study::batch::shards::{read_shard_list, slurm_script, MergeOptions, Slur
 use usm_study::batch::{merge, run_sweep, SweepOptions};
 use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
 use usm_study::pipeline::review::write_review;
-use usm_study::review::{report_ranked, Reported, Rerank};
+use usm_study::review::{report_ranked, Reported, Rerank, HOOK as REPORT};
 use usm_study::study::cases::resolve_case;
 use usm_study::study::doe::expand;
 use usm_study::study::{load_study_at, StudyError};
@@ -212,6 +212,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         case_timeout: case_budget(a.case_timeout)?,
         force: a.force,
         tuning: Some(TUNING),
+        report: Some(REPORT),
     };
     if a.dry_run {
         let cases = expand(&study, shard)?;
@@ -330,7 +331,8 @@ pub fn run_merge(a: &MergeArgs) -> anyhow::Result<ExitCode> {
         partial: a.partial,
         force: a.force,
     };
-    let (m, warnings) = merge(&dirs, &a.out, opts, Some(TUNING)).map_err(study_err)?;
+    let (m, warnings) =
+        merge(&dirs, &a.out, opts, Some(TUNING), Some(REPORT)).map_err(study_err)?;
     for w in &warnings {
         eprintln!("[merge] warning: {w}");
     }

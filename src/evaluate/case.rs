@@ -12,9 +12,9 @@ use super::metrics::{
     authority_metrics, design_metrics, tcm_metrics, Metrics, AUTHORITY_COLUMNS, DESIGN_COLUMNS,
     TCM_COLUMNS,
 };
+use super::overrides::{apply_overrides, OverrideError, Overrides, Side};
 use super::static_table::{authority_spec, static_spec, STATIC_TABLE};
 use super::status::{CaseEnd, CaseStatus, Disqualification, PANIC, UNDER_ACTUATED};
-use crate::input::keypath::{set, Seg, SetError};
 use crate::model::design::parse_design_table;
 use crate::model::Vehicle;
 use crate::sampling::derive_seed;
@@ -30,42 +30,6 @@ pub struct Phases {
     pub closed_loop: bool,
 }
 
-/// Which table an override edits.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Side {
-    /// The design table.
-    Design,
-    /// The scenario-side table.
-    Scenario,
-}
-
-/// One edit applied on top of a case's tables before it is evaluated.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Override {
-    /// The table edited.
-    pub side: Side,
-    /// The key path inside it.
-    pub path: Vec<Seg>,
-    /// The value written.
-    pub value: toml::Value,
-    /// The key as a user wrote it (for messages).
-    pub shown: String,
-}
-
-/// An override that does not apply to the case's tables (the case is skipped).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{source}")]
-pub struct OverrideError {
-    /// The key as a user wrote it.
-    pub shown: String,
-    /// Why it does not apply (naming the key).
-    #[source]
-    pub source: SetError,
-}
-
-/// Edits applied on top of a case's tables (e.g. a sampled world); empty for a nominal case.
-pub type Overrides = [Override];
-
 /// What to evaluate.
 #[derive(Clone, Copy, Debug)]
 pub struct CaseInput<'a> {
@@ -75,7 +39,8 @@ pub struct CaseInput<'a> {
     pub design_hash: &'a str,
     /// The scenario-side table (with `[static]` when the static analysis runs).
     pub scenario: &'a toml::Table,
-    /// Edits on top of both tables.
+    /// Edits on top of both tables, applied in order before anything else
+    /// ([`super::overrides`]: the one road for whatever varies a case).
     pub overrides: &'a Overrides,
     /// The case seed (`derive_seed(seed, 1)` seeds the static analysis).
     pub seed: u64,
@@ -189,7 +154,7 @@ impl Evaluator {
                     edited = t;
                     (&edited.0, &edited.1)
                 }
-                Err(e) => return out.finish(CaseEnd::Skipped, e.to_string()),
+                Err(e) => return out.finish(CaseEnd::NotApplicable, e.to_string()),
             }
         };
         let Some(v) = self.vehicle(input, design, out) else {
@@ -249,19 +214,11 @@ fn cache_key(input: &CaseInput<'_>) -> String {
     key
 }
 
-/// The case's tables with its overrides applied; `Err` is the reason the case is skipped.
+/// The case's tables with its overrides applied ([`apply_overrides`]); `Err` is the reason
+/// the case is skipped.
 fn apply(input: &CaseInput<'_>) -> Result<(toml::Table, toml::Table), OverrideError> {
     let (mut design, mut scenario) = (input.design.clone(), input.scenario.clone());
-    for o in input.overrides {
-        let t = match o.side {
-            Side::Design => &mut design,
-            Side::Scenario => &mut scenario,
-        };
-        set(t, &o.path, o.value.clone(), &o.shown).map_err(|source| OverrideError {
-            shown: o.shown.clone(),
-            source,
-        })?;
-    }
+    apply_overrides(&mut design, &mut scenario, input.overrides)?;
     Ok((design, scenario))
 }
 

@@ -3,7 +3,7 @@
 use std::time::{Duration, Instant};
 
 use super::*;
-use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
+use crate::evaluate::{Deadline, Override, Side, AUTHORITY_COLUMNS, DESIGN_COLUMNS, TCM_COLUMNS};
 use crate::input::keypath::Seg;
 
 fn design() -> toml::Table {

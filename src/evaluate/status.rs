@@ -96,8 +96,11 @@ pub enum CaseEnd {
     },
     /// Another failure: the static analysis, the trajectory, tuning or the worlds (failed).
     Error,
-    /// The case could not be set up (an override that does not apply, an invalid design).
+    /// The case could not be set up (an invalid design, a bad `[static]` table).
     Skipped,
+    /// The case's overrides do not apply to its tables (an index beyond an array, a design
+    /// the generator cannot build for thruster edits): skipped, never run.
+    NotApplicable,
 }
 
 impl CaseEnd {
@@ -110,7 +113,7 @@ impl CaseEnd {
             | CaseEnd::Diverged { .. }
             | CaseEnd::Panic { .. }
             | CaseEnd::Error => CaseStatus::Failed,
-            CaseEnd::Skipped => CaseStatus::Skipped,
+            CaseEnd::Skipped | CaseEnd::NotApplicable => CaseStatus::Skipped,
         }
     }
 
@@ -146,7 +149,7 @@ impl CaseEnd {
             | CaseEnd::Diverged { .. }
             | CaseEnd::Panic { .. }
             | CaseEnd::Error => Some(Criterion::NoFailure.as_str()),
-            CaseEnd::Ok | CaseEnd::Skipped => None,
+            CaseEnd::Ok | CaseEnd::Skipped | CaseEnd::NotApplicable => None,
         }
     }
 
@@ -161,7 +164,7 @@ impl CaseEnd {
             | CaseEnd::Diverged { .. }
             | CaseEnd::Panic { .. }
             | CaseEnd::Error => Some(Criterion::NoFailure),
-            CaseEnd::Ok | CaseEnd::Skipped => None,
+            CaseEnd::Ok | CaseEnd::Skipped | CaseEnd::NotApplicable => None,
         }
     }
 

@@ -8,6 +8,7 @@ use super::selection::Selection;
 use super::summary::write_report;
 use crate::batch::manifest::{read_manifest, Manifest};
 use crate::batch::records::{final_table, Extreme, CASES_PARQUET, CASE_ID, PARTIAL_FILE};
+use crate::batch::report_hook::ReportHook;
 use crate::batch::tuning_hook::{case_tuner, tuned_columns, TuneError, TuningHook};
 use crate::batch::worker::evaluate_resolved;
 use crate::evaluate::{trajectory_table, Deadline, Evaluator};
@@ -42,6 +43,10 @@ pub enum RerunError {
     #[error("the rerun ran out of the case's --case-timeout ({0}); no time series written")]
     Timeout(String),
 }
+
+/// [`finish_report`] as the hook a caller hands to a sweep or a merge
+/// ([`crate::batch::SweepOptions::report`], [`crate::batch::merge`]).
+pub const HOOK: ReportHook = ReportHook(finish_report);
 
 /// Write the report, rerunning the best and worst cases of dynamic studies for their
 /// trajectories when the study is available (at their tuned values through `tuning` for a

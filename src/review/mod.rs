@@ -8,7 +8,7 @@
 //! - [`plots_ranked`], [`plots`]: the sweep's plots, ranked designs told apart.
 //! - [`summary_robust`], [`verdict_box`], [`verdict_firm`], [`summary`]: `summary.md`.
 //! - [`rerank`]: `usm-study report --objective/--pareto`.
-//! - [`finish`]: the report step and `usm-study report`.
+//! - [`finish`]: the report step (handed to a sweep as its [`HOOK`]) and `usm-study report`.
 
 pub mod families;
 pub mod finish;
@@ -21,5 +21,5 @@ pub mod summary_robust;
 pub mod verdict_box;
 pub mod verdict_firm;
 
-pub use finish::{report, report_ranked, Reported};
+pub use finish::{report, report_ranked, Reported, HOOK};
 pub use rerank::Rerank;

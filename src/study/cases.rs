@@ -5,8 +5,9 @@ use super::doe::Case;
 use super::hash::{case_hashes, unresolved_case_hash};
 use super::runner::{method_control, SettingsError};
 use super::schema::{Study, Target};
+use crate::evaluate::{apply_overrides, Override, OverrideError, Side};
 use crate::input::keypath::{set, Seg, SetError};
-use crate::model::design::{parse_design_table, thrusters_to_toml, DesignError};
+use crate::model::design::DesignError;
 use crate::sampling::derive_seed;
 
 /// A case with every override applied.
@@ -38,36 +39,71 @@ pub enum CaseError {
     Control(#[from] SettingsError),
 }
 
+/// `value` written at `target` (as named `name`): the typed override of an axis value, a
+/// world's parameter or a validation variant's key ([`crate::evaluate::overrides`]).
+pub fn override_of(name: &str, target: &Target, value: &toml::Value) -> Override {
+    let (side, path) = match target {
+        Target::Design(p) => (Side::Design, &p.0),
+        Target::Scenario(p) => (Side::Scenario, &p.0),
+    };
+    Override {
+        side,
+        path: path.clone(),
+        value: value.clone(),
+        shown: name.to_string(),
+    }
+}
+
+/// The typed overrides of `(name, target, value)` triples, in order.
+pub fn overrides_of<'a>(
+    items: impl IntoIterator<Item = (&'a str, &'a Target, &'a toml::Value)>,
+) -> Vec<Override> {
+    items
+        .into_iter()
+        .map(|(n, t, v)| override_of(n, t, v))
+        .collect()
+}
+
+impl From<OverrideError> for CaseError {
+    fn from(e: OverrideError) -> Self {
+        match e {
+            OverrideError::Set(e) => CaseError::Set(e),
+            OverrideError::Design(e) => CaseError::Design(e),
+        }
+    }
+}
+
 /// Apply a case's overrides to the study's tables. `Err` is the reason the case is skipped
 /// (an index beyond an array, a design the generator cannot build for thruster overrides).
+/// The axis values are applied by the one road for variation
+/// ([`crate::evaluate::apply_overrides`]), then a `control.method` axis writes out its
+/// method's `[control]` ([`method_axis_control`]).
 pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
     let mut design = study.design.clone();
     let mut scenario = study.scenario_full.clone();
-    let mut thruster_edits = Vec::new();
-    for (a, v) in study.axes.iter().zip(&case.values) {
-        match &a.target {
-            Target::Design(p) => {
-                if matches!(p.0.first(), Some(Seg::Key(k)) if k == "thruster") {
-                    thruster_edits.push((a, p, v));
-                } else {
-                    set(&mut design, &p.0, v.clone(), &a.name)?;
-                }
-            }
-            Target::Scenario(p) => set(&mut scenario, &p.0, v.clone(), &a.name)?,
-        }
-    }
-    if !thruster_edits.is_empty() && study.generator && !design.contains_key("thruster") {
-        // Write the generated thrusters out so that they can be edited one by one.
-        let v = parse_design_table(&design, "generated design").map_err(CaseError::Design)?;
-        design.insert("thruster".into(), thrusters_to_toml(&v));
-    }
-    for (a, p, v) in thruster_edits {
-        set(&mut design, &p.0, v.clone(), &a.name)?;
-    }
+    let overrides = overrides_of(
+        study
+            .axes
+            .iter()
+            .zip(&case.values)
+            .map(|(a, v)| (a.name.as_str(), &a.target, v)),
+    );
+    apply_overrides(&mut design, &mut scenario, &overrides)?;
     if let Some(c) = method_axis_control(study, case)? {
         scenario.insert("control".into(), toml::Value::Table(c));
     }
-    let seed = derive_seed(study.seed, case.id as u64);
+    Ok(resolved(study, design, scenario, case.id))
+}
+
+/// The study's own tables as case `id`, no axis value applied (the base an optimiser's point
+/// varies, [`crate::optimise`]).
+pub fn base_case(study: &Study, id: usize) -> Resolved {
+    resolved(study, study.design.clone(), study.scenario_full.clone(), id)
+}
+
+/// Case `id` of `study` with tables `design` and `scenario`: its seed and hashes.
+fn resolved(study: &Study, design: toml::Table, scenario: toml::Table, id: usize) -> Resolved {
+    let seed = derive_seed(study.seed, id as u64);
     let (hash, design_hash) = match (&study.tune, study.robust_table.is_empty()) {
         (None, true) => case_hashes(&design, &scenario, seed),
         (t, _) => {
@@ -92,13 +128,13 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
             )
         }
     };
-    Ok(Resolved {
+    Resolved {
         design,
         scenario,
         seed,
         hash,
         design_hash,
-    })
+    }
 }
 
 /// With an axis over `control.method` (transport): the case's `[control]` written out from
@@ -106,12 +142,30 @@ pub fn resolve_case(study: &Study, case: &Case) -> Result<Resolved, CaseError> {
 /// `control.…` values on top ([`method_control`]); `None` without such an axis (the study's
 /// own method was resolved when the file was parsed).
 fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>, CaseError> {
+    method_control_of(
+        study,
+        study
+            .axes
+            .iter()
+            .zip(&case.values)
+            .map(|(a, v)| (a.name.as_str(), &a.target, v)),
+    )
+}
+
+/// [`method_axis_control`] of the varied keys `values` (`(name, target, value)`, in order) on
+/// top of `study`'s tables: when one of them is `control.method`, that method's `[control]`
+/// with the study's own `[control]` keys and the other `control.…` values on top; else `None`.
+/// The optimiser's points and scenarios vary a case this way ([`crate::optimise`]).
+pub fn method_control_of<'a>(
+    study: &Study,
+    values: impl IntoIterator<Item = (&'a str, &'a Target, &'a toml::Value)> + Clone,
+) -> Result<Option<toml::Table>, CaseError> {
     let on_control = |t: &Target| match t {
         Target::Scenario(p) => matches!(p.0.first(), Some(Seg::Key(k)) if k == "control"),
         Target::Design(_) => false,
     };
-    let method_axis = study.axes.iter().any(|a| {
-        on_control(&a.target) && matches!(&a.target, Target::Scenario(p) if p.0.len() == 2 && matches!(&p.0[1], Seg::Key(k) if k == "method"))
+    let method_axis = values.clone().into_iter().any(|(_, t, _)| {
+        on_control(t) && matches!(t, Target::Scenario(p) if p.0.len() == 2 && matches!(&p.0[1], Seg::Key(k) if k == "method"))
     });
     if !method_axis {
         return Ok(None);
@@ -125,9 +179,9 @@ fn method_axis_control(study: &Study, case: &Case) -> Result<Option<toml::Table>
             .cloned()
             .unwrap_or_else(|| toml::Value::Table(toml::Table::new())),
     );
-    for (a, v) in study.axes.iter().zip(&case.values) {
-        if let (true, Target::Scenario(p)) = (on_control(&a.target), &a.target) {
-            set(&mut own, &p.0, v.clone(), &a.name)?;
+    for (name, t, v) in values {
+        if let (true, Target::Scenario(p)) = (on_control(t), t) {
+            set(&mut own, &p.0, v.clone(), name)?;
         }
     }
     Ok(method_control(study.mode, own.get("control")).transpose()?)
@@ -140,27 +194,4 @@ pub fn case_hash(study: &Study, case: &Case, resolved: &Result<Resolved, CaseErr
         Ok(r) => r.hash.clone(),
         Err(_) => unresolved_case_hash(&study.hash, case.id, &case.values),
     }
-}
-
-/// Case `r` with overrides applied (a world's values, a validation variant's keys): new
-/// tables and a new design hash (the vehicle cache key), the case hash and seed unchanged.
-pub fn apply_overrides<'a>(
-    r: &Resolved,
-    overrides: impl IntoIterator<Item = (&'a str, &'a Target, &'a toml::Value)>,
-) -> Result<Resolved, SetError> {
-    let mut out = r.clone();
-    let mut design_changed = false;
-    for (name, target, value) in overrides {
-        match target {
-            Target::Design(p) => {
-                set(&mut out.design, &p.0, value.clone(), name)?;
-                design_changed = true;
-            }
-            Target::Scenario(p) => set(&mut out.scenario, &p.0, value.clone(), name)?,
-        }
-    }
-    if design_changed {
-        out.design_hash = case_hashes(&out.design, &out.scenario, out.seed).1;
-    }
-    Ok(out)
 }
