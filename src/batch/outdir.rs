@@ -47,8 +47,8 @@ pub const SWEEP_FILES: [&str; 10] = [
 ];
 
 /// Extensions of the files the tool writes (at the top of an output and in `plots/`).
-const OUTPUT_EXTENSIONS: [&str; 8] = [
-    "csv", "parquet", "json", "jsonl", "md", "html", "toml", "svg",
+const OUTPUT_EXTENSIONS: [&str; 9] = [
+    "csv", "parquet", "json", "jsonl", "md", "html", "toml", "svg", "pdf",
 ];
 
 /// Create `dir` if missing and return its canonical path: the one path every later write of
@@ -293,8 +293,8 @@ pub fn record_owned(dir: &Path, since: SystemTime, always: &[&str]) -> Result<()
     Ok(())
 }
 
-/// Remove the figures a report wrote into `dir/plots` before (`plots/NAME.svg` entries of the
-/// record, [`OWNED_FILE`]), so that the report about to be written leaves only its own: a
+/// Remove the figures a report wrote into `dir/plots` before (`plots/NAME.svg` and their
+/// column-width `plots/NAME.pdf` entries of the record, [`OWNED_FILE`]), so that the report about to be written leaves only its own: a
 /// figure an earlier version of the study drew (a metric since dropped) would otherwise stay
 /// beside the new ones and be shown on the review page. Only regular files named in the
 /// record go, and nothing when `plots` is not a real directory (a symbolic link is never
@@ -309,7 +309,7 @@ pub fn remove_owned_plots(dir: &Path) -> Result<usize, StudyError> {
         let Some(name) = f.strip_prefix("plots/") else {
             continue;
         };
-        if !name.ends_with(".svg") {
+        if !(name.ends_with(".svg") || name.ends_with(".pdf")) {
             continue;
         }
         let p = plots.join(name);

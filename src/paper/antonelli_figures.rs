@@ -174,7 +174,7 @@ pub fn write_figures(
         ),
     ));
     for (file, f) in figures {
-        f.write_svg(&out.join(format!("{file}.svg")))?;
+        f.write_svg_pdf(&out.join(format!("{file}.svg")))?;
     }
     Ok(())
 }

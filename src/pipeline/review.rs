@@ -388,7 +388,7 @@ impl Page<'_> {
             t = escape(&title)
         );
         self.verdict_section(&mut h);
-        if let Some(p) = pareto_html(figures) {
+        if let Some(p) = pareto_html(self.dir, figures) {
             h.push_str(&p);
         }
         if let Some(d) = self.design_html {
@@ -397,7 +397,7 @@ impl Page<'_> {
         self.success_section(&mut h);
         self.tables_section(&mut h);
         self.designs_section(&mut h);
-        plots_section(&mut h, figures, !self.marks.is_empty(), warnings);
+        plots_section(&mut h, self.dir, figures, !self.marks.is_empty(), warnings);
         self.study_section(&mut h);
         self.ledger_section(&mut h);
         self.manifest_section(&mut h);

@@ -298,9 +298,31 @@ pub(super) fn figure_files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// Every figure, inline, its caption saying what it shows of the ranked and not-ranked designs.
+/// The link to the column-width PDF beside the figure `svg` of the study directory `dir`
+/// (` · PDF, column width`), or nothing when there is no such file.
+pub(super) fn pdf_link(dir: &Path, svg: &Path) -> String {
+    let pdf = svg.with_extension("pdf");
+    let Ok(rel) = pdf.strip_prefix(dir) else {
+        return String::new();
+    };
+    if !pdf.is_file() {
+        return String::new();
+    }
+    let href: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    format!(
+        " · <a class=\"r-pdf\" href=\"{}\">PDF, column width</a>",
+        escape(&href.join("/"))
+    )
+}
+
+/// Every figure, inline, its caption saying what it shows of the ranked and not-ranked designs
+/// and linking its column-width PDF when there is one.
 pub(super) fn plots_section(
     h: &mut String,
+    dir: &Path,
     figures: &[PathBuf],
     ranked: bool,
     warnings: &mut Vec<String>,
@@ -322,10 +344,11 @@ pub(super) fn plots_section(
             Ok(svg) => {
                 let _ = writeln!(
                     h,
-                    "<figure class=\"r-plot\" id=\"plot-{k}\">{}<figcaption>{} — {}</figcaption></figure>",
+                    "<figure class=\"r-plot\" id=\"plot-{k}\">{}<figcaption>{} — {}{}</figcaption></figure>",
                     inline_svg(&svg, &format!("p{k}-")),
                     escape(&name),
-                    figure_scope(&name, ranked)
+                    figure_scope(&name, ranked),
+                    pdf_link(dir, p)
                 );
             }
             Err(e) => warnings.push(format!("{}: {e}", p.display())),

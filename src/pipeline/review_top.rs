@@ -4,7 +4,7 @@
 //! end of the page.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::report::html::{escape, inline_svg, markdown_to_html, CaseLink};
 
@@ -82,7 +82,7 @@ pub(super) fn verdict_html(
 
 /// The Pareto figure among `figures` (a file named `pareto.svg`), inlined, for the top of the
 /// page; `None` when the study has none.
-pub(super) fn pareto_html(figures: &[PathBuf]) -> Option<String> {
+pub(super) fn pareto_html(dir: &Path, figures: &[PathBuf]) -> Option<String> {
     let p = figures
         .iter()
         .find(|p| p.file_name().is_some_and(|n| n == "pareto.svg"))?;
@@ -92,8 +92,9 @@ pub(super) fn pareto_html(figures: &[PathBuf]) -> Option<String> {
          <figcaption>pareto.svg — the Pareto front of the study's two trade-off metrics over \
          the cases successful in the nominal world: ranked designs in blue, not-ranked ones in \
          grey (labelled \"not ranked\" on the front), unsuccessful ones in red; axes clipped to \
-         the ranked designs, points beyond drawn at the edge</figcaption></figure>\n</section>\n",
-        inline_svg(&svg, "top-")
+         the ranked designs, points beyond drawn at the edge{}</figcaption></figure>\n</section>\n",
+        inline_svg(&svg, "top-"),
+        super::review_page::pdf_link(dir, p)
     ))
 }
 

@@ -112,6 +112,28 @@ pub enum ReportError {
         /// plotters' error message.
         message: String,
     },
+    /// A figure's PDF could not be made.
+    #[error("PDF of figure `{figure}`: {source}")]
+    Pdf {
+        /// The figure's title.
+        figure: String,
+        /// What is wrong.
+        #[source]
+        source: PdfError,
+    },
+}
+
+/// Errors of the PDF writer ([`crate::report::pdf`]).
+#[derive(Debug, thiserror::Error)]
+pub enum PdfError {
+    /// A page side is not finite or outside 1..=14400 pt.
+    #[error("page size {width}×{height} pt must be finite and within 1..=14400 pt")]
+    BadPage {
+        /// The width asked for [pt].
+        width: f64,
+        /// The height asked for [pt].
+        height: f64,
+    },
 }
 
 /// Convenience alias for results of this module.

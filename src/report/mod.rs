@@ -12,6 +12,8 @@
 //! - [`plot`]: data-driven figure specifications ([`Figure`], [`Panel`], [`Series`],
 //!   [`Heatmap`]) rendered to SVG with native `<text>` elements (no font files), byte-identical
 //!   between runs.
+//! - [`pdf`]: a small PDF 1.4 writer (one page, standard fonts Helvetica and Symbol from
+//!   [`pdf_fonts`], not embedded); the figures' column-width PDFs are drawn through it.
 //! - [`html`]: pieces of self-contained HTML pages (escaping, the summary's Markdown, inlined
 //!   SVG).
 //! - [`atomic`]: every whole-file write goes through [`atomic_write`] (temporary file in the
@@ -30,6 +32,8 @@ pub mod html;
 pub mod markdown;
 pub mod number;
 pub mod pareto;
+pub mod pdf;
+pub mod pdf_fonts;
 pub mod plot;
 pub mod table;
 pub mod table_io;
@@ -39,14 +43,14 @@ pub use atomic::{
     process_alive, remove_dead_temporaries, run_token, temporary_suffix,
 };
 pub use csv_append::{push_csv_row, write_csv_streamed, CsvAppender};
-pub use error::{ReportError, Result};
+pub use error::{PdfError, ReportError, Result};
 pub use markdown::MarkdownTable;
 pub use number::{fmt_num, fmt_short, fmt_value, format_f64};
 pub use pareto::pareto_front;
 pub use plot::{
-    heatmap, histogram, rank_interval_svg, scatter_labelled, tornado_svg, Colour, ColourScale,
-    Figure, Heatmap, LabelledPoint, LineStyle, Panel, PanelKind, RankRow, Scale, Series,
-    TornadoRow,
+    heatmap, histogram, rank_interval_pdf, rank_interval_svg, scatter_labelled, tornado_pdf,
+    tornado_svg, Colour, ColourScale, Figure, Heatmap, LabelledPoint, LineStyle, Panel, PanelKind,
+    RankRow, Scale, Series, TornadoRow, COLUMN_PT_PER_PX, COLUMN_PX,
 };
 pub use table::{Column, ColumnData, ColumnKind, Table, Value};
 pub use table_io::{

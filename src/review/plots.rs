@@ -213,7 +213,7 @@ pub(crate) fn pareto_plot(
             let (x, y): (Vec<f64>, Vec<f64>) = r.iter().map(|&r| (f.xs[r], f.ys[r])).unzip();
             clip_to_ranked(p, &x, &y, true);
         }
-        fig.write_svg(&plots.join("pareto.svg"))
+        fig.write_svg_pdf(&plots.join("pareto.svg"))
     });
     if let Err(e) = result {
         warnings.push(e.to_string());
@@ -287,7 +287,7 @@ pub(crate) fn axis_plots(
             fig.note = format!("Left out, the same in every case: {}", constant.join(", "));
         }
         fig.grid_layout(3, 320);
-        if let Err(e) = fig.write_svg(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
+        if let Err(e) = fig.write_svg_pdf(&plots.join(format!("axis_{}.svg", file_stem_safe(a)))) {
             warnings.push(e.to_string());
         }
     }
@@ -373,7 +373,7 @@ pub(crate) fn heatmaps(
                 file_stem_safe(axes[i]),
                 file_stem_safe(axes[j])
             ));
-            if let Err(e) = h.and_then(|h| h.write_svg(&path)) {
+            if let Err(e) = h.and_then(|h| h.write_svg_pdf(&path)) {
                 warnings.push(e.to_string());
             }
         }
@@ -424,7 +424,7 @@ pub(crate) fn timeseries_plot(
         })
         .collect();
     if !trajs.is_empty() {
-        if let Err(e) = timeseries(&trajs).write_svg(&plots.join("timeseries.svg")) {
+        if let Err(e) = timeseries(&trajs).write_svg_pdf(&plots.join("timeseries.svg")) {
             warnings.push(e.to_string());
         }
     }

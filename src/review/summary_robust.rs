@@ -19,7 +19,9 @@ use crate::batch::robust::{
     study_verdict, RobustInfo, StudyVerdict, P_BEST, RANK_COLUMNS, WORLDS_CSV,
 };
 use crate::batch::worlds::{SUCCESS_PROBABILITY, VALIDATE_PREFIX};
-use crate::report::plot::{rank_interval_svg, tornado_svg, RankRow, TornadoRow};
+use crate::report::plot::{
+    rank_interval_pdf, rank_interval_svg, tornado_pdf, tornado_svg, RankRow, TornadoRow,
+};
 use crate::report::{fmt_short, read_csv, MarkdownTable, Table};
 use crate::report::{Colour, Figure, Panel, Series};
 use crate::stats::ranking::Verdict;
@@ -365,7 +367,7 @@ impl<'a> Robust<'a> {
         let mut fig = Figure::new("Per-design tuning: best so far");
         fig.panels.push(panel);
         fig.size = (720, 420);
-        match fig.write_svg(&plots.join("tuning_curves.svg")) {
+        match fig.write_svg_pdf(&plots.join("tuning_curves.svg")) {
             Ok(()) => true,
             Err(e) => {
                 warnings.push(format!("tuning_curves.svg: {e}"));
@@ -629,6 +631,8 @@ impl<'a> Robust<'a> {
             match tornado_svg(&format!("What drives {m}"), method, &rows) {
                 Ok(svg) => {
                     write_plot(plots, &file, &svg, warnings);
+                    let pdf = tornado_pdf(&format!("What drives {m}"), method, &rows);
+                    write_pdf(plots, &file, pdf, warnings);
                     let _ = writeln!(md, "![tornado {m}](plots/{file})\n");
                 }
                 Err(e) => warnings.push(format!("{file}: {e}")),
@@ -677,6 +681,19 @@ impl<'a> Robust<'a> {
 fn write_plot(dir: &Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
     if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
         warnings.push(format!("{name}: {e}"));
+    }
+}
+
+/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
+fn write_pdf(
+    dir: &Path,
+    svg_name: &str,
+    pdf: crate::report::Result<Vec<u8>>,
+    warnings: &mut Vec<String>,
+) {
+    let path = dir.join(svg_name).with_extension("pdf");
+    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
+        warnings.push(format!("{svg_name} (PDF): {e}"));
     }
 }
 

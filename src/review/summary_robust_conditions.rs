@@ -7,8 +7,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::{
-    rank_interval_svg, verdict_box, write_plot, BoxInput, RankRow, Robust, RANK_COLUMNS, TOP,
-    VERDICT_END,
+    rank_interval_pdf, rank_interval_svg, verdict_box, write_pdf, write_plot, BoxInput, RankRow,
+    Robust, RANK_COLUMNS, TOP, VERDICT_END,
 };
 use crate::batch::conditions::PER_CONDITION;
 use crate::batch::robust::condition_verdicts;
@@ -155,6 +155,8 @@ impl<'a> Robust<'a> {
             match rank_interval_svg(&title, &rank_rows, self.verdict.ranked) {
                 Ok(svg) => {
                     write_plot(plots, &file, &svg, warnings);
+                    let pdf = rank_interval_pdf(&title, &rank_rows, self.verdict.ranked);
+                    write_pdf(plots, &file, pdf, warnings);
                     let _ = writeln!(md, "![rank intervals](plots/{file})\n");
                 }
                 Err(e) => warnings.push(format!("{file}: {e}")),

@@ -5,22 +5,22 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::{
-    Cartesian2d, ChartBuilder, ChartContext, Circle, DashedLineSeries, EmptyElement, IntoFont,
-    LineSeries, PathElement, RGBColor, Rectangle, SVGBackend, SeriesLabelPosition, ShapeStyle,
-    Text, TextStyle, BLACK, WHITE,
+    Cartesian2d, ChartBuilder, ChartContext, Circle, DashedLineSeries, DrawingBackend,
+    EmptyElement, IntoFont, LineSeries, PathElement, RGBColor, Rectangle, SeriesLabelPosition,
+    ShapeStyle, Text, TextStyle, BLACK, WHITE,
 };
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, finite_points, merge_bounds, render_to_svg, widen, Area, DrawResult,
-    DESC_FONT, FONT, TICK_FONT,
+    auto_range, bounds, finite_points, merge_bounds, render_to_svg, titled, widen, Area,
+    DrawResult, Look, DESC_FONT, FONT, TICK_FONT,
 };
 use super::labels::{place_labels, LABEL_FONT};
 use super::scale::Scale;
 use super::spec::{Figure, LineStyle, Panel, PanelKind, Series};
 
-/// A chart with `f64` axes on an SVG canvas.
-type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+/// A chart with `f64` axes on a canvas of backend `DB`.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 use crate::report::atomic::atomic_write;
 use crate::report::error::{ReportError, Result};
 
@@ -28,7 +28,9 @@ impl Figure {
     /// Renders the figure to an SVG document.
     pub fn render_svg(&self) -> Result<String, ReportError> {
         self.validate()?;
-        render_to_svg(self.size, &self.title, |root| draw_figure(self, root))
+        render_to_svg(self.size, &self.title, |root| {
+            draw_figure(self, root, Look::SCREEN)
+        })
     }
 
     /// Renders the figure and writes it to `path` atomically.
@@ -37,28 +39,49 @@ impl Figure {
     }
 }
 
-fn draw_figure(fig: &Figure, root: &Area<'_>) -> DrawResult {
+/// Draws `fig` onto `root` in `look`.
+pub(super) fn draw_figure<DB: DrawingBackend>(
+    fig: &Figure,
+    root: &Area<DB>,
+    look: Look,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE)?;
     let body = if fig.title.is_empty() {
         root.clone()
     } else {
-        root.titled(&fig.title, (FONT, 22))?
+        titled(root, &fig.title, 22, look)?
     };
-    let note = fig.note_lines();
+    let note = fig.note_lines_for(look);
     let body = if note.is_empty() {
         body
     } else {
         let (_, h) = body.dim_in_pixel();
-        let (top, bottom) = body.split_vertically(h as i32 - fig.note_height() as i32);
-        let style = TextStyle::from((FONT, NOTE_FONT).into_font()).color(&NOTE_RGB);
+        let (top, bottom) = body.split_vertically(h as i32 - fig.note_height_for(look) as i32);
+        let style = TextStyle::from((FONT, look.font(NOTE_FONT)).into_font()).color(&NOTE_RGB);
+        let step = look.pxi(18);
         for (k, line) in note.into_iter().enumerate() {
-            bottom.draw(&Text::new(line, (12, 4 + 18 * k as i32), style.clone()))?;
+            bottom.draw(&Text::new(line, (12, 4 + step * k as i32), style.clone()))?;
         }
         top
     };
     let areas = body.split_evenly(fig.grid());
+    // At the column a grid shows each legend once (its names without their counts).
+    let mut shown: Vec<Vec<String>> = Vec::new();
     for (panel, area) in fig.panels.iter().zip(&areas) {
-        draw_panel(panel, area)?;
+        let names: Vec<String> = panel
+            .series
+            .iter()
+            .filter(|s| !s.name.is_empty())
+            .map(|s| s.name.chars().filter(|c| !c.is_ascii_digit()).collect())
+            .collect();
+        let legend = !look.fits() || !shown.contains(&names);
+        if panel.legend && !names.is_empty() && legend {
+            shown.push(names);
+        }
+        draw_panel(panel, area, look, legend)?;
     }
     Ok(())
 }
@@ -215,26 +238,51 @@ fn polylines(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64)) -> Vec<Vec<(f
     out
 }
 
-fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
+fn draw_panel<DB: DrawingBackend>(
+    panel: &Panel,
+    area: &Area<DB>,
+    look: Look,
+    legend: bool,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let panel = &*drawn(panel);
     let (xr, yr) = panel_ranges(panel);
     // Tick counts from the panel size (plotters rounds them to "nice" steps).
     let (w, h) = area.dim_in_pixel();
-    let x_ticks = panel.x_scale.tick_count(xr, (w as usize / 60).clamp(3, 12));
-    let y_ticks = panel.y_scale.tick_count(yr, (h as usize / 40).clamp(3, 12));
+    let x_ticks = panel
+        .x_scale
+        .tick_count(xr, (w as usize / look.px(60) as usize).clamp(3, 12));
+    let y_ticks = panel
+        .y_scale
+        .tick_count(yr, (h as usize / look.px(40) as usize).clamp(3, 12));
+    let desc_font = look.fit_font(
+        DESC_FONT,
+        &[
+            (&panel.x_label, w as i32 - look.pxi(98)),
+            (&panel.y_label, h as i32 - look.pxi(90)),
+        ],
+    );
     let mut chart = ChartBuilder::on(area)
-        .caption(&panel.title, (FONT, CAPTION_FONT))
-        .margin(10)
-        .x_label_area_size(50)
-        .y_label_area_size(78)
+        .caption(
+            &panel.title,
+            (
+                FONT,
+                look.fit_to(look.title(CAPTION_FONT), &[(&panel.title, w as i32)]),
+            ),
+        )
+        .margin(look.px(10))
+        .x_label_area_size(look.px(50))
+        .y_label_area_size(look.px(78))
         .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
     let x_fmt = |v: &f64| panel.x_scale.label(*v);
     let y_fmt = |v: &f64| panel.y_scale.label(*v);
     let mut mesh = chart.configure_mesh();
     mesh.x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
-        .label_style((FONT, TICK_FONT))
-        .axis_desc_style((FONT, DESC_FONT))
+        .label_style((FONT, look.font(TICK_FONT)))
+        .axis_desc_style((FONT, desc_font))
         .x_labels(x_ticks)
         .y_labels(y_ticks)
         .max_light_lines(0)
@@ -251,36 +299,41 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
             stroke_width: 2,
         };
         let kind = s.kind.unwrap_or(panel.kind);
-        draw_data(&mut chart, s, kind, line, (xr, yr))?;
+        draw_data(&mut chart, s, kind, line, (xr, yr), look)?;
         if !s.name.is_empty() {
             named += 1;
             let anno = chart.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?;
             let anno = anno.label(s.name.as_str());
+            let u = |v: i32| look.pxi(v);
             match (kind, s.style) {
                 (PanelKind::Line, LineStyle::Dashed) => {
                     anno.legend(move |(x, y)| {
-                        DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 4, line)
+                        DashedPathElement::new(vec![(x, y), (x + u(20), y)], 6, 4, line)
                     });
                 }
                 (PanelKind::Line, LineStyle::Solid) => {
-                    anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+                    anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + u(20), y)], line));
                 }
                 (PanelKind::Scatter, _) => {
-                    anno.legend(move |(x, y)| Circle::new((x + 10, y), 3, rgb.filled()));
+                    let r = look.px(3);
+                    anno.legend(move |(x, y)| Circle::new((x + u(10), y), r, rgb.filled()));
                 }
                 (PanelKind::Bars { .. }, _) => {
                     anno.legend(move |(x, y)| {
-                        Rectangle::new([(x + 4, y - 5), (x + 16, y + 5)], rgb.mix(0.7).filled())
+                        Rectangle::new(
+                            [(x + u(4), y - u(5)), (x + u(16), y + u(5))],
+                            rgb.mix(0.7).filled(),
+                        )
                     });
                 }
             }
         }
     }
-    if panel.legend && named > 0 {
+    if panel.legend && named > 0 && legend {
         chart
             .configure_series_labels()
             .position(legend_corner(panel, (xr, yr)))
-            .label_font((FONT, TICK_FONT))
+            .label_font((FONT, look.font(TICK_FONT)))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()?;
@@ -290,20 +343,25 @@ fn draw_panel(panel: &Panel, area: &Area<'_>) -> DrawResult {
 
 /// Draws the data of series `s` as `kind` (lines broken at non-finite values and clipped to
 /// the ranges, markers or bars inside them) and its point labels.
-fn draw_data(
-    chart: &mut Chart<'_, '_>,
+fn draw_data<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
     s: &Series,
     kind: PanelKind,
     line: ShapeStyle,
     (xr, yr): ((f64, f64), (f64, f64)),
-) -> DrawResult {
+    look: Look,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let rgb = s.colour.rgb();
     let inside = |p: &(f64, f64)| p.0 >= xr.0 && p.0 <= xr.1 && p.1 >= yr.0 && p.1 <= yr.1;
     match kind {
         PanelKind::Line => {
             for poly in polylines(&s.x, &s.y, xr, yr) {
                 if poly.len() == 1 {
-                    chart.draw_series(poly.iter().map(|&p| Circle::new(p, 2, rgb.filled())))?;
+                    let r = look.px(2);
+                    chart.draw_series(poly.iter().map(|&p| Circle::new(p, r, rgb.filled())))?;
                 } else if s.style == LineStyle::Dashed {
                     chart.draw_series(DashedLineSeries::new(poly, 6, 4, line))?;
                 } else {
@@ -313,7 +371,8 @@ fn draw_data(
         }
         PanelKind::Scatter => {
             let pts: Vec<(f64, f64)> = finite_points(&s.x, &s.y).filter(|p| inside(p)).collect();
-            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, rgb.filled())))?;
+            let r = look.px(3);
+            chart.draw_series(pts.into_iter().map(|p| Circle::new(p, r, rgb.filled())))?;
         }
         PanelKind::Bars { width } => {
             let fill = rgb.mix(0.7).filled();
@@ -336,18 +395,22 @@ fn draw_data(
         }
     }
     if !s.labels.is_empty() {
-        draw_labels(chart, s, &inside)?;
+        draw_labels(chart, s, &inside, look)?;
     }
     Ok(())
 }
 
 /// The point labels of `s` (those inside the ranges), placed so that none overlaps another
 /// or a marker of the series ([`place_labels`]), with leader lines to labels moved away.
-fn draw_labels(
-    chart: &mut Chart<'_, '_>,
+fn draw_labels<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
     s: &Series,
     inside: &dyn Fn(&(f64, f64)) -> bool,
-) -> DrawResult {
+    look: Look,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let labelled: Vec<((f64, f64), &str)> =
         s.x.iter()
             .zip(&s.y)
@@ -366,10 +429,14 @@ fn draw_labels(
     let (xs, ys) = chart.plotting_area().get_pixel_range();
     let area = [xs.start, ys.start, xs.end, ys.end];
     let texts: Vec<&str> = labelled.iter().map(|(_, l)| *l).collect();
-    let placed = place_labels(&px, &texts, &markers, area);
+    let placed = place_labels(&px, &texts, &markers, area, look.k);
     let grey = RGBColor(120, 120, 120).stroke_width(1);
     for (((p, l), pl), _) in labelled.iter().zip(&placed).zip(&px) {
-        let text = Text::new(l.to_string(), pl.offset, (FONT, LABEL_FONT).into_font());
+        let text = Text::new(
+            l.to_string(),
+            pl.offset,
+            (FONT, look.font(LABEL_FONT)).into_font(),
+        );
         match pl.leader {
             Some(end) => chart.draw_series(std::iter::once(
                 EmptyElement::at(*p) + PathElement::new(vec![(0, 0), end], grey) + text,

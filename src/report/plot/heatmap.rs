@@ -2,12 +2,12 @@
 
 use std::path::Path;
 
-use plotters::prelude::{ChartBuilder, RGBColor, Rectangle, WHITE};
+use plotters::prelude::{ChartBuilder, DrawingBackend, RGBColor, Rectangle, WHITE};
 use plotters::style::Color;
 
 use super::canvas::{
-    auto_range, bounds, check_size, render_to_svg, widen, Area, DrawResult, DESC_FONT, FONT, LIMIT,
-    TICK_FONT,
+    auto_range, bounds, check_size, render_to_svg, titled, widen, Area, DrawResult, Look,
+    DESC_FONT, FONT, LIMIT, TICK_FONT,
 };
 use super::scale::Scale;
 use crate::report::atomic::atomic_write;
@@ -142,7 +142,7 @@ impl Heatmap {
         }
     }
 
-    fn validate(&self) -> Result<()> {
+    pub(super) fn validate(&self) -> Result<()> {
         check_size(self.size).map_err(|e| self.invalid(e.to_string()))?;
         for (axis, c) in [("x", &self.x), ("y", &self.y)] {
             let ok = c.iter().all(|v| v.is_finite() && v.abs() <= LIMIT)
@@ -172,7 +172,7 @@ impl Heatmap {
     /// Renders the heat map to an SVG document.
     pub fn render_svg(&self) -> Result<String, ReportError> {
         self.validate()?;
-        render_to_svg(self.size, &self.title, |root| self.draw(root))
+        render_to_svg(self.size, &self.title, |root| self.draw(root, Look::SCREEN))
     }
 
     /// Renders the heat map and writes it to `path` atomically.
@@ -180,14 +180,18 @@ impl Heatmap {
         atomic_write(path, self.render_svg()?.as_bytes())
     }
 
-    fn draw(&self, root: &Area<'_>) -> DrawResult {
+    /// Draws the heat map onto `root` in `look`.
+    pub(super) fn draw<DB: DrawingBackend>(&self, root: &Area<DB>, look: Look) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
         root.fill(&WHITE)?;
         let body = if self.title.is_empty() {
             root.clone()
         } else {
-            root.titled(&self.title, (FONT, 22))?
+            titled(root, &self.title, 22, look)?
         };
-        let bar_width = 110_i32.min(self.size.0 as i32 / 3);
+        let bar_width = look.pxi(110).min(self.size.0 as i32 / 3);
         let (w, _) = body.dim_in_pixel();
         let (main, bar) = body.split_horizontally(w as i32 - bar_width);
 
@@ -213,10 +217,18 @@ impl Heatmap {
         };
         let xr = widen((xe[0], xe[xe.len() - 1]));
         let yr = widen((ye[0], ye[ye.len() - 1]));
+        let (mw, mh) = main.dim_in_pixel();
+        let desc_font = look.fit_font(
+            DESC_FONT,
+            &[
+                (&self.x_label, mw as i32 - look.pxi(98)),
+                (&self.y_label, mh as i32 - look.pxi(70)),
+            ],
+        );
         let mut chart = ChartBuilder::on(&main)
-            .margin(10)
-            .x_label_area_size(50)
-            .y_label_area_size(78)
+            .margin(look.px(10))
+            .x_label_area_size(look.px(50))
+            .y_label_area_size(look.px(78))
             .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)?;
         let x_fmt = |v: &f64| self.x_scale.label(*v);
         let y_fmt = |v: &f64| self.y_scale.label(*v);
@@ -224,10 +236,11 @@ impl Heatmap {
         mesh.disable_mesh()
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
-            .label_style((FONT, TICK_FONT))
-            .axis_desc_style((FONT, DESC_FONT));
-        mesh.x_labels(self.x_scale.tick_count(xr, 10))
-            .y_labels(self.y_scale.tick_count(yr, 10))
+            .label_style((FONT, look.font(TICK_FONT)))
+            .axis_desc_style((FONT, desc_font));
+        let ticks = (10.0 / look.k).round() as usize;
+        mesh.x_labels(self.x_scale.tick_count(xr, ticks))
+            .y_labels(self.y_scale.tick_count(yr, ticks))
             .x_label_formatter(&x_fmt)
             .y_label_formatter(&y_fmt);
         mesh.draw()?;
@@ -250,20 +263,20 @@ impl Heatmap {
             "no finite values".to_owned()
         };
         let mut cb = ChartBuilder::on(&bar)
-            .margin_top(10)
-            .margin_bottom(10)
-            .margin_right(5)
-            .caption(caption, (FONT, TICK_FONT))
-            .x_label_area_size(45)
-            .y_label_area_size(72)
+            .margin_top(look.px(10))
+            .margin_bottom(look.px(10))
+            .margin_right(look.px(5))
+            .caption(caption, (FONT, look.font(TICK_FONT)))
+            .x_label_area_size(look.px(45))
+            .y_label_area_size(look.px(72))
             .build_cartesian_2d(0.0..1.0, zr.0..zr.1)?;
         cb.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
             .y_label_formatter(&|v| Scale::Linear.label(*v))
             .y_desc(self.z_label.as_str())
-            .label_style((FONT, TICK_FONT))
-            .axis_desc_style((FONT, DESC_FONT))
+            .label_style((FONT, look.font(TICK_FONT)))
+            .axis_desc_style((FONT, look.font(DESC_FONT)))
             .draw()?;
         let n = 64;
         let dz = (zr.1 - zr.0) / n as f64;

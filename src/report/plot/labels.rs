@@ -34,32 +34,36 @@ pub(super) struct Placement {
     pub leader: Option<(i32, i32)>,
 }
 
-/// The size of the box of `text` [px].
-fn text_box(text: &str) -> (i32, i32) {
+/// The size of the box of `text` [px] in a font `k` times the point labels' size.
+fn text_box(text: &str, k: f64) -> (i32, i32) {
     (
-        (CHAR_W * text.chars().count() as f64).ceil() as i32 + 2,
-        RENDERED.ceil() as i32 + 3,
+        (CHAR_W * k * text.chars().count() as f64).ceil() as i32 + 2,
+        (RENDERED * k).ceil() as i32 + 3,
     )
 }
 
 /// Places `texts` at `points` (pixels) inside `area` `[x0, y0, x1, y1]`, avoiding the
-/// `markers` (pixel centres of every drawn point) and each other.
+/// `markers` (pixel centres of every drawn point) and each other; `k` multiplies the font
+/// size and the distances (1 on screen).
 pub(super) fn place_labels(
     points: &[(i32, i32)],
     texts: &[&str],
     markers: &[(i32, i32)],
     area: [i32; 4],
+    k: f64,
 ) -> Vec<Placement> {
+    let marker = (f64::from(MARKER) * k).round() as i32;
+    let leader_from = (f64::from(LEADER_FROM) * k).round() as i32;
     let mut taken: Vec<PxBox> = markers
         .iter()
-        .map(|m| [m.0 - MARKER, m.1 - MARKER, 2 * MARKER, 2 * MARKER])
+        .map(|m| [m.0 - marker, m.1 - marker, 2 * marker, 2 * marker])
         .collect();
     let mut out = Vec::with_capacity(points.len());
     for (p, t) in points.iter().zip(texts) {
-        let (w, h) = text_box(t);
+        let (w, h) = text_box(t, k);
         let mut first = None;
         let mut chosen = None;
-        'search: for r in RINGS {
+        'search: for r in RINGS.map(|r| r * k) {
             // Up-right first (the usual label position), then around the point.
             for k in [7.0, 0.0, 1.0, 6.0, 2.0, 5.0, 3.0, 4.0] {
                 let a = k * std::f64::consts::FRAC_PI_4;
@@ -95,7 +99,7 @@ pub(super) fn place_labels(
             p.0.clamp(b[0], b[0] + w) - p.0,
             p.1.clamp(b[1], b[1] + h) - p.1,
         );
-        let far = near.0.abs().max(near.1.abs()) > LEADER_FROM;
+        let far = near.0.abs().max(near.1.abs()) > leader_from;
         out.push(Placement {
             offset: (b[0] - p.0, b[1] - p.1),
             leader: far.then_some(near),
@@ -120,13 +124,13 @@ mod tests {
             "#1",
             "#2",
         ];
-        let placed = place_labels(&pts, &texts, &pts, [0, 0, 600, 400]);
+        let placed = place_labels(&pts, &texts, &pts, [0, 0, 600, 400], 1.0);
         let boxes: Vec<PxBox> = placed
             .iter()
             .zip(&pts)
             .zip(&texts)
             .map(|((pl, p), t)| {
-                let (w, h) = text_box(t);
+                let (w, h) = text_box(t, 1.0);
                 [p.0 + pl.offset.0, p.1 + pl.offset.1, w, h]
             })
             .collect();
@@ -136,13 +140,16 @@ mod tests {
             }
         }
         assert!(placed.iter().any(|p| p.leader.is_some()));
-        assert_eq!(placed, place_labels(&pts, &texts, &pts, [0, 0, 600, 400]));
+        assert_eq!(
+            placed,
+            place_labels(&pts, &texts, &pts, [0, 0, 600, 400], 1.0)
+        );
     }
 
     #[test]
     fn labels_stay_inside_the_area() {
-        let placed = place_labels(&[(598, 2)], &["far corner"], &[], [0, 0, 600, 400]);
-        let (w, h) = text_box("far corner");
+        let placed = place_labels(&[(598, 2)], &["far corner"], &[], [0, 0, 600, 400], 1.0);
+        let (w, h) = text_box("far corner", 1.0);
         let b = [598 + placed[0].offset.0, 2 + placed[0].offset.1, w, h];
         assert!(
             b[0] >= 0 && b[1] >= 0 && b[0] + w <= 600 && b[1] + h <= 400,

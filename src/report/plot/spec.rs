@@ -2,7 +2,7 @@
 
 use plotters::prelude::RGBColor;
 
-use super::canvas::check_size;
+use super::canvas::{check_size, Look};
 use super::scale::Scale;
 use crate::report::error::{ReportError, Result};
 
@@ -221,9 +221,15 @@ impl Figure {
     }
 
     /// The note wrapped to the figure's width: one string per line (none without a note).
+    #[cfg(test)]
     pub(super) fn note_lines(&self) -> Vec<String> {
-        // About 0.6 em per character of the 12.1 px note font.
-        let per_line = ((self.size.0 as usize).saturating_sub(24) / 7).max(20);
+        self.note_lines_for(Look::SCREEN)
+    }
+
+    /// The note wrapped to the figure's width in `look`.
+    pub(super) fn note_lines_for(&self, look: Look) -> Vec<String> {
+        // About 0.6 em per character of the 12.1 px note font (× the look's factor).
+        let per_line = ((self.size.0 as usize).saturating_sub(24) / look.px(7) as usize).max(20);
         let mut lines: Vec<String> = Vec::new();
         for word in self.note.split_whitespace() {
             match lines.last_mut() {
@@ -240,9 +246,14 @@ impl Figure {
     /// The height [px] of the strip under the panels that holds the note (0 without one):
     /// add it to the height the panels need.
     pub fn note_height(&self) -> u32 {
-        match self.note_lines().len() {
+        self.note_height_for(Look::SCREEN)
+    }
+
+    /// [`Figure::note_height`] in `look` [px].
+    pub(super) fn note_height_for(&self, look: Look) -> u32 {
+        match self.note_lines_for(look).len() {
             0 => 0,
-            n => 8 + 18 * n as u32,
+            n => 8 + look.px(18) * n as u32,
         }
     }
 
