@@ -112,7 +112,13 @@ fn the_sweep_report_is_self_contained_and_draws_every_named_design() {
     );
     assert!(html.contains("What success means") && html.contains("2 unsuccessful"));
     // Every plot of plots/ is inlined.
-    let plots = std::fs::read_dir(out.join("plots")).unwrap().count();
+    let plots = std::fs::read_dir(out.join("plots"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.path().extension().is_some_and(|x| x == "svg"))
+        })
+        .count();
     assert!(plots > 0);
     assert_eq!(html.matches("<figure class=\"r-plot\"").count(), plots);
     // Design names (axis values) stand next to case numbers.

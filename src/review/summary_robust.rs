@@ -28,6 +28,7 @@ use crate::stats::ranking::Verdict;
 use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
 use crate::study::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
+use per_condition::write_pdf;
 
 /// How the verdict line [`Robust::verdict_line`] writes opens.
 pub const VERDICT_OPENINGS: [&str; 5] = [
@@ -681,19 +682,6 @@ impl<'a> Robust<'a> {
 fn write_plot(dir: &Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
     if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
         warnings.push(format!("{name}: {e}"));
-    }
-}
-
-/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
-fn write_pdf(
-    dir: &Path,
-    svg_name: &str,
-    pdf: crate::report::Result<Vec<u8>>,
-    warnings: &mut Vec<String>,
-) {
-    let path = dir.join(svg_name).with_extension("pdf");
-    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
-        warnings.push(format!("{svg_name} (PDF): {e}"));
     }
 }
 

@@ -7,8 +7,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::{
-    rank_interval_pdf, rank_interval_svg, verdict_box, write_pdf, write_plot, BoxInput, RankRow,
-    Robust, RANK_COLUMNS, TOP, VERDICT_END,
+    rank_interval_pdf, rank_interval_svg, verdict_box, write_plot, BoxInput, RankRow, Robust,
+    RANK_COLUMNS, TOP, VERDICT_END,
 };
 use crate::batch::conditions::PER_CONDITION;
 use crate::batch::robust::condition_verdicts;
@@ -162,5 +162,18 @@ impl<'a> Robust<'a> {
                 Err(e) => warnings.push(format!("{file}: {e}")),
             }
         }
+    }
+}
+
+/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
+pub(super) fn write_pdf(
+    dir: &Path,
+    svg_name: &str,
+    pdf: crate::report::Result<Vec<u8>>,
+    warnings: &mut Vec<String>,
+) {
+    let path = dir.join(svg_name).with_extension("pdf");
+    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
+        warnings.push(format!("{svg_name} (PDF): {e}"));
     }
 }
