@@ -43,10 +43,12 @@ name = "control.k_psi"
 lower = 0.3
 upper = 0.9
 [tune.solver]
+method = "nelder-mead"
 max_evals = 3
 [tune.objective]
 [[tune.objective.term]]
 metric = "energy_per_metre"
+weight = 1.0
 
 [uncertainty]
 worlds = 2
@@ -166,7 +168,7 @@ fn every_variation_of_a_case_equals_the_study_that_writes_it_out() {
         &written("[fault]\nthruster = 0\nat = 10.0\nkind = \"dead\"\ninformed = true\n"),
     );
     assert_eq!(
-        cell(&cases, "fault.1.objective"),
+        cell(&cases, "fault.t1.objective"),
         cell(&row(&fault, "cases.csv"), "energy_per_metre"),
         "the fault of thruster 1"
     );
