@@ -14,9 +14,7 @@
 //! checked at its two ends and its middle ([`UncertainParam::value`] at u = 0, ½, 1 — the
 //! samples' inverse CDF is monotone and clamped, so this bounds every world), a `choice` at
 //! every value. A value that cannot be set on the reference case (an index beyond its design's
-//! thrusters) is left to the cases, whose designs differ. A tuning parameter's `lower`,
-//! `upper` and `start` (`[[tune.param]]`) are checked the same way: every tuning point lies
-//! between them. `[faults]` is checked by its own parser (`super::fault_spec`). The values are
+//! thrusters) is left to the cases, whose designs differ. `[faults]` is checked by its own parser (`super::fault_spec`). The values are
 //! applied as every case applies them: as typed overrides ([`crate::evaluate::overrides`]).
 
 use super::cases::{override_of, resolve_case, Resolved};
@@ -63,43 +61,6 @@ pub fn check_values(study: &Study, doc: &Document) -> Result<(), InputError> {
             if let Err(e) = check_with(study, &reference, name, target, v) {
                 if base.as_ref().err() != Some(&e) {
                     let key = format!("validate[{i}].set.{name}");
-                    return Err(refusal(doc, &key, name, v, &e));
-                }
-            }
-        }
-    }
-    check_tune_params(study, doc, &reference, base.as_ref().err())
-}
-
-/// The tuning points' range (`[[tune.param]]` `lower`, `upper` and `start`) checked like an
-/// axis's values: every tuning candidate lies between them, so a bound that a run would refuse
-/// is refused here, at its line. A name that is not a key of the study is the tuner's to
-/// refuse (it names the closest key).
-fn check_tune_params(
-    study: &Study,
-    doc: &Document,
-    reference: &Resolved,
-    base: Option<&KeyError>,
-) -> Result<(), InputError> {
-    let params = study
-        .tune
-        .as_ref()
-        .and_then(|t| t.get("param"))
-        .and_then(|p| p.as_array());
-    for (i, p) in params.into_iter().flatten().enumerate() {
-        let Some(name) = p.get("name").and_then(|n| n.as_str()) else {
-            continue;
-        };
-        let Ok(Some((target, _))) = super::axes::study_target(study, name) else {
-            continue;
-        };
-        for bound in ["lower", "upper", "start"] {
-            let Some(v) = p.get(bound) else {
-                continue;
-            };
-            if let Err(e) = check_with(study, reference, name, &target, v) {
-                if base != Some(&e) && names_target(&e.key, &target) {
-                    let key = format!("tune.param[{i}].{bound}");
                     return Err(refusal(doc, &key, name, v, &e));
                 }
             }
