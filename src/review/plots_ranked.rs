@@ -187,3 +187,16 @@ mod tests {
         );
     }
 }
+
+/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
+pub(super) fn write_pdf(
+    dir: &std::path::Path,
+    svg_name: &str,
+    pdf: crate::report::Result<Vec<u8>>,
+    warnings: &mut Vec<String>,
+) {
+    let path = dir.join(svg_name).with_extension("pdf");
+    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
+        warnings.push(format!("{svg_name} (PDF): {e}"));
+    }
+}

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::plots_ranked::write_pdf;
 use super::selection::cell_text;
 use super::verdict_box::{verdict_box, BoxInput};
 use crate::batch::conditions::Condition;
@@ -28,7 +29,6 @@ use crate::stats::ranking::Verdict;
 use crate::stats::sobol::{sobol_indices, SaltelliDesign};
 use crate::stats::srrc::srrc;
 use crate::study::schema::{TUNED_PREFIX, TUNE_BOUND_HITS, TUNE_NOISE};
-use per_condition::write_pdf;
 
 /// How the verdict line [`Robust::verdict_line`] writes opens.
 pub const VERDICT_OPENINGS: [&str; 5] = [

@@ -12,6 +12,7 @@ use super::{
 };
 use crate::batch::conditions::PER_CONDITION;
 use crate::batch::robust::condition_verdicts;
+use crate::review::plots_ranked::write_pdf;
 
 impl<'a> Robust<'a> {
     /// Whether this is the whole study of one with condition axes (its verdict, leader and
@@ -162,18 +163,5 @@ impl<'a> Robust<'a> {
                 Err(e) => warnings.push(format!("{file}: {e}")),
             }
         }
-    }
-}
-
-/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
-pub(super) fn write_pdf(
-    dir: &Path,
-    svg_name: &str,
-    pdf: crate::report::Result<Vec<u8>>,
-    warnings: &mut Vec<String>,
-) {
-    let path = dir.join(svg_name).with_extension("pdf");
-    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
-        warnings.push(format!("{svg_name} (PDF): {e}"));
     }
 }
