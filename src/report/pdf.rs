@@ -61,7 +61,7 @@ impl PdfPage {
     /// A blank page of `width` × `height` points; both must be finite, positive and at most
     /// [`MAX_PAGE_PT`].
     pub fn new(width: f64, height: f64) -> Result<Self, PdfError> {
-        let ok = |v: f64| v.is_finite() && v >= 1.0 && v <= MAX_PAGE_PT;
+        let ok = |v: f64| (1.0..=MAX_PAGE_PT).contains(&v);
         if !(ok(width) && ok(height)) {
             return Err(PdfError::BadPage { width, height });
         }
@@ -287,7 +287,7 @@ impl PdfPage {
         let xref = out.len();
         let mut tail = format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1);
         for o in &offsets {
-            let _ = write!(tail, "{o:010} 00000 n \n");
+            let _ = writeln!(tail, "{o:010} 00000 n ");
         }
         let _ = write!(
             tail,

@@ -153,6 +153,19 @@ pub(crate) fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Optio
     })
 }
 
+/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
+pub(super) fn write_pdf(
+    dir: &std::path::Path,
+    svg_name: &str,
+    pdf: crate::report::Result<Vec<u8>>,
+    warnings: &mut Vec<String>,
+) {
+    let path = dir.join(svg_name).with_extension("pdf");
+    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
+        warnings.push(format!("{svg_name} (PDF): {e}"));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,18 +198,5 @@ mod tests {
             (s[0].name.as_str(), s[0].x.len(), s[1].x.len()),
             (RANKED, 2, 1)
         );
-    }
-}
-
-/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
-pub(super) fn write_pdf(
-    dir: &std::path::Path,
-    svg_name: &str,
-    pdf: crate::report::Result<Vec<u8>>,
-    warnings: &mut Vec<String>,
-) {
-    let path = dir.join(svg_name).with_extension("pdf");
-    if let Err(e) = pdf.and_then(|pdf| crate::report::atomic_write(&path, &pdf)) {
-        warnings.push(format!("{svg_name} (PDF): {e}"));
     }
 }
