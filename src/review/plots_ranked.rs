@@ -153,7 +153,14 @@ pub(crate) fn unsuccessful_series(bad: &[bool], xs: &[f64], ys: &[f64]) -> Optio
     })
 }
 
-/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`).
+/// Writes the SVG `svg` of a figure as `dir/name`; a failure becomes a warning of the page.
+pub(super) fn write_plot(dir: &std::path::Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
+    if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
+        warnings.push(format!("{name}: {e}"));
+    }
+}
+
+/// Writes the column-width PDF of figure `svg_name` beside it (`NAME.pdf`), as [`write_plot`].
 pub(super) fn write_pdf(
     dir: &std::path::Path,
     svg_name: &str,

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::plots_ranked::write_pdf;
+use super::plots_ranked::{write_pdf, write_plot};
 use super::selection::cell_text;
 use super::verdict_box::{verdict_box, BoxInput};
 use crate::batch::conditions::Condition;
@@ -676,12 +676,6 @@ impl<'a> Robust<'a> {
             ]);
         }
         let _ = writeln!(md, "{}", t.finish());
-    }
-}
-
-fn write_plot(dir: &Path, name: &str, svg: &str, warnings: &mut Vec<String>) {
-    if let Err(e) = crate::report::atomic_write(&dir.join(name), svg.as_bytes()) {
-        warnings.push(format!("{name}: {e}"));
     }
 }
 

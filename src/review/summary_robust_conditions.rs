@@ -7,12 +7,12 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::{
-    rank_interval_pdf, rank_interval_svg, verdict_box, write_plot, BoxInput, RankRow, Robust,
-    RANK_COLUMNS, TOP, VERDICT_END,
+    rank_interval_pdf, rank_interval_svg, verdict_box, BoxInput, RankRow, Robust, RANK_COLUMNS,
+    TOP, VERDICT_END,
 };
 use crate::batch::conditions::PER_CONDITION;
 use crate::batch::robust::condition_verdicts;
-use crate::review::plots_ranked::write_pdf;
+use crate::review::plots_ranked::{write_pdf, write_plot};
 
 impl<'a> Robust<'a> {
     /// Whether this is the whole study of one with condition axes (its verdict, leader and
