@@ -20,6 +20,9 @@ pub struct OcpArgs {
     pub out: PathBuf,
 }
 
+/// Relative grid defect above which `ocp` warns (docs/ocp.md §4, eq. (F2)).
+const FIDELITY_WARN: f64 = 0.05;
+
 /// Run `ocp`.
 pub fn run(args: &OcpArgs) -> anyhow::Result<ExitCode> {
     let spec = load_problem(&args.problem)?;
@@ -40,6 +43,30 @@ pub fn run(args: &OcpArgs) -> anyhow::Result<ExitCode> {
         s.terminal_violation,
         s.timing.total
     );
+    match &run.fidelity {
+        Ok(f) => {
+            println!(
+                "grid fidelity ({} → {} steps per interval): relative defect {:.2e} (interval {}), \
+                 work of water and integrator {:.3e} J on the grid, {:.3e} J refined; actuators \
+                 {:.3e} J",
+                f.substeps,
+                f.refined_substeps,
+                f.relative_defect,
+                f.worst_interval,
+                f.other_work,
+                f.other_work_refined,
+                f.actuator_work
+            );
+            if f.relative_defect > FIDELITY_WARN {
+                println!(
+                    "warning: the grid is too coarse for this solution (relative defect above \
+                     {:.0} %): raise horizon.knots or horizon.substeps (docs/ocp.md §4)",
+                    FIDELITY_WARN * 100.0
+                );
+            }
+        }
+        Err(e) => println!("grid fidelity: the refined integration failed: {e}"),
+    }
     println!("wrote {}", args.out.display());
     Ok(if s.status == Status::Converged {
         ExitCode::SUCCESS

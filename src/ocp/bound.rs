@@ -79,6 +79,7 @@ pub fn leg_problem(vehicle: &Vehicle, leg: &LegSpec) -> ProblemSpec {
         thrusters: true,
         duration: leg.duration,
         knots: leg.knots,
+        substeps: 1,
         joint_angles: vec![0.0; n],
         current: Some(leg.current),
         ee_displacement: None,

@@ -37,6 +37,7 @@
 
 use super::cost::PathCosts;
 use super::model::{FdScratch, ModelError, OcpModel};
+use super::sub_scratch::SubScratch;
 use crate::dynamics::{dynamics_terms, solve_forward, DynOptions, DynWorkspace};
 use crate::kinematics::{forward_kinematics, generalized_thrust_map, BasePose};
 use crate::model::Vehicle;
@@ -87,6 +88,12 @@ pub struct ChainModel {
     pub(super) ws: DynWorkspace,
     pub(super) opts: DynOptions,
     dt: f64,
+    /// Symplectic Euler steps per interval (docs/ocp.md §2, "Substeps") and their length
+    /// `h = Δt / substeps` [s].
+    substeps: usize,
+    h: f64,
+    /// Scratch of the composite step and its chained Jacobians (`substeps > 1`).
+    sub: SubScratch,
     terminal: TerminalSpec,
     costs: Option<PathCosts>,
     tau: Vec<f64>,
@@ -108,6 +115,9 @@ impl ChainModel {
             ws,
             opts,
             dt,
+            substeps: 1,
+            h: dt,
+            sub: SubScratch::default(),
             terminal: TerminalSpec {
                 ee_position: Some(target),
                 zero_velocity: true,
@@ -119,6 +129,52 @@ impl ChainModel {
             gmap: None,
             fd: FdScratch::default(),
         }
+    }
+
+    /// The same chain with each interval Δt integrated by `substeps` (≥ 1) symplectic Euler
+    /// steps of `h = Δt / substeps` under the interval's constant control (docs/ocp.md §2,
+    /// "Substeps"): `f = f_h ∘ ⋯ ∘ f_h`. One substep is the plain step, bit for bit.
+    pub fn with_substeps(mut self, substeps: usize) -> Self {
+        self.substeps = substeps.max(1);
+        self.h = self.dt / self.substeps as f64;
+        self
+    }
+
+    /// Symplectic Euler steps per interval.
+    pub fn substeps(&self) -> usize {
+        self.substeps
+    }
+
+    /// The same model on intervals of `dt` [s], keeping the number of substeps per interval
+    /// (the refined integration of [`super::fidelity`]).
+    pub(super) fn with_interval(mut self, dt: f64) -> Self {
+        self.dt = dt;
+        self.h = dt / self.substeps as f64;
+        self
+    }
+
+    /// The generalised force `τ` [N, N·m] (6 + n: base wrench in `F_b`, joint torques) of the
+    /// last plain step or substep (`τ = G(q) u_T + [0; τ_q]`, or `τ = u`).
+    pub(super) fn last_actuation(&self) -> &[f64] {
+        &self.tau
+    }
+
+    /// Kinetic energy `½ ζᵀ M(q) ζ` [J] of the state `x` (rigid bodies and, with the
+    /// hydrodynamics, the added mass; docs/ocp.md §4, eq. (F3)).
+    pub fn kinetic_energy(&mut self, x: &[f64]) -> f64 {
+        self.load_terms(x);
+        let n = self.n_joints();
+        let z = &x[7 + n..13 + 2 * n];
+        let m = &self.ws.mass;
+        let mut e = 0.0;
+        // M's lower triangle is the one kept (column-major, as `solve_forward` reads it).
+        for c in 0..z.len() {
+            e += 0.5 * m[(c, c)] * z[c] * z[c];
+            for r in c + 1..z.len() {
+                e += m[(r, c)] * z[r] * z[c];
+            }
+        }
+        e
     }
 
     /// The same chain actuated by its thrusters and joint torques (controls
@@ -312,7 +368,7 @@ impl ChainModel {
             }
         }
         solve_forward(&mut self.ws, &self.tau).map_err(|e| ModelError(e.to_string()))?;
-        let dt = self.dt;
+        let dt = self.h;
         for (z, a) in self.zeta.iter_mut().zip(&self.ws.zeta_dot) {
             *z += dt * a;
         }
@@ -347,8 +403,14 @@ impl OcpModel for ChainModel {
     }
 
     fn step(&mut self, x: &[f64], u: &[f64], out: &mut [f64]) -> Result<(), ModelError> {
-        self.load_terms(x);
-        self.finish_step(x, u, out)
+        if self.substeps == 1 {
+            self.load_terms(x);
+            return self.finish_step(x, u, out);
+        }
+        let mut s = std::mem::take(&mut self.sub);
+        let r = self.substep_chain(x, u, out, &mut s);
+        self.sub = s;
+        r
     }
 
     fn jacobians(
@@ -358,7 +420,13 @@ impl OcpModel for ChainModel {
         a: &mut DMatrix<f64>,
         b: &mut DMatrix<f64>,
     ) -> Result<(), ModelError> {
-        self.structured_jacobians(x, u, a, b)
+        if self.substeps == 1 {
+            return self.structured_jacobians(x, u, a, b);
+        }
+        let mut s = std::mem::take(&mut self.sub);
+        let r = self.chained_jacobians(x, u, a, b, &mut s);
+        self.sub = s;
+        r
     }
 
     fn weighted_hessian(
@@ -368,7 +436,13 @@ impl OcpModel for ChainModel {
         w: &[f64],
         h: &mut DMatrix<f64>,
     ) -> Result<(), ModelError> {
-        self.structured_hessian(x, u, w, h)
+        if self.substeps == 1 {
+            return self.structured_hessian(x, u, w, h);
+        }
+        let mut s = std::mem::take(&mut self.sub);
+        let r = self.chained_hessian(x, u, w, h, &mut s);
+        self.sub = s;
+        r
     }
 
     fn retract(&self, x: &[f64], dx: &[f64], out: &mut [f64]) {

@@ -109,6 +109,11 @@ impl ChainModel {
         }
     }
 
+    /// The unperturbed step `f(x, u)` of the last structured differences at `(x, u)`.
+    pub(super) fn step_origin(&self) -> &[f64] {
+        &self.fd.f0
+    }
+
     /// [`OcpModel::jacobians`]: central differences, structured (module documentation).
     pub(super) fn structured_jacobians(
         &mut self,

@@ -12,9 +12,12 @@
 //! - [`sqp`]: the SQP with the filter line search, KKT residuals, status and log;
 //! - [`derivatives`]: the chain's central and second differences with the dynamics terms
 //!   each perturbation leaves unchanged reused (the same numbers, fewer evaluations);
+//! - [`fidelity`]: a solution integrated again finer (defects, work balance);
 //! - [`cost`]: [`PathCosts`], thruster and joint energy (smoothed) and the joint-limit
 //!   barrier, analytic derivatives;
 //! - [`cruise`]: the cruise start of a transport leg (a start that already moves);
+//! - `substeps`: S symplectic Euler steps per interval, their Jacobians and Hessian by the
+//!   chain rule (scratch in `sub_scratch`);
 //! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
 //! - [`bound`]: the bound of a design on a transport leg (issue 41), N−1 warm-started;
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
@@ -24,6 +27,7 @@ pub mod chain;
 pub mod cost;
 pub mod cruise;
 pub mod derivatives;
+pub mod fidelity;
 pub mod model;
 pub mod problem;
 pub mod qp;
@@ -32,6 +36,8 @@ pub mod run;
 pub mod sqp;
 mod sqp_eval;
 pub mod start;
+mod sub_scratch;
+mod substeps;
 
 #[cfg(test)]
 mod tests;
@@ -43,9 +49,12 @@ mod tests_costs;
 mod tests_cruise;
 #[cfg(test)]
 mod tests_derivatives;
+#[cfg(test)]
+mod tests_fidelity;
 
 pub use chain::{ChainModel, TerminalSpec};
 pub use cost::{CostBreakdown, PathCosts};
+pub use fidelity::{grid_fidelity, GridFidelity};
 pub use model::{LinearModel, ModelError, OcpModel};
 pub use problem::{load_problem, parse_problem, ProblemSpec};
 pub use run::{build_model, solve_spec, write_outputs, OcpRun, StartRecord};

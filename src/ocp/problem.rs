@@ -10,6 +10,7 @@
 //! [horizon]
 //! duration = 10.0            # T [s]
 //! knots = 100                # N intervals, Δt = T/N
+//! substeps = 1               # symplectic Euler steps per interval, h = Δt/substeps (docs/ocp.md §2)
 //! [initial]                  # optional: at rest at the origin
 //! joint_angles = [0.0, 0.0, 0.0, 0.0]   # [rad]
 //! [terminal]                 # every row group optional (at least one)
@@ -57,6 +58,9 @@ use crate::model::Vehicle;
 use serde::Deserialize;
 use std::path::Path;
 
+/// Most substeps per interval accepted (each costs a full dynamics step per evaluation).
+pub const MAX_SUBSTEPS: usize = 1000;
+
 /// Most knots accepted (the solver stores O(N nx²) numbers).
 pub const MAX_KNOTS: usize = 100_000;
 
@@ -94,6 +98,12 @@ struct Physics {
 struct Horizon {
     duration: f64,
     knots: i64,
+    #[serde(default = "one_substep")]
+    substeps: i64,
+}
+
+fn one_substep() -> i64 {
+    1
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -259,6 +269,8 @@ pub struct ProblemSpec {
     pub duration: f64,
     /// Intervals N.
     pub knots: usize,
+    /// Symplectic Euler steps per interval (h = T / (N · substeps), docs/ocp.md §2).
+    pub substeps: usize,
     /// Initial joint angles [rad] (n).
     pub joint_angles: Vec<f64>,
     /// The fluid's current, inertial [m/s] (`None`: the design's).
@@ -358,6 +370,12 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             format!("must be between 1 and {MAX_KNOTS}"),
         ));
     }
+    if h.substeps < 1 || h.substeps > MAX_SUBSTEPS as i64 {
+        return Err(doc.err(
+            "horizon.substeps",
+            format!("must be between 1 and {MAX_SUBSTEPS}"),
+        ));
+    }
     let joint_angles = f
         .initial
         .joint_angles
@@ -405,6 +423,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         thrusters,
         duration: h.duration,
         knots: h.knots as usize,
+        substeps: h.substeps as usize,
         joint_angles,
         current: f.physics.current,
         ee_displacement: f.terminal.ee_displacement,

@@ -8,6 +8,7 @@
 use super::chain::{ChainModel, TerminalSpec};
 use super::cost::PathCosts;
 use super::cruise::cruise_start;
+use super::fidelity::{grid_fidelity, GridFidelity};
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
 use super::qp::QpSettings;
@@ -56,7 +57,13 @@ pub struct OcpRun {
     pub best_start: usize,
     /// Every start.
     pub starts: Vec<StartRecord>,
+    /// The solution integrated again [`FIDELITY_REFINE`] times finer (docs/ocp.md §4,
+    /// "Grid fidelity"); the reason when that integration failed.
+    pub fidelity: Result<GridFidelity, String>,
 }
+
+/// How many times finer the grid-fidelity check integrates each interval.
+pub const FIDELITY_REFINE: usize = 10;
 
 /// The chain model of a problem (terminal rows and path costs) and its initial state.
 pub fn build_model(spec: &ProblemSpec) -> (ChainModel, Vec<f64>) {
@@ -73,7 +80,7 @@ pub fn build_model(spec: &ProblemSpec) -> (ChainModel, Vec<f64>) {
     }
     let start = BasePose::default();
     let x0 = ChainModel::pack(&start, &spec.joint_angles, &[0.0; 6], &vec![0.0; n]);
-    let mut model = ChainModel::new(vehicle, opts, dt, Vec3::zeros());
+    let mut model = ChainModel::new(vehicle, opts, dt, Vec3::zeros()).with_substeps(spec.substeps);
     if spec.thrusters {
         model = model.with_thrusters();
     }
@@ -198,6 +205,8 @@ pub fn solve_spec(spec: &ProblemSpec) -> Result<OcpRun, InputError> {
         Some(p) => p,
         None => model.ee_position(&prob.x0),
     };
+    let fidelity =
+        grid_fidelity(&model, &solution.xs, &solution.us, FIDELITY_REFINE).map_err(|e| e.0);
     Ok(OcpRun {
         model,
         dt,
@@ -205,6 +214,7 @@ pub fn solve_spec(spec: &ProblemSpec) -> Result<OcpRun, InputError> {
         solution,
         best_start,
         starts,
+        fidelity,
     })
 }
 
@@ -318,7 +328,9 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
         "iterations": sol.iterations,
         "time_s": sol.timing,
         "knots": spec.knots,
+        "substeps": spec.substeps,
         "dt": run.dt,
+        "grid_fidelity": fidelity_json(&run.fidelity),
         "hydrodynamics": spec.hydrodynamics,
         "actuation": if spec.thrusters { "thrusters" } else { "base_wrench" },
         "method": "multiple shooting, SQP, Riccati interior-point QP, filter line search",
@@ -333,6 +345,24 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     atomic_write(&dir.join("summary.json"), text.as_bytes())?;
     Ok(())
+}
+
+/// `summary.json`'s `grid_fidelity` ((F1)–(F4) of docs/ocp.md §4), or the failure.
+fn fidelity_json(f: &Result<GridFidelity, String>) -> serde_json::Value {
+    match f {
+        Ok(f) => serde_json::json!({
+            "refined_substeps": f.refined_substeps,
+            "max_configuration_defect": f.max_configuration_defect,
+            "max_velocity_defect": f.max_velocity_defect,
+            "worst_interval": f.worst_interval,
+            "relative_defect": f.relative_defect,
+            "actuator_work_j": f.actuator_work,
+            "actuator_work_refined_j": f.actuator_work_refined,
+            "other_work_j": f.other_work,
+            "other_work_refined_j": f.other_work_refined,
+        }),
+        Err(e) => serde_json::json!({ "failed": e }),
+    }
 }
 
 /// The objective's terms at the returned solution: effort `w Σ Δt ‖u‖²` and the path

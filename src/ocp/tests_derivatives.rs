@@ -17,7 +17,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// A random state (pose anywhere, joints within ±0.6 rad, moderate velocities) and controls.
-fn random_point(m: &ChainModel, rng: &mut ChaCha8Rng) -> (Vec<f64>, Vec<f64>) {
+pub(super) fn random_point(m: &ChainModel, rng: &mut ChaCha8Rng) -> (Vec<f64>, Vec<f64>) {
     let n = m.n_joints();
     let mut r = |s: f64| rng.random_range(-s..s);
     let pose = BasePose {
@@ -32,7 +32,7 @@ fn random_point(m: &ChainModel, rng: &mut ChaCha8Rng) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// `max |a − b| / max(1, max |b|)`.
-fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+pub(super) fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
     (a - b).amax() / b.amax().max(1.0)
 }
 
