@@ -30,8 +30,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let on = parse_study(&with(true), path)?;
     let off = parse_study(&with(false), path)?;
     let (tune_on, tune_off) = (
-        Tuner::new(&on)?.ok_or("no [tune]")?,
-        Tuner::new(&off)?.ok_or("no [tune]")?,
+        Tuner::new(&on).ok_or("no [tune]")?,
+        Tuner::new(&off).ok_or("no [tune]")?,
     );
     let shard = std::env::var("SHARD").ok().and_then(|s| {
         let (i, n) = s.split_once('/')?;

@@ -92,7 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .unwrap_or_else(|| "benches/solver_efficiency.csv".into());
     let study = load_study(Path::new("studies/thrusters.toml"))?;
-    let tuner = Tuner::new(&study)?.ok_or("no [tune] in studies/thrusters.toml")?;
+    let tuner = Tuner::new(&study).ok_or("no [tune] in studies/thrusters.toml")?;
     let cases = expand(&study, None)?;
     let quiet = |_: &Record| {};
     let opts = Options {

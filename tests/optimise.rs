@@ -14,9 +14,9 @@ use usm_study::optimise::problem::{
     Combine, Method, Objective, Polish, SolverSettings, Spec, Term, Variant,
 };
 use usm_study::optimise::search::Evaluator;
-use usm_study::optimise::space::{Param, Scale, Space};
 use usm_study::optimise::{minimise, parse_problem, run, Options, Outcome};
 use usm_study::study::schema::Target;
+use usm_study::study::tune_space::{Param, Scale, Space};
 
 /// An analytic objective `f` of the physical parameters, counting its evaluations.
 struct Analytic {

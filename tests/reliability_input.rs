@@ -14,9 +14,9 @@ use usm_study::optimise::problem::{
     Combine, Method, Objective, SolverSettings, Spec, Term, Variant,
 };
 use usm_study::optimise::search::Evaluator;
-use usm_study::optimise::space::{Param, Scale, Space};
 use usm_study::optimise::{minimise, Options};
 use usm_study::study::schema::Target;
+use usm_study::study::tune_space::{Param, Scale, Space};
 
 /// Four quick static cases.
 const QUICK: &str = r#"[study]

@@ -416,7 +416,7 @@ fn racing_the_tuning_worlds_finds_what_the_full_evaluation_finds_in_fewer_runs()
         let study = parse_study(text, &path).unwrap();
         let case = &expand(&study, None).unwrap()[0];
         let r = resolve_case(&study, case).unwrap();
-        let tuner = Tuner::new(&study).unwrap().unwrap();
+        let tuner = Tuner::new(&study).unwrap();
         tuner.tune(&study, case, &r, Deadline::NONE).unwrap()
     };
     let (a, b) = (tuned(&on), tuned(&off));

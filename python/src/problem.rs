@@ -12,8 +12,8 @@ use usm_study::optimise::evaluate::CaseEvaluator;
 use usm_study::optimise::history::Evaluation;
 use usm_study::optimise::score::Scorer;
 use usm_study::optimise::search::Evaluator;
-use usm_study::optimise::space::Scale;
 use usm_study::optimise::{load_problem, Problem as Loaded};
+use usm_study::study::tune_space::Scale;
 
 use crate::convert::{err, msg, Failure};
 

@@ -17,7 +17,7 @@ use usm_study::batch::outdir;
 use usm_study::batch::records::{axis_text, CASES_PARQUET, PARTIAL_FILE};
 use usm_study::batch::shards::{read_shard_list, slurm_script, MergeOptions, SlurmPlan};
 use usm_study::batch::{merge, run_sweep, SweepOptions};
-use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
+use usm_study::optimise::case_tuner::HOOK as TUNING;
 use usm_study::pipeline::review::write_review;
 use usm_study::review::{report_ranked, Reported, Rerank, HOOK as REPORT};
 use usm_study::study::cases::resolve_case;
@@ -183,8 +183,7 @@ fn study_err(e: StudyError) -> anyhow::Error {
 /// Run `usm-study sweep`.
 pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
     let study = load_study_at(&a.study, a.seed)?;
-    // `[tune]` is checked before anything runs (also for --dry-run and --emit-slurm).
-    Tuner::new(&study)?;
+    // `[tune]` was checked when the study was read (also for --dry-run and --emit-slurm).
     // Worlds a case cannot run within its budget are refused here, not timed out case by case.
     let threads = match a.jobs {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),

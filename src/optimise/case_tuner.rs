@@ -6,7 +6,8 @@
 //!
 //! `[tune]` holds the sections of a problem file (`[[tune.param]]`, `[tune.objective]`,
 //! `[[tune.constraint]]`, `[tune.solver]`; `docs/optimise.md`), read by
-//! [`super::problem::parse_spec`] and validated before any case runs. A parameter without
+//! [`crate::study::tune_spec_parse::parse_spec`] and validated when the study is loaded
+//! ([`crate::study::tune_section`]; the typed section is [`Study::tuning`]). A parameter without
 //! `start` starts from the case's own value of its key (clamped to the bounds), so an axis
 //! over `control.method` starts each method from its own Table III row.
 //!
@@ -17,7 +18,6 @@
 
 use super::evaluate::CaseEvaluator;
 use super::history::Record;
-use super::problem::{in_worlds, parse_spec};
 use super::tune_seeds::{
     compare_in_pooled_worlds, raw_metrics_objective, relative_spread, tune_worlds_seed, SeedResult,
     WorldsOf, SEEDS_STREAM,
@@ -25,20 +25,21 @@ use super::tune_seeds::{
 use super::{minimise, Options, Problem, Spec};
 use crate::batch::tuning_hook::{CaseTuner, TuneError, Tuned, TuningHook};
 use crate::evaluate::{Deadline, AUTHORITY_COLUMNS, TCM_COLUMNS};
-use crate::input::document::Document;
 use crate::input::keypath::get;
 use crate::sampling::{derive_seed, Sampler, Sampling};
 use crate::study::cases::Resolved;
 use crate::study::doe::Case;
 use crate::study::error::InputError;
-use crate::study::schema::{Study, Target, Uncertainty, WorldSampling};
+use crate::study::schema::{Study, Target, TuneSection, Uncertainty};
+pub use crate::study::tune_section::{MAX_SEEDS, MAX_STARTS, MAX_TUNE_WORLDS};
+use crate::study::tune_spec_parse::in_worlds;
 use rayon::prelude::*;
 
 /// The hook wiring this tuner into sweeps, merges and reports.
 pub const HOOK: TuningHook = TuningHook(boxed);
 
 fn boxed(study: &Study) -> Result<Option<Box<dyn CaseTuner>>, InputError> {
-    Ok(Tuner::new(study)?.map(|t| Box::new(t) as Box<dyn CaseTuner>))
+    Ok(Tuner::new(study).map(|t| Box::new(t) as Box<dyn CaseTuner>))
 }
 
 /// A study's validated `[tune]` section.
@@ -71,111 +72,32 @@ pub struct Tuner {
     screen: bool,
 }
 
-/// Most independent tuning seeds.
-pub const MAX_SEEDS: usize = 8;
-
-/// Most independent tuning starts.
-pub const MAX_STARTS: usize = 16;
-
 /// Seed stream of the tuning starts' Sobol points (shared by every case).
 const STARTS_STREAM: u64 = 0x5354_4152_5453; // "STARTS"
-
-/// Most tuning worlds (`[tune] worlds`): each is a full run per evaluation.
-pub const MAX_TUNE_WORLDS: usize = 64;
 
 /// A parameter within this fraction of the unit box from a bound counts as on the bound.
 pub const BOUND_TOLERANCE: f64 = 1e-3;
 
 impl Tuner {
-    /// The tuner of `study`'s `[tune]` section (`None` without one). Every check of a
-    /// problem file applies (`docs/optimise.md`), and: no `[[tune.variant]]` (a case is
-    /// scored in its own scenario), no parameter that is also a sweep axis, `worlds` from 1 to
-    /// [`MAX_TUNE_WORLDS`] and only with the study's `[uncertainty]`. Errors name the file,
-    /// the line and the key (`tune.param[1].upper`).
-    pub fn new(study: &Study) -> Result<Option<Tuner>, InputError> {
-        let Some(t) = &study.tune else {
-            return Ok(None);
-        };
-        let doc = Document::parse(&study.text, &study.path.display().to_string())?;
-        if t.contains_key("variant") {
-            return Err(doc.err(
-                "tune.variant",
-                "not allowed in [tune]: each case is tuned and scored in its own scenario",
-            ));
-        }
-        let params = t.get("param").and_then(|p| p.as_array());
-        for (i, p) in params.into_iter().flatten().enumerate() {
-            let name = p.get("name").and_then(|n| n.as_str()).unwrap_or_default();
-            if study.axes.iter().any(|a| a.name == name) {
-                return Err(doc.err(
-                    &format!("tune.param[{i}].name"),
-                    format!("`{name}` is also a sweep axis: tune it or sweep it"),
-                ));
-            }
-        }
-        let mut t = t.clone();
-        let worlds = match t.remove("worlds") {
-            None => None,
-            Some(toml::Value::Integer(n)) if (1..=MAX_TUNE_WORLDS as i64).contains(&n) => {
-                let Some(u) = &study.uncertainty else {
-                    return Err(doc.err(
-                        "tune.worlds",
-                        "needs the study's [uncertainty] section to draw the tuning worlds from",
-                    ));
-                };
-                let mut u = u.clone();
-                u.worlds = n as usize;
-                // Saltelli's design serves the sensitivity indices of the scoring worlds; the
-                // tuning worlds are a plain Sobol sample of the same distributions.
-                if u.sampling == WorldSampling::Saltelli {
-                    u.sampling = WorldSampling::Points(Sampling::Sobol);
-                }
-                Some(u)
-            }
-            Some(v) => {
-                return Err(doc.err(
-                    "tune.worlds",
-                    format!("must be an integer from 1 to {MAX_TUNE_WORLDS}, got {v}"),
-                ))
-            }
-        };
-        let starts = count(&mut t, "starts", MAX_STARTS, &doc)?;
-        let seeds = count(&mut t, "seeds", MAX_SEEDS, &doc)?;
-        let race = match t.remove("race") {
-            None => true,
-            Some(toml::Value::Boolean(b)) => b,
-            Some(v) => return Err(doc.err("tune.race", format!("must be true or false, got {v}"))),
-        };
-        let screen = match t.remove("screen") {
-            None => false,
-            Some(toml::Value::String(s)) if s == "rk4" => true,
-            Some(toml::Value::String(s)) if s == "none" => false,
-            Some(v) => {
-                return Err(doc.err(
-                    "tune.screen",
-                    format!("must be \"rk4\" or \"none\", got {v}"),
-                ))
-            }
-        };
-        let spec = parse_spec(&doc, &t, "tune", study)?;
-        check_two_roads(&spec, study, &doc)?;
-        if spec.solver.max_evals / starts < 2 {
-            return Err(doc.err(
-                "tune.starts",
-                format!(
-                    "{starts} starts leave fewer than 2 evaluations each of tune.solver.max_evals = {}",
-                    spec.solver.max_evals
-                ),
-            ));
-        }
-        let explicit_start = params
-            .map(|ps| ps.iter().map(|p| p.get("start").is_some()).collect())
-            .unwrap_or_default();
+    /// The tuner of `study`'s `[tune]` section (`None` without one): the section typed and
+    /// validated when the study was read ([`Study::tuning`], `crate::study::tune_section`);
+    /// nothing is parsed here.
+    pub fn new(study: &Study) -> Option<Tuner> {
+        let t = study.tuning.as_ref()?;
+        let TuneSection {
+            spec,
+            explicit_start,
+            starts,
+            worlds,
+            seeds,
+            race,
+            screen,
+        } = t.clone();
         let static_needed = study.static_enabled
             && spec.metrics().iter().any(|m| {
                 TCM_COLUMNS.contains(&m.as_str()) || AUTHORITY_COLUMNS.contains(&m.as_str())
             });
-        Ok(Some(Tuner {
+        Some(Tuner {
             spec,
             explicit_start,
             static_needed,
@@ -184,7 +106,7 @@ impl Tuner {
             seeds,
             race,
             screen,
-        }))
+        })
     }
 
     /// The problem tuning one case: the study with the case's resolved tables as its base
@@ -213,6 +135,7 @@ impl Tuner {
         cs.scenario_full = r.scenario.clone();
         cs.axes.clear();
         cs.tune = None;
+        cs.tuning = None;
         cs.static_enabled = self.static_needed;
         let mut spec = self.spec.clone();
         for (p, explicit) in spec.space.params.iter_mut().zip(&self.explicit_start) {
@@ -329,58 +252,6 @@ impl Tuner {
             runs,
         })
     }
-}
-
-/// `[tune] key`, a count from 1 to `max` (default 1), taken out of `t`; located error otherwise.
-fn count(t: &mut toml::Table, key: &str, max: usize, doc: &Document) -> Result<usize, InputError> {
-    match t.remove(key) {
-        None => Ok(1),
-        Some(toml::Value::Integer(n)) if (1..=max as i64).contains(&n) => Ok(n as usize),
-        Some(v) => Err(doc.err(
-            &format!("tune.{key}"),
-            format!("must be an integer from 1 to {max}, got {v}"),
-        )),
-    }
-}
-
-/// A tuned key that the study's worlds or validation variants also set (issue 39): the world's
-/// or variant's value would replace the tuned one in every run there, so the worlds would score
-/// values other than those the table names (and with `[tune] worlds` every candidate would run
-/// at the world's value: a flat tuning). Refused, naming both keys.
-fn check_two_roads(spec: &Spec, study: &Study, doc: &Document) -> Result<(), InputError> {
-    use crate::study::axes::overlaps;
-    for (i, p) in spec.space.params.iter().enumerate() {
-        let at = format!("tune.param[{i}].name");
-        if let Some(u) = study
-            .uncertainty
-            .iter()
-            .flat_map(|u| &u.params)
-            .find(|u| overlaps(&u.target, &p.target))
-        {
-            return Err(doc.err(
-                &at,
-                format!(
-                    "`{}` is also the uncertain parameter `{}`: every world would replace the \
-                     tuned value, so the worlds would score values the table does not name; \
-                     tune it or vary it, not both",
-                    p.name, u.name
-                ),
-            ));
-        }
-        for v in &study.validate {
-            if let Some((key, _, _)) = v.set.iter().find(|(_, t, _)| overlaps(t, &p.target)) {
-                return Err(doc.err(
-                    &at,
-                    format!(
-                        "`{}` is also set by the validation variant `{}` (`{key}`): the variant \
-                         would replace the tuned value; tune it or validate it, not both",
-                        p.name, v.name
-                    ),
-                ));
-            }
-        }
-    }
-    Ok(())
 }
 
 impl CaseTuner for Tuner {
@@ -569,7 +440,7 @@ mod tests {
     fn each_tuning_start_after_the_first_has_its_own_seed_and_start_point() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/thrusters.toml");
         let study = crate::study::parse::load_study(&path).unwrap();
-        let tuner = Tuner::new(&study).unwrap().unwrap();
+        let tuner = Tuner::new(&study).unwrap();
         let spec = &tuner.spec;
         let d = spec.space.dim();
         let sobol = Sampler::new(Sampling::Sobol, 3, d, 11).unwrap();
@@ -616,7 +487,7 @@ mod tests {
         let cases = crate::study::doe::expand(&study, None).unwrap();
         let problem = |s: &crate::study::schema::Study, id: usize| {
             let r = crate::study::cases::resolve_case(s, &cases[id]).unwrap();
-            Tuner::new(s).unwrap().unwrap().case_problem(s, &r)
+            Tuner::new(s).unwrap().case_problem(s, &r)
         };
         assert_eq!(problem(&nominal, 0).spec.variants.len(), 1);
         let p = problem(&study, 0);
@@ -639,11 +510,7 @@ mod tests {
         let x: Vec<f64> = p.spec.space.params.iter().map(|q| q.start).collect();
         let at = |s: &crate::study::schema::Study| {
             let r = crate::study::cases::resolve_case(s, &cases[5]).unwrap();
-            Tuner::new(s)
-                .unwrap()
-                .unwrap()
-                .at(s, &cases[5], &r, &x)
-                .unwrap()
+            Tuner::new(s).unwrap().at(s, &cases[5], &r, &x).unwrap()
         };
         let (tuned, plain) = (at(&study), at(&nominal));
         assert_eq!(tuned.scenario, plain.scenario);

@@ -4,10 +4,11 @@
 //!
 //! Modules in dependency order (this file only declares and re-exports):
 //!
-//! - [`space`]: parameters, bounds and scales, the normalised unit box the solvers work in.
-//! - [`solver`]: `[solver]`: method, budgets and tolerances, with their limits.
-//! - [`problem`]: problem files → a validated [`Problem`] (study part + optimiser sections);
-//!   [`problem::parse_spec`] reads the optimiser sections under any key prefix.
+//! - [`problem`]: problem files → a validated [`Problem`] (study part + optimiser sections).
+//!   The sections' types and their parser are the `study` room's (what to run), shared with a
+//!   sweep's `[tune]`: [`crate::study::tune_space`] (parameters, bounds, scales, the unit box),
+//!   [`crate::study::tune_solver`] (`[solver]`), [`crate::study::tune_spec`] and
+//!   [`crate::study::tune_spec_parse`].
 //! - [`score`]: objective normalisation, combination over scenarios, constraint violation and
 //!   the feasibility-first ranking.
 //! - [`history`]: evaluation records, the history table and the resume journal.
@@ -31,8 +32,6 @@ pub mod history;
 pub mod problem;
 pub mod score;
 pub mod search;
-pub mod solver;
-pub mod space;
 mod tune_seeds;
 
 pub use driver::{minimise, run, OptimiseError, Options, Outcome};

@@ -37,8 +37,8 @@ use super::cmaes::{default_lambda, Cmaes};
 use super::history::{Evaluation, Journal, JournalError, Record};
 use super::problem::{Method, SolverSettings};
 use super::score::{Score, Scorer};
-use super::space::Space;
 use crate::sampling::{derive_seed, rng_for};
+use crate::study::tune_space::Space;
 
 /// Weight of the squared distance outside the unit box added to the cost.
 pub const PENALTY: f64 = 1.0;

@@ -242,7 +242,7 @@ pub fn summary_md(problem: &Problem, o: &Outcome) -> String {
     ));
     let mut t = MarkdownTable::new(["parameter", "lower", "upper", "scale", "start", "best"]);
     for (k, p) in spec.space.params.iter().enumerate() {
-        let scale = if p.scale == crate::optimise::space::Scale::Log {
+        let scale = if p.scale == crate::study::tune_space::Scale::Log {
             "log"
         } else {
             "lin"

@@ -3,9 +3,9 @@
 //! between its bounds, log-scaled parameters on a log axis, the best point marked).
 
 use crate::optimise::history::{best_so_far, Record};
-use crate::optimise::space::{Param, Scale as ParamScale};
 use crate::optimise::Outcome;
 use crate::report::{Colour, Figure, Panel, PanelKind, Scale, Series};
+use crate::study::tune_space::{Param, Scale as ParamScale};
 
 /// The `q`-quantile (0–1) of `v` (finite values, nearest rank); `None` when empty.
 fn quantile(v: &[f64], q: f64) -> Option<f64> {

@@ -14,7 +14,10 @@
 //! checked at its two ends and its middle ([`UncertainParam::value`] at u = 0, ½, 1 — the
 //! samples' inverse CDF is monotone and clamped, so this bounds every world), a `choice` at
 //! every value. A value that cannot be set on the reference case (an index beyond its design's
-//! thrusters) is left to the cases, whose designs differ. `[faults]` is checked by its own parser (`super::fault_spec`). The values are
+//! thrusters) is left to the cases, whose designs differ. A tuning parameter's `lower`,
+//! `upper` and `start` (`[[tune.param]]`) are checked the same way once `[tune]` is typed
+//! ([`check_tune_values`], after the section's own located errors): every tuning point lies
+//! between them. `[faults]` is checked by its own parser (`super::fault_spec`). The values are
 //! applied as every case applies them: as typed overrides ([`crate::evaluate::overrides`]).
 
 use super::cases::{override_of, resolve_case, Resolved};
@@ -62,6 +65,47 @@ pub fn check_values(study: &Study, doc: &Document) -> Result<(), InputError> {
                 if base.as_ref().err() != Some(&e) {
                     let key = format!("validate[{i}].set.{name}");
                     return Err(refusal(doc, &key, name, v, &e));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The tuning points' range (`[[tune.param]]` `lower`, `upper` and `start`, as written)
+/// checked like an axis's values on the reference case: every tuning candidate lies between
+/// them, so a bound that a run would refuse is refused at its line. Runs after
+/// [`super::tune_section::parse_tune`], so a section's own errors (unknown key, bad bounds)
+/// come first and every parameter's target is resolved.
+pub fn check_tune_values(study: &Study, doc: &Document) -> Result<(), InputError> {
+    let Some(tuning) = &study.tuning else {
+        return Ok(());
+    };
+    let Some(reference) = reference_case(study) else {
+        return Ok(());
+    };
+    let base = check(study, &reference);
+    let raw = study
+        .tune
+        .as_ref()
+        .and_then(|t| t.get("param"))
+        .and_then(|p| p.as_array());
+    for (i, (p, written)) in tuning
+        .spec
+        .space
+        .params
+        .iter()
+        .zip(raw.into_iter().flatten())
+        .enumerate()
+    {
+        for bound in ["lower", "upper", "start"] {
+            let Some(v) = written.get(bound) else {
+                continue;
+            };
+            if let Err(e) = check_with(study, &reference, &p.name, &p.target, v) {
+                if base.as_ref().err() != Some(&e) && names_target(&e.key, &p.target) {
+                    let key = format!("tune.param[{i}].{bound}");
+                    return Err(refusal(doc, &key, &p.name, v, &e));
                 }
             }
         }

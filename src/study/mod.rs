@@ -9,7 +9,12 @@
 //! - [`error`]: [`InputError`] (located study-file problems) and [`StudyError`].
 //! - [`hash`]: canonical text of TOML tables and the study and case hashes.
 //! - [`runner`]: the single adapter to the scenario module's settings (modes, defaults).
-//! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings).
+//! - [`target`]: what a key path edits (design or scenario side).
+//! - [`tune_space`], [`tune_solver`], [`tune_spec`]: the optimiser's sections typed —
+//!   parameters and their normalised box, `[solver]`, objective, constraints, scenarios —
+//!   shared by problem files and a sweep's `[tune]`.
+//! - [`schema`]: the validated [`Study`] (axes, design of experiments, report settings, the
+//!   typed `[tune]`).
 //! - [`axes`]: the `[[axis]]` entries → validated axes, against the valid parameter names.
 //! - [`catalogue`], [`directions`], [`dictionary`]: the metric catalogue, which way is
 //!   better, every output column's unit, type and meaning (`docs/columns.md`).
@@ -18,6 +23,8 @@
 //! - [`doe`]: grid and sampled designs of experiments → cases.
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
 //! - [`admit`]: every axis, world and variant value checked at load.
+//! - [`tune_spec_parse`]: the optimiser's sections of any table → a validated spec;
+//!   [`tune_section`]: a sweep's `[tune]` → the typed section, at load.
 //! - [`parse`]: study files (TOML) → validated [`Study`].
 
 pub mod admit;
@@ -33,6 +40,12 @@ pub mod hash;
 pub mod parse;
 pub mod runner;
 pub mod schema;
+pub mod target;
+pub mod tune_section;
+pub mod tune_solver;
+pub mod tune_space;
+pub mod tune_spec;
+pub mod tune_spec_parse;
 pub mod uncertainty;
 
 pub use error::{InputError, StudyError};

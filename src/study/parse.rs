@@ -255,6 +255,7 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         },
         hash,
         tune: file.tune.clone(),
+        tuning: None,
         uncertainty: None,
         validate: Vec::new(),
         faults: None,
@@ -309,6 +310,8 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         }
     }
     super::admit::check_values(&study, doc)?;
+    study.tuning = super::tune_section::parse_tune(&study, doc)?;
+    super::admit::check_tune_values(&study, doc)?;
     if let Some(f) = &file.faults {
         (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
     }

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use super::runner::{StudyMode, SCENARIO_TABLES};
+pub use super::target::Target;
+use super::tune_spec::Spec;
 use crate::evaluate::static_table::STATIC_TABLE;
 use crate::input::keypath::KeyPath;
 use crate::sampling::{derive_seed, Sampler, Sampling};
@@ -56,15 +58,6 @@ pub enum Dist {
     LogUniform(f64, f64),
     /// Normal with mean and standard deviation.
     Normal(f64, f64),
-}
-
-/// Which table an axis edits.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Target {
-    /// A key of the design table (path relative to the design table, aliases resolved).
-    Design(KeyPath),
-    /// A key of the scenario-side table (`scenario`, `static`, `control`, …).
-    Scenario(KeyPath),
 }
 
 /// A validated sweep axis.
@@ -229,10 +222,11 @@ pub struct Study {
     pub report: ReportSettings,
     /// SHA-256 of the study text, the base design and the tool version (hex).
     pub hash: String,
-    /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`); validated
-    /// by the tuner wired into the sweep (`crate::optimise::case_tuner::Tuner::new`) before any
-    /// case runs.
+    /// The `[tune]` section as written (per-case tuning, `docs/study-format.md`): part of
+    /// every case hash.
     pub tune: Option<toml::Table>,
+    /// The `[tune]` section typed and validated at load ([`TuneSection`]); `None` without one.
+    pub tuning: Option<TuneSection>,
     /// The `[uncertainty]` section: worlds every case meets (issue 22).
     pub uncertainty: Option<Uncertainty>,
     /// The `[[validate]]` variants, scored at the tuned values.
@@ -242,6 +236,31 @@ pub struct Study {
     /// `[uncertainty]` and `[[validate]]` as written (part of every case hash: a row
     /// depends on them); empty without them.
     pub robust_table: toml::Table,
+}
+
+/// A study's validated `[tune]` section (read at load by [`super::tune_section::parse_tune`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TuneSection {
+    /// The optimiser's sections (`[[tune.param]]`, `[tune.objective]`, …), read by
+    /// [`super::tune_spec_parse::parse_spec`] under `tune.`.
+    pub spec: Spec,
+    /// Per parameter: whether `start` is written (otherwise the case's own value).
+    pub explicit_start: Vec<bool>,
+    /// Independent tuning starts (`[tune] starts`, default 1): the case's own start, then
+    /// Sobol points of the box, each with an equal share of the evaluation budget.
+    pub starts: usize,
+    /// The tuning worlds (`[tune] worlds = N`): the study's `[uncertainty]` with `N` worlds
+    /// (Saltelli's design replaced by a plain Sobol sample of the same distributions);
+    /// `None` to tune in the nominal world.
+    pub worlds: Option<Uncertainty>,
+    /// Independent tuning seeds (`[tune] seeds`, default 1), compared in the pooled tuning
+    /// worlds of all seeds (issue 36 item 5).
+    pub seeds: usize,
+    /// Race each candidate's tuning worlds (`[tune] race`, default true).
+    pub race: bool,
+    /// Screen the candidates with RK4 at the control period (`[tune] screen = "rk4"`,
+    /// issue 38 item 3); default false (`"none"`).
+    pub screen: bool,
 }
 
 /// Column of a tuned study's rows: fresh evaluations the case's tuning used.

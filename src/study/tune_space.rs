@@ -5,7 +5,7 @@
 //! evaluated; [`Space::project`] returns the squared distance so the solver's cost can add
 //! a penalty that leads back inside.
 
-use crate::study::schema::Target;
+use super::target::Target;
 
 /// Linear or logarithmic parameter scale.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -1,6 +1,6 @@
 //! `[solver]` of a problem file (or of a sweep's `[tune]`): the method, its budgets and
 //! tolerances, with the limits checked before anything runs (an evaluation budget, restarts
-//! that fit in it, a swarm argmin can allocate). Read by [`super::problem::parse_spec`].
+//! that fit in it, a swarm argmin can allocate). Read by [`super::tune_spec::parse_spec`].
 
 use serde::Deserialize;
 
@@ -21,11 +21,11 @@ pub enum Method {
     #[serde(rename = "lbfgs")]
     Lbfgs,
     /// CMA-ES within the bounds (global-local, seeded; IPOP restarts double the population;
-    /// [`super::cmaes`]).
+    /// [`crate::optimise::cmaes`]).
     #[serde(rename = "cmaes")]
     Cmaes,
     /// Bayesian optimisation: Gaussian-process surrogates of the objective and of
-    /// feasibility, constrained expected improvement (global, seeded; [`super::bayes`]).
+    /// feasibility, constrained expected improvement (global, seeded; [`crate::optimise::bayes`]).
     #[serde(rename = "bayes")]
     Bayes,
 }
