@@ -9,7 +9,6 @@ use super::runner::{StudyMode, SCENARIO_TABLES};
 pub use super::target::Target;
 use super::tune_spec::Spec;
 use crate::evaluate::static_table::STATIC_TABLE;
-use crate::input::keypath::KeyPath;
 use crate::sampling::{derive_seed, Sampler, Sampling};
 use crate::stats::normal::inv_cdf;
 use crate::stats::sobol::SaltelliDesign;
