@@ -270,6 +270,58 @@ fn bad_tune_sections_exit_2_naming_file_line_and_key_before_any_case() {
     }
 }
 
+/// Issue 37 item 1: `[tune]` is typed when the study is read — the loader itself refuses a bad
+/// section at its key (no tuner needed), and a good one arrives as `Study::tuning` with its
+/// parameters resolved, its defaults filled in and the raw table kept for the case hash.
+#[test]
+fn the_tune_section_is_typed_and_checked_at_load() {
+    let text = format!("{BASE}{TUNE}");
+    let study = parse_study(&text, Path::new("t.toml")).unwrap();
+    let t = study.tuning.as_ref().expect("typed [tune]");
+    let names: Vec<&str> = t
+        .spec
+        .space
+        .params
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(names, ["control.k_psi", "control.k_6p"]);
+    assert_eq!((t.starts, t.seeds, t.race, t.screen), (1, 1, true, false));
+    assert_eq!(t.explicit_start, [false, false]);
+    assert!(t.worlds.is_none());
+    assert_eq!(t.spec.solver.max_evals, 6);
+    assert!(
+        study.tune.is_some(),
+        "the section as written stays for the hash"
+    );
+    for (edit, key) in [
+        (
+            text.replace("max_evals = 6", "max_evals = 6\n[tune.bogus]"),
+            "tune",
+        ),
+        (
+            text.replace("[tune]\n", "[tune]\nstarts = 0\n"),
+            "tune.starts",
+        ),
+        (
+            text.replace("[tune]\n", "[tune]\nscreen = \"rk5\"\n"),
+            "tune.screen",
+        ),
+        (
+            text.replace("upper = 0.5", "upper = 0.001"),
+            "tune.param[1].upper",
+        ),
+    ] {
+        let e = parse_study(&edit, Path::new("t.toml")).unwrap_err();
+        assert!(
+            e.at.key.starts_with(key) && e.at.line.is_some(),
+            "{key}: got {e}"
+        );
+    }
+    let plain = parse_study(BASE, Path::new("t.toml")).unwrap();
+    assert!(plain.tuning.is_none() && plain.tune.is_none());
+}
+
 /// The one-design study tuned in two worlds of a drag-scale `[uncertainty]`.
 fn tuned_in_two_worlds() -> String {
     let uncertainty = "
