@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use usm_study::batch::{outdir, run_sweep, SweepOptions};
 use usm_study::metrics::singularity::DEFAULT_RANK_REL_TOL;
 use usm_study::model::design::{design_to_toml, load_design};
-use usm_study::optimise::case_tuner::{Tuner, HOOK as TUNING};
+use usm_study::optimise::case_tuner::HOOK as TUNING;
 use usm_study::optimise::{load_problem, run as run_problem, Options};
 use usm_study::pipeline::create_dir;
 use usm_study::pipeline::optimise::{write_outputs, OptimiseFiles};
@@ -81,7 +81,6 @@ pub fn sweep<'py>(
     }
     let o = py.detach(move || -> Result<_, Failure> {
         let study = load_study(&study).map_err(|e| err(&e))?;
-        Tuner::new(&study).map_err(|e| err(&e))?;
         let opts = SweepOptions {
             jobs,
             resume,
