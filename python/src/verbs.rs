@@ -90,6 +90,7 @@ pub fn sweep<'py>(
             case_timeout: (case_timeout > 0.0).then(|| Duration::from_secs_f64(case_timeout)),
             force,
             tuning: Some(TUNING),
+            bound: Some(usm_study::ocp::study_bound::HOOK),
             report: Some(usm_study::review::HOOK),
         };
         let o = run_sweep(&study, &opts, &mut |_| {}).map_err(|e| err(&e))?;

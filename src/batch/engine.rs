@@ -40,6 +40,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use super::bound_hook::{case_bound, BoundHook, CaseBound};
 use super::journal;
 use super::lock;
 use super::manifest::{
@@ -82,6 +83,9 @@ pub struct SweepOptions {
     /// How cases of a study with `[tune]` are tuned (the optimiser's tuner, wired in by the
     /// caller); a study with `[tune]` and no hook is refused.
     pub tuning: Option<TuningHook>,
+    /// How cases of a study with `[ocp]` get their design's optimal-control bound (the `ocp`
+    /// room's solver, wired in by the caller); a study with `[ocp]` and no hook is refused.
+    pub bound: Option<BoundHook>,
     /// How the finished sweep writes `summary.md` and its plots (the review room's report,
     /// wired in by the caller); `None` writes the tables and the manifest only.
     pub report: Option<ReportHook>,
@@ -165,6 +169,7 @@ pub fn run_sweep(
     }
     super::adaptive::refuse_shards(study, opts.shard)?;
     let tuner = case_tuner(study, opts.tuning)?;
+    let bounder = case_bound(study, opts.bound)?;
     let cases = expand(study, opts.shard)?;
     let out = outdir::resolve(&output_dir(study, opts))?;
     let owner = outdir::LockOwner {
@@ -202,6 +207,7 @@ pub fn run_sweep(
         max: opts.max_cases.unwrap_or(usize::MAX),
         budget: opts.case_timeout,
         tuner: tuner.as_deref(),
+        bounder: bounder.as_deref(),
     };
     let streamed = stream_cases(&run, &cases, &pool, &mut appender, progress)?;
     let _ = appender.sync();
@@ -429,6 +435,7 @@ struct RunSpec<'a> {
     max: usize,
     budget: Option<Duration>,
     tuner: Option<&'a dyn CaseTuner>,
+    bounder: Option<&'a dyn CaseBound>,
 }
 
 /// Run `cases` on `pool` (skipping hashes in `done`, at most `max` runs, each within the
@@ -557,7 +564,7 @@ fn process(
         return Msg::NotRun;
     }
     let row = match resolved {
-        Ok(r) => w.evaluate(study, case, &r, run.tuner),
+        Ok(r) => w.evaluate(study, case, &r, run.tuner, run.bounder),
         Err(reason) => {
             let mut row = Row::new(case.id, hash, case.values.clone());
             row.end(CaseEnd::Skipped, &reason.to_string());

@@ -16,6 +16,7 @@
 //! - [`engine`]: running, resuming and sharding a sweep; [`shards`]: merging shard outputs.
 
 pub mod adaptive;
+pub mod bound_hook;
 pub mod conditions;
 pub mod engine;
 pub mod faults;

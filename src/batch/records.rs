@@ -145,6 +145,7 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
         study
             .tune_columns()
             .into_iter()
+            .chain(study.ocp_columns())
             .map(|c| (c, ColumnKind::F64)),
     );
     if study.mode.is_dynamic() {
@@ -154,7 +155,7 @@ pub fn raw_schema(study: &Study) -> Vec<(String, ColumnKind)> {
 }
 
 /// The named metric columns of a study's raw rows, in raw-schema order: design, TCM (with
-/// the static analysis) and tuning columns. Every other metric of a row is a run metric,
+/// the static analysis), tuning and optimal-control bound columns. Every other metric of a row is a run metric,
 /// packed into [`SCENARIO_METRICS_COLUMN`] in the journal.
 pub fn metric_columns(study: &Study) -> Vec<String> {
     let mut c: Vec<String> = DESIGN_COLUMNS.iter().map(|n| n.to_string()).collect();
@@ -167,6 +168,7 @@ pub fn metric_columns(study: &Study) -> Vec<String> {
         );
     }
     c.extend(study.tune_columns());
+    c.extend(study.ocp_columns());
     c
 }
 

@@ -10,6 +10,7 @@
 
 use std::time::Duration;
 
+use super::bound_hook::{record_efficiency, CaseBound};
 use super::faults::score_faults;
 use super::records::Row;
 use super::tuning_hook::CaseTuner;
@@ -104,17 +105,32 @@ impl Worker {
     /// Evaluate a resolved case into its row (no trajectory is logged: the report's best and
     /// worst reruns log theirs, `finish::rerun_extremes`). With a `tuner`, the case is tuned
     /// first and scored at its tuned values (a tuning that cannot run makes the case `failed`
-    /// with a reason starting `tune:`).
+    /// with a reason starting `tune:`). With a `bounder` (`[ocp]`), a case that ran gets its
+    /// design's optimal-control bound and `controller_efficiency`.
     pub fn evaluate(
         &mut self,
         study: &Study,
         case: &Case,
         r: &Resolved,
         tuner: Option<&dyn CaseTuner>,
+        bounder: Option<&dyn CaseBound>,
     ) -> Row {
         let deadline = Deadline::after(self.budget);
-        let row =
-            |res: CaseResult| Row::from_result(case.id, r.hash.clone(), case.values.clone(), res);
+        // With `[ocp]`, a case that ran gets its design's bound and the controller's
+        // efficiency against it (the bound depends on the design only: its gains are not
+        // an input, so a tuned case is bounded by its own design's solve).
+        let bounded = |mut res: CaseResult| {
+            if let Some(b) = bounder {
+                if !matches!(res.status(), CaseStatus::Failed | CaseStatus::Skipped) {
+                    b.bound(study, r, &mut res.metrics);
+                    record_efficiency(&mut res.metrics);
+                }
+            }
+            res
+        };
+        let row = |res: CaseResult| {
+            Row::from_result(case.id, r.hash.clone(), case.values.clone(), bounded(res))
+        };
         // A design that cannot reach the mission is not tuned nor put in worlds: no gain
         // changes its reach; one untuned evaluation records its static columns and the miss.
         let unreachable = out_of_reach(&r.design, &r.scenario, &study.name);

@@ -97,7 +97,7 @@ pub fn run_worlds(w: &Worlds, out: &Path) -> anyhow::Result<()> {
         .next()
         .context("the scenario as a study has no case")?;
     let resolved = resolve_case(study, &case)?;
-    let row = Worker::new().evaluate(study, &case, &resolved, None);
+    let row = Worker::new().evaluate(study, &case, &resolved, None, None);
     let mut cases = Table::new().with(CASE_ID, ColumnData::I64(vec![0]))?;
     for (k, x) in row.metrics.iter() {
         cases.push(k, ColumnData::F64(vec![x]))?;

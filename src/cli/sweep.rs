@@ -211,6 +211,7 @@ pub fn run(a: &SweepArgs) -> anyhow::Result<ExitCode> {
         case_timeout: case_budget(a.case_timeout)?,
         force: a.force,
         tuning: Some(TUNING),
+        bound: Some(usm_study::ocp::study_bound::HOOK),
         report: Some(REPORT),
     };
     if a.dry_run {

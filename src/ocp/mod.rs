@@ -20,6 +20,7 @@
 //!   chain rule (scratch in `sub_scratch`);
 //! - [`start`]: warm start from a trajectory file, the perturbed starts of a multi-start;
 //! - [`bound`]: the bound of a design on a transport leg (issue 41), N−1 warm-started;
+//!   [`study_bound`]: that bound for every case of a study with `[ocp]` (the sweep's hook);
 //! - [`problem`]: problem files with located errors; [`run`]: solve a file, write outputs.
 
 pub mod bound;
@@ -36,6 +37,7 @@ pub mod run;
 pub mod sqp;
 mod sqp_eval;
 pub mod start;
+pub mod study_bound;
 mod sub_scratch;
 mod substeps;
 

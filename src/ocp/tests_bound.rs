@@ -37,7 +37,7 @@ fn n_minus_one_bound_is_never_below_the_intact_bound() {
 /// shipped reproducer `studies/ocp_transport.toml` pose the same problem: 10 m along +x in
 /// 20 s on 20 knots, the 0.05 m/s cross current, thrusters and ±20 N·m joint torques, the
 /// base level and at rest with the joints straight at T, the same thruster-energy and effort
-/// weights (the leg adds joint energy, docs/ocp.md §6).
+/// and joint-energy weights, 10 substeps per interval (docs/ocp.md §6).
 #[test]
 fn the_bound_leg_is_the_shipped_transport_problem() {
     use super::bound::{leg_problem, LegSpec};
@@ -53,7 +53,10 @@ fn the_bound_leg_is_the_shipped_transport_problem() {
         (spec.hydrodynamics, spec.thrusters),
         (file.hydrodynamics, file.thrusters)
     );
-    assert_eq!((spec.duration, spec.knots), (file.duration, file.knots));
+    assert_eq!(
+        (spec.duration, spec.knots, spec.substeps),
+        (file.duration, file.knots, file.substeps)
+    );
     assert_eq!(spec.current, file.current);
     assert_eq!(spec.base_displacement, file.base_displacement);
     assert_eq!(spec.base_rpy, file.base_rpy);
@@ -61,5 +64,8 @@ fn the_bound_leg_is_the_shipped_transport_problem() {
     assert_eq!(spec.zero_velocity, file.zero_velocity);
     assert_eq!(spec.bounds[2], file.bounds[2]);
     assert_eq!(spec.effort, file.effort);
-    assert_eq!(spec.energy[0], file.energy[0], "thruster energy weight");
+    assert_eq!(
+        spec.energy, file.energy,
+        "thruster and joint energy weights"
+    );
 }

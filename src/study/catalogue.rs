@@ -11,7 +11,7 @@ use crate::input::located::InputError;
 
 /// Whether `name` is a metric column the cases of `study` report: a design descriptor, a
 /// static `T(q)` metric (with `[static]`), a run metric of the mode (`seg{k}_…` included) or a
-/// per-case tuning column.
+/// per-case tuning column or an optimal-control bound column (`[ocp]`).
 pub fn known_metric(name: &str, study: &Study) -> bool {
     DESIGN_COLUMNS.contains(&name)
         || (study.static_enabled
@@ -20,6 +20,7 @@ pub fn known_metric(name: &str, study: &Study) -> bool {
         || scenario_mode(study.mode)
             .is_some_and(|m| crate::outcome::run_summary::is_run_metric(m, name))
         || study.tune_columns().iter().any(|c| c == name)
+        || study.ocp_columns().iter().any(|c| c == name)
 }
 
 /// The closed-loop mode of a study mode (`None` for static studies).
@@ -49,6 +50,7 @@ pub fn metric_catalogue(study: &Study) -> Vec<String> {
         v.push(AUTHORITY_MARGIN.to_string());
     }
     v.extend(study.tune_columns());
+    v.extend(study.ocp_columns());
     v
 }
 

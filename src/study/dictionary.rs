@@ -19,6 +19,7 @@ pub const DICTIONARY: &[(&str, &[ColumnDoc])] = &[
         AUTHORITY,
     ),
     ("cases.csv: per-case tuning (`[tune]`)", TUNING),
+    ("cases.csv: the optimal-control bound (`[ocp]`)", OCP),
     ("cases.csv: the closed-loop run, both modes", RUN_COMMON),
     ("cases.csv: transport runs", RUN_TRANSPORT),
     ("cases.csv: work runs", RUN_WORK),
@@ -107,6 +108,17 @@ const TUNING: &[ColumnDoc] = &[
     c("tune_noise", "–", "f64", "relative spread (max − min)/min of the tuned objective: with `[tune] seeds` ≥ 2, of each seed's best point run in the pooled tuning worlds of every seed; else of the best feasible objective across the independent tuning starts (`[tune] starts`); NaN with one start and one seed"),
     c("tune_success_spread", "–", "f64", "with `[tune] seeds` ≥ 2: spread (max − min) over the seeds of the fraction of the pooled tuning worlds in which each seed's best point meets every `[[tune.constraint]]`"),
     c("tune_bound_hits", "–", "i64", "tuned parameters within 0.1 % of a bound of their box"),
+];
+
+const OCP: &[ColumnDoc] = &[
+    c("ocp_energy", "J", "f64", "with `[ocp]`: the optimal-control bound of the case's design on the section's straight transport leg (from rest to rest, thrusts and joint torques as controls, full hydrodynamics): thruster shaft energy at zero inflow plus joint mechanical energy of the best local optimum found over the starts (never claimed global); the same definitions as the closed loop's `thruster_energy_static` and `joint_energy`"),
+    c("ocp_energy_per_metre", "J/m", "f64", "`ocp_energy` per metre of the leg"),
+    c("ocp_energy_spread", "–", "f64", "(max − min)/min of the converged starts' objectives; NaN with fewer than two converged starts"),
+    c("ocp_status", "code", "i64", "the best start's status: 0 converged (KKT ≤ tolerance), 1 max iterations, 2 stalled (line search found no acceptable step), 3 infeasible, 4 diverged"),
+    c("ocp_kkt", "–", "f64", "the best start's largest KKT residual (primal, stationarity, complementarity)"),
+    c("ocp_primal", "–", "f64", "the best start's primal residual (dynamics defects and the leg's terminal rows): at most the tolerance means a trajectory the model can fly that ends the leg"),
+    c("ocp_iterations", "–", "i64", "SQP iterations of every start of the design's solve together (one solve per design, shared by its cases)"),
+    c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world: ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[

@@ -38,6 +38,11 @@ pub enum StudyError {
     /// The study has a `[tune]` section but the caller wired no tuner into the sweep.
     #[error("the study has a [tune] section but no tuner was wired into the sweep")]
     NoTuner,
+    /// The study has an `[ocp]` section but the caller wired no bound solver into the sweep.
+    #[error(
+        "the study has an [ocp] section but no optimal-control solver was wired into the sweep"
+    )]
+    NoBounder,
     /// Anything else.
     #[error("{0}")]
     Other(String),

@@ -19,7 +19,7 @@
 //! - [`catalogue`], [`directions`], [`dictionary`]: the metric catalogue, which way is
 //!   better, every output column's unit, type and meaning (`docs/columns.md`).
 //! - [`uncertainty`]: `[uncertainty]` and `[[validate]]`: uncertain parameters, ranking
-//!   settings, validation variants; [`fault_spec`]: `[faults]`.
+//!   settings, validation variants; [`fault_spec`]: `[faults]`; [`ocp_section`]: `[ocp]`.
 //! - [`doe`]: grid and sampled designs of experiments → cases.
 //! - [`cases`]: a case's overrides applied, its seed and hashes.
 //! - [`admit`]: every axis, world and variant value checked at load.
@@ -37,6 +37,7 @@ pub mod doe;
 pub mod error;
 pub mod fault_spec;
 pub mod hash;
+pub mod ocp_section;
 pub mod parse;
 pub mod runner;
 pub mod schema;

@@ -55,6 +55,7 @@ struct StudyFile {
     validate: Option<Vec<toml::Table>>,
     faults: Option<toml::Table>,
     fault: Option<toml::Table>,
+    ocp: Option<toml::Table>,
     secondary: Option<toml::Table>,
 }
 
@@ -259,6 +260,11 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
         uncertainty: None,
         validate: Vec::new(),
         faults: None,
+        ocp: super::ocp_section::parse_ocp(
+            file.ocp.as_ref(),
+            side.mode == StudyMode::Transport,
+            doc,
+        )?,
         robust_table: toml::Table::new(),
     };
     check_report(&study, doc)?;
@@ -314,6 +320,10 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
     super::admit::check_tune_values(&study, doc)?;
     if let Some(f) = &file.faults {
         (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
+    }
+    if let Some(o) = &file.ocp {
+        // The bound's columns depend on the leg: part of every case hash, as the worlds are.
+        (study.robust_table).insert("ocp".into(), toml::Value::Table(o.clone()));
     }
     if let Some(u) = &file.uncertainty {
         study

@@ -232,6 +232,8 @@ pub struct Study {
     pub validate: Vec<Variant>,
     /// `[faults]`: the single thruster fault every case is re-run with, per thruster.
     pub faults: Option<super::fault_spec::FaultStudy>,
+    /// `[ocp]`: the optimal-control bound of every case's design on a transport leg (issue 41).
+    pub ocp: Option<super::ocp_section::OcpSection>,
     /// `[uncertainty]` and `[[validate]]` as written (part of every case hash: a row
     /// depends on them); empty without them.
     pub robust_table: toml::Table,
@@ -262,6 +264,42 @@ pub struct TuneSection {
     pub screen: bool,
 }
 
+/// Column of a study with `[ocp]`: the objective's energy part at the best local optimum found
+/// on the leg, `Σ Δt Σ_j c |u_j|^{3/2} + Σ Δt Σ_i |τ_i q̇_i|` [J] (thruster shaft energy at zero
+/// inflow plus joint mechanical energy, the closed loop's `thruster_energy_static` +
+/// `joint_energy`) over the leg [J]; the best local optimum found, never claimed global.
+pub const OCP_ENERGY: &str = "ocp_energy";
+/// Column: [`OCP_ENERGY`] per metre of the leg [J/m].
+pub const OCP_ENERGY_PER_METRE: &str = "ocp_energy_per_metre";
+/// Column: (max − min)/min of the converged starts' objectives (NaN with fewer than two).
+pub const OCP_SPREAD: &str = "ocp_energy_spread";
+/// Column: the best start's status: 0 converged, 1 max iterations, 2 stalled, 3 infeasible,
+/// 4 diverged.
+pub const OCP_STATUS: &str = "ocp_status";
+/// Column: the best start's largest KKT residual (primal, stationarity, complementarity).
+pub const OCP_KKT: &str = "ocp_kkt";
+/// Column: the best start's primal residual (defects and terminal rows): ≤ the tolerance
+/// means the trajectory is dynamically feasible and meets the leg's end.
+pub const OCP_PRIMAL: &str = "ocp_primal";
+/// Column: SQP iterations of every start of the design's solve together (the solve's cost in a
+/// deterministic unit; wall time is not a table column, so tables stay bit-identical for any
+/// thread count — `benches/README.md` gives the time per solve).
+pub const OCP_ITERATIONS: &str = "ocp_iterations";
+/// Column: `ocp_energy_per_metre` / the closed loop's `(thruster_energy_static +
+/// joint_energy) / path_progress`: ≤ 1 when both are right; > 1 flags one of them.
+pub const CONTROLLER_EFFICIENCY: &str = "controller_efficiency";
+/// The columns `[ocp]` adds to every row, in order.
+pub const OCP_COLUMNS: [&str; 8] = [
+    OCP_ENERGY,
+    OCP_ENERGY_PER_METRE,
+    OCP_SPREAD,
+    OCP_STATUS,
+    OCP_KKT,
+    OCP_PRIMAL,
+    OCP_ITERATIONS,
+    CONTROLLER_EFFICIENCY,
+];
+
 /// Column of a tuned study's rows: fresh evaluations the case's tuning used.
 pub const TUNE_EVALUATIONS: &str = "tune_evaluations";
 /// Column of a tuned study's rows: 1 when the tuned point met every `[[tune.constraint]]`.
@@ -280,6 +318,14 @@ pub const TUNE_CURVE_PREFIX: &str = "tune_curve.";
 pub const TUNED_PREFIX: &str = "tuned.";
 
 impl Study {
+    /// The columns `[ocp]` adds to every row ([`OCP_COLUMNS`]; none without `[ocp]`).
+    pub fn ocp_columns(&self) -> Vec<String> {
+        match &self.ocp {
+            Some(_) => OCP_COLUMNS.iter().map(|c| c.to_string()).collect(),
+            None => Vec::new(),
+        }
+    }
+
     /// The columns per-case tuning adds to every row: `tuned.<param>` for each
     /// `[[tune.param]]` in file order, then [`TUNE_EVALUATIONS`], [`TUNE_FEASIBLE`],
     /// [`TUNE_NOISE`], [`TUNE_SUCCESS_SPREAD`] (only with `[tune] seeds` ≥ 2) and
