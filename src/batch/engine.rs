@@ -160,12 +160,10 @@ pub fn run_sweep(
 ) -> Result<SweepOutcome, StudyError> {
     let t0 = Instant::now();
     let start_time = now_rfc3339();
-    if let Some((i, n)) = opts.shard {
-        if n == 0 || i >= n {
-            return Err(StudyError::Input(format!(
-                "--shard {i}/{n}: need 0 <= I < N"
-            )));
-        }
+    if let Some((i, n)) = opts.shard.filter(|&(i, n)| n == 0 || i >= n) {
+        return Err(StudyError::Input(format!(
+            "--shard {i}/{n}: need 0 <= I < N"
+        )));
     }
     super::adaptive::refuse_shards(study, opts.shard)?;
     let tuner = case_tuner(study, opts.tuning)?;
@@ -192,10 +190,9 @@ pub fn run_sweep(
     }
     let schema = raw_schema(study);
     let (mut appender, done) = open_journal(study, &out, &schema, opts.resume, &mut notes)?;
-    let jobs = if opts.jobs == 0 {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
-    } else {
-        opts.jobs
+    let jobs = match opts.jobs {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        j => j,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)

@@ -116,11 +116,15 @@ impl Worker {
         bounder: Option<&dyn CaseBound>,
     ) -> Row {
         let deadline = Deadline::after(self.budget);
+        // A design that cannot reach the mission is not tuned nor put in worlds: no gain
+        // changes its reach; one untuned evaluation records its static columns and the miss.
+        let unreachable = out_of_reach(&r.design, &r.scenario, &study.name);
         // With `[ocp]`, a case that ran gets its design's bound and the controller's
         // efficiency against it (the bound depends on the design only: its gains are not
-        // an input, so a tuned case is bounded by its own design's solve).
+        // an input, so a tuned case is bounded by its own design's solve). A design that
+        // cannot reach the mission gets no bound (NaN columns): it cannot do the mission.
         let bounded = |mut res: CaseResult| {
-            if let Some(b) = bounder {
+            if let Some(b) = bounder.filter(|_| !unreachable) {
                 if !matches!(res.status(), CaseStatus::Failed | CaseStatus::Skipped) {
                     b.bound(study, r, &mut res.metrics);
                     record_efficiency(&mut res.metrics);
@@ -131,9 +135,6 @@ impl Worker {
         let row = |res: CaseResult| {
             Row::from_result(case.id, r.hash.clone(), case.values.clone(), bounded(res))
         };
-        // A design that cannot reach the mission is not tuned nor put in worlds: no gain
-        // changes its reach; one untuned evaluation records its static columns and the miss.
-        let unreachable = out_of_reach(&r.design, &r.scenario, &study.name);
         let Some(t) = tuner.filter(|_| !unreachable) else {
             let mut res =
                 evaluate_resolved(&mut self.evaluator, study, case.id, r, false, deadline);

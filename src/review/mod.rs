@@ -6,7 +6,8 @@
 //!
 //! - [`selection`], [`families`]: best/worst, Pareto front, families of ranked designs.
 //! - [`plots_ranked`], [`plots`]: the sweep's plots, ranked designs told apart.
-//! - [`summary_robust`], [`verdict_box`], [`verdict_firm`], [`summary`]: `summary.md`.
+//! - [`summary_robust`], [`verdict_box`], [`verdict_firm`], [`summary_bound`], [`summary`]:
+//!   `summary.md` (with `[ocp]`, the physical-limit section and `plots/bound.svg`).
 //! - [`rerank`]: `usm-study report --objective/--pareto`.
 //! - [`finish`]: the report step (handed to a sweep as its [`HOOK`]) and `usm-study report`.
 
@@ -17,6 +18,7 @@ pub mod plots_ranked;
 pub mod rerank;
 pub mod selection;
 pub mod summary;
+pub mod summary_bound;
 pub mod summary_robust;
 pub mod verdict_box;
 pub mod verdict_firm;

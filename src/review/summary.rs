@@ -95,6 +95,17 @@ pub fn write_report(dir: &Path, table: &Table, m: &Manifest) -> Vec<String> {
     if let Some(r) = &robust {
         md.push_str(&r.sections(dir, &plots, &mut warnings));
     }
+    let bound = super::summary_bound::bound_section(
+        table,
+        &c.axes,
+        &c.ok_rows,
+        &c.sel,
+        &plots,
+        &mut warnings,
+    );
+    if let Some(b) = bound {
+        md.push_str(&b);
+    }
     tune_section(&c, &mut md, robust.is_some());
     best_section(&c, &mut md);
     effects_section(&c, &mut md);

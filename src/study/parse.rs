@@ -318,25 +318,28 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
     super::admit::check_values(&study, doc)?;
     study.tuning = super::tune_section::parse_tune(&study, doc)?;
     super::admit::check_tune_values(&study, doc)?;
+    study.robust_table = robust_table(&file);
+    Ok(study)
+}
+
+/// `[faults]`, `[ocp]`, `[uncertainty]` and `[[validate]]` as written: part of every case hash
+/// (a row depends on them; the bound's columns depend on the leg, as the worlds' do).
+fn robust_table(file: &StudyFile) -> toml::Table {
+    let mut t = toml::Table::new();
     if let Some(f) = &file.faults {
-        (study.robust_table).insert("faults".into(), toml::Value::Table(f.clone()));
+        t.insert("faults".into(), toml::Value::Table(f.clone()));
     }
     if let Some(o) = &file.ocp {
-        // The bound's columns depend on the leg: part of every case hash, as the worlds are.
-        (study.robust_table).insert("ocp".into(), toml::Value::Table(o.clone()));
+        t.insert("ocp".into(), toml::Value::Table(o.clone()));
     }
     if let Some(u) = &file.uncertainty {
-        study
-            .robust_table
-            .insert("uncertainty".into(), toml::Value::Table(u.clone()));
+        t.insert("uncertainty".into(), toml::Value::Table(u.clone()));
     }
     if let Some(v) = &file.validate {
         let list = v.iter().cloned().map(toml::Value::Table).collect();
-        study
-            .robust_table
-            .insert("validate".into(), toml::Value::Array(list));
+        t.insert("validate".into(), toml::Value::Array(list));
     }
-    Ok(study)
+    t
 }
 
 /// `study.objective`, `study.pareto` and `study.maximise` name metrics the cases report

@@ -1,0 +1,315 @@
+//! The physical-limit section of `summary.md` (issue 41, docs/ocp.md §6): with `[ocp]`, each
+//! design's optimal-control bound beside its closed-loop cost on the same measure (thruster
+//! energy at zero inflow plus joint energy, per metre), the plot of one against the other
+//! (`plots/bound.svg`: the diagonal is the perfect controller), and the sentence on whether the
+//! ranking by bound agrees with the closed-loop ranking — and where it does not, which designs
+//! are limited by the controller rather than by the layout.
+//!
+//! A bound counts only where it is a trajectory the model can fly: primal residual (defects
+//! and the leg's terminal rows) at most [`FEASIBLE`]. A design whose closed loop spends *less*
+//! per metre than its bound (`controller_efficiency` > 1) is flagged, never dropped: one of the
+//! two is wrong, or the two missions differ more than the comparison assumes (the leg is
+//! straight from rest to rest; the run follows the study's path).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plots::{case_name, metric_title};
+use super::plots_ranked::ranked_mask;
+use super::selection::Selection;
+use crate::batch::records::CASE_ID;
+use crate::report::{
+    fmt_short, scatter_labelled, LabelledPoint, LineStyle, MarkdownTable, PanelKind, Series, Table,
+};
+use crate::study::schema::{
+    CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL, OCP_SPREAD, OCP_STATUS,
+};
+
+/// A bound with a primal residual at most this is a trajectory the model can fly.
+pub const FEASIBLE: f64 = 1e-6;
+
+/// The words of an `ocp_status` code.
+fn status_word(code: f64) -> &'static str {
+    match code as i64 {
+        0 if code == 0.0 => "converged",
+        1 => "max iterations",
+        2 => "stalled",
+        3 => "infeasible",
+        4 => "diverged",
+        _ => "–",
+    }
+}
+
+/// One design of the section.
+struct Entry {
+    row: usize,
+    closed: f64,
+    bound: f64,
+    efficiency: f64,
+    objective: f64,
+}
+
+/// The section, or `None` without `ocp_energy_per_metre` in the table. `rows` are the designs
+/// compared (the successful ones; the ranked ones of a robust study), `objective` the study's
+/// objective column (ascending is better unless `sel` maximises it).
+pub(crate) fn bound_section(
+    table: &Table,
+    axes: &[&str],
+    rows: &[usize],
+    sel: &Selection,
+    plots: &Path,
+    warnings: &mut Vec<String>,
+) -> Option<String> {
+    let bound = table.f64(OCP_ENERGY_PER_METRE).ok()?;
+    let col = |n: &str| table.f64(n).ok();
+    let (ts, je, pp) = (
+        col("thruster_energy_static")?,
+        col("joint_energy")?,
+        col("path_progress")?,
+    );
+    let eff = col(CONTROLLER_EFFICIENCY)?;
+    let primal = col(OCP_PRIMAL)?;
+    let status = col(OCP_STATUS)?;
+    let spread = col(OCP_SPREAD);
+    let objective = sel.objective.as_deref();
+    let obj = objective.and_then(col);
+    let maximise = objective.is_some_and(|o| sel.maximise.contains(o));
+    let mask = ranked_mask(table);
+    let rows: Vec<usize> = rows
+        .iter()
+        .copied()
+        .filter(|&r| mask.as_ref().is_none_or(|m| m[r]))
+        .collect();
+    let mut md = String::from("## Physical limit: the optimal-control bound (`[ocp]`)\n\n");
+    let _ = writeln!(
+        md,
+        "Each design's **bound** is the least thruster energy (zero inflow) plus joint energy the \
+         best local optimum found spends on the study's straight transport leg (`[ocp]`: from \
+         rest to rest, thrusts and joint torques as controls on the full hydrodynamic model; \
+         never claimed global), per metre. Beside it the closed loop's \
+         `(thruster_energy_static + joint_energy) / path_progress` in the nominal world, and \
+         `controller_efficiency` = bound / closed loop. **What the bound does not carry:** the \
+         path's turn and initial offset (the leg is straight), any `[mission]` payload (the \
+         leg's vehicle is the bare design), the worlds. A bound counts where its trajectory is \
+         feasible (primal residual ≤ {}).\n",
+        fmt_short(FEASIBLE)
+    );
+    let mut entries: Vec<Entry> = rows
+        .iter()
+        .map(|&r| Entry {
+            row: r,
+            closed: (ts[r] + je[r]) / pp[r],
+            bound: bound[r],
+            efficiency: eff[r],
+            objective: obj.map_or(f64::NAN, |o| o[r]),
+        })
+        .collect();
+    let key = |e: &Entry| if maximise { -e.objective } else { e.objective };
+    entries.sort_by(|a, b| key(a).total_cmp(&key(b)).then(a.row.cmp(&b.row)));
+    let ids = table.i64(CASE_ID).unwrap_or(&[]);
+    let name = |r: usize| {
+        format!(
+            "#{} {}",
+            ids.get(r).copied().unwrap_or(r as i64),
+            case_name(table, axes, r)
+        )
+    };
+    let mut t = MarkdownTable::new([
+        "design",
+        objective.unwrap_or("objective"),
+        "closed loop J/m",
+        "bound J/m",
+        "controller_efficiency",
+        "bound status",
+        "bound spread",
+    ]);
+    for e in &entries {
+        let feasible = primal[e.row] <= FEASIBLE;
+        t.row([
+            name(e.row),
+            fmt_short(e.objective),
+            fmt_short(e.closed),
+            if feasible {
+                fmt_short(e.bound)
+            } else {
+                format!("({}, infeasible)", fmt_short(e.bound))
+            },
+            fmt_short(e.efficiency),
+            status_word(status[e.row]).to_string(),
+            spread.map_or("–".into(), |s| fmt_short(s[e.row])),
+        ]);
+    }
+    md.push_str(&t.finish());
+    md.push('\n');
+    let ok: Vec<&Entry> = entries
+        .iter()
+        .filter(|e| primal[e.row] <= FEASIBLE && e.bound.is_finite() && e.closed.is_finite())
+        .collect();
+    md.push_str(&agreement(&ok, &name));
+    let above: Vec<String> = ok
+        .iter()
+        .filter(|e| e.efficiency > 1.0)
+        .map(|e| format!("{} ({})", name(e.row), fmt_short(e.efficiency)))
+        .collect();
+    if !above.is_empty() {
+        let _ = writeln!(
+            md,
+            "\n**Flagged: closed loop below its bound** (`controller_efficiency` > 1, an error of \
+             one of them or missions that differ more than assumed): {}.",
+            above.join(", ")
+        );
+    }
+    bound_plot(&ok, &name, plots, warnings);
+    md.push_str("\n![closed loop against bound](plots/bound.svg)\n\n");
+    Some(md)
+}
+
+/// The sentence on agreement: is the closed-loop leader also the design with the lowest
+/// bound, the rank correlation of the two orders, and the designs limited by the controller
+/// (bound below the leader's, closed loop above it). `ok` is sorted by the objective.
+fn agreement(ok: &[&Entry], name: &dyn Fn(usize) -> String) -> String {
+    let Some(leader) = ok.first() else {
+        return "No design has both a feasible bound and a closed-loop run to compare.\n".into();
+    };
+    let lowest = ok
+        .iter()
+        .min_by(|a, b| a.bound.total_cmp(&b.bound).then(a.row.cmp(&b.row)))
+        .expect("non-empty");
+    let rho = spearman(
+        &ok.iter().map(|e| e.closed).collect::<Vec<_>>(),
+        &ok.iter().map(|e| e.bound).collect::<Vec<_>>(),
+    );
+    let mut s = if leader.row == lowest.row {
+        format!(
+            "**The ranking by bound agrees at the top:** the closed-loop leader {} also has the \
+             lowest bound ({} J/m).",
+            name(leader.row),
+            fmt_short(leader.bound)
+        )
+    } else {
+        format!(
+            "**The ranking by bound disagrees at the top:** the closed-loop leader {} has bound {} \
+             J/m; the lowest bound is {}'s ({} J/m).",
+            name(leader.row),
+            fmt_short(leader.bound),
+            name(lowest.row),
+            fmt_short(lowest.bound)
+        )
+    };
+    let _ = write!(
+        s,
+        " Spearman rank correlation of closed-loop cost and bound over the {} designs: {}.",
+        ok.len(),
+        fmt_short(rho)
+    );
+    let limited: Vec<String> = ok
+        .iter()
+        .skip(1)
+        .filter(|e| e.bound < leader.bound)
+        .map(|e| name(e.row))
+        .collect();
+    if limited.is_empty() {
+        s.push_str(" No design with a lower bound than the leader's ranks below it.\n");
+    } else {
+        let _ = writeln!(
+            s,
+            " Limited by the controller rather than by the layout (a lower bound than the \
+             leader's, a worse closed loop): {}.",
+            limited.join(", ")
+        );
+    }
+    s
+}
+
+/// Spearman's rank correlation of `a` and `b` (average ranks on ties; NaN below 3 points).
+pub(crate) fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    if a.len() < 3 || a.len() != b.len() {
+        return f64::NAN;
+    }
+    let ranks = |v: &[f64]| {
+        let mut idx: Vec<usize> = (0..v.len()).collect();
+        idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
+        let mut r = vec![0.0; v.len()];
+        let mut i = 0;
+        while i < idx.len() {
+            let mut j = i;
+            while j + 1 < idx.len() && v[idx[j + 1]] == v[idx[i]] {
+                j += 1;
+            }
+            for k in i..=j {
+                r[idx[k]] = (i + j) as f64 / 2.0;
+            }
+            i = j + 1;
+        }
+        r
+    };
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = ra.len() as f64;
+    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in ra.iter().zip(&rb) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+/// `plots/bound.svg` (and its PDF): closed loop (y) against bound (x) per design, the diagonal
+/// y = x (the perfect controller) dashed.
+fn bound_plot(
+    ok: &[&Entry],
+    name: &dyn Fn(usize) -> String,
+    plots: &Path,
+    warnings: &mut Vec<String>,
+) {
+    let points: Vec<LabelledPoint> = ok
+        .iter()
+        .map(|e| LabelledPoint {
+            x: e.bound,
+            y: e.closed,
+            label: name(e.row),
+        })
+        .collect();
+    let lead = if points.is_empty() { vec![] } else { vec![0] };
+    let hi = ok
+        .iter()
+        .flat_map(|e| [e.bound, e.closed])
+        .fold(0.0_f64, f64::max);
+    let fig = scatter_labelled(
+        &points,
+        &lead,
+        "Closed loop against the optimal-control bound",
+        &format!("bound: {}", metric_title(OCP_ENERGY_PER_METRE)),
+        "closed loop: (thruster_energy_static + joint_energy) / path_progress [J/m]",
+    );
+    let result = fig.and_then(|mut fig| {
+        let p = &mut fig.panels[0];
+        p.series[0].name = "designs (feasible bound)".into();
+        if let Some(s) = p.series.get_mut(2) {
+            s.name = "closed-loop leader".into();
+        }
+        let mut diag = Series::new("perfect controller (y = x)", vec![0.0, hi], vec![0.0, hi])
+            .kind(PanelKind::Line);
+        diag.style = LineStyle::Dashed;
+        p.series.push(diag);
+        fig.write_svg_pdf(&plots.join("bound.svg"))
+    });
+    if let Err(e) = result {
+        warnings.push(e.to_string());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spearman;
+
+    #[test]
+    fn spearman_matches_scipy_on_a_small_sample() {
+        // scipy.stats.spearmanr([1, 2, 3, 4, 5], [5, 6, 7, 8, 7]).statistic = 0.8207826816681233
+        let r = spearman(&[1.0, 2.0, 3.0, 4.0, 5.0], &[5.0, 6.0, 7.0, 8.0, 7.0]);
+        assert!((r - 0.820_782_681_668_123_3).abs() < 1e-12, "{r}");
+        assert!((spearman(&[1.0, 2.0, 3.0], &[3.0, 2.0, 1.0]) + 1.0).abs() < 1e-15);
+        assert!(spearman(&[1.0, 2.0], &[1.0, 2.0]).is_nan());
+    }
+}
