@@ -250,7 +250,11 @@ fn summarise(model: &ChainModel, mut sols: Vec<OcpSolution>, tolerance: f64) -> 
         } else {
             f64::INFINITY
         };
-        (s.status != Status::Converged, s.kkt[0].is_nan() || s.kkt[0] > tolerance, j)
+        (
+            s.status != Status::Converged,
+            s.kkt[0].is_nan() || s.kkt[0] > tolerance,
+            j,
+        )
     };
     let mut best = 0;
     for (i, s) in sols.iter().enumerate() {
