@@ -127,7 +127,8 @@ impl Worker {
             if let Some(b) = bounder.filter(|_| !unreachable) {
                 if !matches!(res.status(), CaseStatus::Failed | CaseStatus::Skipped) {
                     b.bound(study, r, &mut res.metrics);
-                    record_efficiency(&mut res.metrics);
+                    let tol = study.ocp.as_ref().map_or(0.0, |o| o.tolerance);
+                    record_efficiency(&mut res.metrics, tol);
                 }
             }
             res

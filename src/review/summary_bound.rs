@@ -134,7 +134,11 @@ pub(crate) fn bound_section(
             } else {
                 format!("({}, infeasible)", fmt_short(e.bound))
             },
-            fmt_short(e.efficiency),
+            if feasible {
+                fmt_short(e.efficiency)
+            } else {
+                "–".into()
+            },
             status_word(status[e.row]).to_string(),
             spread.map_or("–".into(), |s| fmt_short(s[e.row])),
         ]);

@@ -118,7 +118,7 @@ const OCP: &[ColumnDoc] = &[
     c("ocp_kkt", "–", "f64", "the best start's largest KKT residual (primal, stationarity, complementarity)"),
     c("ocp_primal", "–", "f64", "the best start's primal residual (dynamics defects and the leg's terminal rows): at most the tolerance means a trajectory the model can fly that ends the leg"),
     c("ocp_iterations", "–", "i64", "SQP iterations of every start of the design's solve together (one solve per design, shared by its cases)"),
-    c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world: ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
+    c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world (NaN when the bound is not feasible: `ocp_primal` above the `[ocp]` tolerance): ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[

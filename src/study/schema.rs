@@ -286,7 +286,8 @@ pub const OCP_PRIMAL: &str = "ocp_primal";
 /// thread count — `benches/README.md` gives the time per solve).
 pub const OCP_ITERATIONS: &str = "ocp_iterations";
 /// Column: `ocp_energy_per_metre` / the closed loop's `(thruster_energy_static +
-/// joint_energy) / path_progress`: ≤ 1 when both are right; > 1 flags one of them.
+/// joint_energy) / path_progress` (NaN without a feasible bound): ≤ 1 when both are right; > 1
+/// flags one of them.
 pub const CONTROLLER_EFFICIENCY: &str = "controller_efficiency";
 /// The columns `[ocp]` adds to every row, in order.
 pub const OCP_COLUMNS: [&str; 8] = [
