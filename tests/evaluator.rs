@@ -59,7 +59,8 @@ fn a_tuned_study_without_a_tuner_is_refused_before_anything_runs() {
     let dir = tempfile::tempdir().unwrap();
     let text = format!(
         "{STATIC}[tune]\n[[tune.param]]\nname = \"static.samples\"\nlower = 8\nupper = 16\n\
-[tune.objective]\n[[tune.objective.term]]\nmetric = \"tcm_singular_fraction\"\n"
+[tune.objective]\n[[tune.objective.term]]\nmetric = \"tcm_singular_fraction\"\nweight = 1.0\n\
+[tune.solver]\nmethod = \"nelder-mead\"\nmax_evals = 4\n"
     );
     let study = parse_study(&text, Path::new("e.toml")).unwrap();
     let opts = SweepOptions {
