@@ -81,8 +81,10 @@ fn study_and_batch_do_not_import_optimise() {
         let text = std::fs::read_to_string(&p).unwrap();
         for (i, line) in text.lines().enumerate() {
             let code = line.split("//").next().unwrap_or("");
+            // Neither the optimiser (the tuning hook) nor the optimal control (the bound
+            // hook, issue 41): the running and review rooms reach both through hooks.
             assert!(
-                !code.contains("crate::optimise"),
+                !code.contains("crate::optimise") && !code.contains("crate::ocp"),
                 "{}:{}: {line}",
                 p.display(),
                 i + 1
