@@ -199,12 +199,19 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
     for s in 0..spec.starts.max(1) {
         let (lo, hi) = (&prob.u_lo, &prob.u_hi);
         let us = perturbed_controls(&base, lo, hi, spec.perturbation, spec.seed, s);
-        let xs = if s == 0 {
-            warm.map(|w| w.0.clone())
+        // Start s ≥ 1 keeps start 0's states (multiple shooting: the perturbed controls'
+        // defects are the SQP's to close) and takes plain trial points: rolled out open loop,
+        // or by the feedback rollout from x0, a perturbed cruise diverges (docs/ocp.md §4).
+        let xs = warm.map(|w| w.0.clone());
+        let set_s = if s == 0 || xs.is_none() {
+            set
         } else {
-            None
+            SqpSettings {
+                feedback: false,
+                ..set
+            }
         };
-        sols.push(solve(&mut model, &prob, Some(us), xs, &set));
+        sols.push(solve(&mut model, &prob, Some(us), xs, &set_s));
     }
     // A leg the cruise settings cannot fly (short legs, where the cruise start is far from
     // the optimum): one more start from zero controls with the plain SQP (no damping, plain
