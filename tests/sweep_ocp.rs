@@ -122,6 +122,49 @@ fn every_case_gets_its_designs_bound_and_the_tables_do_not_depend_on_jobs() {
     assert!(one.join("plots/bound.svg").exists() && one.join("plots/bound.pdf").exists());
 }
 
+/// [`STUDY`] with two uncertain worlds of more drag (×1.1 … ×1.5) and a current, and the
+/// bound solved in both.
+fn study_in_worlds() -> String {
+    format!(
+        "{}worlds = 2\n\n[uncertainty]\nworlds = 2\nsampling = \"sobol\"\n\n\
+         [[uncertainty.param]]\nname = \"hydro.drag_scale\"\n\
+         distribution = {{ kind = \"uniform\", low = 1.1, high = 1.5 }}\n\n\
+         [[uncertainty.param]]\nname = \"physics.current_speed\"\n\
+         distribution = {{ kind = \"uniform\", low = 0.0, high = 0.02 }}\n",
+        STUDY
+    )
+}
+
+#[test]
+fn the_bound_in_worlds_costs_more_where_the_water_drags_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write(dir.path(), "w.toml", &study_in_worlds());
+    let out = dir.path().join("w");
+    sweep(&study, &out, &["--jobs", "2"]);
+    let rs = rows(&out);
+    assert_eq!(rs.len(), 4);
+    let three = rs.iter().find(|r| num(r, "design.links") == 3.0).unwrap();
+    // The nominal bound is trusted on its grid: the water's work agrees 10× finer.
+    assert!(
+        num(three, "ocp_work_error") <= 0.05,
+        "{}",
+        three["ocp_work_error"]
+    );
+    assert_eq!(num(three, "ocp_world_feasible"), 2.0, "{three:?}");
+    let (lo, hi, nominal) = (
+        num(three, "ocp_world_energy_per_metre_min"),
+        num(three, "ocp_world_energy_per_metre_max"),
+        num(three, "ocp_energy_per_metre"),
+    );
+    assert!(lo <= hi, "{lo} > {hi}");
+    // Every world drags at least 10 % more than the nominal one: its bound is higher.
+    assert!(lo > nominal, "world bound {lo} vs nominal {nominal}");
+    assert!(num(three, "ocp_world_iterations") >= 2.0);
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(md.contains("bound in worlds J/m"), "{md}");
+    assert!(md.contains("also solved in the study's first scoring worlds"));
+}
+
 #[test]
 fn bad_ocp_sections_exit_2_naming_file_line_and_key() {
     let dir = tempfile::tempdir().unwrap();
@@ -134,6 +177,12 @@ fn bad_ocp_sections_exit_2_naming_file_line_and_key() {
         (
             STUDY.replace("distance = 1.0", "distance = -1.0"),
             "ocp.distance",
+        ),
+        // Worlds without [uncertainty], and more worlds than it has.
+        (format!("{STUDY}worlds = 2\n"), "ocp.worlds"),
+        (
+            study_in_worlds().replace("worlds = 2\n\n[uncertainty]", "worlds = 3\n\n[uncertainty]"),
+            "ocp.worlds",
         ),
         (
             STUDY.replace("substeps = 2", "substeps = 2\ncurrent = [0.0, 9.0, 0.0]"),

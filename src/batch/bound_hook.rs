@@ -12,7 +12,10 @@ use std::fmt;
 use crate::evaluate::Metrics;
 use crate::study::cases::Resolved;
 use crate::study::error::StudyError;
-use crate::study::schema::{Study, CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL};
+use crate::study::schema::{
+    Study, CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL, OCP_WORK_ERROR,
+    OCP_WORK_TRUSTED,
+};
 
 /// Solves the bound of the cases of one study.
 pub trait CaseBound: Sync {
@@ -51,14 +54,17 @@ pub fn case_bound(
 /// `controller_efficiency` of a row: `ocp_energy_per_metre` over the closed loop's
 /// `(thruster_energy_static + joint_energy) / path_progress`; NaN when either is missing, the
 /// run made no progress, or the bound's trajectory is not feasible (`ocp_primal` above
-/// `tolerance`, the section's KKT tolerance: not a trajectory the model can fly, so no bound).
+/// `tolerance`, the section's KKT tolerance: not a trajectory the model can fly, so no bound)
+/// or not trusted on its grid (`ocp_work_error` above [`OCP_WORK_TRUSTED`]: it swims on energy
+/// the integration supplies).
 /// Set by name.
 pub fn record_efficiency(metrics: &mut Metrics, tolerance: f64) {
     let get = |m: &Metrics, k: &str| m.get(k).unwrap_or(f64::NAN);
     let progress = get(metrics, "path_progress");
     let closed = (get(metrics, "thruster_energy_static") + get(metrics, "joint_energy")) / progress;
     let bound = get(metrics, OCP_ENERGY_PER_METRE);
-    let feasible = get(metrics, OCP_PRIMAL) <= tolerance;
+    let feasible =
+        get(metrics, OCP_PRIMAL) <= tolerance && get(metrics, OCP_WORK_ERROR) <= OCP_WORK_TRUSTED;
     let eff = if feasible && progress > 0.0 && closed > 0.0 {
         bound / closed
     } else {

@@ -14,7 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::chain::ChainModel;
-use super::cruise::cruise_start;
+use super::cruise::{cruise_start, ramped_cruise_start, RAMP};
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
 use super::qp::QpSettings;
@@ -117,10 +117,27 @@ pub fn leg_problem(vehicle: &Vehicle, leg: &LegSpec) -> ProblemSpec {
     }
 }
 
+/// Least and greatest ramp fraction of the multi-start's cruise starts (C1): from a quick
+/// start (a tenth of the horizon accelerating) to a triangular speed profile.
+pub const RAMP_RANGE: (f64, f64) = (0.1, 0.5);
+
+/// The ramp fraction of start `s` of a cruise-started leg: [`RAMP`] for start 0, else uniform
+/// in [`RAMP_RANGE`] from ChaCha8 seeded with (`seed`, `s`).
+pub fn start_ramp(seed: u64, s: usize) -> f64 {
+    use rand::{Rng, SeedableRng};
+    if s == 0 {
+        return RAMP;
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(s as u64);
+    rng.random_range(RAMP_RANGE.0..=RAMP_RANGE.1)
+}
+
 /// The bound of one design on one problem: the best local optimum over the starts.
 #[derive(Clone, Debug)]
 pub struct Bound {
-    /// Objective J of the best start (converged first, then lowest J).
+    /// Objective J of the best start (converged first, then feasible with the lowest J, then
+    /// the lowest primal residual).
     pub objective: f64,
     /// `Σ Δt Σ_j c |u_j|^{3/2}` of the best start [J]: thruster energy at zero inflow.
     pub thruster_energy_static: f64,
@@ -138,8 +155,31 @@ pub struct Bound {
     pub converged: usize,
     /// SQP iterations of every start together.
     pub iterations: usize,
+    /// The best start's work-balance error on its grid (docs/ocp.md §6):
+    /// `|W_other − W_other,refined| / max(|W_act|, |W_act,refined|)` against the same controls
+    /// integrated [`WORK_REFINE`] times finer (`ocp::fidelity` (F3)–(F4)); NaN when the refined
+    /// integration fails. Above a few per cent the optimum swims on energy the grid supplies.
+    pub work_error: f64,
     /// The best start's solution.
     pub solution: OcpSolution,
+}
+
+/// Refinement of the work-balance check of [`Bound::work_error`].
+pub const WORK_REFINE: usize = 10;
+
+/// [`Bound::work_error`] of `(xs, us)` on `model`.
+pub fn work_error(model: &ChainModel, xs: &[Vec<f64>], us: &[Vec<f64>]) -> f64 {
+    match super::fidelity::grid_fidelity(model, xs, us, WORK_REFINE) {
+        Ok(f) => {
+            let scale = f
+                .actuator_work
+                .abs()
+                .max(f.actuator_work_refined.abs())
+                .max(f64::MIN_POSITIVE);
+            (f.other_work - f.other_work_refined).abs() / scale
+        }
+        Err(_) => f64::NAN,
+    }
 }
 
 /// The control bounds of a thruster-actuated problem: thrust limits, then ±joint torque.
@@ -185,9 +225,9 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
     };
     // Start 0: the warm start, else the cruise start (`spec.cruise_start`, docs/ocp.md §4
     // (C1)–(C3); zero controls if it fails), else zero controls rolled out.
+    let d = spec.base_displacement.unwrap_or_default();
     let cruise = match warm {
         None if spec.cruise_start => {
-            let d = spec.base_displacement.unwrap_or_default();
             cruise_start(&mut model, &prob.x0, spec.knots, d, &prob.u_lo, &prob.u_hi).ok()
         }
         _ => None,
@@ -198,20 +238,36 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
     let mut sols: Vec<OcpSolution> = Vec::with_capacity(spec.starts);
     for s in 0..spec.starts.max(1) {
         let (lo, hi) = (&prob.u_lo, &prob.u_hi);
-        let us = perturbed_controls(&base, lo, hi, spec.perturbation, spec.seed, s);
-        // Start s ≥ 1 keeps start 0's states (multiple shooting: the perturbed controls'
-        // defects are the SQP's to close) and takes plain trial points: rolled out open loop,
-        // or by the feedback rollout from x0, a perturbed cruise diverges (docs/ocp.md §4).
-        let xs = warm.map(|w| w.0.clone());
-        let set_s = if s == 0 || xs.is_none() {
-            set
-        } else {
-            SqpSettings {
-                feedback: false,
-                ..set
+        // Start s ≥ 1 of a cruise-started leg: the cruise start with its own ramp fraction
+        // (`start_ramp`), dynamically consistent as start 0 (a perturbed cruise rolled out
+        // diverged at iteration 0–1, and kept on start 0's states it did not converge in 150
+        // iterations: docs/ocp.md §6).
+        let ramped = (s > 0 && spec.cruise_start)
+            .then(|| {
+                let r = start_ramp(spec.seed, s);
+                ramped_cruise_start(&mut model, &prob.x0, spec.knots, d, r, lo, hi).ok()
+            })
+            .flatten();
+        let sol = match ramped {
+            Some((xs, us)) => solve(&mut model, &prob, Some(us), Some(xs), &set),
+            None => {
+                let us = perturbed_controls(&base, lo, hi, spec.perturbation, spec.seed, s);
+                // Without a cruise start, start s ≥ 1 keeps start 0's states (multiple
+                // shooting: the perturbed controls' defects are the SQP's to close) with
+                // plain trial points.
+                let xs = warm.map(|w| w.0.clone());
+                let set_s = if s == 0 || xs.is_none() {
+                    set
+                } else {
+                    SqpSettings {
+                        feedback: false,
+                        ..set
+                    }
+                };
+                solve(&mut model, &prob, Some(us), xs, &set_s)
             }
         };
-        sols.push(solve(&mut model, &prob, Some(us), xs, &set_s));
+        sols.push(sol);
     }
     // A leg the cruise settings cannot fly (short legs, where the cruise start is far from
     // the optimum): one more start from zero controls with the plain SQP (no damping, plain
@@ -234,7 +290,8 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
 }
 
 /// The best of `sols` (converged first, then primal feasible — defects and terminal rows within
-/// `tolerance` —, then the lowest objective; ties to the earlier start).
+/// `tolerance` — with the lowest objective, else the lowest primal residual; ties to the
+/// earlier start).
 fn summarise(model: &ChainModel, mut sols: Vec<OcpSolution>, tolerance: f64) -> Bound {
     let conv: Vec<f64> = sols
         .iter()
@@ -257,10 +314,18 @@ fn summarise(model: &ChainModel, mut sols: Vec<OcpSolution>, tolerance: f64) -> 
         } else {
             f64::INFINITY
         };
+        let infeasible = s.kkt[0].is_nan() || s.kkt[0] > tolerance;
+        // Among infeasible starts the nearest to feasible (the zero-control fallback barely
+        // moves, J ≈ 0 at primal ≈ 5: the lowest J would name it).
+        let p = if s.kkt[0].is_nan() {
+            f64::INFINITY
+        } else {
+            s.kkt[0]
+        };
         (
             s.status != Status::Converged,
-            s.kkt[0].is_nan() || s.kkt[0] > tolerance,
-            j,
+            infeasible,
+            if infeasible { p } else { j },
         )
     };
     let mut best = 0;
@@ -275,7 +340,9 @@ fn summarise(model: &ChainModel, mut sols: Vec<OcpSolution>, tolerance: f64) -> 
         let b = c.breakdown(n, &solution.xs, &solution.us);
         (b.thruster_energy_static, b.joint_energy)
     });
+    let work_error = work_error(model, &solution.xs, &solution.us);
     Bound {
+        work_error,
         objective: solution.objective,
         thruster_energy_static: e_t,
         joint_energy: e_j,

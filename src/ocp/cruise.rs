@@ -41,7 +41,12 @@ const ALLOCATION_DAMPING: f64 = 1e-8;
 /// The speed weights `w_0 … w_N` of (C1): zero at both ends, a sin² ramp over `⌈RAMP·N⌉`
 /// knots at each end, one between.
 pub fn speed_profile(knots: usize) -> Vec<f64> {
-    let m = ((RAMP * knots as f64).ceil() as usize).max(1);
+    ramp_profile(knots, RAMP)
+}
+
+/// [`speed_profile`] with the ramp fraction `ramp` (in (0, 0.5]) instead of [`RAMP`].
+pub fn ramp_profile(knots: usize, ramp: f64) -> Vec<f64> {
+    let m = ((ramp * knots as f64).ceil() as usize).clamp(1, knots.div_ceil(2).max(1));
     (0..=knots)
         .map(|k| {
             let edge = k.min(knots - k);
@@ -67,12 +72,27 @@ pub fn cruise_start(
     u_lo: &[f64],
     u_hi: &[f64],
 ) -> Result<Trajectory, ModelError> {
+    ramped_cruise_start(model, x0, knots, displacement, RAMP, u_lo, u_hi)
+}
+
+/// [`cruise_start`] with the ramp fraction `ramp` of (C1) (in (0, 0.5]; [`RAMP`] there): the
+/// multi-start's other starts of a leg (docs/ocp.md §6), each a dynamically consistent
+/// guess with its own speed profile.
+pub fn ramped_cruise_start(
+    model: &mut ChainModel,
+    x0: &[f64],
+    knots: usize,
+    displacement: [f64; 3],
+    ramp: f64,
+    u_lo: &[f64],
+    u_hi: &[f64],
+) -> Result<Trajectory, ModelError> {
     let n = model.n_joints();
     let (nx, nu, nq) = (model.nx(), model.nu(), model.nq());
     let dt = model.dt();
     let pose0 = ChainModel::pose(x0);
     let d_body = pose0.orientation.inverse() * Vec3::from(displacement);
-    let w = speed_profile(knots);
+    let w = ramp_profile(knots, ramp);
     let scale = 1.0 / (dt * w[1..].iter().sum::<f64>());
     let (q0, qd0) = (&x0[7..7 + n], vec![0.0; n]);
     let mut xs = Vec::with_capacity(knots + 1);

@@ -9,20 +9,34 @@
 //! that meet one design at once wait for one solve; the numbers are the same whichever
 //! computes them (each solve is sequential and seeded), so the tables do not depend on the
 //! thread count.
+//!
+//! The bound's vehicle is the case's plant in the nominal world
+//! ([`crate::scenario::ScenarioFile::world_vehicle`]: payload, `[hydro]` scales, derating). With
+//! `[ocp] worlds = K` the design's bound is also solved in the study's first K scoring worlds
+//! (the `[uncertainty]` sample every case meets): the world's overrides applied to the case's
+//! tables as the closed loop's worlds apply them, the plant that world makes, and the world's
+//! current change added to the leg's; each warm-started from the nominal optimum (one start:
+//! cold, a world's leg did not converge in 300 iterations where warm it converged in 39).
+//! Columns [`OCP_WORLD_COLUMNS`]: the least and greatest feasible bound per metre over those
+//! worlds, how many were feasible, and their iterations. A design without a nominal bound that
+//! counts (feasible, trusted on its grid) has none to start the worlds from: they are not
+//! tried (0 feasible, 0 iterations).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::bound::{leg_problem, solve_bound, LegSpec};
+use super::bound::{leg_problem, solve_bound, Bound, LegSpec};
 use super::sqp::Status;
 use crate::batch::bound_hook::{BoundHook, CaseBound};
-use crate::evaluate::Metrics;
+use crate::evaluate::{apply_overrides, Metrics, Override};
 use crate::model::design::parse_design_table;
-use crate::study::cases::Resolved;
+use crate::model::Vehicle;
+use crate::study::cases::{overrides_of, Resolved};
 use crate::study::ocp_section::OcpSection;
 use crate::study::schema::{
     Study, OCP_ENERGY, OCP_ENERGY_PER_METRE, OCP_ITERATIONS, OCP_KKT, OCP_PRIMAL, OCP_SPREAD,
-    OCP_STATUS,
+    OCP_STATUS, OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_ITERATIONS,
+    OCP_WORLD_MAX, OCP_WORLD_MIN,
 };
 
 /// The hook wiring this solver into sweeps.
@@ -32,7 +46,7 @@ fn boxed(study: &Study) -> Option<Box<dyn CaseBound>> {
     study
         .ocp
         .as_ref()
-        .map(|s| Box::new(StudyBound::new(s, study.seed)) as Box<dyn CaseBound>)
+        .map(|s| Box::new(StudyBound::new(s, study)) as Box<dyn CaseBound>)
 }
 
 /// The columns of one design's bound, in [`crate::study::schema::OCP_COLUMNS`] order (without
@@ -51,8 +65,18 @@ pub struct BoundColumns {
     pub kkt: f64,
     /// Primal residual of the best start.
     pub primal: f64,
+    /// Work-balance error of the best start on its grid.
+    pub work_error: f64,
     /// SQP iterations of every start.
     pub iterations: f64,
+    /// Least feasible bound per metre over the bound's worlds [J/m] (NaN: none feasible).
+    pub world_min: f64,
+    /// Greatest feasible bound per metre over the bound's worlds [J/m].
+    pub world_max: f64,
+    /// Worlds whose bound is primal feasible.
+    pub world_feasible: f64,
+    /// SQP iterations of every world together.
+    pub world_iterations: f64,
 }
 
 impl BoundColumns {
@@ -64,7 +88,12 @@ impl BoundColumns {
         status: f64::NAN,
         kkt: f64::NAN,
         primal: f64::NAN,
+        work_error: f64::NAN,
         iterations: f64::NAN,
+        world_min: f64::NAN,
+        world_max: f64::NAN,
+        world_feasible: f64::NAN,
+        world_iterations: f64::NAN,
     };
 }
 
@@ -97,10 +126,33 @@ pub fn leg_of(section: &OcpSection, seed: u64) -> LegSpec {
     }
 }
 
-/// The bound of the design table `design` on `leg` (NaN columns when it does not build or has
-/// no thrusters).
-pub fn design_bound(design: &toml::Table, leg: &LegSpec) -> BoundColumns {
-    let Ok(vehicle) = parse_design_table(design, "case design") else {
+/// The plant of a case's tables `design` and `scenario` with `overrides` applied (a world's;
+/// none for the nominal one), as the closed loop builds it: `None` when they do not apply or
+/// the design does not build.
+fn plant(design: &toml::Table, scenario: &toml::Table, overrides: &[Override]) -> Option<Vehicle> {
+    let (mut d, mut s) = (design.clone(), scenario.clone());
+    apply_overrides(&mut d, &mut s, overrides).ok()?;
+    let vehicle = parse_design_table(&d, "case design").ok()?;
+    let file =
+        crate::scenario::parse_table(&s, &crate::scenario::Source::unplaced("scenario")).ok()?;
+    file.world_vehicle(&vehicle).ok()
+}
+
+/// Whether `b` is a trajectory the model can fly that meets the leg's end, trusted on its grid.
+fn feasible(b: &Bound, tolerance: f64) -> bool {
+    (b.status == Status::Converged || b.kkt[0] <= tolerance) && b.work_error <= OCP_WORK_TRUSTED
+}
+
+/// The bound of the case tables `design`, `scenario` on `leg` in the nominal world and in the
+/// worlds `worlds` (their overrides; NaN columns when the design does not build or has no
+/// thrusters).
+pub fn design_bound(
+    design: &toml::Table,
+    scenario: &toml::Table,
+    leg: &LegSpec,
+    worlds: &[Vec<Override>],
+) -> BoundColumns {
+    let Some(vehicle) = plant(design, scenario, &[]) else {
         return BoundColumns::NAN;
     };
     if vehicle.n_thrusters() == 0 {
@@ -108,28 +160,86 @@ pub fn design_bound(design: &toml::Table, leg: &LegSpec) -> BoundColumns {
     }
     let b = solve_bound(&leg_problem(&vehicle, leg), None);
     let energy = b.thruster_energy_static + b.joint_energy;
-    BoundColumns {
+    let mut out = BoundColumns {
         energy,
         energy_per_metre: energy / leg.distance,
         spread: b.spread,
         status: status_code(b.status),
         kkt: b.kkt.iter().copied().fold(0.0, f64::max),
         primal: b.kkt[0],
+        work_error: b.work_error,
         iterations: b.iterations as f64,
+        ..BoundColumns::NAN
+    };
+    if worlds.is_empty() {
+        return out;
     }
+    if !feasible(&b, leg.tolerance) {
+        // No nominal bound to start the worlds from (cold, a world's leg did not converge in
+        // 300 iterations): the worlds are not tried, and say so (0 feasible, 0 iterations).
+        out.world_feasible = 0.0;
+        out.world_iterations = 0.0;
+        return out;
+    }
+    let warm = (b.solution.xs.clone(), b.solution.us.clone());
+    let (mut lo, mut hi, mut ok, mut its) = (f64::INFINITY, f64::NEG_INFINITY, 0usize, 0usize);
+    for w in worlds {
+        let Some(world) = plant(design, scenario, w) else {
+            continue;
+        };
+        let mut wleg = leg.clone();
+        wleg.starts = 1;
+        for i in 0..3 {
+            wleg.current[i] += world.fluid.current[i] - vehicle.fluid.current[i];
+        }
+        let wb = solve_bound(&leg_problem(&world, &wleg), Some(&warm));
+        its += wb.iterations;
+        if feasible(&wb, leg.tolerance) {
+            let e = (wb.thruster_energy_static + wb.joint_energy) / leg.distance;
+            lo = lo.min(e);
+            hi = hi.max(e);
+            ok += 1;
+        }
+    }
+    if ok > 0 {
+        out.world_min = lo;
+        out.world_max = hi;
+    }
+    out.world_feasible = ok as f64;
+    out.world_iterations = its as f64;
+    out
 }
 
 /// A study's bound solver: the leg, and one solve per design for the whole sweep.
 pub struct StudyBound {
     leg: LegSpec,
+    /// The overrides of the bound's worlds (the study's first `[ocp] worlds` scoring worlds).
+    worlds: Vec<Vec<Override>>,
     cache: Mutex<HashMap<String, Arc<OnceLock<BoundColumns>>>>,
 }
 
 impl StudyBound {
-    /// The solver of `section`, its perturbed starts seeded by `seed`.
-    pub fn new(section: &OcpSection, seed: u64) -> Self {
+    /// The solver of `study`'s `section`, its starts seeded by the study seed.
+    pub fn new(section: &OcpSection, study: &Study) -> Self {
+        let worlds = match (&study.uncertainty, section.worlds) {
+            (Some(u), k) if k > 0 => u
+                .sample(study.seed)
+                .iter()
+                .take(k)
+                .map(|w| {
+                    overrides_of(
+                        u.params
+                            .iter()
+                            .zip(&w.values)
+                            .map(|(p, v)| (p.name.as_str(), &p.target, v)),
+                    )
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
         Self {
-            leg: leg_of(section, seed),
+            leg: leg_of(section, study.seed),
+            worlds,
             cache: Mutex::new(HashMap::new()),
         }
     }
@@ -140,7 +250,7 @@ impl StudyBound {
             let mut c = self.cache.lock().unwrap_or_else(|p| p.into_inner());
             c.entry(r.design_hash.clone()).or_default().clone()
         };
-        *cell.get_or_init(|| design_bound(&r.design, &self.leg))
+        *cell.get_or_init(|| design_bound(&r.design, &r.scenario, &self.leg, &self.worlds))
     }
 }
 
@@ -153,6 +263,13 @@ impl CaseBound for StudyBound {
         metrics.set(OCP_STATUS, b.status);
         metrics.set(OCP_KKT, b.kkt);
         metrics.set(OCP_PRIMAL, b.primal);
+        metrics.set(OCP_WORK_ERROR, b.work_error);
         metrics.set(OCP_ITERATIONS, b.iterations);
+        if !self.worlds.is_empty() {
+            metrics.set(OCP_WORLD_MIN, b.world_min);
+            metrics.set(OCP_WORLD_MAX, b.world_max);
+            metrics.set(OCP_WORLD_FEASIBLE, b.world_feasible);
+            metrics.set(OCP_WORLD_ITERATIONS, b.world_iterations);
+        }
     }
 }

@@ -6,7 +6,9 @@
 //! are limited by the controller rather than by the layout.
 //!
 //! A bound counts only where it is a trajectory the model can fly: primal residual (defects
-//! and the leg's terminal rows) at most [`FEASIBLE`]. A design whose closed loop spends *less*
+//! and the leg's terminal rows) at most [`FEASIBLE`], and work balance on its grid within
+//! [`OCP_WORK_TRUSTED`] (`ocp_work_error`: else the optimum swims on energy the integration
+//! supplies). A design whose closed loop spends *less*
 //! per metre than its bound (`controller_efficiency` > 1) is flagged, never dropped: one of the
 //! two is wrong, or the two missions differ more than the comparison assumes (the leg is
 //! straight from rest to rest; the run follows the study's path).
@@ -23,6 +25,7 @@ use crate::report::{
 };
 use crate::study::schema::{
     CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL, OCP_SPREAD, OCP_STATUS,
+    OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_MAX, OCP_WORLD_MIN,
 };
 
 /// A bound with a primal residual at most this is a trajectory the model can fly.
@@ -71,6 +74,17 @@ pub(crate) fn bound_section(
     let primal = col(OCP_PRIMAL)?;
     let status = col(OCP_STATUS)?;
     let spread = col(OCP_SPREAD);
+    let work = col(OCP_WORK_ERROR);
+    let worlds = match (
+        col(OCP_WORLD_MIN),
+        col(OCP_WORLD_MAX),
+        col(OCP_WORLD_FEASIBLE),
+    ) {
+        (Some(a), Some(b), Some(c)) => Some((a, b, c)),
+        _ => None,
+    };
+    // Feasible and trusted on its grid (tables without the work column: feasible only).
+    let counts = |r: usize| primal[r] <= FEASIBLE && work.is_none_or(|w| w[r] <= OCP_WORK_TRUSTED);
     let objective = sel.objective.as_deref();
     let obj = objective.and_then(col);
     let maximise = objective.is_some_and(|o| sel.maximise.contains(o));
@@ -81,18 +95,28 @@ pub(crate) fn bound_section(
         .filter(|&r| mask.as_ref().is_none_or(|m| m[r]))
         .collect();
     let mut md = String::from("## Physical limit: the optimal-control bound (`[ocp]`)\n\n");
+    let carried = if worlds.is_some() {
+        "It is also solved in the study's first scoring worlds (`[ocp] worlds`: their damping, \
+         drag, added mass, derating, buoyancy errors and current, warm-started from the nominal \
+         optimum): the range over those worlds is shown. **What the bound does not carry:** the \
+         path's turn and initial offset (the leg is straight), the other worlds."
+    } else {
+        "**What the bound does not carry:** the path's turn and initial offset (the leg is \
+         straight), the worlds (`[ocp] worlds` solves it in the first scoring worlds too)."
+    };
     let _ = writeln!(
         md,
         "Each design's **bound** is the least thruster energy (zero inflow) plus joint energy the \
          best local optimum found spends on the study's straight transport leg (`[ocp]`: from \
-         rest to rest, thrusts and joint torques as controls on the full hydrodynamic model; \
-         never claimed global), per metre. Beside it the closed loop's \
-         `(thruster_energy_static + joint_energy) / path_progress` in the nominal world, and \
-         `controller_efficiency` = bound / closed loop. **What the bound does not carry:** the \
-         path's turn and initial offset (the leg is straight), any `[mission]` payload (the \
-         leg's vehicle is the bare design), the worlds. A bound counts where its trajectory is \
-         feasible (primal residual ≤ {}).\n",
-        fmt_short(FEASIBLE)
+         rest to rest, thrusts and joint torques as controls on the full hydrodynamic model of \
+         the case's plant, `[mission]` payload included; never claimed global), per metre. \
+         Beside it the closed loop's `(thruster_energy_static + joint_energy) / path_progress` \
+         in the nominal world, and `controller_efficiency` = bound / closed loop. {carried} A \
+         bound counts where its trajectory is feasible (primal residual ≤ {}) and its work \
+         balance holds on its grid (`ocp_work_error` ≤ {}: the controls integrated 10× finer; \
+         above it the optimum swims on energy the integration supplies).\n",
+        fmt_short(FEASIBLE),
+        fmt_short(OCP_WORK_TRUSTED)
     );
     let mut entries: Vec<Entry> = rows
         .iter()
@@ -122,9 +146,33 @@ pub(crate) fn bound_section(
         "controller_efficiency",
         "bound status",
         "bound spread",
+        "bound in worlds J/m",
     ]);
     for e in &entries {
-        let feasible = primal[e.row] <= FEASIBLE;
+        let feasible = counts(e.row);
+        let why = if primal[e.row] <= FEASIBLE {
+            format!(
+                "off its grid: work error {}",
+                fmt_short(work.map_or(f64::NAN, |w| w[e.row]))
+            )
+        } else {
+            "infeasible".to_string()
+        };
+        let in_worlds = worlds.map_or("–".into(), |(a, b, c)| {
+            let r = e.row;
+            if c[r] > 0.0 {
+                format!(
+                    "{}–{} ({} feasible)",
+                    fmt_short(a[r]),
+                    fmt_short(b[r]),
+                    c[r]
+                )
+            } else if c[r] == 0.0 {
+                "none feasible".into()
+            } else {
+                "–".into()
+            }
+        });
         t.row([
             name(e.row),
             fmt_short(e.objective),
@@ -132,7 +180,7 @@ pub(crate) fn bound_section(
             if feasible {
                 fmt_short(e.bound)
             } else {
-                format!("({}, infeasible)", fmt_short(e.bound))
+                format!("({}, {why})", fmt_short(e.bound))
             },
             if feasible {
                 fmt_short(e.efficiency)
@@ -141,13 +189,14 @@ pub(crate) fn bound_section(
             },
             status_word(status[e.row]).to_string(),
             spread.map_or("–".into(), |s| fmt_short(s[e.row])),
+            in_worlds,
         ]);
     }
     md.push_str(&t.finish());
     md.push('\n');
     let ok: Vec<&Entry> = entries
         .iter()
-        .filter(|e| primal[e.row] <= FEASIBLE && e.bound.is_finite() && e.closed.is_finite())
+        .filter(|e| counts(e.row) && e.bound.is_finite() && e.closed.is_finite())
         .collect();
     md.push_str(&agreement(&ok, &name));
     let above: Vec<String> = ok

@@ -17,7 +17,15 @@
 //! effort = 1e-3          # weight of Σ Δt ‖u‖²
 //! tolerance = 1e-6       # KKT tolerance
 //! max_iterations = 150   # SQP iterations per start
+//! worlds = 0             # also in the first K scoring worlds of [uncertainty] (warm-started)
 //! ```
+//!
+//! The bound's vehicle is the case's plant in the nominal world (`ScenarioFile::world_vehicle`:
+//! the payload, the `[hydro]` scales, the thrust derating); with `worlds = K` the bound is also
+//! solved in each of the study's first K `[uncertainty]` worlds — the plant that world makes
+//! (damping, drag, added mass, derating, buoyancy and centre-of-buoyancy errors, payload wet
+//! weight) and the world's current on top of `current` — warm-started from the nominal
+//! optimum (cold, a world's leg did not converge in 300 iterations where warm it took 39).
 
 use crate::input::document::{deserialize_table, Document};
 use crate::input::located::InputError;
@@ -29,6 +37,34 @@ pub const MAX_KNOTS: usize = 200;
 pub const MAX_SUBSTEPS: usize = 100;
 /// Most starts of the multi-start.
 pub const MAX_STARTS: usize = 16;
+/// Most worlds the bound is solved in.
+pub const MAX_WORLDS: usize = 64;
+
+/// Check `[ocp] worlds` against the study's `[uncertainty]` (`n_worlds`: its worlds per case,
+/// `None` without one): the bound's worlds are the first of the scoring worlds.
+pub fn check_worlds(
+    section: Option<&OcpSection>,
+    n_worlds: Option<usize>,
+    doc: &Document,
+) -> Result<(), InputError> {
+    let Some(k) = section.map(|s| s.worlds).filter(|&k| k > 0) else {
+        return Ok(());
+    };
+    match n_worlds {
+        None => Err(doc.err(
+            "ocp.worlds",
+            format!(
+                "the bound's {k} worlds are the first of the study's scoring worlds, and this \
+                 study has no `[uncertainty]`: add one, or drop `ocp.worlds`"
+            ),
+        )),
+        Some(n) if n < k => Err(doc.err(
+            "ocp.worlds",
+            format!("{k} worlds asked, the study's `[uncertainty]` has {n}"),
+        )),
+        Some(_) => Ok(()),
+    }
+}
 
 /// The validated `[ocp]` section: the leg every design's bound is solved on.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +89,8 @@ pub struct OcpSection {
     pub tolerance: f64,
     /// SQP iterations per start.
     pub max_iterations: usize,
+    /// The study's first `worlds` scoring worlds in which the bound is solved too (0: none).
+    pub worlds: usize,
 }
 
 #[derive(Deserialize)]
@@ -68,6 +106,7 @@ struct OcpFile {
     effort: Option<f64>,
     tolerance: Option<f64>,
     max_iterations: Option<i64>,
+    worlds: Option<i64>,
 }
 
 /// Parse `[ocp]` of a study file (`None` without one) of a closed-loop `transport` mode
@@ -138,5 +177,9 @@ pub fn parse_ocp(
         effort,
         tolerance,
         max_iterations: count("max_iterations", f.max_iterations, 150, 10_000)?,
+        worlds: match f.worlds {
+            None | Some(0) => 0,
+            Some(_) => count("worlds", f.worlds, 0, MAX_WORLDS)?,
+        },
     }))
 }

@@ -270,6 +270,11 @@ fn study_from_file(file: StudyFile, doc: &Document, path: &Path) -> Result<Study
     check_report(&study, doc)?;
     let mut study = study;
     study.uncertainty = parse_uncertainty(file.uncertainty.as_ref(), &study, doc)?;
+    super::ocp_section::check_worlds(
+        study.ocp.as_ref(),
+        study.uncertainty.as_ref().map(|u| u.n_worlds()),
+        doc,
+    )?;
     study.validate = parse_variants(file.validate.as_deref(), &study, doc)?;
     if let (Some(i), None) = (
         study.axes.iter().position(|a| a.condition),

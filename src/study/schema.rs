@@ -285,18 +285,42 @@ pub const OCP_PRIMAL: &str = "ocp_primal";
 /// deterministic unit; wall time is not a table column, so tables stay bit-identical for any
 /// thread count — `benches/README.md` gives the time per solve).
 pub const OCP_ITERATIONS: &str = "ocp_iterations";
+/// Column: the best start's work-balance error on its grid, `|W_other − W_other,refined| /
+/// max(|W_act|, |W_act,refined|)` with the controls integrated 10× finer (docs/ocp.md §6): above
+/// [`OCP_WORK_TRUSTED`] the optimum swims on energy the grid's integration supplies and is no
+/// bound.
+pub const OCP_WORK_ERROR: &str = "ocp_work_error";
+/// The largest [`OCP_WORK_ERROR`] of a bound that counts (5 %, the `ocp` verb's grid warning).
+pub const OCP_WORK_TRUSTED: f64 = 0.05;
 /// Column: `ocp_energy_per_metre` / the closed loop's `(thruster_energy_static +
-/// joint_energy) / path_progress` (NaN without a feasible bound): ≤ 1 when both are right; > 1
-/// flags one of them.
+/// joint_energy) / path_progress` (NaN without a feasible bound trusted on its grid,
+/// [`OCP_WORK_TRUSTED`]): ≤ 1 when both are right; > 1 flags one of them.
 pub const CONTROLLER_EFFICIENCY: &str = "controller_efficiency";
+/// Column of a study with `[ocp] worlds`: the least primal-feasible bound per metre over the
+/// bound's worlds (the study's first scoring worlds) [J/m]; NaN when none is feasible.
+pub const OCP_WORLD_MIN: &str = "ocp_world_energy_per_metre_min";
+/// Column: the greatest primal-feasible bound per metre over the bound's worlds [J/m].
+pub const OCP_WORLD_MAX: &str = "ocp_world_energy_per_metre_max";
+/// Column: how many of the bound's worlds have a primal-feasible bound.
+pub const OCP_WORLD_FEASIBLE: &str = "ocp_world_feasible";
+/// Column: SQP iterations of every world's solve together.
+pub const OCP_WORLD_ITERATIONS: &str = "ocp_world_iterations";
+/// The columns `[ocp] worlds` adds after [`OCP_COLUMNS`], in order.
+pub const OCP_WORLD_COLUMNS: [&str; 4] = [
+    OCP_WORLD_MIN,
+    OCP_WORLD_MAX,
+    OCP_WORLD_FEASIBLE,
+    OCP_WORLD_ITERATIONS,
+];
 /// The columns `[ocp]` adds to every row, in order.
-pub const OCP_COLUMNS: [&str; 8] = [
+pub const OCP_COLUMNS: [&str; 9] = [
     OCP_ENERGY,
     OCP_ENERGY_PER_METRE,
     OCP_SPREAD,
     OCP_STATUS,
     OCP_KKT,
     OCP_PRIMAL,
+    OCP_WORK_ERROR,
     OCP_ITERATIONS,
     CONTROLLER_EFFICIENCY,
 ];
@@ -319,10 +343,19 @@ pub const TUNE_CURVE_PREFIX: &str = "tune_curve.";
 pub const TUNED_PREFIX: &str = "tuned.";
 
 impl Study {
-    /// The columns `[ocp]` adds to every row ([`OCP_COLUMNS`]; none without `[ocp]`).
+    /// The columns `[ocp]` adds to every row ([`OCP_COLUMNS`], then [`OCP_WORLD_COLUMNS`] with
+    /// `[ocp] worlds`; none without `[ocp]`).
     pub fn ocp_columns(&self) -> Vec<String> {
         match &self.ocp {
-            Some(_) => OCP_COLUMNS.iter().map(|c| c.to_string()).collect(),
+            Some(s) => OCP_COLUMNS
+                .iter()
+                .chain(if s.worlds > 0 {
+                    &OCP_WORLD_COLUMNS[..]
+                } else {
+                    &[]
+                })
+                .map(|c| c.to_string())
+                .collect(),
             None => Vec::new(),
         }
     }
