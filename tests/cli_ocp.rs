@@ -61,6 +61,29 @@ fn small_problem_is_solved_and_written() {
         assert!(header.contains(&c), "column {c} in {header:?}");
     }
     assert_eq!(lines.count(), 21, "N + 1 knots");
+    // The plots: states, controls (their bounds: `ocp::plots` tests), convergence, the body
+    // at 8 knots.
+    let plot = |f: &str| std::fs::read_to_string(out_dir.join("plots").join(f)).unwrap();
+    let states = plot("states.svg");
+    for t in [
+        "Base position",
+        "Base attitude",
+        "Joint angles",
+        "Joint rates",
+    ] {
+        assert!(states.contains(t), "states.svg: {t}");
+    }
+    let controls = plot("controls.svg");
+    assert!(controls.contains("Base wrench") && controls.contains("Joint torques"));
+    let iterations = s["iterations"].as_u64().unwrap();
+    assert!(plot("convergence.svg")
+        .contains(&format!("Convergence: {iterations} iterations, converged")));
+    let shapes = plot("shapes.svg");
+    assert_eq!(
+        shapes.matches("class=\"snap\"").count(),
+        2 * 8,
+        "8 knots in 2 views"
+    );
 }
 
 #[test]

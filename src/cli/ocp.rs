@@ -28,6 +28,11 @@ pub fn run(args: &OcpArgs) -> anyhow::Result<ExitCode> {
     let spec = load_problem(&args.problem)?;
     let mut run = solve_spec(&spec)?;
     write_outputs(&args.out, &spec, &mut run)?;
+    usm_study::pipeline::ocp_shapes::write_ocp_shapes(
+        &spec.vehicle,
+        &mut run,
+        &args.out.join("plots"),
+    )?;
     let s = &run.solution;
     println!(
         "ocp {}: {:?} after {} iterations ({}); J = {:.6}, KKT primal {:.2e} stationarity {:.2e} \

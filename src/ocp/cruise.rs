@@ -38,13 +38,8 @@ pub const RAMP: f64 = 0.25;
 /// Tikhonov weight λ of the allocation (C3).
 const ALLOCATION_DAMPING: f64 = 1e-8;
 
-/// The speed weights `w_0 … w_N` of (C1): zero at both ends, a sin² ramp over `⌈RAMP·N⌉`
-/// knots at each end, one between.
-pub fn speed_profile(knots: usize) -> Vec<f64> {
-    ramp_profile(knots, RAMP)
-}
-
-/// [`speed_profile`] with the ramp fraction `ramp` (in (0, 0.5]) instead of [`RAMP`].
+/// The speed weights `w_0 … w_N` of (C1): zero at both ends, a sin² ramp over `⌈ramp·N⌉`
+/// knots at each end (`ramp` in (0, 0.5]; [`RAMP`] for the cruise start), one between.
 pub fn ramp_profile(knots: usize, ramp: f64) -> Vec<f64> {
     let m = ((ramp * knots as f64).ceil() as usize).clamp(1, knots.div_ceil(2).max(1));
     (0..=knots)

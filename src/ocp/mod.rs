@@ -30,6 +30,7 @@ pub mod cruise;
 pub mod derivatives;
 pub mod fidelity;
 pub mod model;
+pub mod plots;
 pub mod problem;
 pub mod qp;
 pub mod riccati;

@@ -344,6 +344,13 @@ pub fn write_outputs(dir: &Path, spec: &ProblemSpec, run: &mut OcpRun) -> Result
     });
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     atomic_write(&dir.join("summary.json"), text.as_bytes())?;
+    let plot = super::plots::PlotRun {
+        solution: &run.solution,
+        nb,
+        thrusters: thrusters.is_some(),
+        dt: run.dt,
+    };
+    super::plots::write_plots(&dir.join("plots"), spec, &plot)?;
     Ok(())
 }
 

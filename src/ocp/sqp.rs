@@ -110,6 +110,19 @@ pub enum Status {
     Stalled,
 }
 
+impl Status {
+    /// The status as `summary.json` writes it (`converged`, `max_iterations`, …).
+    pub fn word(self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::MaxIterations => "max_iterations",
+            Status::Infeasible => "infeasible",
+            Status::Diverged => "diverged",
+            Status::Stalled => "stalled",
+        }
+    }
+}
+
 /// One row of the iteration log.
 #[derive(Clone, Debug, Serialize)]
 pub struct IterLog {

@@ -69,3 +69,47 @@ fn the_bound_leg_is_the_shipped_transport_problem() {
         "thruster and joint energy weights"
     );
 }
+
+/// The multi-start of a cruise-started leg (docs/ocp.md §6): start s ≥ 1 is the cruise start
+/// with its own seeded ramp fraction, dynamically consistent like start 0, so the starts
+/// converge and the spread is a number; the ramps are deterministic and within range; the
+/// optimum's work balance holds 10× finer.
+#[test]
+fn cruise_starts_of_other_ramps_converge_and_give_the_spread() {
+    use super::bound::{leg_problem, solve_bound, start_ramp, LegSpec, RAMP_RANGE};
+    use super::cruise::RAMP;
+    assert_eq!(start_ramp(7, 0), RAMP);
+    for s in 1..6 {
+        let r = start_ramp(7, s);
+        assert!((RAMP_RANGE.0..=RAMP_RANGE.1).contains(&r), "{r}");
+        assert_eq!(r, start_ramp(7, s), "deterministic");
+    }
+    assert_ne!(start_ramp(7, 1), start_ramp(8, 1), "seeded");
+    let design: toml::Table =
+        toml::from_str("[generator]\nlinks = 4\nbody_profile = \"paper\"\nthrust_limit = 40.0\n")
+            .unwrap();
+    let vehicle = crate::model::design::parse_design_table(&design, "test").unwrap();
+    let leg = LegSpec {
+        distance: 5.0,
+        duration: 12.0,
+        knots: 12,
+        substeps: 5,
+        starts: 3,
+        seed: 3,
+        ..LegSpec::default()
+    };
+    let b = solve_bound(&leg_problem(&vehicle, &leg), None);
+    // Two of the three converge (the third stalls): enough for a spread.
+    assert!(
+        b.converged >= 2,
+        "converged starts {}: {:?}",
+        b.converged,
+        b.status
+    );
+    assert!(
+        b.spread.is_finite() && b.spread >= 0.0,
+        "spread {}",
+        b.spread
+    );
+    assert!(b.work_error <= 0.05, "work error {}", b.work_error);
+}

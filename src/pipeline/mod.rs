@@ -19,6 +19,7 @@ pub mod allocate;
 pub mod draw;
 pub mod error;
 pub mod inspect;
+pub mod ocp_shapes;
 pub mod optimise;
 mod optimise_plots;
 pub mod review;

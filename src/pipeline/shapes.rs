@@ -52,7 +52,7 @@ fn state_at(r: &RunResult, v: &Vehicle, k: usize) -> Option<VehicleState> {
 /// Metres of arrow per newton for a run: the largest logged |thrust| drawn about a quarter of
 /// the vehicle length (a 1–2–5 value), so that the thrusts a run actually uses are visible;
 /// the design's limit-based [`arrow_scale`] when no thrust was logged.
-fn thrust_scale(v: &Vehicle, thrust: &[&[f64]]) -> f64 {
+pub(super) fn thrust_scale(v: &Vehicle, thrust: &[&[f64]]) -> f64 {
     let peak = thrust
         .iter()
         .flat_map(|c| c.iter())
@@ -69,7 +69,7 @@ fn thrust_scale(v: &Vehicle, thrust: &[&[f64]]) -> f64 {
 /// Sets each thrust arrow to the thrust `u[j]` [N] logged for it: length `|u| · m_per_n`,
 /// pointing along the thrust direction for `u > 0` and against it for `u < 0` (a thruster
 /// without a logged finite thrust gets no arrow: length 0).
-fn set_thrust(arrows: &mut [Arrow], u: &[f64], m_per_n: f64) {
+pub(super) fn set_thrust(arrows: &mut [Arrow], u: &[f64], m_per_n: f64) {
     for (j, a) in arrows.iter_mut().enumerate() {
         let f = u.get(j).copied().filter(|x| x.is_finite()).unwrap_or(0.0);
         a.length = f.abs() * m_per_n;

@@ -95,29 +95,8 @@ pub(crate) fn bound_section(
         .filter(|&r| mask.as_ref().is_none_or(|m| m[r]))
         .collect();
     let mut md = String::from("## Physical limit: the optimal-control bound (`[ocp]`)\n\n");
-    let carried = if worlds.is_some() {
-        "It is also solved in the study's first scoring worlds (`[ocp] worlds`: their damping, \
-         drag, added mass, derating, buoyancy errors and current, warm-started from the nominal \
-         optimum): the range over those worlds is shown. **What the bound does not carry:** the \
-         path's turn and initial offset (the leg is straight), the other worlds."
-    } else {
-        "**What the bound does not carry:** the path's turn and initial offset (the leg is \
-         straight), the worlds (`[ocp] worlds` solves it in the first scoring worlds too)."
-    };
-    let _ = writeln!(
-        md,
-        "Each design's **bound** is the least thruster energy (zero inflow) plus joint energy the \
-         best local optimum found spends on the study's straight transport leg (`[ocp]`: from \
-         rest to rest, thrusts and joint torques as controls on the full hydrodynamic model of \
-         the case's plant, `[mission]` payload included; never claimed global), per metre. \
-         Beside it the closed loop's `(thruster_energy_static + joint_energy) / path_progress` \
-         in the nominal world, and `controller_efficiency` = bound / closed loop. {carried} A \
-         bound counts where its trajectory is feasible (primal residual ≤ {}) and its work \
-         balance holds on its grid (`ocp_work_error` ≤ {}: the controls integrated 10× finer; \
-         above it the optimum swims on energy the integration supplies).\n",
-        fmt_short(FEASIBLE),
-        fmt_short(OCP_WORK_TRUSTED)
-    );
+    md.push_str(&intro(worlds.is_some()));
+    md.push('\n');
     let mut entries: Vec<Entry> = rows
         .iter()
         .map(|&r| Entry {
@@ -150,38 +129,12 @@ pub(crate) fn bound_section(
     ]);
     for e in &entries {
         let feasible = counts(e.row);
-        let why = if primal[e.row] <= FEASIBLE {
-            format!(
-                "off its grid: work error {}",
-                fmt_short(work.map_or(f64::NAN, |w| w[e.row]))
-            )
-        } else {
-            "infeasible".to_string()
-        };
-        let in_worlds = worlds.map_or("–".into(), |(a, b, c)| {
-            let r = e.row;
-            if c[r] > 0.0 {
-                format!(
-                    "{}–{} ({} feasible)",
-                    fmt_short(a[r]),
-                    fmt_short(b[r]),
-                    c[r]
-                )
-            } else if c[r] == 0.0 {
-                "none feasible".into()
-            } else {
-                "–".into()
-            }
-        });
+        let in_worlds = world_cell(worlds, e.row);
         t.row([
             name(e.row),
             fmt_short(e.objective),
             fmt_short(e.closed),
-            if feasible {
-                fmt_short(e.bound)
-            } else {
-                format!("({}, {why})", fmt_short(e.bound))
-            },
+            bound_cell(e.bound, feasible, primal[e.row], work.map(|w| w[e.row])),
             if feasible {
                 fmt_short(e.efficiency)
             } else {
@@ -215,6 +168,61 @@ pub(crate) fn bound_section(
     bound_plot(&ok, &name, plots, warnings);
     md.push_str("\n![closed loop against bound](plots/bound.svg)\n\n");
     Some(md)
+}
+
+/// The opening paragraph: what the bound is, what it carries (`in_worlds`: `[ocp] worlds`),
+/// when it counts.
+fn intro(in_worlds: bool) -> String {
+    let carried = if in_worlds {
+        "It is also solved in the study's first scoring worlds (`[ocp] worlds`: their damping, \
+         drag, added mass, derating, buoyancy errors and current, warm-started from the nominal \
+         optimum): the range over those worlds is shown. **What the bound does not carry:** the \
+         path's turn and initial offset (the leg is straight), the other worlds."
+    } else {
+        "**What the bound does not carry:** the path's turn and initial offset (the leg is \
+         straight), the worlds (`[ocp] worlds` solves it in the first scoring worlds too)."
+    };
+    format!(
+        "Each design's **bound** is the least thruster energy (zero inflow) plus joint energy the \
+         best local optimum found spends on the study's straight transport leg (`[ocp]`: from \
+         rest to rest, thrusts and joint torques as controls on the full hydrodynamic model of \
+         the case's plant, `[mission]` payload included; never claimed global), per metre. \
+         Beside it the closed loop's `(thruster_energy_static + joint_energy) / path_progress` \
+         in the nominal world, and `controller_efficiency` = bound / closed loop. {carried} A \
+         bound counts where its trajectory is feasible (primal residual ≤ {}) and its work \
+         balance holds on its grid (`ocp_work_error` ≤ {}: the controls integrated 10× finer; \
+         above it the optimum swims on energy the integration supplies).\n",
+        fmt_short(FEASIBLE),
+        fmt_short(OCP_WORK_TRUSTED)
+    )
+}
+
+/// The bound cell: the bound per metre, or in brackets with why it does not count.
+fn bound_cell(bound: f64, counts: bool, primal: f64, work: Option<f64>) -> String {
+    if counts {
+        fmt_short(bound)
+    } else if primal <= FEASIBLE {
+        let w = fmt_short(work.unwrap_or(f64::NAN));
+        format!("({}, off its grid: work error {w})", fmt_short(bound))
+    } else {
+        format!("({}, infeasible)", fmt_short(bound))
+    }
+}
+
+/// The bound-in-worlds cell of row `r`: the range over the worlds whose bound counts.
+fn world_cell(worlds: Option<(&[f64], &[f64], &[f64])>, r: usize) -> String {
+    match worlds {
+        Some((a, b, c)) if c[r] > 0.0 => {
+            format!(
+                "{}–{} ({} feasible)",
+                fmt_short(a[r]),
+                fmt_short(b[r]),
+                c[r]
+            )
+        }
+        Some((_, _, c)) if c[r] == 0.0 => "none feasible".into(),
+        _ => "–".into(),
+    }
 }
 
 /// The sentence on agreement: is the closed-loop leader also the design with the lowest
