@@ -30,7 +30,7 @@ use crate::sampling::{derive_seed, Sampler, Sampling};
 use crate::study::cases::Resolved;
 use crate::study::doe::Case;
 use crate::study::error::InputError;
-use crate::study::schema::{Study, Target, TuneSection, Uncertainty};
+use crate::study::schema::{Study, Target, TuneSection};
 pub use crate::study::tune_section::{MAX_SEEDS, MAX_STARTS, MAX_TUNE_WORLDS};
 use crate::study::tune_spec_parse::in_worlds;
 use rayon::prelude::*;
@@ -45,31 +45,10 @@ fn boxed(study: &Study) -> Result<Option<Box<dyn CaseTuner>>, InputError> {
 /// A study's validated `[tune]` section.
 #[derive(Clone, Debug)]
 pub struct Tuner {
-    spec: Spec,
-    /// Per parameter: whether `start` is written (otherwise the case's own value).
-    explicit_start: Vec<bool>,
+    /// The `[tune]` section as the study read it (spec, starts, worlds, seeds, race, screen).
+    section: TuneSection,
     /// Whether the tuning objective or constraints read static TCM metrics.
     static_needed: bool,
-    /// Independent tuning starts (`[tune] starts`, default 1): the case's own start, then
-    /// Sobol points of the box, each with an equal share of the evaluation budget.
-    starts: usize,
-    /// The tuning worlds (`[tune] worlds = N`): the study's `[uncertainty]` with `N` worlds
-    /// drawn apart from the scoring worlds; `None` to tune in the nominal world.
-    worlds: Option<Uncertainty>,
-    /// Independent tuning seeds (`[tune] seeds`, default 1): each seed tunes the case afresh
-    /// with its own tuning worlds, start points and solver seeds; the seeds' best points are
-    /// then compared in the pooled tuning worlds of all seeds (issue 36 item 5).
-    seeds: usize,
-    /// Race each candidate's tuning worlds (`[tune] race`, default true): Bayesian
-    /// optimisation stops a candidate at the first world after which it is certainly
-    /// infeasible and not better than the best so far ([`super::score::Scorer::cannot_rank_before`]).
-    race: bool,
-    /// Screen the tuning candidates with the cheaper fixed-step integrator (`[tune] screen =
-    /// "rk4"`: RK4 at the control period, `physics.integrator = "rk4"`, `scenario.dt =
-    /// scenario.control_dt`), issue 38 item 3. The seeds' pooled comparison and everything
-    /// the case is scored by (nominal run, worlds, variants, faults) stay at the scenario's
-    /// own integrator. Default false: candidates run as the case does.
-    screen: bool,
 }
 
 /// Seed stream of the tuning starts' Sobol points (shared by every case).
@@ -84,28 +63,13 @@ impl Tuner {
     /// nothing is parsed here.
     pub fn new(study: &Study) -> Option<Tuner> {
         let t = study.tuning.as_ref()?;
-        let TuneSection {
-            spec,
-            explicit_start,
-            starts,
-            worlds,
-            seeds,
-            race,
-            screen,
-        } = t.clone();
         let static_needed = study.static_enabled
-            && spec.metrics().iter().any(|m| {
+            && t.spec.metrics().iter().any(|m| {
                 TCM_COLUMNS.contains(&m.as_str()) || AUTHORITY_COLUMNS.contains(&m.as_str())
             });
         Some(Tuner {
-            spec,
-            explicit_start,
+            section: t.clone(),
             static_needed,
-            starts,
-            worlds,
-            seeds,
-            race,
-            screen,
         })
     }
 
@@ -137,22 +101,27 @@ impl Tuner {
         cs.tune = None;
         cs.tuning = None;
         cs.static_enabled = self.static_needed;
-        let mut spec = self.spec.clone();
-        for (p, explicit) in spec.space.params.iter_mut().zip(&self.explicit_start) {
+        let mut spec = self.section.spec.clone();
+        for (p, explicit) in spec
+            .space
+            .params
+            .iter_mut()
+            .zip(&self.section.explicit_start)
+        {
             if !explicit {
                 if let Some(x) = case_value(&p.target, r) {
                     p.start = x.clamp(p.lower, p.upper);
                 }
             }
         }
-        if let Some(u) = &self.worlds {
+        if let Some(u) = &self.section.worlds {
             // Every candidate in every tuning world: the objective combines the worlds
             // (`[tune.objective] combine`, default the mean) and each constraint must hold in
             // each of them, as in a problem file's `[uncertainty]`.
             let seeds: Vec<usize> = match which {
                 WorldsOf::Nominal => Vec::new(),
                 WorldsOf::Seed(k) => vec![k],
-                WorldsOf::Pooled => (0..self.seeds).collect(),
+                WorldsOf::Pooled => (0..self.section.seeds).collect(),
             };
             if !seeds.is_empty() {
                 let variants = std::mem::take(&mut spec.variants);
@@ -181,7 +150,7 @@ impl Tuner {
         k: usize,
     ) -> Result<SeedResult, TuneError> {
         let mut problem = self.case_problem_with(study, r, WorldsOf::Seed(k));
-        if self.screen {
+        if self.section.screen {
             screen_with_rk4(&mut problem.study.scenario_full);
         }
         let ev = CaseEvaluator::new(&problem).for_case(case.id, deadline);
@@ -195,7 +164,7 @@ impl Tuner {
             journal: None,
             resume: false,
             on_record: &quiet,
-            race: self.race,
+            race: self.section.race,
         };
         let d = spec.space.dim();
         let starts_seed = if k == 0 {
@@ -203,18 +172,18 @@ impl Tuner {
         } else {
             derive_seed(derive_seed(study.seed, STARTS_STREAM), k as u64)
         };
-        let sobol = Sampler::new(Sampling::Sobol, self.starts.max(2), d, starts_seed)
+        let sobol = Sampler::new(Sampling::Sobol, self.section.starts.max(2), d, starts_seed)
             .map_err(TuneError::from_error)?;
-        spec.solver.max_evals = self.spec.solver.max_evals / self.starts;
+        spec.solver.max_evals = self.section.spec.solver.max_evals / self.section.starts;
         // The starts' points depend only on the Sobol stream, so the starts are independent
         // runs: side by side (a case tuned last, or alone, keeps every thread busy), their
         // outcomes combined in start order so nothing depends on the thread count.
         let specs = if k == 0 {
-            start_specs(&spec, self.starts, &sobol)
+            start_specs(&spec, self.section.starts, &sobol)
         } else {
             // A later seed starts every start from the Sobol stream (its start 0 too), so it
             // does not retrace seed 0's first start from the case's own values.
-            let mut v = start_specs(&spec, self.starts + 1, &sobol);
+            let mut v = start_specs(&spec, self.section.starts + 1, &sobol);
             v.remove(0);
             v
         };
@@ -271,7 +240,7 @@ impl CaseTuner for Tuner {
         r: &Resolved,
         deadline: Deadline,
     ) -> Result<Tuned, TuneError> {
-        let runs: Vec<Result<SeedResult, TuneError>> = (0..self.seeds)
+        let runs: Vec<Result<SeedResult, TuneError>> = (0..self.section.seeds)
             .into_par_iter()
             .with_max_len(1)
             .map(|k| self.tune_seed(study, case, r, deadline, k))
