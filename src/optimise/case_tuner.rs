@@ -410,7 +410,7 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/thrusters.toml");
         let study = crate::study::parse::load_study(&path).unwrap();
         let tuner = Tuner::new(&study).unwrap();
-        let spec = &tuner.spec;
+        let spec = &tuner.section.spec;
         let d = spec.space.dim();
         let sobol = Sampler::new(Sampling::Sobol, 3, d, 11).unwrap();
         let specs = start_specs(spec, 4, &sobol);

@@ -25,7 +25,8 @@ use crate::report::{
 };
 use crate::study::schema::{
     CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL, OCP_SPREAD, OCP_STATUS,
-    OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_MAX, OCP_WORLD_MIN,
+    OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_ITERATIONS, OCP_WORLD_MAX,
+    OCP_WORLD_MIN,
 };
 
 /// A bound with a primal residual at most this is a trajectory the model can fly.
@@ -75,21 +76,14 @@ pub(crate) fn bound_section(
     let status = col(OCP_STATUS)?;
     let spread = col(OCP_SPREAD);
     let work = col(OCP_WORK_ERROR);
-    let worlds = match (
-        col(OCP_WORLD_MIN),
-        col(OCP_WORLD_MAX),
-        col(OCP_WORLD_FEASIBLE),
-    ) {
-        (Some(a), Some(b), Some(c)) => Some((a, b, c)),
-        _ => None,
-    };
+    let worlds = world_columns(table);
     // Feasible and trusted on its grid (tables without the work column: feasible only).
     let counts = |r: usize| primal[r] <= FEASIBLE && work.is_none_or(|w| w[r] <= OCP_WORK_TRUSTED);
     let objective = sel.objective.as_deref();
     let obj = objective.and_then(col);
     let maximise = objective.is_some_and(|o| sel.maximise.contains(o));
     let mask = ranked_mask(table);
-    let rows: Vec<usize> = rows
+    let ranked: Vec<usize> = rows
         .iter()
         .copied()
         .filter(|&r| mask.as_ref().is_none_or(|m| m[r]))
@@ -97,6 +91,17 @@ pub(crate) fn bound_section(
     let mut md = String::from("## Physical limit: the optimal-control bound (`[ocp]`)\n\n");
     md.push_str(&intro(worlds.is_some()));
     md.push('\n');
+    // A robust study that ranks no design still shows its successful designs' bounds (the
+    // bound does not depend on the ranking), and says so.
+    let rows = if ranked.is_empty() && mask.is_some() && !rows.is_empty() {
+        md.push_str(
+            "No design is ranked over the worlds: the table compares the designs that met \
+             `[success]` in the nominal world.\n\n",
+        );
+        rows.to_vec()
+    } else {
+        ranked
+    };
     let mut entries: Vec<Entry> = rows
         .iter()
         .map(|&r| Entry {
@@ -210,9 +215,9 @@ fn bound_cell(bound: f64, counts: bool, primal: f64, work: Option<f64>) -> Strin
 }
 
 /// The bound-in-worlds cell of row `r`: the range over the worlds whose bound counts.
-fn world_cell(worlds: Option<(&[f64], &[f64], &[f64])>, r: usize) -> String {
+fn world_cell(worlds: Option<WorldColumns<'_>>, r: usize) -> String {
     match worlds {
-        Some((a, b, c)) if c[r] > 0.0 => {
+        Some((a, b, c, _)) if c[r] > 0.0 => {
             format!(
                 "{}–{} ({} feasible)",
                 fmt_short(a[r]),
@@ -220,9 +225,25 @@ fn world_cell(worlds: Option<(&[f64], &[f64], &[f64])>, r: usize) -> String {
                 c[r]
             )
         }
-        Some((_, _, c)) if c[r] == 0.0 => "none feasible".into(),
+        // No nominal bound that counts: nothing to start the worlds from.
+        Some((_, _, c, i)) if c[r] == 0.0 && i[r] == 0.0 => "not tried".into(),
+        Some((_, _, c, i)) if c[r] == 0.0 => format!("none feasible ({} iterations)", i[r]),
         _ => "–".into(),
     }
+}
+
+/// The world columns: least, greatest, feasible count, iterations.
+type WorldColumns<'a> = (&'a [f64], &'a [f64], &'a [f64], &'a [f64]);
+
+/// The world columns of `table` (`None` without `[ocp] worlds`).
+fn world_columns(table: &Table) -> Option<WorldColumns<'_>> {
+    let col = |n: &str| table.f64(n).ok();
+    Some((
+        col(OCP_WORLD_MIN)?,
+        col(OCP_WORLD_MAX)?,
+        col(OCP_WORLD_FEASIBLE)?,
+        col(OCP_WORLD_ITERATIONS)?,
+    ))
 }
 
 /// The sentence on agreement: is the closed-loop leader also the design with the lowest

@@ -117,8 +117,13 @@ const OCP: &[ColumnDoc] = &[
     c("ocp_status", "code", "i64", "the best start's status: 0 converged (KKT ≤ tolerance), 1 max iterations, 2 stalled (line search found no acceptable step), 3 infeasible, 4 diverged"),
     c("ocp_kkt", "–", "f64", "the best start's largest KKT residual (primal, stationarity, complementarity)"),
     c("ocp_primal", "–", "f64", "the best start's primal residual (dynamics defects and the leg's terminal rows): at most the tolerance means a trajectory the model can fly that ends the leg"),
+    c("ocp_work_error", "–", "f64", "the best start's work-balance error on its grid: `\\|W_other − W_other,refined\\| / max(\\|W_act\\|, \\|W_act,refined\\|)` with its controls integrated 10× finer (docs/ocp.md §6); above 0.05 the optimum swims on energy the grid's integration supplies, and the bound does not count"),
+    c("ocp_world_energy_per_metre_min", "J/m", "f64", "with `[ocp] worlds = K`: the least bound per metre that counts over the study's first K scoring worlds (each warm-started from the nominal optimum); NaN when none counts"),
+    c("ocp_world_energy_per_metre_max", "J/m", "f64", "the greatest of the same"),
+    c("ocp_world_feasible", "–", "i64", "how many of those K worlds have a bound that counts (0 when the nominal bound does not count: the worlds are not tried)"),
+    c("ocp_world_iterations", "–", "i64", "SQP iterations of every world's solve together (0: not tried)"),
     c("ocp_iterations", "–", "i64", "SQP iterations of every start of the design's solve together (one solve per design, shared by its cases)"),
-    c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world (NaN when the bound is not feasible: `ocp_primal` above the `[ocp]` tolerance): ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
+    c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world (NaN when the bound does not count: `ocp_primal` above the `[ocp]` tolerance or `ocp_work_error` above 0.05): ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
 ];
 
 const RUN_COMMON: &[ColumnDoc] = &[
