@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::draw::vehicle_scene;
 use super::error::PipelineError;
-use super::shapes::{set_thrust, thrust_scale, SHAPE_SNAPSHOTS};
+use super::shapes::{even_picks, set_thrust, thrust_scale, SHAPE_SNAPSHOTS};
 use crate::model::Vehicle;
 use crate::ocp::chain::ChainModel;
 use crate::ocp::OcpRun;
@@ -23,17 +23,7 @@ pub fn ocp_drawing(v: &Vehicle, run: &mut OcpRun, count: usize) -> RunDrawing {
     let sol = &run.solution;
     let n = v.n_joints();
     let knots = sol.xs.len();
-    let count = count.clamp(1, knots.max(1));
-    let mut picks: Vec<usize> = (0..count)
-        .map(|i| {
-            if count == 1 {
-                0
-            } else {
-                i * (knots - 1) / (count - 1)
-            }
-        })
-        .collect();
-    picks.dedup();
+    let picks = even_picks(knots.max(1), count);
     let thrusters = run.model.thruster_actuated();
     let m = v.n_thrusters();
     let thrust: Vec<Vec<f64>> = (0..m)

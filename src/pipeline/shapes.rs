@@ -95,14 +95,9 @@ fn trace(r: &RunResult, ch: fn(Pose) -> Channel) -> Vec<Vec3> {
     }
 }
 
-/// The drawing of run `r` of `v` with `count` snapshots at evenly spaced samples (first and
-/// last included); `None` when the run logged no samples.
-pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawing> {
-    let t = r.trajectory.get(Channel::T)?;
-    let n = t.len();
-    if n == 0 {
-        return None;
-    }
+/// `count` (clamped to 1…n) evenly spaced indices of `n ≥ 1` samples, first and last included,
+/// without repeats.
+pub(super) fn even_picks(n: usize, count: usize) -> Vec<usize> {
     let count = count.clamp(1, n);
     let mut picks: Vec<usize> = (0..count)
         .map(|i| {
@@ -114,6 +109,18 @@ pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawin
         })
         .collect();
     picks.dedup();
+    picks
+}
+
+/// The drawing of run `r` of `v` with `count` snapshots at evenly spaced samples (first and
+/// last included); `None` when the run logged no samples.
+pub fn run_drawing(r: &RunResult, v: &Vehicle, count: usize) -> Option<RunDrawing> {
+    let t = r.trajectory.get(Channel::T)?;
+    let n = t.len();
+    if n == 0 {
+        return None;
+    }
+    let picks = even_picks(n, count);
     let thrust = r.trajectory.indexed(Channel::U);
     let m_per_n = thrust_scale(v, &thrust);
     let snapshots = picks
