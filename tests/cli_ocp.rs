@@ -135,3 +135,59 @@ fn malformed_problem_files_exit_2_naming_file_line_and_key() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("nodesign.toml:1"), "{}", stderr(&out));
 }
+
+/// `ocp --track SCENARIO` flies the optimum in closed loop through the scenario's plant
+/// (`simulate SCENARIO --reference trajectory.csv`) and puts the tracked run beside the
+/// optimum in summary.json.
+#[test]
+fn the_optimum_is_tracked_in_closed_loop_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "p.toml",
+        r#"design = "usm-paper"
+actuation = "thrusters"
+[physics]
+hydrodynamics = true
+[horizon]
+duration = 2.0
+knots = 8
+[terminal]
+ee_displacement = [0.0, 0.03, -0.02]
+[objective]
+effort = 1.0
+[bounds]
+joint_torque = 20.0
+"#,
+    );
+    let out_dir = dir.path().join("out");
+    let out = run(&[
+        "ocp",
+        arg(&p),
+        "--out",
+        arg(&out_dir),
+        "--track",
+        "work-setpoint",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let t = &s["tracked"];
+    assert_eq!(t["scenario"], "work-setpoint");
+    assert_eq!(t["design"], "usm-paper");
+    let num = |k: &str| t[k].as_f64().unwrap_or_else(|| panic!("tracked.{k}: {t}"));
+    assert!(num("thruster_energy_j") > 0.0);
+    assert!(num("optimum_thruster_energy_static_j") >= 0.0);
+    let price = num("thruster_energy_static_j") - num("optimum_thruster_energy_static_j");
+    assert!((num("price_static_j") - price).abs() <= 1e-12 * price.abs().max(1.0));
+    // The tracking law follows the optimum's base path (a 3.6 cm move of the end effector).
+    assert!(num("base_error_max_m") < 0.02, "{t}");
+    assert!(num("final_position_error_m").is_finite());
+    // The run lasts the reference's span, 2 s.
+    let ts = std::fs::read_to_string(out_dir.join("tracked/timeseries.csv")).unwrap();
+    let last = ts.lines().last().unwrap().split(',').next().unwrap();
+    assert!((last.parse::<f64>().unwrap() - 2.0).abs() < 1e-9, "{last}");
+    assert!(out_dir.join("tracked/tracking.json").exists());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("tracked in closed loop"));
+}

@@ -18,6 +18,12 @@ pub struct OcpArgs {
     /// Output directory (created).
     #[arg(long)]
     pub out: PathBuf,
+    /// Fly the optimum in closed loop: run SCENARIO (a scenario file or preset of the same
+    /// design) following DIR/trajectory.csv, as `simulate SCENARIO --reference` does, into
+    /// DIR/tracked/, and give the tracked run's energy and final errors beside the open-loop
+    /// optimum in summary.json (`tracked`).
+    #[arg(long, value_name = "SCENARIO")]
+    pub track: Option<String>,
 }
 
 /// Relative grid defect above which `ocp` warns (docs/ocp.md §4, eq. (F2)).
@@ -72,10 +78,81 @@ pub fn run(args: &OcpArgs) -> anyhow::Result<ExitCode> {
         }
         Err(e) => println!("grid fidelity: the refined integration failed: {e}"),
     }
+    if let Some(scenario) = &args.track {
+        track_optimum(scenario, &spec.vehicle.name, &args.out)?;
+    }
     println!("wrote {}", args.out.display());
     Ok(if s.status == Status::Converged {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
     })
+}
+
+/// Run `scenario` following `out/trajectory.csv` into `out/tracked/` and add the tracked run
+/// beside the optimum to `out/summary.json` (`tracked`): thruster energy (the project's
+/// definition with the axial inflow, and at zero inflow) of the run and of the optimum, the
+/// controller's price (their difference at zero inflow), the end effector's final errors
+/// against the optimum's last pose, the base path error and the run's success.
+fn track_optimum(scenario: &str, design: &str, out: &std::path::Path) -> anyhow::Result<()> {
+    let t = super::simulate_reference::track(
+        scenario,
+        &out.join("trajectory.csv"),
+        &out.join("tracked"),
+    )?;
+    if t.design != design {
+        println!(
+            "warning: --track {scenario}: the scenario's design is {}, the problem's {design}: \
+             the tracked run flies another plant",
+            t.design
+        );
+    }
+    let summary_path = out.join("summary.json");
+    let mut summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary_path)?)?;
+    let optimum_inflow = summary["objective_terms"]["thruster_energy_with_inflow"].as_f64();
+    let metric = |k: &str| t.run.metric(k);
+    let c = &t.comparison;
+    let price = c
+        .reference_thruster_energy_static
+        .map(|r| c.tracked_thruster_energy_static - r);
+    let tracked = serde_json::json!({
+        "scenario": t.scenario,
+        "design": t.design,
+        "out": "tracked",
+        "thruster_energy_j": metric("thruster_energy"),
+        "optimum_thruster_energy_j": optimum_inflow,
+        "thruster_energy_static_j": c.tracked_thruster_energy_static,
+        "optimum_thruster_energy_static_j": c.reference_thruster_energy_static,
+        "price_static_j": price,
+        "final_position_error_m": metric("final_position_error"),
+        "final_orientation_error_deg": metric("final_orientation_error_deg"),
+        "base_error_max_m": c.base_error_max,
+        "base_error_final_m": c.base_error_final,
+        "success": metric("success"),
+        "failure": t.run.failure.as_ref().map(|(time, cause)| format!("t = {time:.3} s: {cause}")),
+    });
+    println!(
+        "tracked in closed loop ({scenario}, {}): thruster energy {:.4e} J (optimum {}), final \
+         end-effector error {:.4} m / {:.3} deg, base error max {:.4} m{}",
+        out.join("tracked").display(),
+        metric("thruster_energy").unwrap_or(f64::NAN),
+        optimum_inflow.map_or("n/a".into(), |e| format!("{e:.4e} J")),
+        metric("final_position_error").unwrap_or(f64::NAN),
+        metric("final_orientation_error_deg").unwrap_or(f64::NAN),
+        c.base_error_max,
+        t.run
+            .failure
+            .as_ref()
+            .map_or(String::new(), |(time, cause)| format!(
+                "; stopped at t = {time:.3} s: {cause}"
+            )),
+    );
+    if let Some(map) = summary.as_object_mut() {
+        map.insert("tracked".into(), tracked);
+    }
+    let mut text = serde_json::to_string_pretty(&summary)?;
+    text.push('\n');
+    usm_study::report::atomic_write(&summary_path, text.as_bytes())?;
+    Ok(())
 }

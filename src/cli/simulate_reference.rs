@@ -115,3 +115,44 @@ pub fn write_comparison(
     atomic_write(&out.join("tracking.json"), text.as_bytes())?;
     Ok(c)
 }
+
+/// The closed-loop run of a trajectory file through a scenario's plant ([`follow`],
+/// [`start_at_reference`]), as `simulate SCENARIO --reference FILE --out DIR` runs it.
+pub struct Tracked {
+    /// The scenario as given (file or preset).
+    pub scenario: String,
+    /// The plant's design name.
+    pub design: String,
+    /// The run (its metrics: `thruster_energy` with the axial inflow, `final_position_error`
+    /// of the end effector against the reference's last pose, …).
+    pub run: usm_study::outcome::RunResult,
+    /// The run against its reference (`tracking.json`).
+    pub comparison: TrackingComparison,
+}
+
+/// Run `scenario` following `reference` and write the run's outputs (time series, figure,
+/// `summary.json`, `tracking.json`) into `out` (created).
+pub fn track(scenario: &str, reference: &Path, out: &Path) -> anyhow::Result<Tracked> {
+    let (mut table, src) = usm_study::scenario::load_table(scenario)?;
+    follow(&mut table, reference)?;
+    table.remove("uncertainty");
+    let mut file = usm_study::scenario::parse_table(&table, &src)?;
+    let vehicle = usm_study::scenario::resolve_design(&file, &src)?;
+    usm_study::pipeline::create_dir(out)?;
+    let table = start_at_reference(&mut file, &vehicle, &[], out)?;
+    let run =
+        usm_study::outcome::run_scenario_until(&vehicle, &file, usm_study::scenario::Stop::NEVER)?;
+    let files = usm_study::pipeline::simulate::RunFiles {
+        timeseries: true,
+        figure: true,
+        shapes: false,
+    };
+    usm_study::pipeline::simulate::write_run_outputs(&run, out, &vehicle, files)?;
+    let comparison = write_comparison(&table, &file, &vehicle, &run.trajectory, out)?;
+    Ok(Tracked {
+        scenario: scenario.to_string(),
+        design: vehicle.name.clone(),
+        run,
+        comparison,
+    })
+}
