@@ -100,6 +100,7 @@ pub fn leg_problem(vehicle: &Vehicle, leg: &LegSpec) -> ProblemSpec {
         smoothing: [0.01, 0.01],
         bounds: [f64::INFINITY, f64::INFINITY, leg.joint_torque],
         joint_limit: (f64::INFINITY, 0.0),
+        sigma_floor: None,
         tolerance: leg.tolerance,
         max_iterations: leg.max_iterations,
         hessian: Hessian::Exact,

@@ -37,6 +37,7 @@
 
 use super::cost::PathCosts;
 use super::model::{FdScratch, ModelError, OcpModel};
+use super::sigma_floor::SigmaFloor;
 use super::sub_scratch::SubScratch;
 use crate::dynamics::{dynamics_terms, solve_forward, DynOptions, DynWorkspace};
 use crate::kinematics::{forward_kinematics, generalized_thrust_map, BasePose};
@@ -96,6 +97,8 @@ pub struct ChainModel {
     sub: SubScratch,
     terminal: TerminalSpec,
     costs: Option<PathCosts>,
+    /// The σ_min floor's barrier ([`SigmaFloor`], docs/ocp.md §1), if any.
+    sigma: Option<SigmaFloor>,
     tau: Vec<f64>,
     zeta: Vec<f64>,
     /// Thruster actuation: the generalised thrust map G(q), (6+n)×m (None: base wrench).
@@ -124,6 +127,7 @@ impl ChainModel {
                 ..TerminalSpec::default()
             },
             costs: None,
+            sigma: None,
             tau: vec![0.0; nv],
             zeta: vec![0.0; nv],
             gmap: None,
@@ -200,6 +204,43 @@ impl ChainModel {
     /// The path costs, if any.
     pub fn costs(&self) -> Option<&PathCosts> {
         self.costs.as_ref()
+    }
+
+    /// The same chain with the σ_min floor `floor` (its barrier (Σ2) at every knot; docs/ocp.md
+    /// §1).
+    pub fn with_sigma_floor(mut self, floor: SigmaFloor) -> Self {
+        self.sigma = Some(floor);
+        self
+    }
+
+    /// The σ_min floor, if any.
+    pub fn sigma_floor(&self) -> Option<&SigmaFloor> {
+        self.sigma.as_ref()
+    }
+
+    /// The least commanded-axis σ_min of the floor's scaled `T(q)` over the knots `xs`
+    /// (`None` without a floor).
+    pub fn least_sigma(&mut self, xs: &[Vec<f64>]) -> Option<f64> {
+        let v = &self.vehicle;
+        self.sigma.as_mut().map(|f| f.least_along(v, xs))
+    }
+
+    /// The σ floor's barrier (Σ2) at the state `x` (0 without a floor).
+    fn sigma_barrier(&mut self, x: &[f64]) -> f64 {
+        let n = self.n_joints();
+        let (v, dt) = (&self.vehicle, self.dt);
+        self.sigma
+            .as_mut()
+            .map_or(0.0, |f| f.value(v, dt, &x[7..7 + n]))
+    }
+
+    /// Add the σ floor's gradient and Gauss–Newton Hessian (Σ4) at the state `x`.
+    fn sigma_derivatives(&mut self, x: &[f64], g: &mut [f64], h: &mut DMatrix<f64>) {
+        let n = self.n_joints();
+        let (v, dt) = (&self.vehicle, self.dt);
+        if let Some(f) = self.sigma.as_mut() {
+            f.add_derivatives(v, dt, &x[7..7 + n], g, h);
+        }
     }
 
     /// The terminal equality.
@@ -504,12 +545,12 @@ impl OcpModel for ChainModel {
     }
 
     fn has_path_costs(&self) -> bool {
-        self.costs.is_some()
+        self.costs.is_some() || self.sigma.is_some()
     }
 
     fn stage_cost(&mut self, x: &[f64], u: &[f64]) -> f64 {
         let n = self.n_joints();
-        self.costs.as_ref().map_or(0.0, |c| c.stage(n, x, u))
+        self.costs.as_ref().map_or(0.0, |c| c.stage(n, x, u)) + self.sigma_barrier(x)
     }
 
     fn stage_cost_derivatives(
@@ -524,16 +565,23 @@ impl OcpModel for ChainModel {
         if let Some(c) = self.costs.as_ref() {
             c.stage_derivatives(n, x, u, exact, g, h);
         }
+        self.sigma_derivatives(x, g, h);
     }
 
-    fn max_step(&self, x: &[f64], dx: &[f64]) -> f64 {
+    fn max_step(&mut self, x: &[f64], dx: &[f64]) -> f64 {
         let n = self.n_joints();
-        self.costs.as_ref().map_or(1.0, |c| c.max_step(n, x, dx))
+        let a = self.costs.as_ref().map_or(1.0, |c| c.max_step(n, x, dx));
+        let v = &self.vehicle;
+        let b = self
+            .sigma
+            .as_mut()
+            .map_or(1.0, |f| f.max_step(v, &x[7..7 + n], &dx[6..6 + n]));
+        a.min(b)
     }
 
     fn terminal_cost(&mut self, x: &[f64]) -> f64 {
         let n = self.n_joints();
-        self.costs.as_ref().map_or(0.0, |c| c.barrier(n, x))
+        self.costs.as_ref().map_or(0.0, |c| c.barrier(n, x)) + self.sigma_barrier(x)
     }
 
     fn terminal_cost_derivatives(&mut self, x: &[f64], g: &mut [f64], h: &mut DMatrix<f64>) {
@@ -541,5 +589,6 @@ impl OcpModel for ChainModel {
         if let Some(c) = self.costs.as_ref() {
             c.barrier_derivatives(n, x, g, h);
         }
+        self.sigma_derivatives(x, g, h);
     }
 }

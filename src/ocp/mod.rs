@@ -35,6 +35,7 @@ pub mod problem;
 pub mod qp;
 pub mod riccati;
 pub mod run;
+pub mod sigma_floor;
 pub mod sqp;
 mod sqp_eval;
 pub mod start;
@@ -54,6 +55,8 @@ mod tests_cruise;
 mod tests_derivatives;
 #[cfg(test)]
 mod tests_fidelity;
+#[cfg(test)]
+mod tests_sigma;
 
 pub use chain::{ChainModel, TerminalSpec};
 pub use cost::{CostBreakdown, PathCosts};

@@ -142,7 +142,7 @@ pub trait OcpModel {
 
     /// Largest step α ≤ 1 along the tangent step `dx` at x that keeps the stage cost's
     /// barrier domain by the fraction to the boundary (1 unless overridden).
-    fn max_step(&self, _x: &[f64], _dx: &[f64]) -> f64 {
+    fn max_step(&mut self, _x: &[f64], _dx: &[f64]) -> f64 {
         1.0
     }
 

@@ -32,6 +32,9 @@
 //! joint_torque = 50.0        # [N·m]
 //! joint_angle = 1.0          # |q_i| ≤ value [rad], by a logarithmic barrier (strictly inside)
 //! barrier = 1e-3             # the barrier's weight μ
+//! sigma_min = 0.05           # commanded-axis σ_min of the scaled T(q) > value at every knot (barrier; docs/ocp.md §1)
+//! sigma_axes = ["surge", "sway", "heave", "roll", "pitch", "yaw"]  # the commanded axes (default all six)
+//! char_length = 1.5          # L of the scaling [m] (default half the vehicle's length)
 //! [solver]
 //! tolerance = 1e-6           # KKT tolerance
 //! max_iterations = 200
@@ -176,6 +179,9 @@ struct Bounds {
     joint_torque: Option<f64>,
     joint_angle: Option<f64>,
     barrier: Option<f64>,
+    sigma_min: Option<f64>,
+    sigma_axes: Option<Vec<String>>,
+    char_length: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -297,6 +303,8 @@ pub struct ProblemSpec {
     pub bounds: [f64; 3],
     /// Symmetric joint-angle limit [rad] (∞: none) and the barrier weight μ.
     pub joint_limit: (f64, f64),
+    /// The σ_min floor (`bounds.sigma_min`; its barrier weight is `joint_limit.1`).
+    pub sigma_floor: Option<SigmaFloorSpec>,
     /// KKT tolerance.
     pub tolerance: f64,
     /// Most SQP iterations.
@@ -408,6 +416,13 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         }
     }
     let joint_limit = check_joint_limit(&doc, &f.bounds, &joint_angles)?;
+    let sigma_floor = check_sigma_floor(
+        &doc,
+        &f.bounds,
+        &vehicle,
+        &joint_angles,
+        f.terminal.joint_angles.as_deref(),
+    )?;
     let sv = &f.solver;
     let (hessian, gauss_newton_above, warm_start) = check_solver(&doc, sv, path)?;
     let (feedback, cruise_start) = check_strategy(
@@ -437,6 +452,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         smoothing: [f.objective.thrust_smoothing, f.objective.power_smoothing],
         bounds,
         joint_limit,
+        sigma_floor,
         tolerance: f.solver.tolerance,
         max_iterations: f.solver.max_iterations as usize,
         hessian,
@@ -450,6 +466,104 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
         seed: sv.seed,
         perturbation: sv.perturbation,
     })
+}
+
+/// A σ_min floor of a problem file (`[bounds] sigma_min`, `sigma_axes`, `char_length`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SigmaFloorSpec {
+    /// σ_lo [N/N] (> 0).
+    pub lo: f64,
+    /// The commanded axes, surge … yaw.
+    pub axes: [bool; 6],
+    /// Characteristic length L [m] (> 0).
+    pub char_length: f64,
+}
+
+/// Names of the six axes in `bounds.sigma_axes`, in the order of `T(q)`'s rows.
+pub const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+
+/// The σ_min floor keys, validated: σ_lo positive and finite, the design has thrusters, the
+/// axes known and distinct, L positive, and σ at the initial joint angles (and at the terminal
+/// ones, when the terminal equality fixes them) above the floor — the barrier needs a
+/// strictly feasible start.
+fn check_sigma_floor(
+    doc: &Document,
+    b: &Bounds,
+    vehicle: &Vehicle,
+    joint_angles: &[f64],
+    terminal_joints: Option<&[f64]>,
+) -> Result<Option<SigmaFloorSpec>, InputError> {
+    let Some(lo) = b.sigma_min else {
+        for (k, given) in [
+            ("bounds.sigma_axes", b.sigma_axes.is_some()),
+            ("bounds.char_length", b.char_length.is_some()),
+        ] {
+            if given {
+                return Err(doc.err(k, "applies only with bounds.sigma_min"));
+            }
+        }
+        return Ok(None);
+    };
+    if !(lo.is_finite() && lo > 0.0) {
+        return Err(doc.err("bounds.sigma_min", "must be positive and finite [N/N]"));
+    }
+    if vehicle.n_thrusters() == 0 {
+        return Err(doc.err("bounds.sigma_min", "the design has no thrusters"));
+    }
+    let mut axes = [false; 6];
+    match &b.sigma_axes {
+        None => axes = [true; 6],
+        Some(names) => {
+            if names.is_empty() {
+                return Err(doc.err("bounds.sigma_axes", "must name at least one axis"));
+            }
+            for name in names {
+                let Some(i) = AXES.iter().position(|a| a == name) else {
+                    return Err(doc.err(
+                        "bounds.sigma_axes",
+                        &format!("unknown axis {name:?} (one of {})", AXES.join(", ")),
+                    ));
+                };
+                if axes[i] {
+                    return Err(doc.err("bounds.sigma_axes", &format!("{name:?} given twice")));
+                }
+                axes[i] = true;
+            }
+        }
+    }
+    let char_length = b.char_length.unwrap_or(0.5 * vehicle.total_length());
+    if !(char_length.is_finite() && char_length > 0.0) {
+        return Err(doc.err("bounds.char_length", "must be positive and finite [m]"));
+    }
+    let spec = SigmaFloorSpec {
+        lo,
+        axes,
+        char_length,
+    };
+    let mut floor = super::sigma_floor::SigmaFloor::new(
+        vehicle,
+        lo,
+        1.0,
+        crate::metrics::singularity::CommandedDofs::new(axes),
+        char_length,
+    );
+    for (which, q) in [
+        ("initial", Some(joint_angles)),
+        ("terminal", terminal_joints),
+    ] {
+        let Some(q) = q else { continue };
+        let s = floor.sigma(vehicle, q);
+        if !(s > lo) {
+            return Err(doc.err(
+                "bounds.sigma_min",
+                &format!(
+                    "the {which} joint angles have σ_min = {s:.4} of the scaled T(q), not above \
+                     the floor {lo} (a straight body is often singular: start bent)"
+                ),
+            ));
+        }
+    }
+    Ok(Some(spec))
 }
 
 /// The joint-limit keys (`bounds.joint_angle`, `barrier`), validated against the initial

@@ -12,12 +12,14 @@ use super::fidelity::{grid_fidelity, GridFidelity};
 use super::model::OcpModel;
 use super::problem::ProblemSpec;
 use super::qp::QpSettings;
+use super::sigma_floor::SigmaFloor;
 use super::sqp::{solve, OcpProblem, OcpSolution, SqpSettings, Status};
 pub use super::start::trajectory_columns;
 use super::start::{perturbed_controls, read_warm_start};
 use crate::dynamics::DynOptions;
 use crate::input::located::InputError;
 use crate::kinematics::BasePose;
+use crate::metrics::singularity::CommandedDofs;
 use crate::metrics::trajectory::PowerModel;
 use crate::report::{atomic_write, format_f64, ReportError};
 use crate::spatial::{euler_zyx, Vec3};
@@ -114,6 +116,16 @@ pub fn build_model(spec: &ProblemSpec) -> (ChainModel, Vec<f64>) {
     model = model.with_terminal(terminal);
     if paths {
         model = model.with_costs(costs);
+    }
+    if let Some(f) = &spec.sigma_floor {
+        let floor = SigmaFloor::new(
+            &spec.vehicle,
+            f.lo,
+            spec.joint_limit.1,
+            CommandedDofs::new(f.axes),
+            f.char_length,
+        );
+        model = model.with_sigma_floor(floor);
     }
     (model, x0)
 }
@@ -374,7 +386,17 @@ fn fidelity_json(f: &Result<GridFidelity, String>) -> serde_json::Value {
 
 /// The objective's terms at the returned solution: effort `w Σ Δt ‖u‖²` and the path
 /// costs' breakdown (smoothed, exact).
-fn objective_terms(run: &OcpRun) -> serde_json::Value {
+fn objective_terms(run: &mut OcpRun) -> serde_json::Value {
+    let least_sigma = run.model.least_sigma(&run.solution.xs);
+    let floor = run.model.sigma_floor().map(|f| {
+        serde_json::json!({
+            "floor": f.lo,
+            "axes": (0..6).filter(|&i| f.dofs.contains(i)).map(|i| super::problem::AXES[i]).collect::<Vec<_>>(),
+            "char_length_m": f.char_length,
+            "barrier": f.mu,
+            "least_along_optimum": least_sigma,
+        })
+    });
     let sol = &run.solution;
     let n = run.model.n_joints();
     let sq: f64 = sol.us.iter().flatten().map(|v| v * v).sum();
@@ -391,6 +413,7 @@ fn objective_terms(run: &OcpRun) -> serde_json::Value {
         "effort_sum_dt_u2": sq * run.dt,
         "path_costs": costs,
         "thruster_energy_with_inflow": inflow_energy(run),
+        "sigma_floor": floor,
     })
 }
 
