@@ -160,6 +160,8 @@ fn the_bound_in_worlds_costs_more_where_the_water_drags_more() {
     // Every world drags at least 10 % more than the nominal one: its bound is higher.
     assert!(lo > nominal, "world bound {lo} vs nominal {nominal}");
     assert!(num(three, "ocp_world_iterations") >= 2.0);
+    // Both worlds count, so neither was rejected for grid energy.
+    assert_eq!(num(three, "ocp_world_grid_rejected"), 0.0, "{three:?}");
     let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
     assert!(md.contains("bound in worlds J/m"), "{md}");
     assert!(md.contains("also solved in the study's first scoring worlds"));

@@ -35,8 +35,8 @@ use crate::study::cases::{overrides_of, Resolved};
 use crate::study::ocp_section::OcpSection;
 use crate::study::schema::{
     Study, OCP_ENERGY, OCP_ENERGY_PER_METRE, OCP_ITERATIONS, OCP_KKT, OCP_PRIMAL, OCP_SPREAD,
-    OCP_STATUS, OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_ITERATIONS,
-    OCP_WORLD_MAX, OCP_WORLD_MIN,
+    OCP_STATUS, OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_GRID_REJECTED,
+    OCP_WORLD_ITERATIONS, OCP_WORLD_MAX, OCP_WORLD_MIN,
 };
 
 /// The hook wiring this solver into sweeps.
@@ -77,6 +77,9 @@ pub struct BoundColumns {
     pub world_feasible: f64,
     /// SQP iterations of every world together.
     pub world_iterations: f64,
+    /// Worlds ending primal feasible whose energy the grid supplied (work error above
+    /// [`OCP_WORK_TRUSTED`]): rejected.
+    pub world_grid_rejected: f64,
 }
 
 impl BoundColumns {
@@ -94,6 +97,7 @@ impl BoundColumns {
         world_max: f64::NAN,
         world_feasible: f64::NAN,
         world_iterations: f64::NAN,
+        world_grid_rejected: f64::NAN,
     };
 }
 
@@ -151,6 +155,7 @@ pub fn design_bound(
     scenario: &toml::Table,
     leg: &LegSpec,
     worlds: &[Vec<Override>],
+    world_substeps: usize,
 ) -> BoundColumns {
     let Some(vehicle) = plant(design, scenario, &[]) else {
         return BoundColumns::NAN;
@@ -179,16 +184,19 @@ pub fn design_bound(
         // 300 iterations): the worlds are not tried, and say so (0 feasible, 0 iterations).
         out.world_feasible = 0.0;
         out.world_iterations = 0.0;
+        out.world_grid_rejected = 0.0;
         return out;
     }
     let warm = (b.solution.xs.clone(), b.solution.us.clone());
     let (mut lo, mut hi, mut ok, mut its) = (f64::INFINITY, f64::NEG_INFINITY, 0usize, 0usize);
+    let mut rejected = 0usize;
     for w in worlds {
         let Some(world) = plant(design, scenario, w) else {
             continue;
         };
         let mut wleg = leg.clone();
         wleg.starts = 1;
+        wleg.substeps = world_substeps;
         for i in 0..3 {
             wleg.current[i] += world.fluid.current[i] - vehicle.fluid.current[i];
         }
@@ -199,6 +207,8 @@ pub fn design_bound(
             lo = lo.min(e);
             hi = hi.max(e);
             ok += 1;
+        } else if wb.kkt[0] <= leg.tolerance {
+            rejected += 1;
         }
     }
     if ok > 0 {
@@ -207,12 +217,15 @@ pub fn design_bound(
     }
     out.world_feasible = ok as f64;
     out.world_iterations = its as f64;
+    out.world_grid_rejected = rejected as f64;
     out
 }
 
 /// A study's bound solver: the leg, and one solve per design for the whole sweep.
 pub struct StudyBound {
     leg: LegSpec,
+    /// Substeps of the worlds' legs (`[ocp] world_substeps`).
+    world_substeps: usize,
     /// The overrides of the bound's worlds (the study's first `[ocp] worlds` scoring worlds).
     worlds: Vec<Vec<Override>>,
     cache: Mutex<HashMap<String, Arc<OnceLock<BoundColumns>>>>,
@@ -239,6 +252,7 @@ impl StudyBound {
         };
         Self {
             leg: leg_of(section, study.seed),
+            world_substeps: section.world_substeps,
             worlds,
             cache: Mutex::new(HashMap::new()),
         }
@@ -250,7 +264,15 @@ impl StudyBound {
             let mut c = self.cache.lock().unwrap_or_else(|p| p.into_inner());
             c.entry(r.design_hash.clone()).or_default().clone()
         };
-        *cell.get_or_init(|| design_bound(&r.design, &r.scenario, &self.leg, &self.worlds))
+        *cell.get_or_init(|| {
+            design_bound(
+                &r.design,
+                &r.scenario,
+                &self.leg,
+                &self.worlds,
+                self.world_substeps,
+            )
+        })
     }
 }
 
@@ -270,6 +292,7 @@ impl CaseBound for StudyBound {
             metrics.set(OCP_WORLD_MAX, b.world_max);
             metrics.set(OCP_WORLD_FEASIBLE, b.world_feasible);
             metrics.set(OCP_WORLD_ITERATIONS, b.world_iterations);
+            metrics.set(OCP_WORLD_GRID_REJECTED, b.world_grid_rejected);
         }
     }
 }

@@ -25,8 +25,8 @@ use crate::report::{
 };
 use crate::study::schema::{
     CONTROLLER_EFFICIENCY, OCP_ENERGY_PER_METRE, OCP_PRIMAL, OCP_SPREAD, OCP_STATUS,
-    OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_ITERATIONS, OCP_WORLD_MAX,
-    OCP_WORLD_MIN,
+    OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_GRID_REJECTED,
+    OCP_WORLD_ITERATIONS, OCP_WORLD_MAX, OCP_WORLD_MIN,
 };
 
 /// A bound with a primal residual at most this is a trajectory the model can fly.
@@ -214,26 +214,41 @@ fn bound_cell(bound: f64, counts: bool, primal: f64, work: Option<f64>) -> Strin
     }
 }
 
-/// The bound-in-worlds cell of row `r`: the range over the worlds whose bound counts.
+/// The bound-in-worlds cell of row `r`: the range over the worlds whose bound counts, and how
+/// many were rejected because the grid supplied their energy.
 fn world_cell(worlds: Option<WorldColumns<'_>>, r: usize) -> String {
+    let rejected = |g: Option<&[f64]>| match g.map(|g| g[r]) {
+        Some(n) if n > 0.0 => format!("; {n} rejected: grid energy"),
+        _ => String::new(),
+    };
     match worlds {
-        Some((a, b, c, _)) if c[r] > 0.0 => {
+        Some((a, b, c, _, g)) if c[r] > 0.0 => {
             format!(
-                "{}–{} ({} feasible)",
+                "{}–{} ({} feasible{})",
                 fmt_short(a[r]),
                 fmt_short(b[r]),
-                c[r]
+                c[r],
+                rejected(g)
             )
         }
         // No nominal bound that counts: nothing to start the worlds from.
-        Some((_, _, c, i)) if c[r] == 0.0 && i[r] == 0.0 => "not tried".into(),
-        Some((_, _, c, i)) if c[r] == 0.0 => format!("none feasible ({} iterations)", i[r]),
+        Some((_, _, c, i, _)) if c[r] == 0.0 && i[r] == 0.0 => "not tried".into(),
+        Some((_, _, c, i, g)) if c[r] == 0.0 => {
+            format!("none feasible ({} iterations{})", i[r], rejected(g))
+        }
         _ => "–".into(),
     }
 }
 
-/// The world columns: least, greatest, feasible count, iterations.
-type WorldColumns<'a> = (&'a [f64], &'a [f64], &'a [f64], &'a [f64]);
+/// The world columns: least, greatest, feasible count, iterations, and the grid-rejected
+/// count (absent from tables written before it existed).
+type WorldColumns<'a> = (
+    &'a [f64],
+    &'a [f64],
+    &'a [f64],
+    &'a [f64],
+    Option<&'a [f64]>,
+);
 
 /// The world columns of `table` (`None` without `[ocp] worlds`).
 fn world_columns(table: &Table) -> Option<WorldColumns<'_>> {
@@ -243,6 +258,7 @@ fn world_columns(table: &Table) -> Option<WorldColumns<'_>> {
         col(OCP_WORLD_MAX)?,
         col(OCP_WORLD_FEASIBLE)?,
         col(OCP_WORLD_ITERATIONS)?,
+        col(OCP_WORLD_GRID_REJECTED),
     ))
 }
 

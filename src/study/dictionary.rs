@@ -122,6 +122,7 @@ const OCP: &[ColumnDoc] = &[
     c("ocp_world_energy_per_metre_max", "J/m", "f64", "the greatest of the same"),
     c("ocp_world_feasible", "–", "i64", "how many of those K worlds have a bound that counts (0 when the nominal bound does not count: the worlds are not tried)"),
     c("ocp_world_iterations", "–", "i64", "SQP iterations of every world's solve together (0: not tried)"),
+    c("ocp_world_grid_rejected", "–", "i64", "worlds whose leg ended primal feasible but was rejected: the grid supplied its energy (work error above 5 %)"),
     c("ocp_iterations", "–", "i64", "SQP iterations of every start of the design's solve together (one solve per design, shared by its cases)"),
     c("controller_efficiency", "–", "f64", "`ocp_energy_per_metre` / the closed loop's `(thruster_energy_static + joint_energy) / path_progress` in the nominal world (NaN when the bound does not count: `ocp_primal` above the `[ocp]` tolerance or `ocp_work_error` above 0.05): ≤ 1 when both are right, > 1 flags an error of one of them (the two missions differ: the leg is straight from rest to rest, the run follows the study's path)"),
 ];

@@ -305,12 +305,16 @@ pub const OCP_WORLD_MAX: &str = "ocp_world_energy_per_metre_max";
 pub const OCP_WORLD_FEASIBLE: &str = "ocp_world_feasible";
 /// Column: SQP iterations of every world's solve together.
 pub const OCP_WORLD_ITERATIONS: &str = "ocp_world_iterations";
+/// Column: how many of the bound's worlds ended primal feasible but were rejected because the
+/// grid supplied their energy (work error above [`OCP_WORK_TRUSTED`]).
+pub const OCP_WORLD_GRID_REJECTED: &str = "ocp_world_grid_rejected";
 /// The columns `[ocp] worlds` adds after [`OCP_COLUMNS`], in order.
-pub const OCP_WORLD_COLUMNS: [&str; 4] = [
+pub const OCP_WORLD_COLUMNS: [&str; 5] = [
     OCP_WORLD_MIN,
     OCP_WORLD_MAX,
     OCP_WORLD_FEASIBLE,
     OCP_WORLD_ITERATIONS,
+    OCP_WORLD_GRID_REJECTED,
 ];
 /// The columns `[ocp]` adds to every row, in order.
 pub const OCP_COLUMNS: [&str; 9] = [
