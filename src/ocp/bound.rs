@@ -22,6 +22,7 @@ use super::run::build_model;
 use super::sqp::{solve, Hessian, OcpProblem, OcpSolution, SqpSettings, Status};
 use super::start::{perturbed_controls, Trajectory};
 use crate::model::Vehicle;
+use crate::study::schema::OCP_WORK_TRUSTED;
 use nalgebra::DMatrix;
 
 /// A straight transport leg as an optimal-control problem (module documentation).
@@ -273,8 +274,8 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
     // A leg the cruise settings cannot fly (short legs, where the cruise start is far from
     // the optimum): one more start from zero controls with the plain SQP (no damping, plain
     // rollout, QP tolerance 1e-10). Counted among the starts; the best feasible one is kept.
-    let feasible = |s: &OcpSolution| s.status == Status::Converged || s.kkt[0] <= spec.tolerance;
-    if spec.cruise_start && warm_given.is_none() && !sols.iter().any(feasible) {
+    let flies = |s: &OcpSolution| flies(s.status, &s.kkt, spec.tolerance);
+    if spec.cruise_start && warm_given.is_none() && !sols.iter().any(flies) {
         let plain = SqpSettings {
             proximal: 0.0,
             feedback: false,
@@ -288,6 +289,26 @@ pub fn solve_bound(spec: &ProblemSpec, warm: Option<&Trajectory>) -> Bound {
         sols.push(solve(&mut model, &prob, Some(zero), None, &plain));
     }
     summarise(&model, sols, spec.tolerance)
+}
+
+/// Whether a solve that ended with `status` and KKT residuals `kkt` holds a trajectory the model
+/// can fly that meets the leg's end: converged, or primal feasible (defects and terminal rows
+/// within `tolerance`) — a stalled or capped solve may still hold one.
+pub fn flies(status: Status, kkt: &[f64; 3], tolerance: f64) -> bool {
+    status == Status::Converged || kkt[0] <= tolerance
+}
+
+impl Bound {
+    /// Whether the best start holds a trajectory the model can fly ([`flies`]).
+    pub fn flies(&self, tolerance: f64) -> bool {
+        flies(self.status, &self.kkt, tolerance)
+    }
+
+    /// Whether the bound counts: it flies, and its energy is the actuators' rather than the
+    /// grid's (work error at most [`OCP_WORK_TRUSTED`]).
+    pub fn counts(&self, tolerance: f64) -> bool {
+        self.flies(tolerance) && self.work_error <= OCP_WORK_TRUSTED
+    }
 }
 
 /// The best of `sols` (converged first, then primal feasible — defects and terminal rows within
@@ -397,8 +418,8 @@ pub fn intact_and_n_minus_one(spec: &ProblemSpec, j: usize) -> (Bound, Bound) {
     let warm = solve_bound(&single, Some(&reinsert_thruster(&minus.solution, j)));
     // A start counts when it converged or ended primal feasible (a stalled warm start
     // still holds the feasible N−1 point it started from); the lower objective wins.
-    let feasible = |b: &Bound| b.status == Status::Converged || b.kkt[0] <= spec.tolerance;
-    let intact = match (feasible(&cold), feasible(&warm)) {
+    let t = spec.tolerance;
+    let intact = match (cold.flies(t), warm.flies(t)) {
         (true, true) if cold.objective <= warm.objective => cold,
         (true, false) => cold,
         _ => warm,

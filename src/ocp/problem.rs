@@ -53,6 +53,8 @@
 // Stage and component loops read clearest with indices (k: knot, i: component).
 #![allow(clippy::needless_range_loop)]
 
+use super::sigma_floor::{check_sigma_floor, SigmaKeys};
+pub use super::sigma_floor::{SigmaFloorSpec, AXES};
 use super::sqp::Hessian;
 use crate::input::document::{read_text, Document};
 use crate::input::located::{InputError, Location};
@@ -415,14 +417,7 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
             bounds[i] = v;
         }
     }
-    let joint_limit = check_joint_limit(&doc, &f.bounds, &joint_angles)?;
-    let sigma_floor = check_sigma_floor(
-        &doc,
-        &f.bounds,
-        &vehicle,
-        &joint_angles,
-        f.terminal.joint_angles.as_deref(),
-    )?;
+    let (joint_limit, sigma_floor) = check_limits(&doc, &f, &vehicle, &joint_angles)?;
     let sv = &f.solver;
     let (hessian, gauss_newton_above, warm_start) = check_solver(&doc, sv, path)?;
     let (feedback, cruise_start) = check_strategy(
@@ -468,102 +463,28 @@ pub fn parse_problem(text: &str, path: &Path) -> Result<ProblemSpec, InputError>
     })
 }
 
-/// A σ_min floor of a problem file (`[bounds] sigma_min`, `sigma_axes`, `char_length`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SigmaFloorSpec {
-    /// σ_lo [N/N] (> 0).
-    pub lo: f64,
-    /// The commanded axes, surge … yaw.
-    pub axes: [bool; 6],
-    /// Characteristic length L [m] (> 0).
-    pub char_length: f64,
-}
-
-/// Names of the six axes in `bounds.sigma_axes`, in the order of `T(q)`'s rows.
-pub const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
-
-/// The σ_min floor keys, validated: σ_lo positive and finite, the design has thrusters, the
-/// axes known and distinct, L positive, and σ at the initial joint angles (and at the terminal
-/// ones, when the terminal equality fixes them) above the floor — the barrier needs a
-/// strictly feasible start.
-fn check_sigma_floor(
+/// The joint limit (limit, barrier weight) and the σ_min floor of `f`, validated against the
+/// start (and the fixed terminal joint angles).
+fn check_limits(
     doc: &Document,
-    b: &Bounds,
+    f: &File,
     vehicle: &Vehicle,
     joint_angles: &[f64],
-    terminal_joints: Option<&[f64]>,
-) -> Result<Option<SigmaFloorSpec>, InputError> {
-    let Some(lo) = b.sigma_min else {
-        for (k, given) in [
-            ("bounds.sigma_axes", b.sigma_axes.is_some()),
-            ("bounds.char_length", b.char_length.is_some()),
-        ] {
-            if given {
-                return Err(doc.err(k, "applies only with bounds.sigma_min"));
-            }
-        }
-        return Ok(None);
+) -> Result<((f64, f64), Option<SigmaFloorSpec>), InputError> {
+    let b = &f.bounds;
+    let keys = SigmaKeys {
+        sigma_min: b.sigma_min,
+        sigma_axes: b.sigma_axes.as_deref(),
+        char_length: b.char_length,
     };
-    if !(lo.is_finite() && lo > 0.0) {
-        return Err(doc.err("bounds.sigma_min", "must be positive and finite [N/N]"));
-    }
-    if vehicle.n_thrusters() == 0 {
-        return Err(doc.err("bounds.sigma_min", "the design has no thrusters"));
-    }
-    let mut axes = [false; 6];
-    match &b.sigma_axes {
-        None => axes = [true; 6],
-        Some(names) => {
-            if names.is_empty() {
-                return Err(doc.err("bounds.sigma_axes", "must name at least one axis"));
-            }
-            for name in names {
-                let Some(i) = AXES.iter().position(|a| a == name) else {
-                    return Err(doc.err(
-                        "bounds.sigma_axes",
-                        &format!("unknown axis {name:?} (one of {})", AXES.join(", ")),
-                    ));
-                };
-                if axes[i] {
-                    return Err(doc.err("bounds.sigma_axes", &format!("{name:?} given twice")));
-                }
-                axes[i] = true;
-            }
-        }
-    }
-    let char_length = b.char_length.unwrap_or(0.5 * vehicle.total_length());
-    if !(char_length.is_finite() && char_length > 0.0) {
-        return Err(doc.err("bounds.char_length", "must be positive and finite [m]"));
-    }
-    let spec = SigmaFloorSpec {
-        lo,
-        axes,
-        char_length,
-    };
-    let mut floor = super::sigma_floor::SigmaFloor::new(
+    let floor = check_sigma_floor(
+        doc,
+        keys,
         vehicle,
-        lo,
-        1.0,
-        crate::metrics::singularity::CommandedDofs::new(axes),
-        char_length,
-    );
-    for (which, q) in [
-        ("initial", Some(joint_angles)),
-        ("terminal", terminal_joints),
-    ] {
-        let Some(q) = q else { continue };
-        let s = floor.sigma(vehicle, q);
-        if !(s > lo) {
-            return Err(doc.err(
-                "bounds.sigma_min",
-                &format!(
-                    "the {which} joint angles have σ_min = {s:.4} of the scaled T(q), not above \
-                     the floor {lo} (a straight body is often singular: start bent)"
-                ),
-            ));
-        }
-    }
-    Ok(Some(spec))
+        joint_angles,
+        f.terminal.joint_angles.as_deref(),
+    )?;
+    Ok((check_joint_limit(doc, b, joint_angles)?, floor))
 }
 
 /// The joint-limit keys (`bounds.joint_angle`, `barrier`), validated against the initial

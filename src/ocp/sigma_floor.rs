@@ -18,6 +18,8 @@
 //! knot** (the same argument as the joint-limit barrier of [`super::cost`]). The barrier lives in
 //! its own kinematics workspace, so it never disturbs the dynamics' cached terms.
 
+use crate::input::document::Document;
+use crate::input::located::InputError;
 use crate::kinematics::{forward_kinematics, thruster_matrix, KinWorkspace};
 use crate::metrics::singularity::{commanded_sigma, CommandedDofs};
 use crate::model::Vehicle;
@@ -148,4 +150,104 @@ impl SigmaFloor {
             .map(|x| self.sigma(vehicle, &x[7..7 + n]))
             .fold(f64::INFINITY, f64::min)
     }
+}
+
+/// A σ_min floor of a problem file (`[bounds] sigma_min`, `sigma_axes`, `char_length`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SigmaFloorSpec {
+    /// σ_lo [N/N] (> 0).
+    pub lo: f64,
+    /// The commanded axes, surge … yaw.
+    pub axes: [bool; 6],
+    /// Characteristic length L [m] (> 0).
+    pub char_length: f64,
+}
+
+/// The `[bounds]` keys of the floor, as read.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SigmaKeys<'a> {
+    pub sigma_min: Option<f64>,
+    pub sigma_axes: Option<&'a [String]>,
+    pub char_length: Option<f64>,
+}
+
+/// Names of the six axes in `bounds.sigma_axes`, in the order of `T(q)`'s rows.
+pub const AXES: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+
+/// The σ_min floor keys, validated: σ_lo positive and finite, the design has thrusters, the
+/// axes known and distinct, L positive, and σ at the initial joint angles (and at the terminal
+/// ones, when the terminal equality fixes them) above the floor — the barrier needs a
+/// strictly feasible start.
+pub(super) fn check_sigma_floor(
+    doc: &Document,
+    b: SigmaKeys<'_>,
+    vehicle: &Vehicle,
+    joint_angles: &[f64],
+    terminal_joints: Option<&[f64]>,
+) -> Result<Option<SigmaFloorSpec>, InputError> {
+    let Some(lo) = b.sigma_min else {
+        for (k, given) in [
+            ("bounds.sigma_axes", b.sigma_axes.is_some()),
+            ("bounds.char_length", b.char_length.is_some()),
+        ] {
+            if given {
+                return Err(doc.err(k, "applies only with bounds.sigma_min"));
+            }
+        }
+        return Ok(None);
+    };
+    if !(lo.is_finite() && lo > 0.0) {
+        return Err(doc.err("bounds.sigma_min", "must be positive and finite [N/N]"));
+    }
+    if vehicle.n_thrusters() == 0 {
+        return Err(doc.err("bounds.sigma_min", "the design has no thrusters"));
+    }
+    let mut axes = [false; 6];
+    match b.sigma_axes {
+        None => axes = [true; 6],
+        Some(names) => {
+            if names.is_empty() {
+                return Err(doc.err("bounds.sigma_axes", "must name at least one axis"));
+            }
+            for name in names {
+                let Some(i) = AXES.iter().position(|a| a == name) else {
+                    return Err(doc.err(
+                        "bounds.sigma_axes",
+                        &format!("unknown axis {name:?} (one of {})", AXES.join(", ")),
+                    ));
+                };
+                if axes[i] {
+                    return Err(doc.err("bounds.sigma_axes", &format!("{name:?} given twice")));
+                }
+                axes[i] = true;
+            }
+        }
+    }
+    let char_length = b.char_length.unwrap_or(0.5 * vehicle.total_length());
+    if !(char_length.is_finite() && char_length > 0.0) {
+        return Err(doc.err("bounds.char_length", "must be positive and finite [m]"));
+    }
+    let spec = SigmaFloorSpec {
+        lo,
+        axes,
+        char_length,
+    };
+    let mut floor = SigmaFloor::new(vehicle, lo, 1.0, CommandedDofs::new(axes), char_length);
+    for (which, q) in [
+        ("initial", Some(joint_angles)),
+        ("terminal", terminal_joints),
+    ] {
+        let Some(q) = q else { continue };
+        let s = floor.sigma(vehicle, q);
+        if !(s > lo) {
+            return Err(doc.err(
+                "bounds.sigma_min",
+                &format!(
+                    "the {which} joint angles have σ_min = {s:.4} of the scaled T(q), not above \
+                     the floor {lo} (a straight body is often singular: start bent)"
+                ),
+            ));
+        }
+    }
+    Ok(Some(spec))
 }

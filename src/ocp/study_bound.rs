@@ -25,7 +25,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::bound::{leg_problem, solve_bound, Bound, LegSpec};
+use super::bound::{leg_problem, solve_bound, LegSpec};
 use super::sqp::Status;
 use crate::batch::bound_hook::{BoundHook, CaseBound};
 use crate::evaluate::{apply_overrides, Metrics, Override};
@@ -35,8 +35,8 @@ use crate::study::cases::{overrides_of, Resolved};
 use crate::study::ocp_section::OcpSection;
 use crate::study::schema::{
     Study, OCP_ENERGY, OCP_ENERGY_PER_METRE, OCP_ITERATIONS, OCP_KKT, OCP_PRIMAL, OCP_SPREAD,
-    OCP_STATUS, OCP_WORK_ERROR, OCP_WORK_TRUSTED, OCP_WORLD_FEASIBLE, OCP_WORLD_GRID_REJECTED,
-    OCP_WORLD_ITERATIONS, OCP_WORLD_MAX, OCP_WORLD_MIN,
+    OCP_STATUS, OCP_WORK_ERROR, OCP_WORLD_FEASIBLE, OCP_WORLD_GRID_REJECTED, OCP_WORLD_ITERATIONS,
+    OCP_WORLD_MAX, OCP_WORLD_MIN,
 };
 
 /// The hook wiring this solver into sweeps.
@@ -78,7 +78,7 @@ pub struct BoundColumns {
     /// SQP iterations of every world together.
     pub world_iterations: f64,
     /// Worlds ending primal feasible whose energy the grid supplied (work error above
-    /// [`OCP_WORK_TRUSTED`]): rejected.
+    /// [`crate::study::schema::OCP_WORK_TRUSTED`]): rejected.
     pub world_grid_rejected: f64,
 }
 
@@ -142,11 +142,6 @@ fn plant(design: &toml::Table, scenario: &toml::Table, overrides: &[Override]) -
     file.world_vehicle(&vehicle).ok()
 }
 
-/// Whether `b` is a trajectory the model can fly that meets the leg's end, trusted on its grid.
-fn feasible(b: &Bound, tolerance: f64) -> bool {
-    (b.status == Status::Converged || b.kkt[0] <= tolerance) && b.work_error <= OCP_WORK_TRUSTED
-}
-
 /// The bound of the case tables `design`, `scenario` on `leg` in the nominal world and in the
 /// worlds `worlds` (their overrides; NaN columns when the design does not build or has no
 /// thrusters).
@@ -179,7 +174,7 @@ pub fn design_bound(
     if worlds.is_empty() {
         return out;
     }
-    if !feasible(&b, leg.tolerance) {
+    if !b.counts(leg.tolerance) {
         // No nominal bound to start the worlds from (cold, a world's leg did not converge in
         // 300 iterations): the worlds are not tried, and say so (0 feasible, 0 iterations).
         out.world_feasible = 0.0;
@@ -202,12 +197,12 @@ pub fn design_bound(
         }
         let wb = solve_bound(&leg_problem(&world, &wleg), Some(&warm));
         its += wb.iterations;
-        if feasible(&wb, leg.tolerance) {
+        if wb.counts(leg.tolerance) {
             let e = (wb.thruster_energy_static + wb.joint_energy) / leg.distance;
             lo = lo.min(e);
             hi = hi.max(e);
             ok += 1;
-        } else if wb.kkt[0] <= leg.tolerance {
+        } else if wb.flies(leg.tolerance) {
             rejected += 1;
         }
     }
