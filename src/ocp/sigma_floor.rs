@@ -108,7 +108,7 @@ impl SigmaFloor {
         h: &mut DMatrix<f64>,
     ) {
         let s = self.gradient(vehicle, q);
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             return;
         }
         let w = self.mu * dt;
@@ -125,7 +125,7 @@ impl SigmaFloor {
     /// already outside the domain (the line search then decides).
     pub fn max_step(&mut self, vehicle: &Vehicle, q: &[f64], dq: &[f64]) -> f64 {
         let s0 = self.sigma(vehicle, q) - self.lo;
-        if !(s0 > 0.0) {
+        if s0.is_nan() || s0 <= 0.0 {
             return 1.0;
         }
         let mut alpha = 1.0;
@@ -213,11 +213,11 @@ pub(super) fn check_sigma_floor(
                 let Some(i) = AXES.iter().position(|a| a == name) else {
                     return Err(doc.err(
                         "bounds.sigma_axes",
-                        &format!("unknown axis {name:?} (one of {})", AXES.join(", ")),
+                        format!("unknown axis {name:?} (one of {})", AXES.join(", ")),
                     ));
                 };
                 if axes[i] {
-                    return Err(doc.err("bounds.sigma_axes", &format!("{name:?} given twice")));
+                    return Err(doc.err("bounds.sigma_axes", format!("{name:?} given twice")));
                 }
                 axes[i] = true;
             }
@@ -239,10 +239,10 @@ pub(super) fn check_sigma_floor(
     ] {
         let Some(q) = q else { continue };
         let s = floor.sigma(vehicle, q);
-        if !(s > lo) {
+        if s.is_nan() || s <= lo {
             return Err(doc.err(
                 "bounds.sigma_min",
-                &format!(
+                format!(
                     "the {which} joint angles have σ_min = {s:.4} of the scaled T(q), not above \
                      the floor {lo} (a straight body is often singular: start bent)"
                 ),
