@@ -82,18 +82,18 @@ impl SigmaFloor {
     /// ∇_q σ at `q` by (Σ3) into the scratch gradient; returns σ(q) − σ_lo.
     fn gradient(&mut self, vehicle: &Vehicle, q: &[f64]) -> f64 {
         let s = self.sigma(vehicle, q) - self.lo;
-        self.q.copy_from_slice(q);
+        // The scratch point is taken out of `self` while `sigma` borrows it mutably.
+        let mut p = std::mem::take(&mut self.q);
+        p.copy_from_slice(q);
         for i in 0..q.len() {
-            self.q[i] = q[i] + EPS;
-            let q_plus = std::mem::take(&mut self.q);
-            let hi = self.sigma(vehicle, &q_plus);
-            let mut q_minus = q_plus;
-            q_minus[i] = q[i] - EPS;
-            let lo = self.sigma(vehicle, &q_minus);
-            q_minus[i] = q[i];
-            self.q = q_minus;
+            p[i] = q[i] + EPS;
+            let hi = self.sigma(vehicle, &p);
+            p[i] = q[i] - EPS;
+            let lo = self.sigma(vehicle, &p);
+            p[i] = q[i];
             self.grad[i] = (hi - lo) / (2.0 * EPS);
         }
+        self.q = p;
         s
     }
 
